@@ -1,0 +1,82 @@
+// animorder — the animated mesh every command works on (DESIGN.md "Animated mesh").
+//
+// One fixed triangle-list index buffer over V vertices (front faces counter-clockwise), one
+// index range per primitive, and F keyframes, each a full array of V positions. Clips own
+// contiguous runs of keyframes. Loaders (glTF, assimp, procedural) produce this; algorithms read
+// its arrays. No file I/O here.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace animorder {
+
+struct Primitive {
+    std::string name;
+    size_t first_index = 0;  // into AnimatedMesh::indices
+    size_t index_count = 0;  // multiple of 3
+};
+
+struct Clip {
+    std::string name;
+    double duration_s = 0;       // last key time − first key time
+    double sample_rate = 30;     // keyframes per second (DESIGN.md default 30)
+    size_t first_keyframe = 0;   // into AnimatedMesh keyframes
+    size_t keyframe_count = 0;
+};
+
+struct AnimatedMesh {
+    std::string name;
+    size_t vertex_count = 0;
+    std::vector<uint32_t> indices;       // triangle list, CCW front faces
+    std::vector<Primitive> primitives;   // cover indices in order, without gaps
+    std::vector<Clip> clips;
+    std::vector<float> keyframe_positions;  // keyframe_count() × vertex_count × xyz
+    size_t joint_count = 0;              // 0 for vertex-keyframe or static meshes
+    size_t morph_target_count = 0;
+
+    size_t triangle_count() const { return indices.size() / 3; }
+    size_t keyframe_count() const {
+        return vertex_count ? keyframe_positions.size() / (3 * vertex_count) : 0;
+    }
+    const float* keyframe(size_t k) const { return keyframe_positions.data() + k * vertex_count * 3; }
+    float* keyframe(size_t k) { return keyframe_positions.data() + k * vertex_count * 3; }
+};
+
+// Throws InvalidInput (animorder.h) when the mesh breaks its own invariants: indices out of
+// range or not a multiple of 3, primitives that do not tile the index buffer, clips outside the
+// keyframes, a keyframe array of the wrong size, or a non-finite position.
+void validate_animated_mesh(const AnimatedMesh& mesh);
+
+// ---------------------------------------------------------------------------------------------
+// Linear blend skinning (skinning.cpp).
+
+// Column-major 4×4 matrix, as glTF stores them.
+using Mat4 = std::array<float, 16>;
+
+// For each vertex v: out[v] = Σ_i w[v][i] · (joint_matrices[j[v][i]] · bind[v]), over
+// influences_per_vertex influences. Weights are normalised by their sum when it is not 1 (and a
+// vertex whose weights sum to 0 keeps its bind position). joints and weights are
+// vertex_count × influences_per_vertex arrays. Throws InvalidInput for a joint index >=
+// joint_count or a non-finite weight.
+void skin_positions(float* out_positions, const float* bind_positions, size_t vertex_count,
+                    const uint16_t* joints, const float* weights, size_t influences_per_vertex,
+                    const Mat4* joint_matrices, size_t joint_count);
+
+// ---------------------------------------------------------------------------------------------
+// Procedural inputs (procedural_character.cpp, procedural_shapes.cpp): no external file needed.
+
+// The bundled default input: a skinned humanoid-like character of about 10k triangles with
+// limbs that occlude one another (torso, head, two arms, two legs, a shield), and two clips with
+// different motion ("walk", "wave"), sampled at 30 keyframes per second. Deterministic.
+AnimatedMesh make_procedural_character();
+
+// Static test meshes (one clip of one keyframe), closed and consistently wound (CCW outward).
+// The triangle count is close to target_triangles (within a few percent).
+AnimatedMesh make_uv_sphere(size_t target_triangles);
+AnimatedMesh make_torus_knot(size_t target_triangles, int p = 2, int q = 3);
+
+}  // namespace animorder

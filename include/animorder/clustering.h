@@ -1,0 +1,109 @@
+// animorder — Han & Sander 2017: k index buffers for an animated mesh by k-means over
+// (keyframe, viewpoint) nodes, and the runtime lookup table that picks one (DESIGN.md
+// "Han & Sander 2017, as the project implements it", "Runtime selection"). No file I/O here.
+#pragma once
+
+#include "animorder/animated_mesh.h"
+#include "animorder/animorder.h"
+#include "animorder/overdraw.h"
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace animorder {
+
+// ---------------------------------------------------------------------------------------------
+// Patches of a whole character (mesh_patches.cpp)
+
+// Every primitive Tipsified and cut into patches on its own; patches never straddle primitives.
+struct MeshPatches {
+    std::vector<uint32_t> cache_order;      // face permutation: primitives in file order, each Tipsified
+    std::vector<uint32_t> patch_starts;     // positions in cache_order; patch_count() + 1 entries
+    std::vector<uint32_t> patch_primitive;  // primitive of each patch
+    size_t patch_count() const { return patch_primitive.size(); }
+};
+
+MeshPatches build_mesh_patches(const AnimatedMesh& mesh, double lambda, unsigned cache_size = kDefaultCacheSize);
+
+// A face permutation of the whole mesh from a patch permutation: primitives stay in file order
+// (patches of a primitive keep their relative order from patch_order), triangles inside a patch
+// keep their Tipsify order.
+std::vector<uint32_t> patch_order_to_triangle_order(const MeshPatches& patches, const std::vector<uint32_t>& patch_order);
+
+// Area-weighted centroid of every patch at every keyframe of the list, after framing (the
+// keyframe's centre subtracted): centroids[(i · patch_count + p) · 3 + c] for keyframes[i].
+std::vector<float> patch_centroids(const AnimatedMesh& mesh, const MeshPatches& patches, const Framing& framing,
+                                   const std::vector<uint32_t>& keyframes);
+
+// ---------------------------------------------------------------------------------------------
+// k-means over nodes (clustering.cpp)
+
+enum class DistanceVariant {
+    Jcgt,  // d(p) = Σ over the cluster's nodes of |viewpoint − centroid(p, keyframe)| (JCGT 2017)
+    I3d,   // the I3D poster: skip nodes where p faces wholly away, divide by the nodes that see it
+};
+
+struct ClusteringSettings {
+    size_t clusters = 5;               // k
+    size_t views = 162;                // icosphere viewpoints (12, 42, 162, 642)
+    unsigned resolution = 256;
+    uint64_t seed = 1;
+    double min_separation_deg = 30;    // between bootstrap viewpoints (rejection sampling)
+    size_t max_iterations = 30;
+    DistanceVariant distance = DistanceVariant::Jcgt;
+    unsigned threads = 0;
+    std::function<void(const std::string&)> log;         // one line per event (re-seeding, …)
+    std::function<void(size_t, size_t)> progress;        // nodes scored, total, per iteration
+};
+
+struct ClusteringIteration {
+    double mean_ovr = 0;        // mean node OVR with every node drawn by its assigned buffer
+    size_t reassigned = 0;      // nodes whose cluster changed in this assignment step
+    size_t reseeded = 0;        // clusters that were empty and got re-seeded
+    double seconds_raster = 0;  // assignment step (rasterise + score)
+    double seconds_update = 0;  // integrated-distance update
+};
+
+struct ClusteringResult {
+    std::vector<uint32_t> keyframes;        // the keyframes clustered (global indices)
+    std::vector<float> directions;          // the clustering viewpoints, xyz each
+    std::vector<std::vector<uint32_t>> patch_orders;     // k patch permutations
+    std::vector<std::vector<uint32_t>> triangle_orders;  // k face permutations of the whole mesh
+    // assignment[i · views + v]: the cluster of node (keyframes[i], directions[v]).
+    std::vector<uint32_t> assignment;
+    std::vector<ClusteringIteration> iterations;
+    bool converged = false;
+};
+
+// Han & Sander 2017, Algorithm 1, over the nodes keyframes × icosphere viewpoints.
+ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patches, const Framing& framing,
+                               const std::vector<uint32_t>& keyframes, const ClusteringSettings& settings);
+
+// ---------------------------------------------------------------------------------------------
+// The runtime lookup table (selection_table.cpp)
+
+// Per keyframe of the clip, a grid over the view direction's polar angle θ ∈ [0, π] (from +Y)
+// and azimuth φ ∈ [0, 2π) (from +Z towards +X). Cell (f, i, j) stands for θ = i·π/(theta_steps−1)
+// and φ = j·2π/phi_steps, and holds the buffer of the clustering viewpoint nearest to it at
+// keyframe f. Lookup rounds f, θ and φ to the nearest cell (φ wraps around).
+struct SelectionTable {
+    uint32_t keyframes = 0;
+    uint32_t theta_steps = 0;
+    uint32_t phi_steps = 0;
+    std::vector<uint8_t> cells;  // [(f · theta_steps + i) · phi_steps + j]
+};
+
+// With theta_steps = phi_steps = 0 the grid is chosen from the viewpoint count: 5° cells for up
+// to 162 viewpoints (37 × 72), 2.5° for 642, 1.25° beyond. A cell is then always much closer to
+// its rounding viewpoint than neighbouring viewpoints are (162: 15.9° apart), so a clustering
+// viewpoint looks up exactly its own node.
+SelectionTable build_selection_table(const ClusteringResult& clustering, size_t keyframe_begin, size_t keyframe_count,
+                                     uint32_t theta_steps = 0, uint32_t phi_steps = 0);
+
+// The buffer for keyframe f (clip-local) and a unit view direction (from the frame's centre
+// to the camera, in the mesh's space).
+uint32_t select_buffer(const SelectionTable& table, size_t keyframe, const float direction[3]);
+
+}  // namespace animorder

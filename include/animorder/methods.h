@@ -1,0 +1,47 @@
+// animorder — the named methods of DESIGN.md applied to a whole AnimatedMesh.
+//
+// Each primitive is reordered on its own (primitives are separate draws with their own
+// materials, so triangles never move between them); the result keeps every primitive's index
+// range. This layer composes the algorithms of animorder.h; it does no file I/O either.
+#pragma once
+
+#include "animorder/animated_mesh.h"
+#include "animorder/animorder.h"
+
+#include <string>
+#include <vector>
+
+namespace animorder {
+
+// Methods available so far (DESIGN.md names): "original" (Tipsify only) and "static-sander07".
+enum class StaticMethod { Original, StaticSander07 };
+
+// Parses a DESIGN.md method name; throws InvalidInput listing the known names otherwise.
+StaticMethod parse_static_method(const std::string& name);
+const char* method_name(StaticMethod method);
+
+struct StaticMethodSettings {
+    double lambda = kDefaultLambda;
+    unsigned cache_size = kDefaultCacheSize;
+    size_t keyframe = 0;  // the keyframe whose positions static-sander07 sorts with
+};
+
+struct StaticMethodResult {
+    std::vector<uint32_t> indices;  // same layout as mesh.indices: primitive ranges kept
+    // The same as a face permutation of the whole mesh (primitives drawn in file order), which
+    // is what the overdraw engine's rank tables take.
+    std::vector<uint32_t> order;
+    size_t patch_count = 0;         // summed over primitives (static-sander07)
+    size_t hard_boundary_count = 0;
+};
+
+// Runs the method on every primitive. Throws InvalidInput for an invalid mesh or settings.
+StaticMethodResult run_static_method(const AnimatedMesh& mesh, StaticMethod method,
+                                     const StaticMethodSettings& settings);
+
+// ACMR/ATVR of a whole index buffer drawn primitive by primitive, each draw starting with an
+// empty cache (a draw call does not inherit the previous draw's post-transform cache).
+VertexCacheStats analyze_mesh_vertex_cache(const AnimatedMesh& mesh, const std::vector<uint32_t>& indices,
+                                           unsigned cache_size = kDefaultCacheSize);
+
+}  // namespace animorder

@@ -1,0 +1,73 @@
+// The camera of every node (DESIGN.md "Camera"), following Han & Sander 2017 §4: a perspective
+// camera at distance 3R looking at the framed character, with a field of view that just contains
+// the bounding sphere of radius R, so every keyframe fills the same square viewport.
+//
+// The matrices are the classic OpenGL lookAt and perspective (gluLookAt/gluPerspective), built
+// in double. Vertices are transformed in float, like a vertex shader, and the same clip-space
+// array feeds both our rasteriser and the OpenGL reference, so the two see identical input.
+#include "animorder/animorder.h"
+#include "animorder/overdraw.h"
+
+#include <cmath>
+
+namespace animorder {
+namespace {
+
+struct V3 {
+    double x, y, z;
+};
+V3 sub(V3 a, V3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+V3 cross3(V3 a, V3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+double dot3(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+V3 unit(V3 a) {
+    const double n = std::sqrt(dot3(a, a));
+    return {a.x / n, a.y / n, a.z / n};
+}
+
+Mat4d multiply(const Mat4d& a, const Mat4d& b) {
+    Mat4d r{};
+    for (int col = 0; col < 4; ++col)
+        for (int row = 0; row < 4; ++row) {
+            double s = 0;
+            for (int k = 0; k < 4; ++k) s += a[k * 4 + row] * b[col * 4 + k];
+            r[col * 4 + row] = s;
+        }
+    return r;
+}
+
+}  // namespace
+
+Mat4d node_view_projection(const float view_direction[3], float radius) {
+    if (!(radius > 0) || !std::isfinite(radius)) throw InvalidInput("view radius must be positive and finite");
+    const V3 d = unit({view_direction[0], view_direction[1], view_direction[2]});
+    const V3 eye = {3.0 * radius * d.x, 3.0 * radius * d.y, 3.0 * radius * d.z};
+    const V3 up = std::fabs(d.y) > 0.999 ? V3{0, 0, 1} : V3{0, 1, 0};
+
+    // lookAt: forward f towards the origin, side s = f × up, true up u = s × f.
+    const V3 f = unit(sub({0, 0, 0}, eye));
+    const V3 s = unit(cross3(f, up));
+    const V3 u = cross3(s, f);
+    const Mat4d view = {s.x, u.x, -f.x, 0, s.y, u.y, -f.y, 0, s.z, u.z, -f.z, 0,
+                        -dot3(s, eye), -dot3(u, eye), dot3(f, eye), 1};
+
+    // perspective: tan(fovy/2) = tan(asin(1/3)) = 1/(2√2); near R, far 5R (the sphere spans 2R..4R).
+    const double cot_half_fov = 2.0 * std::sqrt(2.0);
+    const double n = radius, fr = 5.0 * radius;
+    const Mat4d projection = {cot_half_fov, 0, 0, 0, 0, cot_half_fov, 0, 0,
+                              0, 0, (fr + n) / (n - fr), -1, 0, 0, 2.0 * fr * n / (n - fr), 0};
+    return multiply(projection, view);
+}
+
+void transform_to_clip(float* clip_xyzw, const float* positions, size_t vertex_count, const float centre[3],
+                       const Mat4d& vp) {
+    float m[16];
+    for (int i = 0; i < 16; ++i) m[i] = float(vp[i]);
+    for (size_t v = 0; v < vertex_count; ++v) {
+        const float x = positions[3 * v] - centre[0], y = positions[3 * v + 1] - centre[1],
+                    z = positions[3 * v + 2] - centre[2];
+        float* out = clip_xyzw + 4 * v;
+        for (int row = 0; row < 4; ++row) out[row] = m[row] * x + m[4 + row] * y + m[8 + row] * z + m[12 + row];
+    }
+}
+
+}  // namespace animorder

@@ -1,0 +1,74 @@
+// Scoring triangle orders over many nodes: the measurement behind Han & Sander 2017 §3 (node
+// assignment by measured overdraw) and every OVR in the reports.
+//
+// Nodes are independent, so they run in parallel (oneTBB). Each worker keeps one rasteriser and
+// one clip-space buffer and writes each node's counts into that node's own slot: the numbers do
+// not depend on the thread count or on scheduling, and memory grows with the workers, not with
+// the nodes.
+#include "animorder/animorder.h"
+#include "animorder/overdraw.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <atomic>
+#include <mutex>
+#include <string>
+
+namespace animorder {
+
+std::vector<uint32_t> make_rank_table(const std::vector<const uint32_t*>& orders, size_t triangle_count) {
+    const size_t k = orders.size();
+    std::vector<uint32_t> ranks(triangle_count * k);
+    for (size_t o = 0; o < k; ++o) {
+        validate_triangle_order(orders[o], triangle_count);
+        for (size_t i = 0; i < triangle_count; ++i) ranks[size_t(orders[o][i]) * k + o] = uint32_t(i);
+    }
+    return ranks;
+}
+
+void score_nodes(uint64_t* visible, uint64_t* passed, const float* keyframe_positions, size_t vertex_count,
+                 const Framing& framing, const uint32_t* indices, size_t index_count, const OverdrawNode* nodes,
+                 size_t node_count, const uint32_t* ranks, size_t order_count, const ScoreSettings& settings) {
+    validate_indices(indices, index_count, vertex_count);
+    const size_t keyframes = framing.centres.size() / 3;
+    for (size_t n = 0; n < node_count; ++n)
+        if (nodes[n].keyframe >= keyframes)
+            throw InvalidInput("node " + std::to_string(n) + " names keyframe " + std::to_string(nodes[n].keyframe) +
+                               ", but there are " + std::to_string(keyframes));
+
+    struct Worker {
+        NodeRasterizer rasterizer;
+        std::vector<float> clip;
+    };
+    tbb::enumerable_thread_specific<Worker> workers;
+    std::atomic<size_t> done{0};
+    std::mutex progress_mutex;
+    const size_t report_every = std::max<size_t>(1, node_count / 100);
+
+    auto body = [&](const tbb::blocked_range<size_t>& range) {
+        Worker& w = workers.local();
+        w.clip.resize(vertex_count * 4);
+        for (size_t n = range.begin(); n != range.end(); ++n) {
+            const OverdrawNode& node = nodes[n];
+            const Mat4d vp = node_view_projection(node.direction, framing.radius);
+            transform_to_clip(w.clip.data(), keyframe_positions + size_t(node.keyframe) * vertex_count * 3, vertex_count,
+                              framing.centres.data() + 3 * size_t(node.keyframe), vp);
+            w.rasterizer.rasterize(w.clip.data(), vertex_count, indices, index_count, settings.resolution);
+            visible[n] = w.rasterizer.visible_pixels();
+            w.rasterizer.score(passed + n * order_count, ranks, order_count);
+            const size_t finished = ++done;
+            if (settings.progress && (finished % report_every == 0 || finished == node_count)) {
+                std::lock_guard<std::mutex> lock(progress_mutex);
+                settings.progress(finished, node_count);
+            }
+        }
+    };
+    const int threads = settings.threads ? int(settings.threads) : tbb::this_task_arena::max_concurrency();
+    tbb::task_arena arena(threads);
+    arena.execute([&] { tbb::parallel_for(tbb::blocked_range<size_t>(0, node_count, 1), body); });
+}
+
+}  // namespace animorder

@@ -1,0 +1,380 @@
+// The overdraw engine's rasteriser: exact coverage and depth per DESIGN.md, fragments kept per
+// pixel so that any number of triangle orders are scored from one rasterisation.
+//
+// It measures what Han & Sander, "Triangle Reordering for Efficient Rendering in Complex Scenes"
+// (JCGT 2017, §3) measure with GPU occlusion queries, under the rules of OpenGL as Mesa's
+// llvmpipe implements them (the reference it is checked against):
+// - clip space in, clipped against the near and far planes (and a guard band, which changes no
+//   covered pixel), divided by w as x·(1/w), mapped to the viewport in float;
+// - vertices snapped to 1/256 pixel after moving pixel centres to integer coordinates, rounding
+//   half away from zero (llvmpipe's subpixel_snap);
+// - orientation from the snapped coordinates: counter-clockwise in OpenGL window space is front,
+//   clockwise and zero-area triangles are culled;
+// - y flipped to point down, then Direct3D's top-left rule (a pixel centre on an edge is covered
+//   only by a top or a left edge), with exact integer edge functions;
+// - depth linear in screen space (the plane through the three window-space vertices), a float
+//   depth buffer cleared to 1 and a LESS test.
+//
+// Overdraw depends only on, per pixel, the set of fragments and the order they arrive in. So a
+// node is rasterised once, in any order, keeping every fragment (pixel, triangle, depth); the
+// fragments are then grouped by pixel and sorted by depth. Drawn in an order with ranks r, a
+// fragment passes LESS iff its rank is lower than the ranks of all fragments of that pixel at
+// smaller or equal depth: one walk from the nearest fragment with a running minimum rank gives
+// the count for every order at once. Exact ties in depth form a group of which only the fragment
+// drawn first can pass.
+#include "animorder/animorder.h"
+#include "animorder/overdraw.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace animorder {
+
+// A vertex in window space: snapped fixed-point x and y (y down, pixel centres at integer
+// multiples of 256) for coverage, float x, y (same frame, in pixels) and depth for the depth plane.
+struct WindowVertex {
+    int64_t X, Y;
+    float x, y, z;
+};
+
+constexpr uint32_t kTieBit = 0x80000000u;
+constexpr uint32_t kTriangleMask = 0x7fffffffu;
+
+struct NodeRasterizer::State {
+    unsigned resolution = 0;
+    // Raw fragments, in rasterisation order: the first raw_count entries are this node's.
+    std::vector<uint32_t> raw_pixel, raw_triangle;
+    std::vector<float> raw_depth;
+    size_t raw_count = 0;
+    // Per pixel fragment count; start of the pixel's slots among the multi-fragment pixels.
+    std::vector<uint32_t> pixel_count, pixel_start, pixel_cursor;
+    // Pixels with two or more fragments, their fragments nearest first: what scoring walks.
+    // A fragment is its triangle index, with kTieBit set when its depth equals the previous one's.
+    size_t multi_count = 0;
+    std::vector<uint32_t> multi_pixel, multi_start, multi_fragment;
+    std::vector<float> multi_depth;
+    uint64_t visible = 0, single = 0;
+    // Per-vertex setup, done once per node rather than once per triangle corner.
+    std::vector<WindowVertex> window;
+    std::vector<uint8_t> unclipped;  // inside the near, far and guard-band planes
+};
+
+namespace {
+
+constexpr int kSubpixelBits = 8;
+constexpr int64_t kSubpixel = int64_t(1) << kSubpixelBits;  // 256
+constexpr float kGuardBand = 2.0f;  // |x|, |y| <= 2w: twice the viewport, never a visible pixel
+
+struct ClipVertex {
+    float x, y, z, w;
+};
+
+// llvmpipe's util_iround: round half away from zero.
+int64_t round_half_away(float v) { return int64_t(v >= 0.0f ? v + 0.5f : v - 0.5f); }
+
+int64_t floor_div(int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
+int64_t ceil_div(int64_t a, int64_t b) { return -floor_div(-a, b); }
+
+// Where the rasteriser puts fragments: three parallel arrays (pixel, triangle, depth).
+// Capacity is ensured once per triangle (its bounding box bounds its fragments), so adding a
+// fragment is three plain stores.
+struct FragmentSink {
+    std::vector<uint32_t>& pixel;
+    std::vector<uint32_t>& triangle;
+    std::vector<float>& depth;
+    size_t count = 0;
+
+    void reserve_more(size_t fragments) {
+        if (count + fragments <= pixel.size()) return;
+        const size_t size = std::max(2 * pixel.size(), count + fragments);
+        pixel.resize(size);
+        triangle.resize(size);
+        depth.resize(size);
+    }
+    void add(uint32_t p, uint32_t t, float z) {
+        pixel[count] = p;
+        triangle[count] = t;
+        depth[count] = z;
+        ++count;
+    }
+};
+
+void project(const ClipVertex& v, unsigned resolution, WindowVertex& out) {
+    const float half = 0.5f * float(resolution);
+    const float inv_w = 1.0f / v.w;
+    const float x = v.x * inv_w * half + half;  // OpenGL window coordinates, y up
+    const float y = v.y * inv_w * half + half;
+    out.z = v.z * inv_w * 0.5f + 0.5f;
+    const int64_t top_row = int64_t(resolution - 1) * kSubpixel;
+    out.X = round_half_away((x - 0.5f) * float(kSubpixel));
+    out.Y = top_row - round_half_away((y - 0.5f) * float(kSubpixel));  // y down, centres at integers
+    out.x = x - 0.5f;
+    out.y = float(resolution) - y - 0.5f;
+}
+
+// Rasterises one window-space triangle: culling, fill rule and depth as described at the top.
+void rasterize_window_triangle(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2,
+                               uint32_t triangle, unsigned resolution, FragmentSink& sink) {
+    // With y pointing down, OpenGL's counter-clockwise front faces have negative area.
+    const int64_t area = (v1.X - v0.X) * (v2.Y - v0.Y) - (v2.X - v0.X) * (v1.Y - v0.Y);
+    if (area >= 0) return;  // back face or zero area: culled
+    // Corners 0, 2, 1: positive area, so edge functions are >= 0 inside.
+    const WindowVertex* c[3] = {&v0, &v2, &v1};
+
+    const int64_t min_x = std::min({c[0]->X, c[1]->X, c[2]->X}), max_x = std::max({c[0]->X, c[1]->X, c[2]->X});
+    const int64_t min_y = std::min({c[0]->Y, c[1]->Y, c[2]->Y}), max_y = std::max({c[0]->Y, c[1]->Y, c[2]->Y});
+    const int64_t px0 = std::max<int64_t>(0, ceil_div(min_x, kSubpixel));
+    const int64_t px1 = std::min<int64_t>(resolution - 1, floor_div(max_x, kSubpixel));
+    const int64_t py0 = std::max<int64_t>(0, ceil_div(min_y, kSubpixel));
+    const int64_t py1 = std::min<int64_t>(resolution - 1, floor_div(max_y, kSubpixel));
+    if (px0 > px1 || py0 > py1) return;
+
+    // Edge a→b: E(P) = (Xb−Xa)(Py−Ya) − (Yb−Ya)(Px−Xa). Top edge: horizontal going right; left
+    // edge: going up (y down, clockwise on screen). Other edges exclude their own pixel centres.
+    int64_t e_row[3], step_x[3], step_y[3];
+    for (int i = 0; i < 3; ++i) {
+        const WindowVertex& a = *c[i];
+        const WindowVertex& b = *c[(i + 1) % 3];
+        const int64_t dx = b.X - a.X, dy = b.Y - a.Y;
+        const bool top_left = (dy == 0 && dx > 0) || dy < 0;
+        e_row[i] = dx * (py0 * kSubpixel - a.Y) - dy * (px0 * kSubpixel - a.X) - (top_left ? 0 : 1);
+        step_x[i] = -dy * kSubpixel;
+        step_y[i] = dx * kSubpixel;
+    }
+
+    // Depth plane through the three window-space vertices (centres at integer coordinates).
+    const double ax = c[1]->x - c[0]->x, ay = c[1]->y - c[0]->y, az = c[1]->z - c[0]->z;
+    const double bx = c[2]->x - c[0]->x, by = c[2]->y - c[0]->y, bz = c[2]->z - c[0]->z;
+    const double det = ax * by - ay * bx;
+    if (det == 0.0) return;  // float-degenerate sliver: no fragment has a defined depth
+    const double dzdx = (az * by - ay * bz) / det;
+    const double dzdy = (ax * bz - az * bx) / det;
+    const double z_origin = c[0]->z - dzdx * c[0]->x - dzdy * c[0]->y;  // depth at pixel (0, 0)
+
+    sink.reserve_more(size_t(px1 - px0 + 1) * size_t(py1 - py0 + 1));
+    for (int64_t py = py0; py <= py1; ++py) {
+        int64_t e0 = e_row[0], e1 = e_row[1], e2 = e_row[2];
+        const double z_row = z_origin + dzdy * double(py);
+        const uint32_t row = uint32_t(py * resolution);
+        for (int64_t px = px0; px <= px1; ++px) {
+            if ((e0 | e1 | e2) >= 0) {
+                const float depth = float(z_row + dzdx * double(px));
+                if (depth < 1.0f && depth >= 0.0f) sink.add(row + uint32_t(px), triangle, depth);
+            }
+            e0 += step_x[0];
+            e1 += step_x[1];
+            e2 += step_x[2];
+        }
+        e_row[0] += step_y[0];
+        e_row[1] += step_y[1];
+        e_row[2] += step_y[2];
+    }
+}
+
+// Sutherland–Hodgman against one plane: keeps the part where dot(plane, v) >= 0.
+int clip_polygon(const ClipVertex* in, int count, ClipVertex* out, float a, float b, float c, float d) {
+    int n = 0;
+    for (int i = 0; i < count; ++i) {
+        const ClipVertex& p = in[i];
+        const ClipVertex& q = in[(i + 1) % count];
+        const float dp = a * p.x + b * p.y + c * p.z + d * p.w;
+        const float dq = a * q.x + b * q.y + c * q.z + d * q.w;
+        if (dp >= 0) out[n++] = p;
+        if ((dp >= 0) != (dq >= 0)) {
+            const float t = dp / (dp - dq);
+            out[n++] = {p.x + t * (q.x - p.x), p.y + t * (q.y - p.y), p.z + t * (q.z - p.z), p.w + t * (q.w - p.w)};
+        }
+    }
+    return n;
+}
+
+bool inside_all(const ClipVertex& v) {
+    return v.z >= -v.w && v.z <= v.w && std::fabs(v.x) <= kGuardBand * v.w && std::fabs(v.y) <= kGuardBand * v.w;
+}
+
+// The rare triangle that crosses the near or far plane or leaves the guard band: clipped in
+// clip space, then drawn as a fan (shared fan edges are split exactly by the fill rule).
+void rasterize_clipped_triangle(const ClipVertex (&v)[3], uint32_t triangle, unsigned resolution, FragmentSink& sink) {
+    ClipVertex a[12], b[12];
+    int n = 3;
+    std::copy(v, v + 3, a);
+    const float planes[6][4] = {{0, 0, 1, 1},          {0, 0, -1, 1},          {1, 0, 0, kGuardBand},
+                                {-1, 0, 0, kGuardBand}, {0, 1, 0, kGuardBand}, {0, -1, 0, kGuardBand}};
+    for (const auto& p : planes) {
+        n = clip_polygon(a, n, b, p[0], p[1], p[2], p[3]);
+        std::copy(b, b + n, a);
+        if (n < 3) return;
+    }
+    WindowVertex w[12];
+    for (int i = 0; i < n; ++i) project(a[i], resolution, w[i]);
+    for (int i = 1; i + 1 < n; ++i) rasterize_window_triangle(w[0], w[i], w[i + 1], triangle, resolution, sink);
+}
+
+// Groups the node's fragments by pixel (a counting sort), then sorts each pixel with two or more
+// fragments by depth into the compact list that scoring walks. Single-fragment pixels only count:
+// their fragment passes under every order.
+void group_fragments(NodeRasterizer::State& s) {
+    const size_t pixels = size_t(s.resolution) * s.resolution;
+    s.pixel_count.assign(pixels, 0);
+    for (size_t f = 0; f < s.raw_count; ++f) ++s.pixel_count[s.raw_pixel[f]];
+    s.pixel_start.resize(pixels + 1);
+    uint32_t running = 0;
+    s.visible = s.single = 0;
+    size_t multi_pixels = 0;
+    for (size_t p = 0; p < pixels; ++p) {
+        const uint32_t n = s.pixel_count[p];
+        s.pixel_start[p] = running;
+        // Only pixels with several fragments get slots: singles need no sorting or replay.
+        running += n > 1 ? n : 0;
+        s.visible += n > 0;
+        s.single += n == 1;
+        multi_pixels += n > 1;
+    }
+    s.pixel_start[pixels] = running;
+    if (s.multi_fragment.size() < running) {
+        s.multi_fragment.resize(running);
+        s.multi_depth.resize(running);
+    }
+    std::vector<uint32_t>& cursor = s.pixel_cursor;
+    cursor.assign(s.pixel_start.begin(), s.pixel_start.end() - 1);
+    for (size_t f = 0; f < s.raw_count; ++f) {
+        const uint32_t p = s.raw_pixel[f];
+        if (s.pixel_count[p] < 2) continue;
+        const uint32_t slot = cursor[p]++;
+        s.multi_fragment[slot] = s.raw_triangle[f];
+        s.multi_depth[slot] = s.raw_depth[f];
+    }
+
+    // Per multi pixel: insertion sort by (depth, triangle) — a handful of entries — then mark
+    // each fragment whose depth equals its predecessor's.
+    s.multi_count = multi_pixels;
+    s.multi_pixel.resize(multi_pixels);
+    s.multi_start.resize(multi_pixels + 1);
+    size_t m = 0;
+    for (size_t p = 0; p < pixels; ++p) {
+        if (s.pixel_count[p] < 2) continue;
+        const uint32_t begin = s.pixel_start[p], end = begin + s.pixel_count[p];
+        uint32_t* tri = s.multi_fragment.data();
+        float* depth = s.multi_depth.data();
+        for (uint32_t i = begin + 1; i < end; ++i) {
+            const float d = depth[i];
+            const uint32_t t = tri[i];
+            uint32_t j = i;
+            for (; j > begin && (depth[j - 1] > d || (depth[j - 1] == d && tri[j - 1] > t)); --j) {
+                depth[j] = depth[j - 1];
+                tri[j] = tri[j - 1];
+            }
+            depth[j] = d;
+            tri[j] = t;
+        }
+        for (uint32_t i = begin + 1; i < end; ++i)
+            if (depth[i] == depth[i - 1]) tri[i] |= kTieBit;
+        s.multi_pixel[m] = uint32_t(p);
+        s.multi_start[m] = begin;
+        ++m;
+    }
+    s.multi_start[multi_pixels] = running;
+}
+
+}  // namespace
+
+NodeRasterizer::NodeRasterizer() : state_(std::make_unique<State>()) {}
+NodeRasterizer::~NodeRasterizer() = default;
+NodeRasterizer::NodeRasterizer(NodeRasterizer&&) noexcept = default;
+NodeRasterizer& NodeRasterizer::operator=(NodeRasterizer&&) noexcept = default;
+
+unsigned NodeRasterizer::resolution() const { return state_->resolution; }
+uint64_t NodeRasterizer::visible_pixels() const { return state_->visible; }
+uint64_t NodeRasterizer::fragments() const { return state_->raw_count; }
+
+void NodeRasterizer::visit_fragments(const std::function<void(uint32_t, uint32_t, float)>& visit) const {
+    const State& s = *state_;
+    for (size_t f = 0; f < s.raw_count; ++f) visit(s.raw_pixel[f], s.raw_triangle[f], s.raw_depth[f]);
+}
+
+void NodeRasterizer::rasterize(const float* clip_xyzw, size_t vertex_count, const uint32_t* indices,
+                               size_t index_count, unsigned resolution) {
+    validate_indices(indices, index_count, vertex_count);
+    if (resolution == 0 || resolution > 16384)
+        throw InvalidInput("resolution " + std::to_string(resolution) + " is outside 1..16384");
+    State& s = *state_;
+    s.resolution = resolution;
+
+    const ClipVertex* cv = reinterpret_cast<const ClipVertex*>(clip_xyzw);
+    s.window.resize(vertex_count);
+    s.unclipped.resize(vertex_count);
+    for (size_t v = 0; v < vertex_count; ++v) {
+        s.unclipped[v] = inside_all(cv[v]);
+        if (s.unclipped[v]) project(cv[v], resolution, s.window[v]);
+    }
+
+    FragmentSink sink{s.raw_pixel, s.raw_triangle, s.raw_depth};
+    for (size_t t = 0; t < index_count / 3; ++t) {
+        const uint32_t a = indices[3 * t], b = indices[3 * t + 1], c = indices[3 * t + 2];
+        if (s.unclipped[a] & s.unclipped[b] & s.unclipped[c]) {
+            rasterize_window_triangle(s.window[a], s.window[b], s.window[c], uint32_t(t), resolution, sink);
+        } else {
+            const ClipVertex v[3] = {cv[a], cv[b], cv[c]};
+            rasterize_clipped_triangle(v, uint32_t(t), resolution, sink);
+        }
+    }
+    s.raw_count = sink.count;  // the arrays keep their size: no re-zeroing on the next node
+
+    group_fragments(s);
+}
+
+namespace {
+
+// Walks one pixel's fragments nearest first for every order, keeping the lowest rank seen so
+// far (`running`) and the lowest before the current group of equal depths (`before`). A
+// fragment passes LESS iff its rank beats every fragment at smaller or equal depth; of a group
+// of equal depths only the first drawn can pass, hence at most one increment per group.
+template <typename Emit>
+void replay_pixel(const uint32_t* fragments, uint32_t count, const uint32_t* ranks, size_t order_count,
+                  uint32_t* running, uint32_t* before, Emit&& emit) {
+    std::fill(running, running + order_count, UINT32_MAX);
+    for (uint32_t j = 0; j < count; ++j) {
+        const uint32_t f = fragments[j];
+        const uint32_t* r = ranks + size_t(f & kTriangleMask) * order_count;
+        const bool same_group = (f & kTieBit) != 0;
+        for (size_t o = 0; o < order_count; ++o) {
+            if (!same_group) before[o] = running[o];
+            if (r[o] < running[o]) {
+                if (running[o] == before[o]) emit(o);
+                running[o] = r[o];
+            }
+        }
+    }
+}
+
+}  // namespace
+
+void NodeRasterizer::score(uint64_t* passed, const uint32_t* ranks, size_t order_count) const {
+    const State& s = *state_;
+    std::vector<uint32_t> scratch(2 * order_count);
+    for (size_t o = 0; o < order_count; ++o) passed[o] = s.single;  // a lone fragment always passes
+    for (size_t m = 0; m < s.multi_count; ++m) {
+        const uint32_t begin = s.multi_start[m];
+        replay_pixel(s.multi_fragment.data() + begin, s.multi_start[m + 1] - begin, ranks, order_count, scratch.data(),
+                     scratch.data() + order_count, [&](size_t o) { ++passed[o]; });
+    }
+}
+
+std::vector<uint32_t> NodeRasterizer::passed_per_pixel(const uint32_t* ranks, size_t order_count,
+                                                       size_t order_index) const {
+    const State& s = *state_;
+    if (order_index >= order_count) throw InvalidInput("order index out of range");
+    std::vector<uint32_t> image(size_t(s.resolution) * s.resolution, 0);
+    for (size_t p = 0; p < image.size(); ++p) image[p] = s.pixel_count[p] == 1 ? 1 : 0;
+    std::vector<uint32_t> scratch(2 * order_count);
+    for (size_t m = 0; m < s.multi_count; ++m) {
+        const uint32_t begin = s.multi_start[m];
+        uint32_t& pixel = image[s.multi_pixel[m]];
+        replay_pixel(s.multi_fragment.data() + begin, s.multi_start[m + 1] - begin, ranks, order_count, scratch.data(),
+                     scratch.data() + order_count, [&](size_t o) { pixel += o == order_index; });
+    }
+    return image;
+}
+
+}  // namespace animorder

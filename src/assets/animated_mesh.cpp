@@ -1,0 +1,45 @@
+// The invariants of an AnimatedMesh, checked once where a mesh enters the algorithms, so that a
+// loader's mistake or a corrupt file is an error naming the problem rather than a crash later.
+#include "animorder/animated_mesh.h"
+#include "animorder/animorder.h"
+
+#include <cmath>
+#include <string>
+
+namespace animorder {
+
+void validate_animated_mesh(const AnimatedMesh& mesh) {
+    if (mesh.indices.size() % 3 != 0)
+        throw InvalidInput("index count " + std::to_string(mesh.indices.size()) + " is not a multiple of 3");
+    size_t next = 0;
+    for (const Primitive& p : mesh.primitives) {
+        if (p.first_index != next || p.index_count % 3 != 0)
+            throw InvalidInput("primitive '" + p.name + "' does not continue the index buffer in whole triangles");
+        for (size_t i = p.first_index; i < p.first_index + p.index_count; ++i)
+            if (i >= mesh.indices.size() || mesh.indices[i] >= mesh.vertex_count)
+                throw InvalidInput("index " + std::to_string(i - p.first_index) + " of primitive '" + p.name + "' is " +
+                                   (i < mesh.indices.size() ? std::to_string(mesh.indices[i]) : "past the end") +
+                                   ", vertex count is " + std::to_string(mesh.vertex_count));
+        next += p.index_count;
+    }
+    if (next != mesh.indices.size())
+        throw InvalidInput("primitives cover " + std::to_string(next) + " of " + std::to_string(mesh.indices.size()) +
+                           " indices");
+    if (mesh.vertex_count == 0 ? !mesh.keyframe_positions.empty()
+                               : mesh.keyframe_positions.size() % (3 * mesh.vertex_count) != 0)
+        throw InvalidInput("keyframe positions (" + std::to_string(mesh.keyframe_positions.size()) +
+                           " floats) are not a whole number of keyframes of " + std::to_string(mesh.vertex_count) +
+                           " vertices");
+    const size_t keyframes = mesh.keyframe_count();
+    for (const Clip& c : mesh.clips)
+        if (c.keyframe_count == 0 || c.first_keyframe + c.keyframe_count > keyframes)
+            throw InvalidInput("clip '" + c.name + "' spans keyframes " + std::to_string(c.first_keyframe) + ".." +
+                               std::to_string(c.first_keyframe + c.keyframe_count) + ", the mesh has " +
+                               std::to_string(keyframes));
+    for (size_t i = 0; i < mesh.keyframe_positions.size(); ++i)
+        if (!std::isfinite(mesh.keyframe_positions[i]))
+            throw InvalidInput("keyframe " + std::to_string(i / (3 * mesh.vertex_count)) + ": position of vertex " +
+                               std::to_string(i / 3 % mesh.vertex_count) + " is not finite");
+}
+
+}  // namespace animorder

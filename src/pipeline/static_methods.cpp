@@ -1,0 +1,74 @@
+// The static methods of DESIGN.md ("original", "static-sander07") over a whole character.
+//
+// original:        Tipsify (Sander, Nehab & Barczak 2007, §3) — the vertex cache order alone.
+// static-sander07: Tipsify + fast linear clustering (§4) + sort by occlusion potential (§5).
+// Both run per primitive: a character's primitives are separate draws.
+#include "animorder/methods.h"
+
+#include <string>
+
+namespace animorder {
+
+StaticMethod parse_static_method(const std::string& name) {
+    if (name == "original") return StaticMethod::Original;
+    if (name == "static-sander07") return StaticMethod::StaticSander07;
+    throw InvalidInput("unknown method '" + name + "' (available: original, static-sander07)");
+}
+
+const char* method_name(StaticMethod method) {
+    return method == StaticMethod::Original ? "original" : "static-sander07";
+}
+
+StaticMethodResult run_static_method(const AnimatedMesh& mesh, StaticMethod method,
+                                     const StaticMethodSettings& settings) {
+    validate_animated_mesh(mesh);
+    if (mesh.keyframe_count() > 0 && settings.keyframe >= mesh.keyframe_count())
+        throw InvalidInput("keyframe " + std::to_string(settings.keyframe) + " does not exist (the mesh has " +
+                           std::to_string(mesh.keyframe_count()) + ")");
+    if (method == StaticMethod::StaticSander07 && mesh.keyframe_count() == 0 && mesh.triangle_count() > 0)
+        throw InvalidInput("static-sander07 needs positions, and the mesh has no keyframe");
+
+    StaticMethodResult result;
+    result.indices.resize(mesh.indices.size());
+    result.order.reserve(mesh.triangle_count());
+    for (const Primitive& primitive : mesh.primitives) {
+        const uint32_t* source = mesh.indices.data() + primitive.first_index;
+        const size_t triangles = primitive.index_count / 3;
+        std::vector<uint32_t> order(triangles);
+        if (method == StaticMethod::Original) {
+            result.hard_boundary_count +=
+                tipsify(order.data(), source, primitive.index_count, mesh.vertex_count, settings.cache_size)
+                    .hard_boundaries.size();
+        } else {
+            const StaticOrderResult r = order_static_sander07(
+                order.data(), source, primitive.index_count, mesh.keyframe(settings.keyframe), mesh.vertex_count,
+                3 * sizeof(float), settings.lambda, settings.cache_size);
+            result.patch_count += r.patch_count;
+            result.hard_boundary_count += r.hard_boundary_count;
+        }
+        apply_triangle_order(result.indices.data() + primitive.first_index, source, order.data(), triangles);
+        const uint32_t first_triangle = uint32_t(primitive.first_index / 3);
+        for (uint32_t t : order) result.order.push_back(first_triangle + t);
+    }
+    return result;
+}
+
+VertexCacheStats analyze_mesh_vertex_cache(const AnimatedMesh& mesh, const std::vector<uint32_t>& indices,
+                                           unsigned cache_size) {
+    VertexCacheStats total;
+    size_t referenced = 0;
+    for (const Primitive& primitive : mesh.primitives) {
+        const VertexCacheStats s = analyze_vertex_cache(indices.data() + primitive.first_index,
+                                                        primitive.index_count, mesh.vertex_count, cache_size);
+        total.misses += s.misses;
+        total.triangles += s.triangles;
+        referenced += s.referenced_vertices;
+    }
+    // Vertices shared by two primitives count once per primitive, as each draw transforms them.
+    total.referenced_vertices = referenced;
+    total.acmr = total.triangles ? double(total.misses) / double(total.triangles) : 0.0;
+    total.atvr = referenced ? double(total.misses) / double(referenced) : 0.0;
+    return total;
+}
+
+}  // namespace animorder

@@ -1,0 +1,251 @@
+// The rasteriser on hand-worked scenes (coverage, fill rule, culling, clipping, depth order),
+// and its multi-order scoring against a brute-force z-buffer that draws each order separately.
+#include "animorder/animated_mesh.h"
+#include "animorder/animorder.h"
+#include "animorder/overdraw.h"
+#include "support/meshes.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <map>
+#include <random>
+#include <vector>
+
+using namespace animorder;
+
+namespace {
+
+// A scene in clip space with w = 1 (orthographic): x, y, z are NDC.
+struct Scene {
+    std::vector<float> clip;
+    std::vector<uint32_t> ib;
+    unsigned resolution;
+
+    explicit Scene(unsigned res) : resolution(res) {}
+    uint32_t vertex(float x, float y, float z) {
+        clip.insert(clip.end(), {x, y, z, 1.0f});
+        return uint32_t(clip.size() / 4 - 1);
+    }
+    // Window-space rectangle [x0,x1]×[y0,y1] (pixels, y up) at NDC depth z, as two triangles.
+    void rect(float x0, float y0, float x1, float y1, float z, bool counter_clockwise = true) {
+        auto ndc = [&](float p) { return 2.0f * p / float(resolution) - 1.0f; };
+        const uint32_t a = vertex(ndc(x0), ndc(y0), z), b = vertex(ndc(x1), ndc(y0), z),
+                       c = vertex(ndc(x1), ndc(y1), z), d = vertex(ndc(x0), ndc(y1), z);
+        if (counter_clockwise) ib.insert(ib.end(), {a, b, c, a, c, d});
+        else ib.insert(ib.end(), {a, c, b, a, d, c});
+    }
+    size_t triangles() const { return ib.size() / 3; }
+    NodeRasterizer rasterize() const {
+        NodeRasterizer r;
+        r.rasterize(clip.data(), clip.size() / 4, ib.data(), ib.size(), resolution);
+        return r;
+    }
+};
+
+// Orders given as lists of rectangles (each rectangle = 2 consecutive triangles).
+std::vector<uint64_t> score_rect_orders(const Scene& s, const std::vector<std::vector<uint32_t>>& rect_orders) {
+    std::vector<std::vector<uint32_t>> orders;
+    for (const auto& rects : rect_orders) {
+        std::vector<uint32_t> order;
+        for (uint32_t r : rects) order.insert(order.end(), {2 * r, 2 * r + 1});
+        orders.push_back(order);
+    }
+    std::vector<const uint32_t*> pointers;
+    for (const auto& o : orders) pointers.push_back(o.data());
+    const std::vector<uint32_t> ranks = make_rank_table(pointers, s.triangles());
+    std::vector<uint64_t> passed(orders.size());
+    s.rasterize().score(passed.data(), ranks.data(), orders.size());
+    return passed;
+}
+
+}  // namespace
+
+TEST(Rasterizer, PixelAlignedQuadCoversExactlyItsPixelsOnce) {
+    for (unsigned n : {1u, 7u, 64u, 256u}) {
+        Scene s(n);
+        s.rect(0, 0, float(n), float(n), 0.0f);
+        const NodeRasterizer r = s.rasterize();
+        EXPECT_EQ(r.visible_pixels(), uint64_t(n) * n) << n;
+        EXPECT_EQ(r.fragments(), uint64_t(n) * n) << n << ": the shared diagonal is covered once";
+    }
+    Scene s(16);
+    s.rect(2, 3, 6, 7, 0.0f);
+    EXPECT_EQ(s.rasterize().visible_pixels(), 16u);
+    EXPECT_EQ(s.rasterize().fragments(), 16u);
+}
+
+TEST(Rasterizer, TopLeftRuleOnPixelCentres) {
+    // Edges through pixel centres: x ∈ [2.5, 6.5] covers centre columns 2.5..5.5 (the left edge
+    // owns its centres, the right edge does not); y (up) ∈ [3.5, 7.5] covers centre rows 4.5..7.5
+    // (after flipping y, 7.5 is the top edge, which owns its centres; 3.5 is the bottom).
+    const unsigned n = 16;
+    Scene s(n);
+    s.rect(2.5f, 3.5f, 6.5f, 7.5f, 0.0f);
+    const NodeRasterizer r = s.rasterize();
+    const std::vector<uint32_t> ranks{0, 1};
+    const std::vector<uint32_t> image = r.passed_per_pixel(ranks.data(), 1, 0);
+    for (unsigned row = 0; row < n; ++row)
+        for (unsigned col = 0; col < n; ++col) {
+            const unsigned gl_row = n - 1 - row;
+            const bool expected = col >= 2 && col <= 5 && gl_row >= 4 && gl_row <= 7;
+            EXPECT_EQ(image[row * n + col], expected ? 1u : 0u) << "row " << row << " col " << col;
+        }
+}
+
+TEST(Rasterizer, AdjacentQuadsShareTheirEdgeWithoutGapOrDoubleCount) {
+    // Four quads tiling [0,10]² at a fractional split (3.3, 6.5): every pixel exactly once.
+    Scene s(10);
+    s.rect(0, 0, 3.3f, 6.5f, 0);
+    s.rect(3.3f, 0, 10, 6.5f, 0);
+    s.rect(0, 6.5f, 3.3f, 10, 0);
+    s.rect(3.3f, 6.5f, 10, 10, 0);
+    const NodeRasterizer r = s.rasterize();
+    EXPECT_EQ(r.visible_pixels(), 100u);
+    EXPECT_EQ(r.fragments(), 100u);
+}
+
+TEST(Rasterizer, BackFacesAreCulled) {
+    Scene s(16);
+    s.rect(0, 0, 16, 16, 0.0f, /*counter_clockwise=*/false);
+    EXPECT_EQ(s.rasterize().visible_pixels(), 0u);
+    EXPECT_EQ(s.rasterize().fragments(), 0u);
+}
+
+TEST(Rasterizer, OverdrawDependsOnOrderAsHandCounted) {
+    // Rect 0 (near, z = −0.6) covers columns 0–3, rect 1 (far, z = 0.2) columns 2–5, rows 0–3.
+    Scene s(8);
+    s.rect(0, 0, 4, 4, -0.6f);
+    s.rect(2, 0, 6, 4, 0.2f);
+    EXPECT_EQ(s.rasterize().visible_pixels(), 24u);
+    // Near first: 16 + the 8 far-only pixels = 24. Far first: 16 + 16 = 32.
+    EXPECT_EQ(score_rect_orders(s, {{0, 1}, {1, 0}}), (std::vector<uint64_t>{24, 32}));
+}
+
+TEST(Rasterizer, EqualDepthPassesOnlyTheFirstDrawn) {
+    Scene s(8);
+    s.rect(0, 0, 4, 4, 0.1f);
+    s.rect(0, 0, 4, 4, 0.1f);
+    EXPECT_EQ(score_rect_orders(s, {{0, 1}, {1, 0}}), (std::vector<uint64_t>{16, 16}));
+}
+
+TEST(Rasterizer, ThreeLayersBackToFrontShadeEveryLayer) {
+    Scene s(4);
+    s.rect(0, 0, 4, 4, 0.5f);
+    s.rect(0, 0, 4, 4, 0.0f);
+    s.rect(0, 0, 4, 4, -0.5f);
+    // Back to front (0,1,2): 48. Front to back (2,1,0): 16. Middle first (1,0,2): 16 + 0 + 16.
+    EXPECT_EQ(score_rect_orders(s, {{0, 1, 2}, {2, 1, 0}, {1, 0, 2}}), (std::vector<uint64_t>{48, 16, 32}));
+}
+
+TEST(Rasterizer, NearPlaneClipsAwayThePartInFront) {
+    // A full-height quad whose NDC z runs from −2 (x = −1) to 0.5 (x = +1): z < −1 lies in front
+    // of the near plane. z = −1 at NDC x = −0.2, window x = 4.0 at 10 pixels: columns 4–9 remain.
+    Scene s(10);
+    const uint32_t a = s.vertex(-1, -1, -2), b = s.vertex(1, -1, 0.5f), c = s.vertex(1, 1, 0.5f),
+                   d = s.vertex(-1, 1, -2);
+    s.ib = {a, b, c, a, c, d};
+    EXPECT_EQ(s.rasterize().visible_pixels(), 60u);
+    // The same beyond the far plane: z from 0.5 to 2 crosses z = 1 at NDC x = −1/3, window 3.33:
+    // centre columns 0.5, 1.5, 2.5 remain.
+    Scene f(10);
+    const uint32_t e = f.vertex(-1, -1, 0.5f), g = f.vertex(1, -1, 2), h = f.vertex(1, 1, 2), i = f.vertex(-1, 1, 0.5f);
+    f.ib = {e, g, h, e, h, i};
+    EXPECT_EQ(f.rasterize().visible_pixels(), 30u);
+}
+
+TEST(Rasterizer, GeometryOutsideTheViewportIsClippedNotWrapped) {
+    Scene s(8);
+    const uint32_t a = s.vertex(-50, -50, 0), b = s.vertex(50, -50, 0), c = s.vertex(0, 50, 0);
+    s.ib = {a, b, c};
+    EXPECT_EQ(s.rasterize().visible_pixels(), 64u);
+}
+
+TEST(Rasterizer, SphereFillsTheInscribedDisc) {
+    // Framing and camera: the bounding sphere of radius R exactly fits the viewport, so a fine
+    // sphere's silhouette covers π(N/2)² pixels (a little less: the mesh is inscribed).
+    const AnimatedMesh sphere = make_uv_sphere(40000);
+    const Framing framing = frame_keyframes(sphere.keyframe(0), 1, sphere.vertex_count, sphere.indices.data(),
+                                            sphere.indices.size());
+    const std::vector<float> dirs = icosphere_directions(1);
+    for (size_t v = 0; v < 42; v += 7) {
+        std::vector<float> clip(sphere.vertex_count * 4);
+        transform_to_clip(clip.data(), sphere.keyframe(0), sphere.vertex_count, framing.centres.data(),
+                          node_view_projection(&dirs[3 * v], framing.radius));
+        NodeRasterizer r;
+        r.rasterize(clip.data(), sphere.vertex_count, sphere.indices.data(), sphere.indices.size(), 256);
+        const double disc = M_PI * 128.0 * 128.0;
+        EXPECT_NEAR(double(r.visible_pixels()), disc, 0.01 * disc) << "view " << v;
+        // A convex closed mesh: every front-facing fragment is visible, nothing overlaps.
+        EXPECT_EQ(r.fragments(), r.visible_pixels()) << "view " << v;
+    }
+}
+
+namespace {
+// Independent reference: draws the fragments of each order with a real z-buffer, one triangle
+// after another, from the rasteriser's raw fragments.
+uint64_t brute_force_passed(const NodeRasterizer& r, const std::vector<uint32_t>& order) {
+    std::map<uint32_t, std::vector<std::pair<uint32_t, float>>> by_triangle;  // triangle → (pixel, depth)
+    r.visit_fragments([&](uint32_t p, uint32_t t, float z) { by_triangle[t].emplace_back(p, z); });
+    std::vector<float> depth(size_t(r.resolution()) * r.resolution(), 1.0f);
+    uint64_t passed = 0;
+    for (uint32_t t : order)
+        for (const auto& [p, z] : by_triangle[t])
+            if (z < depth[p]) {
+                depth[p] = z;
+                ++passed;
+            }
+    return passed;
+}
+}  // namespace
+
+TEST(Rasterizer, ScoringManyOrdersEqualsDrawingEachOrderWithAZBuffer) {
+    const AnimatedMesh mesh = make_procedural_character();
+    const Framing framing = frame_keyframes(mesh.keyframe_positions.data(), mesh.keyframe_count(), mesh.vertex_count,
+                                            mesh.indices.data(), mesh.indices.size());
+    const size_t n = mesh.triangle_count();
+    std::vector<std::vector<uint32_t>> orders(4, std::vector<uint32_t>(n));
+    std::mt19937 rng(1);
+    for (size_t i = 0; i < n; ++i) orders[0][i] = uint32_t(i);
+    for (size_t i = 0; i < n; ++i) orders[1][i] = uint32_t(n - 1 - i);
+    for (size_t o = 2; o < 4; ++o) {
+        orders[o] = orders[0];
+        for (size_t i = n; i > 1; --i) std::swap(orders[o][i - 1], orders[o][rng() % i]);
+    }
+    std::vector<const uint32_t*> pointers;
+    for (const auto& o : orders) pointers.push_back(o.data());
+    const std::vector<uint32_t> ranks = make_rank_table(pointers, n);
+
+    const std::vector<float> dirs = icosphere_directions(1);
+    for (size_t v : {0u, 5u, 17u, 33u}) {
+        for (uint32_t k : {0u, uint32_t(mesh.keyframe_count() - 1)}) {
+            std::vector<float> clip(mesh.vertex_count * 4);
+            transform_to_clip(clip.data(), mesh.keyframe(k), mesh.vertex_count, &framing.centres[3 * k],
+                              node_view_projection(&dirs[3 * v], framing.radius));
+            NodeRasterizer r;
+            r.rasterize(clip.data(), mesh.vertex_count, mesh.indices.data(), mesh.indices.size(), 128);
+            std::vector<uint64_t> passed(orders.size());
+            r.score(passed.data(), ranks.data(), orders.size());
+            for (size_t o = 0; o < orders.size(); ++o) {
+                EXPECT_EQ(passed[o], brute_force_passed(r, orders[o])) << "view " << v << " keyframe " << k << " order " << o;
+                EXPECT_GE(passed[o], r.visible_pixels());
+                EXPECT_LE(passed[o], r.fragments());
+            }
+            EXPECT_GT(r.fragments(), r.visible_pixels());  // the character does overlap itself
+            // One order alone scores the same as within the batch.
+            const std::vector<uint32_t> single = make_rank_table({orders[2].data()}, n);
+            uint64_t alone = 0;
+            r.score(&alone, single.data(), 1);
+            EXPECT_EQ(alone, passed[2]);
+        }
+    }
+}
+
+TEST(Rasterizer, RejectsBadInput) {
+    NodeRasterizer r;
+    const std::vector<float> clip(12, 0.0f);
+    const std::vector<uint32_t> ib{0, 1, 3};
+    EXPECT_THROW(r.rasterize(clip.data(), 3, ib.data(), 3, 16), InvalidInput);
+    const std::vector<uint32_t> ok{0, 1, 2};
+    EXPECT_THROW(r.rasterize(clip.data(), 3, ok.data(), 3, 0), InvalidInput);
+}

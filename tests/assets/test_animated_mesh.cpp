@@ -1,0 +1,45 @@
+// The AnimatedMesh invariants: a good mesh passes, each defect is named.
+#include "animorder/animated_mesh.h"
+#include "animorder/animorder.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <string>
+
+using namespace animorder;
+
+namespace {
+AnimatedMesh good() {
+    AnimatedMesh m;
+    m.vertex_count = 4;
+    m.indices = {0, 1, 2, 2, 1, 3};
+    m.primitives = {{"a", 0, 3}, {"b", 3, 3}};
+    m.keyframe_positions = std::vector<float>(2 * 4 * 3, 0.5f);
+    m.clips = {{"clip", 1.0 / 30, 30, 0, 2}};
+    return m;
+}
+
+void expect_rejected(const std::function<void(AnimatedMesh&)>& damage, const std::string& message) {
+    AnimatedMesh m = good();
+    damage(m);
+    try {
+        validate_animated_mesh(m);
+        FAIL() << "accepted: " << message;
+    } catch (const InvalidInput& e) {
+        EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+    }
+}
+}  // namespace
+
+TEST(AnimatedMesh, AcceptsAConsistentMesh) { EXPECT_NO_THROW(validate_animated_mesh(good())); }
+
+TEST(AnimatedMesh, NamesEachDefect) {
+    expect_rejected([](AnimatedMesh& m) { m.indices[5] = 9; }, "primitive 'b' is 9");
+    expect_rejected([](AnimatedMesh& m) { m.primitives[1].first_index = 2; }, "does not continue");
+    expect_rejected([](AnimatedMesh& m) { m.primitives.pop_back(); }, "cover 3 of 6");
+    expect_rejected([](AnimatedMesh& m) { m.keyframe_positions.pop_back(); }, "not a whole number of keyframes");
+    expect_rejected([](AnimatedMesh& m) { m.clips[0].keyframe_count = 3; }, "clip 'clip'");
+    expect_rejected([](AnimatedMesh& m) { m.keyframe_positions[13] = NAN; }, "keyframe 1: position of vertex 0");
+}

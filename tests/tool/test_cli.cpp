@@ -1,0 +1,151 @@
+// The animorder tool end to end: exit codes, one-line errors for bad input and options, the JSON
+// report's schema, atomic and deterministic output.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <sys/wait.h>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Outcome {
+    int exit_code = -1;
+    std::string out, err;
+};
+
+std::string slurp(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+class Cli : public ::testing::Test {
+protected:
+    void SetUp() override {
+        dir_ = fs::temp_directory_path() / ("animorder-cli-" + std::to_string(::getpid()) + "-" +
+                                            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        fs::remove_all(dir_);
+        fs::create_directories(dir_);
+    }
+    void TearDown() override { fs::remove_all(dir_); }
+
+    Outcome run(const std::string& args) {
+        const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+        const std::string command = std::string(ANIMORDER_EXE) + " " + args + " >" + out.string() + " 2>" + err.string();
+        const int status = std::system(command.c_str());
+        Outcome o;
+        o.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+        o.out = slurp(out);
+        o.err = slurp(err);
+        return o;
+    }
+    fs::path path(const std::string& name) const { return dir_ / name; }
+
+    fs::path dir_;
+};
+
+size_t line_count(const std::string& text) {
+    size_t n = 0;
+    for (char c : text) n += c == '\n';
+    return n;
+}
+
+}  // namespace
+
+TEST_F(Cli, InspectUsesTheBundledCharacterAndSaysSo) {
+    const Outcome o = run("inspect --json");
+    ASSERT_EQ(o.exit_code, 0) << o.err;
+    EXPECT_NE(o.err.find("bundled procedural character"), std::string::npos) << o.err;
+    const nlohmann::json j = nlohmann::json::parse(o.out);
+    EXPECT_EQ(j["tool"], "animorder");
+    EXPECT_GE(j["triangles"].get<int>(), 9500);
+    EXPECT_GT(j["input_order"]["acmr"].get<double>(), 0.5);
+    EXPECT_EQ(j["clips"].size(), 2u);
+}
+
+TEST_F(Cli, QuietSilencesStderr) {
+    const Outcome o = run("inspect --quiet");
+    ASSERT_EQ(o.exit_code, 0);
+    EXPECT_EQ(o.err, "");
+    EXPECT_NE(o.out.find("ACMR"), std::string::npos);
+}
+
+TEST_F(Cli, OptimizeWritesIndicesAndReport) {
+    const Outcome o = run("optimize -q --method static-sander07 --lambda 0.85 -o " + path("ib.bin").string() +
+                          " --report " + path("report.json").string());
+    ASSERT_EQ(o.exit_code, 0) << o.err;
+    const nlohmann::json j = nlohmann::json::parse(slurp(path("report.json")));
+    for (const char* key : {"tool", "version", "input", "triangles", "vertices", "settings", "methods", "timings_s"})
+        EXPECT_TRUE(j.contains(key)) << key;
+    const nlohmann::json& m = j["methods"][0];
+    EXPECT_EQ(m["name"], "static-sander07");
+    EXPECT_EQ(m["buffers"], 1);
+    EXPECT_TRUE(m["ovr_mean"].is_null());
+    EXPECT_GT(m["acmr"].get<double>(), 0.5);
+    EXPECT_LT(m["acmr"].get<double>(), 1.2);
+    EXPECT_GE(m["time_s"].get<double>(), 0.0);
+    EXPECT_TRUE(j["timings_s"].contains("total"));
+    // The index buffer: 3 little-endian uint32 per triangle.
+    EXPECT_EQ(fs::file_size(path("ib.bin")), 12u * j["triangles"].get<size_t>());
+}
+
+TEST_F(Cli, OptimizeIsByteDeterministic) {
+    ASSERT_EQ(run("optimize -q -o " + path("a.bin").string()).exit_code, 0);
+    ASSERT_EQ(run("optimize -q -o " + path("b.bin").string()).exit_code, 0);
+    EXPECT_EQ(slurp(path("a.bin")), slurp(path("b.bin")));
+}
+
+TEST_F(Cli, LambdaChangesTheAcmrTheWayThePaperSays) {
+    ASSERT_EQ(run("optimize -q --lambda 0 --report " + path("r0.json").string()).exit_code, 0);
+    ASSERT_EQ(run("optimize -q --lambda 3 --report " + path("r3.json").string()).exit_code, 0);
+    const double a0 = nlohmann::json::parse(slurp(path("r0.json")))["methods"][0]["acmr"];
+    const double a3 = nlohmann::json::parse(slurp(path("r3.json")))["methods"][0]["acmr"];
+    EXPECT_LT(a0, 0.9);
+    EXPECT_GT(a3, a0 + 0.5);  // single triangles: far worse for the vertex cache
+}
+
+TEST_F(Cli, BadInputAndOptionsGiveOneLineErrors) {
+    struct Case {
+        std::string args, expect;
+    };
+    const Case cases[] = {
+        {"optimize --lambda nan", "lambda"},
+        {"optimize --lambda -1", "lambda"},
+        {"optimize --method fastest", "unknown method 'fastest'"},
+        {"optimize --cache-size 0", "cache-size"},
+        {"optimize --frame 100000", "keyframe 100000"},
+        {"inspect " + path("missing.glb").string(), "missing.glb"},
+        {"optimize -o " + path("no/such/folder/out.bin").string(), "does not exist"},
+        {"optimize -o " + dir_.string(), "is a directory"},
+    };
+    for (const Case& c : cases) {
+        const Outcome o = run(c.args + " --quiet");  // errors print even when quiet
+        EXPECT_NE(o.exit_code, 0) << c.args;
+        EXPECT_NE(o.err.find(c.expect), std::string::npos) << c.args << " → " << o.err;
+        // One line; option errors from the parser add a pointer to --help.
+        EXPECT_GE(line_count(o.err), 1u) << c.args;
+        EXPECT_LE(line_count(o.err), 2u) << c.args << " → " << o.err;
+    }
+}
+
+TEST_F(Cli, FailedWriteLeavesNoFileBehind) {
+    const Outcome o = run("optimize -q -o " + path("no/such/out.bin").string());
+    EXPECT_NE(o.exit_code, 0);
+    size_t entries = 0;
+    for (const auto& entry : fs::directory_iterator(dir_)) entries += entry.path().filename().string()[0] == '.';
+    EXPECT_EQ(entries, 0u);  // no temporary file left
+}
+
+TEST_F(Cli, NoSubcommandPrintsUsage) {
+    const Outcome o = run("");
+    EXPECT_NE(o.exit_code, 0);
+    EXPECT_NE((o.out + o.err).find("inspect"), std::string::npos);
+}

@@ -1,0 +1,57 @@
+// The subcommands of the animorder tool. Each returns the process exit code.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace animorder::tool {
+
+struct CommonOptions {
+    std::string input;   // empty: the bundled procedural character
+    bool quiet = false;  // no progress on stderr
+    unsigned cache_size = 16;
+};
+
+struct InspectOptions {
+    CommonOptions common;
+    bool json = false;
+};
+
+struct OptimizeOptions {
+    CommonOptions common;
+    std::string method = "static-sander07";
+    double lambda = 0.85;
+    size_t keyframe = 0;
+    std::string output;       // reordered index buffer (little-endian uint32), optional
+    std::string report_path;  // JSON report, optional
+};
+
+struct EvaluateOptions {
+    CommonOptions common;
+    std::string methods = "original,static-sander07";
+    double lambda = 0.85;
+    size_t views = 300;
+    unsigned resolution = 512;
+    uint64_t seed = 20170501;
+    unsigned threads = 0;
+    std::string report_path;
+    std::string csv_path;
+};
+
+struct HeatmapOptions {
+    CommonOptions common;
+    std::string method = "original";
+    double lambda = 0.85;
+    std::vector<float> view = {0.3f, 0.2f, 1.0f};  // direction from the character to the camera
+    size_t keyframe = 0;
+    unsigned resolution = 512;
+    std::string output;
+};
+
+int run_inspect(const InspectOptions& options);
+int run_optimize(const OptimizeOptions& options);
+int run_evaluate(const EvaluateOptions& options);
+int run_heatmap(const HeatmapOptions& options);
+
+}  // namespace animorder::tool

@@ -1,0 +1,107 @@
+// animorder — command-line entry point: parses options, dispatches to a subcommand, and turns
+// every failure into one line on stderr and a non-zero exit code (never a crash).
+#include "commands.h"
+
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <exception>
+
+namespace {
+
+void add_common(CLI::App& command, animorder::tool::CommonOptions& common) {
+    command.add_option("input", common.input, "Input mesh (default: the bundled procedural character)");
+    command.add_flag("-q,--quiet", common.quiet, "No progress or notes on stderr");
+    command.add_option("--cache-size", common.cache_size, "FIFO vertex cache entries for ACMR and Tipsify")
+        ->check(CLI::Range(3u, 1024u));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    using namespace animorder::tool;
+    CLI::App app{"animorder: triangle orders for animated meshes with low overdraw and a good vertex cache\n"
+                 "(Han & Sander 2017; Sander, Nehab & Barczak 2007)"};
+    app.set_version_flag("--version", std::string("animorder ") + ANIMORDER_VERSION);
+    app.require_subcommand(1);
+
+    InspectOptions inspect;
+    CLI::App* inspect_cmd = app.add_subcommand("inspect", "Print triangles, vertices, clips and the ACMR of the current order");
+    add_common(*inspect_cmd, inspect.common);
+    inspect_cmd->add_flag("--json", inspect.json, "Print JSON instead of text");
+
+    OptimizeOptions optimize;
+    CLI::App* optimize_cmd = app.add_subcommand("optimize", "Reorder triangles with a method and report the result");
+    add_common(*optimize_cmd, optimize.common);
+    optimize_cmd->add_option("-m,--method", optimize.method, "original | static-sander07")
+        ->capture_default_str();
+    optimize_cmd->add_option("-l,--lambda", optimize.lambda,
+                             "Patch threshold: soft boundary when a patch's local ACMR < lambda "
+                             "(<0.5: hard boundaries only, >=3: single triangles)")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 1000.0));
+    optimize_cmd->add_option("--frame", optimize.keyframe, "Keyframe whose positions static-sander07 sorts with")
+        ->capture_default_str();
+    optimize_cmd->add_option("-o,--output", optimize.output,
+                             "Write the reordered index buffer (little-endian uint32 triangle list)");
+    optimize_cmd->add_option("-r,--report", optimize.report_path, "Write the JSON report to this file");
+
+    EvaluateOptions evaluate;
+    CLI::App* evaluate_cmd =
+        app.add_subcommand("evaluate", "Score methods' overdraw (OVR) and ACMR over the evaluation nodes (DESIGN.md)");
+    add_common(*evaluate_cmd, evaluate.common);
+    evaluate_cmd->add_option("--methods", evaluate.methods, "Comma-separated: original, static-sander07")
+        ->capture_default_str();
+    evaluate_cmd->add_option("-l,--lambda", evaluate.lambda, "Patch threshold for static-sander07")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 1000.0));
+    evaluate_cmd->add_option("--eval-views", evaluate.views, "Random viewpoints per keyframe")
+        ->capture_default_str()
+        ->check(CLI::Range(size_t(1), size_t(100000)));
+    evaluate_cmd->add_option("--eval-resolution", evaluate.resolution, "Viewport size in pixels")
+        ->capture_default_str()
+        ->check(CLI::Range(1u, 8192u));
+    evaluate_cmd->add_option("--seed", evaluate.seed, "Seed of the evaluation viewpoints")->capture_default_str();
+    evaluate_cmd->add_option("--threads", evaluate.threads, "Worker threads (0: all cores)")
+        ->capture_default_str()
+        ->check(CLI::Range(0u, 1024u));
+    evaluate_cmd->add_option("-r,--report", evaluate.report_path, "Write the JSON report to this file");
+    evaluate_cmd->add_option("--csv", evaluate.csv_path, "Write the table as CSV to this file");
+
+    HeatmapOptions heatmap;
+    CLI::App* heatmap_cmd = app.add_subcommand("heatmap", "Draw a per-pixel overdraw image of one node as PNG");
+    add_common(*heatmap_cmd, heatmap.common);
+    heatmap_cmd->add_option("--order", heatmap.method, "original | static-sander07")->capture_default_str();
+    heatmap_cmd->add_option("-l,--lambda", heatmap.lambda, "Patch threshold for static-sander07")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 1000.0));
+    heatmap_cmd->add_option("--view", heatmap.view, "Direction from the character to the camera, x,y,z")
+        ->delimiter(',')
+        ->expected(3);
+    heatmap_cmd->add_option("--frame", heatmap.keyframe, "Keyframe (over all clips)")->capture_default_str();
+    heatmap_cmd->add_option("--resolution", heatmap.resolution, "Image size in pixels")
+        ->capture_default_str()
+        ->check(CLI::Range(16u, 8192u));
+    heatmap_cmd->add_option("-o,--output", heatmap.output, "PNG file to write")->required();
+
+    if (argc == 1) {  // no arguments: the basics, and where to look next (gltfpack style)
+        std::fputs(app.help().c_str(), stderr);
+        return 2;
+    }
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e);
+    }
+
+    try {
+        if (*inspect_cmd) return run_inspect(inspect);
+        if (*optimize_cmd) return run_optimize(optimize);
+        if (*evaluate_cmd) return run_evaluate(evaluate);
+        if (*heatmap_cmd) return run_heatmap(heatmap);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "animorder: error: %s\n", e.what());
+        return 1;
+    }
+    return 2;
+}

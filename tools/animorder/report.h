@@ -1,0 +1,24 @@
+// The JSON report: the tool's stable, machine-readable interface (the human text may change).
+//
+// Schema (later issues extend it, never rename): {"tool", "version", "input", "triangles",
+// "vertices", "settings": {...}, "input_order": {"acmr", "atvr"},
+// "methods": [{"name", "buffers", "acmr", "atvr", "ovr_mean", "time_s", ...}],
+// "timings_s": {"total", ...}}.
+#pragma once
+
+#include "animorder/animated_mesh.h"
+#include "animorder/animorder.h"
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+
+namespace animorder::tool {
+
+nlohmann::ordered_json report_header(const AnimatedMesh& mesh, const std::string& input_name);
+nlohmann::ordered_json cache_stats_json(const VertexCacheStats& stats);
+
+// Serialised with two-space indentation and a final newline.
+std::string report_text(const nlohmann::ordered_json& report);
+
+}  // namespace animorder::tool

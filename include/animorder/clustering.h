@@ -54,6 +54,9 @@ struct ClusteringSettings {
     size_t max_iterations = 30;
     DistanceVariant distance = DistanceVariant::Jcgt;
     unsigned threads = 0;
+    // Nodes' fragments are kept between iterations (orders change, fragments do not) while they
+    // fit in this many bytes; beyond, every iteration rasterises again (slower, same result).
+    size_t max_cache_bytes = size_t(6) << 30;
     std::function<void(const std::string&)> log;         // one line per event (re-seeding, …)
     std::function<void(size_t, size_t)> progress;        // nodes scored, total, per iteration
 };
@@ -62,7 +65,7 @@ struct ClusteringIteration {
     double mean_ovr = 0;        // mean node OVR with every node drawn by its assigned buffer
     size_t reassigned = 0;      // nodes whose cluster changed in this assignment step
     size_t reseeded = 0;        // clusters that were empty and got re-seeded
-    double seconds_raster = 0;  // assignment step (rasterise + score)
+    double seconds_raster = 0;  // assignment step (scoring k orders at every node)
     double seconds_update = 0;  // integrated-distance update
 };
 
@@ -75,6 +78,7 @@ struct ClusteringResult {
     std::vector<uint32_t> assignment;
     std::vector<ClusteringIteration> iterations;
     bool converged = false;
+    double seconds_rasterization = 0;  // rasterising every node once (kept for all iterations)
 };
 
 // Han & Sander 2017, Algorithm 1, over the nodes keyframes × icosphere viewpoints.

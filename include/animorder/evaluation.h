@@ -4,6 +4,7 @@
 #pragma once
 
 #include "animorder/animated_mesh.h"
+#include "animorder/clustering.h"
 #include "animorder/overdraw.h"
 
 #include <cstdint>
@@ -35,10 +36,19 @@ struct OrderEvaluation {
     std::vector<OverdrawSummary> per_clip;  // mesh.clips order
 };
 
-// Scores each order (a face permutation of the whole mesh, primitives drawn in file order) at
-// every evaluation node, all orders from one rasterisation per node. Returns one entry per order.
-std::vector<OrderEvaluation> evaluate_single_orders(const AnimatedMesh& mesh,
-                                                    const std::vector<std::vector<uint32_t>>& orders,
-                                                    const EvaluationSettings& settings);
+// A method under evaluation: its buffers (face permutations of the whole mesh, primitives drawn
+// in file order) and how it picks one at a node. Without tables it has one buffer for every node;
+// with tables (one per clip, mesh.clips order) a node draws buffer table_base[clip] + the table's
+// cell for (keyframe in the clip, view direction): exactly what an application does at run time.
+struct MethodBuffers {
+    std::vector<std::vector<uint32_t>> orders;
+    std::vector<SelectionTable> tables;
+    std::vector<uint32_t> table_base;
+};
+
+// Scores every method at every evaluation node (clip keyframes × random views, R per clip), all
+// buffers of all methods from one rasterisation per node. Returns one entry per method.
+std::vector<OrderEvaluation> evaluate_methods(const AnimatedMesh& mesh, const std::vector<MethodBuffers>& methods,
+                                              const EvaluationSettings& settings);
 
 }  // namespace animorder

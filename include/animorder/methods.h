@@ -7,6 +7,8 @@
 
 #include "animorder/animated_mesh.h"
 #include "animorder/animorder.h"
+#include "animorder/clustering.h"
+#include "animorder/evaluation.h"
 
 #include <string>
 #include <vector>
@@ -38,6 +40,20 @@ struct StaticMethodResult {
 // Runs the method on every primitive. Throws InvalidInput for an invalid mesh or settings.
 StaticMethodResult run_static_method(const AnimatedMesh& mesh, StaticMethod method,
                                      const StaticMethodSettings& settings);
+
+// Han & Sander 2017 over a whole character: "single" (one set of k buffers per clip) or "joint"
+// (one set for all clips). Buffers are face permutations of the whole mesh; tables pick them.
+struct AnimatedMethodResult {
+    MeshPatches patches;
+    MethodBuffers buffers;                  // single: k per clip, clip after clip; joint: k
+    std::vector<ClusteringResult> runs;     // one per clip (single) or one (joint)
+    Framing framing;                        // all keyframes (centres); R per run inside runs
+    std::vector<float> run_radius;          // R used by each run
+    double seconds_patches = 0;
+};
+
+AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double lambda, unsigned cache_size,
+                                    const ClusteringSettings& settings);
 
 // ACMR/ATVR of a whole index buffer drawn primitive by primitive, each draw starting with an
 // empty cache (a draw call does not inherit the previous draw's post-transform cache).

@@ -39,10 +39,14 @@ std::vector<float> random_sphere_directions(size_t count, uint64_t seed);
 // centre to one of its vertices, over all keyframes. Framing never rotates.
 struct Framing {
     std::vector<float> centres;  // 3 per keyframe
-    float radius = 0;
+    std::vector<float> radii;    // per keyframe: farthest vertex from its centre
+    float radius = 0;            // the view radius R: the largest of radii
 };
 Framing frame_keyframes(const float* keyframe_positions, size_t keyframe_count, size_t vertex_count,
                         const uint32_t* indices, size_t index_count);
+
+// The same framing with R taken over a subset of keyframes (one clip is one animation).
+Framing frame_subset(const Framing& framing, const std::vector<uint32_t>& keyframes);
 
 // ---------------------------------------------------------------------------------------------
 // The camera (camera.cpp)
@@ -107,11 +111,30 @@ public:
     // + column, row 0 at the top; triangle = index in the rasterised triangle list).
     void visit_fragments(const std::function<void(uint32_t, uint32_t, float)>& visit) const;
 
+    // The node's fragments in the compact form scoring needs (see NodeFragments).
+    struct NodeFragments export_fragments() const;
+
     struct State;  // defined in rasterizer.cpp only
 
 private:
     std::unique_ptr<State> state_;
 };
+
+// What scoring needs of a rasterised node, and nothing more: the visible and single-fragment pixel
+// counts, and for each pixel with several fragments its triangles nearest first (the top bit marks
+// a depth equal to the previous fragment's). Orders never change it, so k-means keeps it between
+// iterations instead of rasterising the node again.
+struct NodeFragments {
+    uint64_t visible = 0;
+    uint64_t single = 0;
+    std::vector<uint32_t> starts;     // multi-fragment pixels + 1
+    std::vector<uint32_t> fragments;  // triangle | tie bit
+    size_t bytes() const { return (starts.size() + fragments.size()) * 4 + sizeof(*this); }
+};
+
+// passed[o] for each order of the rank table, from a node's fragments (NodeRasterizer::score
+// gives the same numbers).
+void score_fragments(uint64_t* passed, const NodeFragments& node, const uint32_t* ranks, size_t order_count);
 
 // ---------------------------------------------------------------------------------------------
 // Many nodes at once (overdraw.cpp)
@@ -136,5 +159,16 @@ struct ScoreSettings {
 void score_nodes(uint64_t* visible, uint64_t* passed, const float* keyframe_positions, size_t vertex_count,
                  const Framing& framing, const uint32_t* indices, size_t index_count, const OverdrawNode* nodes,
                  size_t node_count, const uint32_t* ranks, size_t order_count, const ScoreSettings& settings);
+
+// Rasterises every node once and keeps its NodeFragments (in parallel, deterministic), or
+// returns an empty vector when the fragments would take more than max_bytes (the caller then
+// scores with score_nodes, rasterising again each time).
+std::vector<NodeFragments> rasterize_nodes(const float* keyframe_positions, size_t vertex_count, const Framing& framing,
+                                           const uint32_t* indices, size_t index_count, const OverdrawNode* nodes,
+                                           size_t node_count, const ScoreSettings& settings, size_t max_bytes);
+
+// score_nodes' results from kept fragments: no rasterisation at all.
+void score_kept_nodes(uint64_t* visible, uint64_t* passed, const std::vector<NodeFragments>& nodes, const uint32_t* ranks,
+                      size_t order_count, const ScoreSettings& settings);
 
 }  // namespace animorder

@@ -183,6 +183,15 @@ ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patc
     std::vector<uint64_t> visible(node_count), passed(node_count * k);
     result.assignment.assign(node_count, UINT32_MAX);
 
+    // Rasterise every node once; later iterations only replay the kept fragments in new orders.
+    const Clock::time_point raster_start = Clock::now();
+    const std::vector<NodeFragments> kept =
+        rasterize_nodes(mesh.keyframe_positions.data(), mesh.vertex_count, framing, mesh.indices.data(),
+                        mesh.indices.size(), nodes.data(), node_count, score, settings.max_cache_bytes);
+    result.seconds_rasterization = seconds_since(raster_start);
+    if (kept.empty())
+        say(settings, "node fragments exceed the cache budget: rasterising again every iteration");
+
     for (size_t iteration = 0;; ++iteration) {
         ClusteringIteration log;
         // Step 1: node assignment by measured overdraw.
@@ -192,8 +201,11 @@ ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patc
         for (size_t c = 0; c < k; ++c) result.triangle_orders.push_back(patch_order_to_triangle_order(patches, result.patch_orders[c]));
         for (const auto& o : result.triangle_orders) pointers.push_back(o.data());
         const std::vector<uint32_t> ranks = make_rank_table(pointers, mesh.triangle_count());
-        score_nodes(visible.data(), passed.data(), mesh.keyframe_positions.data(), mesh.vertex_count, framing,
-                    mesh.indices.data(), mesh.indices.size(), nodes.data(), node_count, ranks.data(), k, score);
+        if (kept.empty())
+            score_nodes(visible.data(), passed.data(), mesh.keyframe_positions.data(), mesh.vertex_count, framing,
+                        mesh.indices.data(), mesh.indices.size(), nodes.data(), node_count, ranks.data(), k, score);
+        else
+            score_kept_nodes(visible.data(), passed.data(), kept, ranks.data(), k, score);
         std::vector<double> node_ovr(node_count, 0.0);
         double ovr_sum = 0;
         size_t counted = 0;

@@ -71,4 +71,63 @@ void score_nodes(uint64_t* visible, uint64_t* passed, const float* keyframe_posi
     arena.execute([&] { tbb::parallel_for(tbb::blocked_range<size_t>(0, node_count, 1), body); });
 }
 
+std::vector<NodeFragments> rasterize_nodes(const float* keyframe_positions, size_t vertex_count, const Framing& framing,
+                                           const uint32_t* indices, size_t index_count, const OverdrawNode* nodes,
+                                           size_t node_count, const ScoreSettings& settings, size_t max_bytes) {
+    validate_indices(indices, index_count, vertex_count);
+    const size_t keyframes = framing.centres.size() / 3;
+    for (size_t n = 0; n < node_count; ++n)
+        if (nodes[n].keyframe >= keyframes) throw InvalidInput("node " + std::to_string(n) + " names a missing keyframe");
+
+    std::vector<NodeFragments> kept(node_count);
+    // The total is the same whatever the schedule, so whether it fits is decided deterministically.
+    std::atomic<size_t> total{0};
+    std::atomic<bool> too_big{false};
+    std::atomic<size_t> done{0};
+    std::mutex progress_mutex;
+    struct Worker {
+        NodeRasterizer rasterizer;
+        std::vector<float> clip;
+    };
+    tbb::enumerable_thread_specific<Worker> workers;
+    auto body = [&](const tbb::blocked_range<size_t>& range) {
+        Worker& w = workers.local();
+        w.clip.resize(vertex_count * 4);
+        for (size_t n = range.begin(); n != range.end() && !too_big; ++n) {
+            const OverdrawNode& node = nodes[n];
+            transform_to_clip(w.clip.data(), keyframe_positions + size_t(node.keyframe) * vertex_count * 3, vertex_count,
+                              framing.centres.data() + 3 * size_t(node.keyframe),
+                              node_view_projection(node.direction, framing.radius));
+            w.rasterizer.rasterize(w.clip.data(), vertex_count, indices, index_count, settings.resolution);
+            kept[n] = w.rasterizer.export_fragments();
+            if ((total += kept[n].bytes()) > max_bytes) too_big = true;
+            const size_t finished = ++done;
+            if (settings.progress && (finished % std::max<size_t>(1, node_count / 100) == 0 || finished == node_count)) {
+                std::lock_guard<std::mutex> lock(progress_mutex);
+                settings.progress(finished, node_count);
+            }
+        }
+    };
+    const int threads = settings.threads ? int(settings.threads) : tbb::this_task_arena::max_concurrency();
+    tbb::task_arena arena(threads);
+    arena.execute([&] { tbb::parallel_for(tbb::blocked_range<size_t>(0, node_count, 1), body); });
+    if (too_big) return {};
+    return kept;
+}
+
+void score_kept_nodes(uint64_t* visible, uint64_t* passed, const std::vector<NodeFragments>& nodes, const uint32_t* ranks,
+                      size_t order_count, const ScoreSettings& settings) {
+    const int threads = settings.threads ? int(settings.threads) : tbb::this_task_arena::max_concurrency();
+    tbb::task_arena arena(threads);
+    arena.execute([&] {
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, nodes.size(), 64), [&](const tbb::blocked_range<size_t>& range) {
+            for (size_t n = range.begin(); n != range.end(); ++n) {
+                visible[n] = nodes[n].visible;
+                score_fragments(passed + n * order_count, nodes[n], ranks, order_count);
+            }
+        });
+    });
+    if (settings.progress) settings.progress(nodes.size(), nodes.size());
+}
+
 }  // namespace animorder

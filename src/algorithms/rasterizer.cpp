@@ -350,6 +350,28 @@ void replay_pixel(const uint32_t* fragments, uint32_t count, const uint32_t* ran
 
 }  // namespace
 
+NodeFragments NodeRasterizer::export_fragments() const {
+    const State& s = *state_;
+    NodeFragments out;
+    out.visible = s.visible;
+    out.single = s.single;
+    out.starts.assign(s.multi_start.begin(), s.multi_start.begin() + s.multi_count + 1);
+    const uint32_t first = out.starts.empty() ? 0 : out.starts.front();
+    for (uint32_t& start : out.starts) start -= first;
+    out.fragments.assign(s.multi_fragment.begin() + first, s.multi_fragment.begin() + first + out.starts.back());
+    return out;
+}
+
+void score_fragments(uint64_t* passed, const NodeFragments& node, const uint32_t* ranks, size_t order_count) {
+    std::vector<uint32_t> scratch(2 * order_count);
+    for (size_t o = 0; o < order_count; ++o) passed[o] = node.single;
+    for (size_t m = 0; m + 1 < node.starts.size(); ++m) {
+        const uint32_t begin = node.starts[m];
+        replay_pixel(node.fragments.data() + begin, node.starts[m + 1] - begin, ranks, order_count, scratch.data(),
+                     scratch.data() + order_count, [&](size_t o) { ++passed[o]; });
+    }
+}
+
 void NodeRasterizer::score(uint64_t* passed, const uint32_t* ranks, size_t order_count) const {
     const State& s = *state_;
     std::vector<uint32_t> scratch(2 * order_count);

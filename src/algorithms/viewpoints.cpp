@@ -101,6 +101,7 @@ Framing frame_keyframes(const float* keyframe_positions, size_t keyframe_count, 
 
     Framing framing;
     framing.centres.assign(keyframe_count * 3, 0.0f);
+    framing.radii.assign(keyframe_count, 0.0f);
     double radius = 0;
     for (size_t k = 0; k < keyframe_count; ++k) {
         const float* p = keyframe_positions + k * vertex_count * 3;
@@ -118,16 +119,29 @@ Framing frame_keyframes(const float* keyframe_positions, size_t keyframe_count, 
         if (index_count == 0) continue;
         double centre[3];
         for (int c = 0; c < 3; ++c) centre[c] = float(0.5 * (lo[c] + hi[c]));  // the float the camera uses
+        double frame_radius = 0;
         for (size_t v = 0; v < vertex_count; ++v) {
             if (!referenced[v]) continue;
             const double dx = p[3 * v] - centre[0], dy = p[3 * v + 1] - centre[1], dz = p[3 * v + 2] - centre[2];
-            radius = std::max(radius, std::sqrt(dx * dx + dy * dy + dz * dz));
+            frame_radius = std::max(frame_radius, std::sqrt(dx * dx + dy * dy + dz * dz));
         }
+        // A hair larger than the farthest vertex, so float rounding cannot push it out of view.
+        framing.radii[k] = float(frame_radius * (1.0 + 1e-6));
+        radius = std::max(radius, frame_radius);
         for (int c = 0; c < 3; ++c) framing.centres[3 * k + c] = float(centre[c]);
     }
-    // A hair larger than the farthest vertex, so float rounding cannot push it out of the view.
     framing.radius = float(radius * (1.0 + 1e-6));
     return framing;
+}
+
+Framing frame_subset(const Framing& framing, const std::vector<uint32_t>& keyframes) {
+    Framing subset = framing;
+    subset.radius = 0;
+    for (uint32_t k : keyframes) {
+        if (k >= framing.radii.size()) throw InvalidInput("keyframe " + std::to_string(k) + " is not framed");
+        subset.radius = std::max(subset.radius, framing.radii[k]);
+    }
+    return subset;
 }
 
 }  // namespace animorder

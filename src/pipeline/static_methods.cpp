@@ -5,6 +5,7 @@
 // Both run per primitive: a character's primitives are separate draws.
 #include "animorder/methods.h"
 
+#include <chrono>
 #include <string>
 
 namespace animorder {
@@ -69,6 +70,47 @@ VertexCacheStats analyze_mesh_vertex_cache(const AnimatedMesh& mesh, const std::
     total.acmr = total.triangles ? double(total.misses) / double(total.triangles) : 0.0;
     total.atvr = referenced ? double(total.misses) / double(referenced) : 0.0;
     return total;
+}
+
+AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double lambda, unsigned cache_size,
+                                    const ClusteringSettings& settings) {
+    validate_animated_mesh(mesh);
+    if (mesh.clips.empty()) throw InvalidInput("the mesh has no clip to cluster");
+    AnimatedMethodResult result;
+    const auto start = std::chrono::steady_clock::now();
+    result.patches = build_mesh_patches(mesh, lambda, cache_size);
+    result.seconds_patches = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    result.framing = frame_keyframes(mesh.keyframe_positions.data(), mesh.keyframe_count(), mesh.vertex_count,
+                                     mesh.indices.data(), mesh.indices.size());
+
+    auto clip_keyframes = [&](const Clip& c) {
+        std::vector<uint32_t> k;
+        for (size_t f = 0; f < c.keyframe_count; ++f) k.push_back(uint32_t(c.first_keyframe + f));
+        return k;
+    };
+    std::vector<std::vector<uint32_t>> sets;
+    if (joint) {
+        std::vector<uint32_t> all;
+        for (const Clip& c : mesh.clips)
+            for (uint32_t k : clip_keyframes(c)) all.push_back(k);
+        sets.push_back(all);
+    } else {
+        for (const Clip& c : mesh.clips) sets.push_back(clip_keyframes(c));
+    }
+    for (const auto& keyframes : sets) {
+        const Framing framing = frame_subset(result.framing, keyframes);
+        result.run_radius.push_back(framing.radius);
+        result.runs.push_back(cluster_nodes(mesh, result.patches, framing, keyframes, settings));
+    }
+    for (size_t c = 0; c < mesh.clips.size(); ++c) {
+        const size_t run = joint ? 0 : c;
+        result.buffers.table_base.push_back(uint32_t(joint ? 0 : c * settings.clusters));
+        result.buffers.tables.push_back(
+            build_selection_table(result.runs[run], mesh.clips[c].first_keyframe, mesh.clips[c].keyframe_count));
+    }
+    for (const ClusteringResult& r : result.runs)
+        for (const auto& order : r.triangle_orders) result.buffers.orders.push_back(order);
+    return result;
 }
 
 }  // namespace animorder

@@ -79,7 +79,7 @@ TEST_F(Cli, QuietSilencesStderr) {
 }
 
 TEST_F(Cli, OptimizeWritesIndicesAndReport) {
-    const Outcome o = run("optimize -q --method static-sander07 --lambda 0.85 -o " + path("ib.bin").string() +
+    const Outcome o = run("optimize -q --method static-sander07 --lambda 0.85 -o " + path("ib").string() +
                           " --report " + path("report.json").string());
     ASSERT_EQ(o.exit_code, 0) << o.err;
     const nlohmann::json j = nlohmann::json::parse(slurp(path("report.json")));
@@ -93,14 +93,42 @@ TEST_F(Cli, OptimizeWritesIndicesAndReport) {
     EXPECT_LT(m["acmr"].get<double>(), 1.2);
     EXPECT_GE(m["time_s"].get<double>(), 0.0);
     EXPECT_TRUE(j["timings_s"].contains("total"));
-    // The index buffer: 3 little-endian uint32 per triangle.
-    EXPECT_EQ(fs::file_size(path("ib.bin")), 12u * j["triangles"].get<size_t>());
+    // The sidecar: one buffer of 3 little-endian uint32 per triangle, after a 20-byte header and
+    // a 32-byte record per clip, then per clip a 2×1 table of zeros and 12 bytes of centre per keyframe.
+    const nlohmann::json side = nlohmann::json::parse(slurp(path("ib.animorder.json")));
+    EXPECT_EQ(side["buffers"], 1);
+    EXPECT_EQ(side["binary"], "ib.animorder.bin");
+    size_t tables = 0;
+    for (const auto& clip : side["clips"]) tables += clip["keyframes"].get<size_t>() * (2 + 12);
+    EXPECT_EQ(fs::file_size(path("ib.animorder.bin")),
+              20u + 32u * side["clips"].size() + 12u * j["triangles"].get<size_t>() + tables);
 }
 
 TEST_F(Cli, OptimizeIsByteDeterministic) {
-    ASSERT_EQ(run("optimize -q -o " + path("a.bin").string()).exit_code, 0);
-    ASSERT_EQ(run("optimize -q -o " + path("b.bin").string()).exit_code, 0);
-    EXPECT_EQ(slurp(path("a.bin")), slurp(path("b.bin")));
+    ASSERT_EQ(run("optimize -q -o " + path("a").string()).exit_code, 0);
+    ASSERT_EQ(run("optimize -q -o " + path("b").string()).exit_code, 0);
+    EXPECT_EQ(slurp(path("a.animorder.bin")), slurp(path("b.animorder.bin")));
+}
+
+TEST_F(Cli, SingleWritesKBuffersPerClipAndReportsIterations) {
+    // Small settings so the test stays quick; the full defaults run in the benchmarks.
+    const std::string fast = " -q -k 3 --views 12 --resolution 48 --max-iterations 4";
+    ASSERT_EQ(run("optimize --method single" + fast + " --threads 1 -o " + path("s1").string() + " --report " +
+                  path("r.json").string()).exit_code, 0);
+    ASSERT_EQ(run("optimize --method single" + fast + " --threads 2 -o " + path("s2").string()).exit_code, 0);
+    EXPECT_EQ(slurp(path("s1.animorder.bin")), slurp(path("s2.animorder.bin")));  // thread count changes nothing
+    const nlohmann::json j = nlohmann::json::parse(slurp(path("r.json")));
+    const nlohmann::json& m = j["methods"][0];
+    EXPECT_EQ(m["name"], "single");
+    EXPECT_EQ(m["buffers"], 6);  // 3 per clip, 2 clips
+    ASSERT_EQ(m["runs"].size(), 2u);
+    for (const auto& r : m["runs"]) {
+        EXPECT_GE(r["iterations"].size(), 1u);
+        EXPECT_TRUE(r["iterations"][0].contains("mean_ovr"));
+        EXPECT_TRUE(r["iterations"][0].contains("reassigned"));
+    }
+    ASSERT_EQ(run("optimize --joint" + fast + " --report " + path("j.json").string()).exit_code, 0);
+    EXPECT_EQ(nlohmann::json::parse(slurp(path("j.json")))["methods"][0]["buffers"], 3);
 }
 
 TEST_F(Cli, LambdaChangesTheAcmrTheWayThePaperSays) {
@@ -123,8 +151,11 @@ TEST_F(Cli, BadInputAndOptionsGiveOneLineErrors) {
         {"optimize --cache-size 0", "cache-size"},
         {"optimize --frame 100000", "keyframe 100000"},
         {"inspect " + path("missing.glb").string(), "missing.glb"},
-        {"optimize -o " + path("no/such/folder/out.bin").string(), "does not exist"},
-        {"optimize -o " + dir_.string(), "is a directory"},
+        {"optimize -o " + path("no/such/folder/out").string(), "does not exist"},
+        {"optimize --method single --views 100", "icosphere"},
+        {"optimize --method single --distance far", "--distance"},
+        {"optimize --method single --min-separation 400", "min-separation"},
+        {"evaluate --methods original,best", "unknown method 'best'"},
     };
     for (const Case& c : cases) {
         const Outcome o = run(c.args + " --quiet");  // errors print even when quiet
@@ -137,7 +168,7 @@ TEST_F(Cli, BadInputAndOptionsGiveOneLineErrors) {
 }
 
 TEST_F(Cli, FailedWriteLeavesNoFileBehind) {
-    const Outcome o = run("optimize -q -o " + path("no/such/out.bin").string());
+    const Outcome o = run("optimize -q -o " + path("no/such/out").string());
     EXPECT_NE(o.exit_code, 0);
     size_t entries = 0;
     for (const auto& entry : fs::directory_iterator(dir_)) entries += entry.path().filename().string()[0] == '.';

@@ -8,11 +8,13 @@
 
 #include "animorder/evaluation.h"
 #include "animorder/methods.h"
+#include "animorder/sidecar.h"
 #include "animorder/overdraw.h"
 
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <stdexcept>
 #include <sstream>
 #include <string>
@@ -86,69 +88,6 @@ int run_inspect(const InspectOptions& options) {
     return 0;
 }
 
-int run_optimize(const OptimizeOptions& options) {
-    const Clock::time_point start = Clock::now();
-    if (!std::isfinite(options.lambda)) throw std::runtime_error("--lambda must be a finite number");
-    const StaticMethod method = parse_static_method(options.method);
-
-    std::string input_name;
-    const AnimatedMesh mesh = load_input(options.common, input_name);
-    const double load_s = seconds_since(start);
-    note(options.common, "loaded " + input_name + ": " + std::to_string(mesh.triangle_count()) + " triangles, " +
-                             std::to_string(mesh.vertex_count) + " vertices, " +
-                             std::to_string(mesh.keyframe_count()) + " keyframes");
-
-    StaticMethodSettings settings;
-    settings.lambda = options.lambda;
-    settings.cache_size = options.common.cache_size;
-    settings.keyframe = options.keyframe;
-    const Clock::time_point method_start = Clock::now();
-    const StaticMethodResult result = run_static_method(mesh, method, settings);
-    const double method_s = seconds_since(method_start);
-
-    const VertexCacheStats before = analyze_mesh_vertex_cache(mesh, mesh.indices, settings.cache_size);
-    const VertexCacheStats after = analyze_mesh_vertex_cache(mesh, result.indices, settings.cache_size);
-    note(options.common, std::string(method_name(method)) + ": ACMR " + std::to_string(before.acmr) + " -> " +
-                             std::to_string(after.acmr) + ", " + std::to_string(result.patch_count) + " patches");
-
-    if (!options.output.empty()) {
-        std::string bytes(result.indices.size() * 4, '\0');
-        for (size_t i = 0; i < result.indices.size(); ++i)
-            for (int b = 0; b < 4; ++b) bytes[4 * i + b] = char((result.indices[i] >> (8 * b)) & 0xff);
-        write_file_atomically(options.output, bytes);
-        note(options.common, "wrote " + options.output);
-    }
-
-    nlohmann::ordered_json report = report_header(mesh, input_name);
-    report["settings"] = {{"method", method_name(method)},
-                          {"lambda", options.lambda},
-                          {"cache_size", settings.cache_size},
-                          {"keyframe", settings.keyframe}};
-    report["input_order"] = cache_stats_json(before);
-    nlohmann::ordered_json entry = {{"name", method_name(method)},
-                                    {"buffers", 1},
-                                    {"acmr", after.acmr},
-                                    {"atvr", after.atvr},
-                                    {"ovr_mean", nullptr},
-                                    {"time_s", method_s}};
-    if (method == StaticMethod::StaticSander07) entry["lambda"] = options.lambda;
-    entry["patches"] = result.patch_count;
-    entry["hard_boundaries"] = result.hard_boundary_count;
-    report["methods"] = nlohmann::ordered_json::array({entry});
-    report["outputs"] = {{"indices", options.output.empty() ? nlohmann::ordered_json(nullptr)
-                                                             : nlohmann::ordered_json(options.output)}};
-    report["timings_s"] = {{"load", load_s}, {"method", method_s}, {"total", seconds_since(start)}};
-
-    if (!options.report_path.empty()) {
-        write_file_atomically(options.report_path, report_text(report));
-        note(options.common, "wrote " + options.report_path);
-    }
-    std::printf("%s on %s: %zu triangles, ACMR %.4f -> %.4f, ATVR %.4f -> %.4f, %zu patches, %.3f s\n",
-                method_name(method), input_name.c_str(), mesh.triangle_count(), before.acmr, after.acmr, before.atvr,
-                after.atvr, result.patch_count, method_s);
-    return 0;
-}
-
 namespace {
 
 std::vector<std::string> split_list(const std::string& text) {
@@ -164,8 +103,12 @@ std::vector<std::string> split_list(const std::string& text) {
 std::function<void(size_t, size_t)> progress_printer(const CommonOptions& common, const std::string& stage) {
     if (common.quiet) return {};
     const Clock::time_point start = Clock::now();
-    return [stage, start](size_t done, size_t total) {
-        std::fprintf(stderr, "\ranimorder: %s: %zu/%zu nodes, %.1f s", stage.c_str(), done, total, seconds_since(start));
+    auto last = std::make_shared<double>(-1.0);
+    return [stage, start, last](size_t done, size_t total) {
+        const double now = seconds_since(start);
+        if (done != total && now - *last < 0.5) return;  // at most two updates a second
+        *last = now;
+        std::fprintf(stderr, "\ranimorder: %s: %zu/%zu nodes, %.1f s", stage.c_str(), done, total, now);
         if (done == total) std::fputc('\n', stderr);
         std::fflush(stderr);
     };
@@ -175,51 +118,254 @@ void check_lambda(double lambda) {
     if (!std::isfinite(lambda)) throw std::runtime_error("--lambda must be a finite number");
 }
 
+// One method run on the whole character: its buffers, how it picks them, and its report entry.
+struct MethodRun {
+    std::string name;
+    MethodBuffers buffers;
+    Framing framing;  // for the sidecar's keyframe centres
+    VertexCacheStats cache;  // of the first buffer; "acmr" in reports is the mean over buffers
+    double acmr_mean = 0, atvr_mean = 0;
+    double seconds = 0;
+    nlohmann::ordered_json details;
+};
+
+DistanceVariant parse_distance(const std::string& name) {
+    if (name == "jcgt") return DistanceVariant::Jcgt;
+    if (name == "i3d") return DistanceVariant::I3d;
+    throw std::runtime_error("--distance must be jcgt or i3d, not '" + name + "'");
+}
+
+void check_method_options(const MethodOptions& m) {
+    check_lambda(m.lambda);
+    if (m.clusters == 0 || m.clusters > 255) throw std::runtime_error("-k/--clusters must be between 1 and 255");
+    if (!(m.min_separation >= 0 && m.min_separation <= 180))
+        throw std::runtime_error("--min-separation must be between 0 and 180 degrees");
+    icosphere_subdivisions_for(m.views);  // throws for a count that is no icosphere
+    parse_distance(m.distance);
+}
+
+MethodRun run_method(const AnimatedMesh& mesh, const std::string& name, const MethodOptions& m,
+                     const CommonOptions& common) {
+    MethodRun run;
+    run.name = name;
+    const Clock::time_point start = Clock::now();
+    if (name == "single" || name == "joint") {
+        ClusteringSettings settings;
+        settings.clusters = m.clusters;
+        settings.views = m.views;
+        settings.resolution = m.resolution;
+        settings.seed = m.seed;
+        settings.min_separation_deg = m.min_separation;
+        settings.max_iterations = m.max_iterations;
+        settings.distance = parse_distance(m.distance);
+        settings.threads = m.threads;
+        settings.log = [&common, name](const std::string& line) { note(common, name + ": " + line); };
+        settings.progress = progress_printer(common, name + ": assigning nodes");
+        const AnimatedMethodResult r = run_han_sander(mesh, name == "joint", m.lambda, common.cache_size, settings);
+        run.buffers = r.buffers;
+        run.framing = r.framing;
+        double raster = 0, update = 0, rasterization = 0;
+        nlohmann::ordered_json runs = nlohmann::ordered_json::array();
+        for (size_t i = 0; i < r.runs.size(); ++i) {
+            rasterization += r.runs[i].seconds_rasterization;
+            nlohmann::ordered_json iterations = nlohmann::ordered_json::array();
+            for (size_t it = 0; it < r.runs[i].iterations.size(); ++it) {
+                const ClusteringIteration& x = r.runs[i].iterations[it];
+                raster += x.seconds_raster;
+                update += x.seconds_update;
+                iterations.push_back({{"iteration", it + 1},
+                                      {"mean_ovr", x.mean_ovr},
+                                      {"reassigned", x.reassigned},
+                                      {"reseeded", x.reseeded},
+                                      {"seconds_assignment", x.seconds_raster},
+                                      {"seconds_update", x.seconds_update}});
+            }
+            runs.push_back({{"clips", name == "joint" ? nlohmann::ordered_json("all") : nlohmann::ordered_json(mesh.clips[i].name)},
+                            {"nodes", r.runs[i].assignment.size()},
+                            {"view_radius", r.run_radius[i]},
+                            {"converged", r.runs[i].converged},
+                            {"iterations", iterations}});
+        }
+        run.details = {{"clusters", m.clusters},
+                       {"views", m.views},
+                       {"resolution", m.resolution},
+                       {"seed", m.seed},
+                       {"distance", m.distance},
+                       {"patches", r.patches.patch_count()},
+                       {"runs", runs},
+                       {"stages_s",
+                        {{"patches", r.seconds_patches},
+                         {"rasterization", rasterization},
+                         {"assignment", raster},
+                         {"update", update}}}};
+    } else {
+        StaticMethodSettings settings;
+        settings.lambda = m.lambda;
+        settings.cache_size = common.cache_size;
+        settings.keyframe = m.keyframe;
+        const StaticMethod method = parse_static_method(name);
+        StaticMethodResult r = run_static_method(mesh, method, settings);
+        run.buffers.orders.push_back(std::move(r.order));
+        run.framing = frame_keyframes(mesh.keyframe_positions.data(), mesh.keyframe_count(), mesh.vertex_count,
+                                      mesh.indices.data(), mesh.indices.size());
+        for (const Clip& c : mesh.clips) {  // one buffer: a table that always says 0
+            SelectionTable t;
+            t.keyframes = uint32_t(c.keyframe_count);
+            t.theta_steps = 2;
+            t.phi_steps = 1;
+            t.cells.assign(size_t(t.keyframes) * 2, 0);
+            run.buffers.tables.push_back(t);
+            run.buffers.table_base.push_back(0);
+        }
+        run.details = {{"patches", r.patch_count}, {"hard_boundaries", r.hard_boundary_count}};
+    }
+    run.seconds = seconds_since(start);
+    std::vector<uint32_t> indices(mesh.indices.size());
+    for (size_t b = 0; b < run.buffers.orders.size(); ++b) {
+        apply_triangle_order(indices.data(), mesh.indices.data(), run.buffers.orders[b].data(), mesh.triangle_count());
+        const VertexCacheStats s = analyze_mesh_vertex_cache(mesh, indices, common.cache_size);
+        if (b == 0) run.cache = s;
+        run.acmr_mean += s.acmr / double(run.buffers.orders.size());
+        run.atvr_mean += s.atvr / double(run.buffers.orders.size());
+    }
+    return run;
+}
+
+nlohmann::ordered_json method_entry(const MethodRun& run, const MethodOptions& m) {
+    nlohmann::ordered_json entry = {{"name", run.name},
+                                    {"lambda", run.name == "original" ? nlohmann::ordered_json(nullptr)
+                                                                      : nlohmann::ordered_json(m.lambda)},
+                                    {"buffers", run.buffers.orders.size()},
+                                    {"acmr", run.acmr_mean},
+                                    {"atvr", run.atvr_mean},
+                                    {"ovr_mean", nullptr},
+                                    {"ovr_pooled", nullptr},
+                                    {"time_s", run.seconds}};
+    for (auto it = run.details.begin(); it != run.details.end(); ++it) entry[it.key()] = it.value();
+    return entry;
+}
+
+std::string sidecar_json(const AnimatedMesh& mesh, const MethodRun& run, const std::string& binary_name) {
+    nlohmann::ordered_json j;
+    j["format"] = "animorder-sidecar";
+    j["version"] = 1;
+    j["binary"] = binary_name;
+    j["method"] = run.name;
+    j["buffers"] = run.buffers.orders.size();
+    j["index_count"] = mesh.indices.size();
+    j["primitives"] = nlohmann::ordered_json::array();
+    for (const Primitive& p : mesh.primitives)
+        j["primitives"].push_back({{"name", p.name}, {"first_index", p.first_index}, {"index_count", p.index_count}});
+    j["clips"] = nlohmann::ordered_json::array();
+    for (size_t c = 0; c < mesh.clips.size(); ++c)
+        j["clips"].push_back({{"name", mesh.clips[c].name},
+                              {"keyframes", mesh.clips[c].keyframe_count},
+                              {"sample_rate", mesh.clips[c].sample_rate},
+                              {"buffer_base", run.buffers.table_base[c]},
+                              {"theta_steps", run.buffers.tables[c].theta_steps},
+                              {"phi_steps", run.buffers.tables[c].phi_steps}});
+    j["table"] = "cell (f, i, j): theta = i*pi/(theta_steps-1) from +Y, phi = j*2*pi/phi_steps from +Z towards +X; "
+                 "buffer = buffer_base + cell (see animorder_runtime.h)";
+    return j.dump(2) + "\n";
+}
+
 }  // namespace
 
-int run_evaluate(const EvaluateOptions& options) {
+int run_optimize(const OptimizeOptions& options) {
     const Clock::time_point start = Clock::now();
-    check_lambda(options.lambda);
-    std::vector<StaticMethod> methods;
-    for (const std::string& name : split_list(options.methods)) methods.push_back(parse_static_method(name));
-    if (methods.empty()) throw std::runtime_error("--methods names no method");
+    check_method_options(options.settings);
+    const std::string method = options.joint ? "joint" : options.method;
+    if (options.joint && options.method != "single" && options.method != "joint" && options.method != "static-sander07")
+        throw std::runtime_error("--joint applies to the single method, not " + options.method);
+    if (method != "single" && method != "joint") parse_static_method(method);  // reject unknown names early
 
     std::string input_name;
     const AnimatedMesh mesh = load_input(options.common, input_name);
     validate_animated_mesh(mesh);
+    const double load_s = seconds_since(start);
+    note(options.common, "loaded " + input_name + ": " + std::to_string(mesh.triangle_count()) + " triangles, " +
+                             std::to_string(mesh.vertex_count) + " vertices, " + std::to_string(mesh.keyframe_count()) +
+                             " keyframes");
 
-    StaticMethodSettings settings;
-    settings.lambda = options.lambda;
-    settings.cache_size = options.common.cache_size;
-    std::vector<std::vector<uint32_t>> orders;
-    std::vector<VertexCacheStats> cache;
-    std::vector<double> method_seconds;
-    for (StaticMethod method : methods) {
-        const Clock::time_point t = Clock::now();
-        StaticMethodResult result = run_static_method(mesh, method, settings);
-        method_seconds.push_back(seconds_since(t));
-        cache.push_back(analyze_mesh_vertex_cache(mesh, result.indices, settings.cache_size));
-        orders.push_back(std::move(result.order));
+    const MethodRun run = run_method(mesh, method, options.settings, options.common);
+    const VertexCacheStats before = analyze_mesh_vertex_cache(mesh, mesh.indices, options.common.cache_size);
+
+    nlohmann::ordered_json outputs = {{"sidecar", nullptr}, {"sidecar_json", nullptr}};
+    if (!options.output.empty()) {
+        const std::string binary = options.output + ".animorder.bin", json = options.output + ".animorder.json";
+        write_file_atomically(binary, serialize_sidecar(mesh, run.buffers, run.framing));
+        const size_t slash = binary.find_last_of('/');
+        write_file_atomically(json, sidecar_json(mesh, run, slash == std::string::npos ? binary : binary.substr(slash + 1)));
+        outputs = {{"sidecar", binary}, {"sidecar_json", json}};
+        note(options.common, "wrote " + binary + " and " + json);
+    }
+
+    nlohmann::ordered_json report = report_header(mesh, input_name);
+    report["settings"] = {{"method", method},
+                          {"lambda", options.settings.lambda},
+                          {"cache_size", options.common.cache_size},
+                          {"keyframe", options.settings.keyframe},
+                          {"clusters", options.settings.clusters},
+                          {"views", options.settings.views},
+                          {"resolution", options.settings.resolution},
+                          {"seed", options.settings.seed},
+                          {"min_separation_deg", options.settings.min_separation},
+                          {"max_iterations", options.settings.max_iterations},
+                          {"distance", options.settings.distance},
+                          {"threads", options.settings.threads}};
+    report["input_order"] = cache_stats_json(before);
+    report["methods"] = nlohmann::ordered_json::array({method_entry(run, options.settings)});
+    report["outputs"] = outputs;
+    report["timings_s"] = {{"load", load_s}, {"method", run.seconds}, {"total", seconds_since(start)}};
+    if (!options.report_path.empty()) {
+        write_file_atomically(options.report_path, report_text(report));
+        note(options.common, "wrote " + options.report_path);
+    }
+    std::printf("%s on %s: %zu triangles, %zu buffers, ACMR %.4f -> %.4f, ATVR %.4f -> %.4f, %.3f s\n", method.c_str(),
+                input_name.c_str(), mesh.triangle_count(), run.buffers.orders.size(), before.acmr, run.acmr_mean,
+                before.atvr, run.atvr_mean, run.seconds);
+    return 0;
+}
+
+int run_evaluate(const EvaluateOptions& options) {
+    const Clock::time_point start = Clock::now();
+    check_method_options(options.settings);
+    const std::vector<std::string> names = split_list(options.methods);
+    if (names.empty()) throw std::runtime_error("--methods names no method");
+    for (const std::string& n : names)
+        if (n != "single" && n != "joint") parse_static_method(n);
+
+    std::string input_name;
+    const AnimatedMesh mesh = load_input(options.common, input_name);
+    validate_animated_mesh(mesh);
+    std::vector<MethodRun> runs;
+    for (const std::string& n : names) {
+        note(options.common, "running " + n);
+        runs.push_back(run_method(mesh, n, options.settings, options.common));
     }
 
     EvaluationSettings eval;
     eval.views = options.views;
     eval.seed = options.seed;
     eval.resolution = options.resolution;
-    eval.threads = options.threads;
+    eval.threads = options.settings.threads;
     eval.progress = progress_printer(options.common, "evaluating");
-    note(options.common, "evaluating " + std::to_string(methods.size()) + " methods at " +
+    note(options.common, "evaluating " + std::to_string(runs.size()) + " methods at " +
                              std::to_string(mesh.keyframe_count() * options.views) + " nodes (" +
                              std::to_string(mesh.keyframe_count()) + " keyframes x " + std::to_string(options.views) +
                              " views, " + std::to_string(options.resolution) + "^2)");
+    std::vector<MethodBuffers> buffers;
+    for (const MethodRun& r : runs) buffers.push_back(r.buffers);
     const Clock::time_point eval_start = Clock::now();
-    const std::vector<OrderEvaluation> results = evaluate_single_orders(mesh, orders, eval);
+    const std::vector<OrderEvaluation> results = evaluate_methods(mesh, buffers, eval);
     const double eval_s = seconds_since(eval_start);
 
     nlohmann::ordered_json report = report_header(mesh, input_name);
-    report["settings"] = {{"methods", options.methods},       {"lambda", options.lambda},
-                          {"cache_size", settings.cache_size}, {"eval_views", options.views},
-                          {"eval_resolution", options.resolution}, {"seed", options.seed}};
+    report["settings"] = {{"methods", options.methods},       {"lambda", options.settings.lambda},
+                          {"clusters", options.settings.clusters}, {"views", options.settings.views},
+                          {"resolution", options.settings.resolution}, {"cache_size", options.common.cache_size},
+                          {"eval_views", options.views},       {"eval_resolution", options.resolution},
+                          {"eval_seed", options.seed},         {"seed", options.settings.seed}};
     report["methods"] = nlohmann::ordered_json::array();
     std::printf("| method | buffers | ACMR | ATVR | OVR mean | OVR pooled |");
     for (const Clip& c : mesh.clips) std::printf(" %s |", c.name.c_str());
@@ -227,21 +373,14 @@ int run_evaluate(const EvaluateOptions& options) {
     for (size_t c = 0; c < mesh.clips.size(); ++c) std::printf("---|");
     std::printf("\n");
     std::string csv = "method,lambda,buffers,acmr,atvr,ovr_mean,ovr_pooled,time_s\n";
-    for (size_t m = 0; m < methods.size(); ++m) {
+    for (size_t m = 0; m < runs.size(); ++m) {
         const OrderEvaluation& r = results[m];
-        nlohmann::ordered_json entry = {{"name", method_name(methods[m])},
-                                        {"lambda", methods[m] == StaticMethod::StaticSander07
-                                                       ? nlohmann::ordered_json(options.lambda)
-                                                       : nlohmann::ordered_json(nullptr)},
-                                        {"buffers", 1},
-                                        {"acmr", cache[m].acmr},
-                                        {"atvr", cache[m].atvr},
-                                        {"ovr_mean", r.overall.ovr_mean},
-                                        {"ovr_pooled", r.overall.ovr_pooled},
-                                        {"per_clip", nlohmann::ordered_json::array()},
-                                        {"time_s", method_seconds[m]}};
-        std::printf("| %s | 1 | %.3f | %.3f | %.3f | %.3f |", method_name(methods[m]), cache[m].acmr, cache[m].atvr,
-                    r.overall.ovr_mean, r.overall.ovr_pooled);
+        nlohmann::ordered_json entry = method_entry(runs[m], options.settings);
+        entry["ovr_mean"] = r.overall.ovr_mean;
+        entry["ovr_pooled"] = r.overall.ovr_pooled;
+        entry["per_clip"] = nlohmann::ordered_json::array();
+        std::printf("| %s | %zu | %.3f | %.3f | %.3f | %.3f |", runs[m].name.c_str(), runs[m].buffers.orders.size(),
+                    runs[m].acmr_mean, runs[m].atvr_mean, r.overall.ovr_mean, r.overall.ovr_pooled);
         for (size_t c = 0; c < mesh.clips.size(); ++c) {
             entry["per_clip"].push_back({{"clip", mesh.clips[c].name},
                                          {"ovr_mean", r.per_clip[c].ovr_mean},
@@ -252,8 +391,9 @@ int run_evaluate(const EvaluateOptions& options) {
         std::printf("\n");
         report["methods"].push_back(entry);
         char line[256];
-        std::snprintf(line, sizeof line, "%s,%g,1,%.6f,%.6f,%.6f,%.6f,%.6f\n", method_name(methods[m]), options.lambda,
-                      cache[m].acmr, cache[m].atvr, r.overall.ovr_mean, r.overall.ovr_pooled, method_seconds[m]);
+        std::snprintf(line, sizeof line, "%s,%g,%zu,%.6f,%.6f,%.6f,%.6f,%.6f\n", runs[m].name.c_str(),
+                      options.settings.lambda, runs[m].buffers.orders.size(), runs[m].acmr_mean, runs[m].atvr_mean,
+                      r.overall.ovr_mean, r.overall.ovr_pooled, runs[m].seconds);
         csv += line;
     }
     report["nodes"] = mesh.keyframe_count() * options.views;

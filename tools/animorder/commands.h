@@ -18,23 +18,36 @@ struct InspectOptions {
     bool json = false;
 };
 
+// Settings of the methods (DESIGN.md names), shared by optimize and evaluate.
+struct MethodOptions {
+    double lambda = 0.85;
+    size_t keyframe = 0;  // static-sander07: the keyframe whose positions it sorts with
+    size_t clusters = 5;  // single / joint: k
+    size_t views = 162;
+    unsigned resolution = 256;
+    uint64_t seed = 1;
+    double min_separation = 30;
+    size_t max_iterations = 30;
+    std::string distance = "jcgt";
+    unsigned threads = 0;
+};
+
 struct OptimizeOptions {
     CommonOptions common;
     std::string method = "static-sander07";
-    double lambda = 0.85;
-    size_t keyframe = 0;
-    std::string output;       // reordered index buffer (little-endian uint32), optional
+    bool joint = false;       // --joint: the same as --method joint
+    MethodOptions settings;
+    std::string output;       // OUT → OUT.animorder.bin and OUT.animorder.json
     std::string report_path;  // JSON report, optional
 };
 
 struct EvaluateOptions {
     CommonOptions common;
-    std::string methods = "original,static-sander07";
-    double lambda = 0.85;
+    std::string methods = "original,static-sander07,single";
+    MethodOptions settings;
     size_t views = 300;
     unsigned resolution = 512;
     uint64_t seed = 20170501;
-    unsigned threads = 0;
     std::string report_path;
     std::string csv_path;
 };

@@ -16,6 +16,34 @@ void add_common(CLI::App& command, animorder::tool::CommonOptions& common) {
         ->check(CLI::Range(3u, 1024u));
 }
 
+void add_method_options(CLI::App& command, animorder::tool::MethodOptions& m) {
+    command.add_option("-l,--lambda", m.lambda,
+                       "Patch threshold: soft boundary when a patch's local ACMR < lambda "
+                       "(<0.5: hard boundaries only, >=3: single triangles)")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 1000.0));
+    command.add_option("--frame", m.keyframe, "static-sander07: keyframe whose positions it sorts with")
+        ->capture_default_str();
+    command.add_option("-k,--clusters", m.clusters, "single/joint: number of buffers k")
+        ->capture_default_str()
+        ->check(CLI::Range(size_t(1), size_t(255)));
+    command.add_option("--views", m.views, "single/joint: clustering viewpoints (12, 42, 162, 642)")->capture_default_str();
+    command.add_option("--resolution", m.resolution, "single/joint: clustering viewport in pixels")
+        ->capture_default_str()
+        ->check(CLI::Range(8u, 4096u));
+    command.add_option("--seed", m.seed, "single/joint: seed of the bootstrap viewpoints")->capture_default_str();
+    command.add_option("--min-separation", m.min_separation, "single/joint: degrees between bootstrap viewpoints")
+        ->capture_default_str();
+    command.add_option("--max-iterations", m.max_iterations, "single/joint: cap on k-means iterations")
+        ->capture_default_str()
+        ->check(CLI::Range(size_t(1), size_t(1000)));
+    command.add_option("--distance", m.distance, "single/joint: jcgt (sum) or i3d (visible-only mean)")
+        ->capture_default_str();
+    command.add_option("--threads", m.threads, "Worker threads (0: all cores)")
+        ->capture_default_str()
+        ->check(CLI::Range(0u, 1024u));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -31,40 +59,30 @@ int main(int argc, char** argv) {
     inspect_cmd->add_flag("--json", inspect.json, "Print JSON instead of text");
 
     OptimizeOptions optimize;
-    CLI::App* optimize_cmd = app.add_subcommand("optimize", "Reorder triangles with a method and report the result");
+    CLI::App* optimize_cmd = app.add_subcommand("optimize", "Reorder triangles with a method; write buffers, table, report");
     add_common(*optimize_cmd, optimize.common);
-    optimize_cmd->add_option("-m,--method", optimize.method, "original | static-sander07")
+    optimize_cmd->add_option("-m,--method", optimize.method, "original | static-sander07 | single | joint")
         ->capture_default_str();
-    optimize_cmd->add_option("-l,--lambda", optimize.lambda,
-                             "Patch threshold: soft boundary when a patch's local ACMR < lambda "
-                             "(<0.5: hard boundaries only, >=3: single triangles)")
-        ->capture_default_str()
-        ->check(CLI::Range(0.0, 1000.0));
-    optimize_cmd->add_option("--frame", optimize.keyframe, "Keyframe whose positions static-sander07 sorts with")
-        ->capture_default_str();
+    optimize_cmd->add_flag("--joint", optimize.joint, "One set of buffers for all clips (same as --method joint)");
+    add_method_options(*optimize_cmd, optimize.settings);
     optimize_cmd->add_option("-o,--output", optimize.output,
-                             "Write the reordered index buffer (little-endian uint32 triangle list)");
+                             "Write OUT.animorder.bin (buffers + lookup tables) and OUT.animorder.json");
     optimize_cmd->add_option("-r,--report", optimize.report_path, "Write the JSON report to this file");
 
     EvaluateOptions evaluate;
     CLI::App* evaluate_cmd =
         app.add_subcommand("evaluate", "Score methods' overdraw (OVR) and ACMR over the evaluation nodes (DESIGN.md)");
     add_common(*evaluate_cmd, evaluate.common);
-    evaluate_cmd->add_option("--methods", evaluate.methods, "Comma-separated: original, static-sander07")
+    evaluate_cmd->add_option("--methods", evaluate.methods, "Comma-separated: original, static-sander07, single, joint")
         ->capture_default_str();
-    evaluate_cmd->add_option("-l,--lambda", evaluate.lambda, "Patch threshold for static-sander07")
-        ->capture_default_str()
-        ->check(CLI::Range(0.0, 1000.0));
+    add_method_options(*evaluate_cmd, evaluate.settings);
     evaluate_cmd->add_option("--eval-views", evaluate.views, "Random viewpoints per keyframe")
         ->capture_default_str()
         ->check(CLI::Range(size_t(1), size_t(100000)));
     evaluate_cmd->add_option("--eval-resolution", evaluate.resolution, "Viewport size in pixels")
         ->capture_default_str()
         ->check(CLI::Range(1u, 8192u));
-    evaluate_cmd->add_option("--seed", evaluate.seed, "Seed of the evaluation viewpoints")->capture_default_str();
-    evaluate_cmd->add_option("--threads", evaluate.threads, "Worker threads (0: all cores)")
-        ->capture_default_str()
-        ->check(CLI::Range(0u, 1024u));
+    evaluate_cmd->add_option("--eval-seed", evaluate.seed, "Seed of the evaluation viewpoints")->capture_default_str();
     evaluate_cmd->add_option("-r,--report", evaluate.report_path, "Write the JSON report to this file");
     evaluate_cmd->add_option("--csv", evaluate.csv_path, "Write the table as CSV to this file");
 

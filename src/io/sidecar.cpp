@@ -1,0 +1,63 @@
+// The sidecar binary (format: include/animorder_runtime.h). Written byte by byte in
+// little-endian order, so the file is the same on every host and byte-identical for the same
+// input and options.
+#include "animorder/sidecar.h"
+
+#include "animorder/animorder.h"
+
+#include <cstring>
+
+namespace animorder {
+namespace {
+
+void put_u32(std::string& out, uint32_t v) {
+    for (int b = 0; b < 4; ++b) out.push_back(char((v >> (8 * b)) & 0xff));
+}
+void put_f32(std::string& out, float f) {
+    uint32_t u;
+    std::memcpy(&u, &f, 4);
+    put_u32(out, u);
+}
+
+}  // namespace
+
+std::string serialize_sidecar(const AnimatedMesh& mesh, const MethodBuffers& buffers, const Framing& framing) {
+    if (buffers.tables.size() != mesh.clips.size() || buffers.table_base.size() != mesh.clips.size())
+        throw InvalidInput("the sidecar needs one lookup table per clip");
+    const size_t header = 20, clip_record = 32;
+    const size_t buffers_end = header + clip_record * mesh.clips.size() + buffers.orders.size() * mesh.indices.size() * 4;
+    std::string out;
+    out.append("AOR1", 4);
+    put_u32(out, 1);
+    put_u32(out, uint32_t(buffers.orders.size()));
+    put_u32(out, uint32_t(mesh.indices.size()));
+    put_u32(out, uint32_t(mesh.clips.size()));
+    size_t offset = buffers_end;
+    for (size_t c = 0; c < mesh.clips.size(); ++c) {
+        const SelectionTable& t = buffers.tables[c];
+        if (t.keyframes != mesh.clips[c].keyframe_count) throw InvalidInput("a lookup table does not match its clip");
+        put_u32(out, t.keyframes);
+        put_u32(out, t.theta_steps);
+        put_u32(out, t.phi_steps);
+        put_f32(out, float(mesh.clips[c].sample_rate));
+        put_u32(out, buffers.table_base[c]);
+        put_u32(out, uint32_t(offset));
+        put_u32(out, uint32_t(offset + t.cells.size()));
+        put_u32(out, 0);
+        offset += t.cells.size() + size_t(t.keyframes) * 12;
+    }
+    std::vector<uint32_t> indices(mesh.indices.size());
+    for (const auto& order : buffers.orders) {
+        apply_triangle_order(indices.data(), mesh.indices.data(), order.data(), mesh.triangle_count());
+        for (uint32_t i : indices) put_u32(out, i);
+    }
+    for (size_t c = 0; c < mesh.clips.size(); ++c) {
+        out.append(reinterpret_cast<const char*>(buffers.tables[c].cells.data()), buffers.tables[c].cells.size());
+        for (size_t f = 0; f < mesh.clips[c].keyframe_count; ++f)
+            for (int d = 0; d < 3; ++d) put_f32(out, framing.centres[3 * (mesh.clips[c].first_keyframe + f) + d]);
+    }
+    if (out.size() > UINT32_MAX) throw InvalidInput("sidecar larger than 4 GiB");
+    return out;
+}
+
+}  // namespace animorder

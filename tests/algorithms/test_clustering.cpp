@@ -1,0 +1,187 @@
+// Han & Sander k-means: patches of a whole character, the assignment rule checked against an
+// independent scoring of the final buffers, OVR that does not rise, convergence, determinism,
+// re-seeding of empty clusters.
+#include "animorder/animated_mesh.h"
+#include "animorder/clustering.h"
+#include "support/meshes.h"
+
+#include <gtest/gtest.h>
+
+#include <vector>
+
+using namespace animorder;
+
+namespace {
+const AnimatedMesh& character() {
+    static const AnimatedMesh mesh = make_procedural_character();
+    return mesh;
+}
+
+std::vector<uint32_t> walk_keyframes(size_t step) {
+    std::vector<uint32_t> k;
+    const Clip& walk = character().clips[0];
+    for (size_t f = 0; f < walk.keyframe_count; f += step) k.push_back(uint32_t(walk.first_keyframe + f));
+    return k;
+}
+
+ClusteringSettings small_settings() {
+    ClusteringSettings s;
+    s.clusters = 3;
+    s.views = 42;
+    s.resolution = 64;
+    s.seed = 7;
+    s.max_iterations = 12;
+    return s;
+}
+
+Framing framing_of(const AnimatedMesh& m) {
+    return frame_keyframes(m.keyframe_positions.data(), m.keyframe_count(), m.vertex_count, m.indices.data(), m.indices.size());
+}
+}  // namespace
+
+TEST(MeshPatches, CoverEveryTriangleWithinItsPrimitive) {
+    const AnimatedMesh& m = character();
+    const MeshPatches p = build_mesh_patches(m, 0.85);
+    EXPECT_TRUE(test::is_permutation_of_iota(p.cache_order));
+    ASSERT_EQ(p.patch_starts.size(), p.patch_count() + 1);
+    EXPECT_EQ(p.patch_starts.back(), m.triangle_count());
+    for (size_t q = 0; q < p.patch_count(); ++q) {
+        ASSERT_LT(p.patch_starts[q], p.patch_starts[q + 1]);
+        const Primitive& prim = m.primitives[p.patch_primitive[q]];
+        for (uint32_t i = p.patch_starts[q]; i < p.patch_starts[q + 1]; ++i) {
+            const size_t t = p.cache_order[i];
+            EXPECT_GE(3 * t, prim.first_index);
+            EXPECT_LT(3 * t, prim.first_index + prim.index_count);
+        }
+    }
+    // The identity patch order is the Tipsify order; a reversed one keeps primitives in file order.
+    std::vector<uint32_t> identity(p.patch_count()), reversed(p.patch_count());
+    for (size_t q = 0; q < p.patch_count(); ++q) identity[q] = uint32_t(q), reversed[q] = uint32_t(p.patch_count() - 1 - q);
+    EXPECT_EQ(patch_order_to_triangle_order(p, identity), p.cache_order);
+    const std::vector<uint32_t> r = patch_order_to_triangle_order(p, reversed);
+    EXPECT_TRUE(test::is_permutation_of_iota(r));
+    const size_t body_triangles = m.primitives[0].index_count / 3;
+    for (size_t i = 0; i < body_triangles; ++i) EXPECT_LT(r[i], body_triangles);
+}
+
+TEST(Clustering, AssignsEachNodeToItsBestBufferAndImproves) {
+    const AnimatedMesh& m = character();
+    const MeshPatches patches = build_mesh_patches(m, 0.85);
+    const Framing framing = framing_of(m);
+    const std::vector<uint32_t> keyframes = walk_keyframes(5);
+    const ClusteringSettings settings = small_settings();
+    const ClusteringResult r = cluster_nodes(m, patches, framing, keyframes, settings);
+
+    ASSERT_EQ(r.triangle_orders.size(), 3u);
+    for (const auto& o : r.triangle_orders) EXPECT_TRUE(test::is_permutation_of_iota(o));
+    ASSERT_FALSE(r.iterations.empty());
+    // Mean node OVR never rises by more than noise (k-means with a measured assignment step).
+    for (size_t i = 1; i < r.iterations.size(); ++i)
+        EXPECT_LE(r.iterations[i].mean_ovr, r.iterations[i - 1].mean_ovr + 0.01) << "iteration " << i;
+    EXPECT_LT(r.iterations.back().mean_ovr, r.iterations.front().mean_ovr + 1e-9);
+    if (r.converged) {
+        EXPECT_EQ(r.iterations.back().reassigned, 0u);
+    }
+
+    // Independent check of the final assignment: score the final buffers at every node again.
+    std::vector<const uint32_t*> pointers;
+    for (const auto& o : r.triangle_orders) pointers.push_back(o.data());
+    const std::vector<uint32_t> ranks = make_rank_table(pointers, m.triangle_count());
+    std::vector<OverdrawNode> nodes;
+    for (uint32_t k : keyframes)
+        for (size_t v = 0; v < settings.views; ++v) {
+            OverdrawNode n;
+            n.keyframe = k;
+            std::copy(&r.directions[3 * v], &r.directions[3 * v] + 3, n.direction);
+            nodes.push_back(n);
+        }
+    std::vector<uint64_t> visible(nodes.size()), passed(nodes.size() * 3);
+    ScoreSettings score;
+    score.resolution = settings.resolution;
+    score_nodes(visible.data(), passed.data(), m.keyframe_positions.data(), m.vertex_count, framing, m.indices.data(),
+                m.indices.size(), nodes.data(), nodes.size(), ranks.data(), 3, score);
+    ASSERT_EQ(r.assignment.size(), nodes.size());
+    for (size_t n = 0; n < nodes.size(); ++n) {
+        const uint32_t c = r.assignment[n];
+        for (uint32_t o = 0; o < 3; ++o) {
+            EXPECT_LE(passed[3 * n + c], passed[3 * n + o]) << "node " << n;
+            if (o < c) {
+                EXPECT_GT(passed[3 * n + o], passed[3 * n + c]) << "tie not given to the lowest id, node " << n;
+            }
+        }
+    }
+}
+
+TEST(Clustering, DeterministicWithOneOrTwoThreadsAndBothDistances) {
+    const AnimatedMesh& m = character();
+    const MeshPatches patches = build_mesh_patches(m, 0.85);
+    const Framing framing = framing_of(m);
+    const std::vector<uint32_t> keyframes = walk_keyframes(10);
+    for (DistanceVariant d : {DistanceVariant::Jcgt, DistanceVariant::I3d}) {
+        ClusteringSettings s = small_settings();
+        s.distance = d;
+        s.threads = 1;
+        const ClusteringResult one = cluster_nodes(m, patches, framing, keyframes, s);
+        s.threads = 2;
+        const ClusteringResult two = cluster_nodes(m, patches, framing, keyframes, s);
+        EXPECT_EQ(one.assignment, two.assignment);
+        EXPECT_EQ(one.patch_orders, two.patch_orders);
+        EXPECT_EQ(one.iterations.size(), two.iterations.size());
+    }
+}
+
+TEST(Clustering, EmptyClustersAreReseededNotDropped) {
+    // 12 views of one keyframe and 10 clusters: some clusters must end up empty at first.
+    const AnimatedMesh& m = character();
+    const MeshPatches patches = build_mesh_patches(m, 0.85);
+    ClusteringSettings s = small_settings();
+    s.clusters = 10;
+    s.views = 12;
+    s.min_separation_deg = 10;
+    std::vector<std::string> log;
+    s.log = [&](const std::string& line) { log.push_back(line); };
+    const ClusteringResult r = cluster_nodes(m, patches, framing_of(m), {0}, s);
+    size_t reseeded = 0;
+    for (const auto& it : r.iterations) reseeded += it.reseeded;
+    EXPECT_GT(reseeded, 0u);
+    bool logged = false;
+    for (const auto& line : log) logged |= line.find("re-seeded") != std::string::npos;
+    EXPECT_TRUE(logged);
+    EXPECT_EQ(r.triangle_orders.size(), 10u);
+    for (const auto& o : r.triangle_orders) EXPECT_TRUE(test::is_permutation_of_iota(o));
+}
+
+TEST(Clustering, RejectsAbsurdSettings) {
+    const AnimatedMesh& m = character();
+    const MeshPatches patches = build_mesh_patches(m, 0.85);
+    ClusteringSettings s = small_settings();
+    s.clusters = 0;
+    EXPECT_THROW(cluster_nodes(m, patches, framing_of(m), {0}, s), InvalidInput);
+    s = small_settings();
+    s.views = 100;
+    EXPECT_THROW(cluster_nodes(m, patches, framing_of(m), {0}, s), InvalidInput);
+    s = small_settings();
+    EXPECT_THROW(cluster_nodes(m, patches, framing_of(m), {}, s), InvalidInput);
+}
+
+TEST(SelectionTable, ReturnsTheNodesClusterAtEveryClusteringViewpoint) {
+    const AnimatedMesh& m = character();
+    const MeshPatches patches = build_mesh_patches(m, 0.85);
+    const Clip& walk = m.clips[0];
+    std::vector<uint32_t> keyframes;
+    for (size_t f = 0; f < walk.keyframe_count; ++f) keyframes.push_back(uint32_t(walk.first_keyframe + f));
+    ClusteringSettings s = small_settings();
+    s.views = 162;
+    s.resolution = 32;
+    s.max_iterations = 2;
+    const ClusteringResult r = cluster_nodes(m, patches, framing_of(m), keyframes, s);
+    const SelectionTable table = build_selection_table(r, walk.first_keyframe, walk.keyframe_count);
+    EXPECT_EQ(table.keyframes, walk.keyframe_count);
+    for (size_t f = 0; f < walk.keyframe_count; ++f)
+        for (size_t v = 0; v < 162; ++v)
+            ASSERT_EQ(select_buffer(table, f, &r.directions[3 * v]), r.assignment[f * 162 + v]) << "keyframe " << f << " view " << v;
+    // Directions need not be unit length; keyframes past the end clamp to the last.
+    const float scaled[3] = {5 * r.directions[0], 5 * r.directions[1], 5 * r.directions[2]};
+    EXPECT_EQ(select_buffer(table, 0, scaled), r.assignment[0]);
+    EXPECT_EQ(select_buffer(table, 1000, &r.directions[0]), r.assignment[(walk.keyframe_count - 1) * 162]);
+}

@@ -1,0 +1,141 @@
+// The CPU rasteriser against real OpenGL (Mesa llvmpipe over EGL here; a GPU driver elsewhere):
+// the same clip-space vertices, the same orders, occlusion-query counts against ours.
+#include "gl_overdraw.h"
+#include "support/gltf_bind_pose.h"
+
+#include "animorder/animated_mesh.h"
+#include "animorder/animorder.h"
+#include "animorder/overdraw.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <random>
+
+using namespace animorder;
+
+namespace {
+
+// CI has Mesa: there, no context is a failure; on a developer's machine without it, a skip.
+std::unique_ptr<GlOverdrawReference> open_reference(unsigned resolution) {
+    try {
+        return std::make_unique<GlOverdrawReference>(resolution);
+    } catch (const std::exception& e) {
+        if (std::getenv("CI")) ADD_FAILURE() << "CI must have an OpenGL (Mesa llvmpipe): " << e.what();
+        else std::printf("skipping the OpenGL cross-check: %s\n", e.what());
+        return nullptr;
+    }
+}
+
+std::string shared_data(const std::string& relative) {
+    return (std::filesystem::path(ANIMORDER_SOURCE_DIR) / ".." / "shared" / "data" / relative).string();
+}
+
+struct Totals {
+    size_t comparisons = 0, exact = 0;
+    double worst = 0;
+};
+
+void compare_mesh(GlOverdrawReference& gl, const AnimatedMesh& mesh, size_t keyframe, unsigned resolution, Totals& totals) {
+    SCOPED_TRACE(mesh.name + " keyframe " + std::to_string(keyframe));
+    const Framing framing = frame_keyframes(mesh.keyframe_positions.data(), mesh.keyframe_count(), mesh.vertex_count,
+                                            mesh.indices.data(), mesh.indices.size());
+    const size_t n = mesh.triangle_count();
+    std::vector<uint32_t> tipsified(n), random(n);
+    tipsify(tipsified.data(), mesh.indices.data(), mesh.indices.size(), mesh.vertex_count);
+    for (size_t i = 0; i < n; ++i) random[i] = uint32_t(i);
+    std::mt19937 rng(5);
+    for (size_t i = n; i > 1; --i) std::swap(random[i - 1], random[rng() % i]);
+
+    const std::vector<float> views = random_sphere_directions(20, 99);
+    std::vector<float> clip(mesh.vertex_count * 4);
+    NodeRasterizer ours;
+    for (size_t v = 0; v < 20; ++v) {
+        const float* dir = &views[3 * v];
+        transform_to_clip(clip.data(), mesh.keyframe(keyframe), mesh.vertex_count, &framing.centres[3 * keyframe],
+                          node_view_projection(dir, framing.radius));
+        // Front to back at this view: triangles by eye distance of their centroid.
+        const float eye[3] = {3 * framing.radius * dir[0], 3 * framing.radius * dir[1], 3 * framing.radius * dir[2]};
+        std::vector<double> distance(n);
+        const float* p = mesh.keyframe(keyframe);
+        const float* c = &framing.centres[3 * keyframe];
+        for (size_t t = 0; t < n; ++t) {
+            double d2 = 0;
+            for (int d = 0; d < 3; ++d) {
+                const double centroid = (double(p[3 * mesh.indices[3 * t] + d]) + p[3 * mesh.indices[3 * t + 1] + d] +
+                                         p[3 * mesh.indices[3 * t + 2] + d]) / 3.0 - c[d];
+                d2 += (centroid - eye[d]) * (centroid - eye[d]);
+            }
+            distance[t] = d2;
+        }
+        std::vector<uint32_t> front(n);
+        for (size_t i = 0; i < n; ++i) front[i] = uint32_t(i);
+        std::stable_sort(front.begin(), front.end(), [&](uint32_t a, uint32_t b) { return distance[a] < distance[b]; });
+
+        const std::vector<std::vector<uint32_t>*> orders = {&tipsified, &random, &front};
+        std::vector<std::vector<uint32_t>> index_buffers;
+        std::vector<const uint32_t*> pointers;
+        for (auto* o : orders) {
+            index_buffers.emplace_back(mesh.indices.size());
+            apply_triangle_order(index_buffers.back().data(), mesh.indices.data(), o->data(), n);
+            pointers.push_back(o->data());
+        }
+        const std::vector<uint32_t> ranks = make_rank_table(pointers, n);
+        ours.rasterize(clip.data(), mesh.vertex_count, mesh.indices.data(), mesh.indices.size(), resolution);
+        std::vector<uint64_t> passed(3);
+        ours.score(passed.data(), ranks.data(), 3);
+        const GlNodeCounts reference = gl.score(clip.data(), mesh.vertex_count, index_buffers);
+
+        auto check = [&](uint64_t a, uint64_t b, const char* what) {
+            const double relative = b ? std::fabs(double(a) - double(b)) / double(b) : double(a != b);
+            totals.worst = std::max(totals.worst, relative);
+            totals.exact += a == b;
+            ++totals.comparisons;
+            EXPECT_LE(relative, 0.001) << what << " view " << v << ": ours " << a << ", OpenGL " << b;
+        };
+        check(ours.visible_pixels(), reference.visible, "visible");
+        for (size_t o = 0; o < 3; ++o) check(passed[o], reference.passed[o], o == 0 ? "tipsify" : o == 1 ? "random" : "front-to-back");
+    }
+}
+
+}  // namespace
+
+TEST(GlCrosscheck, PixelAlignedQuadCountsExactlyNTimesN) {
+    for (unsigned n : {1u, 7u, 64u, 256u}) {
+        auto gl = open_reference(n);
+        if (!gl) return;
+        const float clip[16] = {-1, -1, 0, 1, 1, -1, 0, 1, 1, 1, 0, 1, -1, 1, 0, 1};
+        const std::vector<std::vector<uint32_t>> ib = {{0, 1, 2, 0, 2, 3}};
+        const GlNodeCounts counts = gl->score(clip, 4, ib);
+        EXPECT_EQ(counts.visible, uint64_t(n) * n);
+        EXPECT_EQ(counts.passed[0], uint64_t(n) * n) << "no double count on the shared edge";
+        NodeRasterizer ours;
+        ours.rasterize(clip, 4, ib[0].data(), 6, n);
+        EXPECT_EQ(ours.visible_pixels(), counts.visible);
+        EXPECT_EQ(ours.fragments(), counts.passed[0]);
+    }
+}
+
+TEST(GlCrosscheck, ThreeMeshesTwentyViewsThreeOrdersMatchOpenGL) {
+    const unsigned resolution = 256;
+    auto gl = open_reference(resolution);
+    if (!gl) return;
+    std::printf("OpenGL renderer: %s\n", gl->renderer().c_str());
+    Totals totals;
+    const AnimatedMesh character = make_procedural_character();
+    compare_mesh(*gl, character, 10, resolution, totals);                                      // walk
+    compare_mesh(*gl, character, character.clips[1].first_keyframe + 20, resolution, totals);  // wave
+    compare_mesh(*gl, make_torus_knot(10000), 0, resolution, totals);
+    const std::string ganfaul = shared_data("mixamo-ganfaul/Ganfaul.gltf");
+    if (std::filesystem::exists(ganfaul)) {
+        compare_mesh(*gl, test::load_gltf_bind_pose(ganfaul), 0, resolution, totals);
+    } else {
+        std::printf("skipping Ganfaul: %s not found (../shared/data is absent)\n", ganfaul.c_str());
+    }
+    std::printf("cross-check: %zu counts compared, %zu exactly equal, worst relative difference %.6f\n",
+                totals.comparisons, totals.exact, totals.worst);
+}

@@ -2,7 +2,8 @@
 //
 // It stands in for the paper's Mixamo characters wherever no file is given, so it has what makes
 // their overdraw interesting: limbs and a shield that occlude the body and each other from many
-// views, joints that bend (smooth weights, so the skin stretches instead of tearing), and two
+// views (a cape behind the back, shoulder pads, a shield on the left forearm), joints that bend
+// (smooth weights, so the skin stretches instead of tearing), and two
 // clips with different motion. Parts are closed capsules (surfaces of revolution) around the
 // bones of a 13-joint skeleton, about 1.8 m tall, Y up, facing +Z, its left on +X. Keyframes are
 // skinned with skin_positions at 30 samples per second, as DESIGN.md says for clips.
@@ -153,7 +154,7 @@ AnimatedMesh make_procedural_character() {
     Builder body;
     const auto& S = kSkeleton;
     // Torso (hips → chest), slightly flattened front to back.
-    body.limb({0, 0.80, 0}, {0, 1.42, 0}, 0.16, 0.19, kHips, kChest, 0.5, 0.12, 8, 28, 30, 0.62);
+    body.limb({0, 0.80, 0}, {0, 1.42, 0}, 0.16, 0.19, kHips, kChest, 0.5, 0.12, 7, 24, 28, 0.7);
     // Head on a short neck.
     body.limb({0, 1.50, 0}, {0, 1.66, 0}, 0.085, 0.10, kHead, kHead, 0.5, 0.05, 6, 11, 24);
     // Arms: upper arm and forearm in one tube bending at the elbow.
@@ -173,6 +174,15 @@ AnimatedMesh make_procedural_character() {
         const double total = upper + std::sqrt(procedural::dot(ankle - knee, ankle - knee));
         body.limb(hip, ankle, 0.08, 0.05, thigh, shin, upper / total, 0.06, 5, 31, 16);
         body.limb(ankle + Vec3{0, -0.03, -0.04}, ankle + Vec3{0, -0.04, 0.16}, 0.045, 0.04, foot, foot, 0.5, 0.05, 4, 9, 12);
+    }
+    // A cape hanging from the shoulders to the knees behind the back, and shoulder pads over the
+    // arms: layers that hide the back, the legs and the arms from many views.
+    body.limb({0, 1.40, -0.16}, {0, 0.55, -0.20}, 0.03, 0.03, kChest, kHips, 0.35, 0.25, 3, 16, 16, 9.0);
+    for (int side = 0; side < 2; ++side) {
+        const uint16_t upper = side ? kRightUpperArm : kLeftUpperArm;
+        const Vec3 shoulder = S[upper].position;
+        body.limb(shoulder + Vec3{side ? -0.03 : 0.03, 0.05, 0}, shoulder + Vec3{side ? -0.05 : 0.05, -0.06, 0}, 0.09, 0.07,
+                  upper, upper, 0.6, 0.05, 4, 4, 14);
     }
     const size_t body_indices = body.indices.size();
     // The shield: a flat disc strapped to the outside of the left forearm.

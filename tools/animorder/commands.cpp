@@ -7,11 +7,15 @@
 #include "heatmap_image.h"
 
 #include "animorder/evaluation.h"
+#include "animorder/io.h"
 #include "animorder/methods.h"
 #include "animorder/sidecar.h"
 #include "animorder/overdraw.h"
 
+#include <algorithm>
+#include <cctype>
 #include <chrono>
+#include <filesystem>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -41,9 +45,16 @@ AnimatedMesh load_input(const CommonOptions& common, std::string& input_name) {
         return make_procedural_character();
     }
     input_name = common.input;
-    throw std::runtime_error(common.input +
-                             ": cannot read this file yet: only the bundled procedural character is "
-                             "supported in this version (run without an input file)");
+    std::string extension = std::filesystem::path(common.input).extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    if (extension == ".gltf" || extension == ".glb") {
+        AnimatedMesh mesh = load_gltf(common.input);
+        note(common, "loaded " + common.input + ": " + std::to_string(mesh.triangle_count()) + " triangles, " +
+                         std::to_string(mesh.clips.size()) + " clips, " + std::to_string(mesh.keyframe_count()) + " keyframes");
+        return mesh;
+    }
+    throw std::runtime_error(common.input + ": cannot read '" + extension +
+                             "' files yet (glTF 2.0 .gltf/.glb only; FBX, Collada, MD2/MD5, .X, .b3d come with assimp)");
 }
 
 void print_inspect_text(const AnimatedMesh& mesh, const std::string& input_name, const VertexCacheStats& cache,

@@ -1,0 +1,31 @@
+// animorder — reading characters from files into the AnimatedMesh every algorithm takes.
+#pragma once
+
+#include "animorder/animated_mesh.h"
+
+#include <stdexcept>
+#include <string>
+
+namespace animorder {
+
+// Thrown for a file that cannot be read as asked: what() starts with the file name and says
+// what is wrong, in one line.
+class LoadError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+struct LoadOptions {
+    double sample_rate = 30;  // keyframes per second of every clip (DESIGN.md)
+};
+
+// glTF 2.0 (.gltf with its buffers, or .glb): every TRIANGLES (strips and fans converted)
+// primitive of every mesh node of the default scene, in node then primitive order, with their own
+// vertex arrays concatenated (vertex identity is kept: primitive p's vertex i is mesh vertex
+// base(p) + i). Each animation is a clip, sampled from its first to its last key time at
+// sample_rate: node TRS (LINEAR with slerp, STEP, CUBICSPLINE), skins (linear blend skinning with
+// inverse bind matrices, weights normalised), morph target weights (default, node, animated;
+// sparse accessors). A file without animation is one clip "static" of one keyframe.
+AnimatedMesh load_gltf(const std::string& path, const LoadOptions& options = {});
+
+}  // namespace animorder

@@ -1,0 +1,514 @@
+// glTF 2.0 characters into keyframes: the node hierarchy, skins, morph targets and animations
+// evaluated on the CPU at a fixed sample rate (DESIGN.md "Keyframes of a clip").
+//
+// Follows the glTF 2.0 specification (Khronos): §3.5 node transforms (matrix, or T·R·S), §3.7
+// skins (joint matrix = joint's global transform · inverse bind matrix; the skinned mesh node's
+// own transform is ignored), §3.7.2.2 morph targets (position = base + Σ weight · delta), §3.11
+// animation samplers (LINEAR with slerp for rotations, STEP, CUBICSPLINE Hermite with tangents
+// scaled by the key interval), sparse accessors. Parsing is tinygltf's (Debian's libtinygltf);
+// every access it leaves unchecked (accessor ranges, indices, joints) is checked here, so a
+// broken file is a one-line LoadError, never a crash.
+#include "animorder/io.h"
+
+#include "animorder/animorder.h"
+
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <map>
+
+namespace animorder {
+namespace {
+
+using Mat = std::array<double, 16>;  // column-major
+using Quat = std::array<double, 4>;  // x, y, z, w
+
+Mat identity() { return {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}; }
+Mat mul(const Mat& a, const Mat& b) {
+    Mat r{};
+    for (int c = 0; c < 4; ++c)
+        for (int row = 0; row < 4; ++row) {
+            double s = 0;
+            for (int k = 0; k < 4; ++k) s += a[k * 4 + row] * b[c * 4 + k];
+            r[c * 4 + row] = s;
+        }
+    return r;
+}
+Mat trs(const std::array<double, 3>& t, const Quat& q, const std::array<double, 3>& s) {
+    const double x = q[0], y = q[1], z = q[2], w = q[3];
+    Mat m = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w), 2 * (x * z - y * w), 0,
+             2 * (x * y - z * w), 1 - 2 * (x * x + z * z), 2 * (y * z + x * w), 0,
+             2 * (x * z + y * w), 2 * (y * z - x * w), 1 - 2 * (x * x + y * y), 0,
+             t[0], t[1], t[2], 1};
+    for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < 3; ++r) m[c * 4 + r] *= s[c];
+    return m;
+}
+
+class Reader {
+public:
+    Reader(const tinygltf::Model& model, const std::string& file) : model_(model), file_(file) {}
+
+    [[noreturn]] void fail(const std::string& what) const { throw LoadError(file_ + ": " + what); }
+
+    // count × components values of an accessor as doubles (normalised integers mapped to [0, 1]
+    // or [−1, 1] as the spec says), sparse substitution applied, every byte range checked.
+    std::vector<double> read(int index, int expected_components = 0) const {
+        if (index < 0 || size_t(index) >= model_.accessors.size()) fail("accessor " + std::to_string(index) + " does not exist");
+        const tinygltf::Accessor& a = model_.accessors[size_t(index)];
+        const int components = tinygltf::GetNumComponentsInType(uint32_t(a.type));
+        const int size = tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType));
+        if (components <= 0 || size <= 0) fail("accessor " + std::to_string(index) + " has an unknown type");
+        if (expected_components && components != expected_components)
+            fail("accessor " + std::to_string(index) + " has " + std::to_string(components) + " components, expected " +
+                 std::to_string(expected_components));
+        std::vector<double> out(a.count * size_t(components), 0.0);
+        if (a.bufferView >= 0) {
+            const unsigned char* base = view_bytes(a.bufferView, a.byteOffset, a.count, size_t(components * size),
+                                                   stride_of(a, components * size), index);
+            const size_t stride = stride_of(a, components * size);
+            for (size_t i = 0; i < a.count; ++i)
+                for (int c = 0; c < components; ++c)
+                    out[i * size_t(components) + size_t(c)] = convert(base + i * stride + size_t(c * size), a.componentType, a.normalized);
+        }
+        if (a.sparse.isSparse) {
+            const size_t n = size_t(a.sparse.count);
+            const int index_size = tinygltf::GetComponentSizeInBytes(uint32_t(a.sparse.indices.componentType));
+            const unsigned char* idx = view_bytes(a.sparse.indices.bufferView, size_t(a.sparse.indices.byteOffset), n,
+                                                  size_t(index_size), size_t(index_size), index);
+            const unsigned char* val = view_bytes(a.sparse.values.bufferView, size_t(a.sparse.values.byteOffset), n,
+                                                  size_t(components * size), size_t(components * size), index);
+            for (size_t i = 0; i < n; ++i) {
+                const size_t target = size_t(convert(idx + i * size_t(index_size), a.sparse.indices.componentType, false));
+                if (target >= a.count) fail("sparse accessor " + std::to_string(index) + " names element " + std::to_string(target));
+                for (int c = 0; c < components; ++c)
+                    out[target * size_t(components) + size_t(c)] =
+                        convert(val + (i * size_t(components) + size_t(c)) * size_t(size), a.componentType, a.normalized);
+            }
+        }
+        for (double v : out)
+            if (!std::isfinite(v)) fail("accessor " + std::to_string(index) + " holds a NaN or infinite value");
+        return out;
+    }
+
+private:
+    size_t stride_of(const tinygltf::Accessor& a, int element) const {
+        const tinygltf::BufferView& v = model_.bufferViews[size_t(a.bufferView)];
+        return v.byteStride ? v.byteStride : size_t(element);
+    }
+
+    const unsigned char* view_bytes(int view_index, size_t offset, size_t count, size_t element, size_t stride,
+                                    int accessor) const {
+        if (view_index < 0 || size_t(view_index) >= model_.bufferViews.size())
+            fail("accessor " + std::to_string(accessor) + " names a missing buffer view");
+        const tinygltf::BufferView& view = model_.bufferViews[size_t(view_index)];
+        if (view.buffer < 0 || size_t(view.buffer) >= model_.buffers.size())
+            fail("buffer view " + std::to_string(view_index) + " names a missing buffer");
+        const std::vector<unsigned char>& data = model_.buffers[size_t(view.buffer)].data;
+        if (view.byteOffset + view.byteLength > data.size())
+            fail("buffer view " + std::to_string(view_index) + " runs past the end of its buffer (truncated file?)");
+        if (count > 0 && offset + stride * (count - 1) + element > view.byteLength)
+            fail("accessor " + std::to_string(accessor) + " runs past the end of its buffer view");
+        return data.data() + view.byteOffset + offset;
+    }
+
+    static double convert(const unsigned char* p, int type, bool normalized) {
+        switch (type) {
+            case TINYGLTF_COMPONENT_TYPE_FLOAT: { float f; std::memcpy(&f, p, 4); return f; }
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? p[0] / 255.0 : p[0];
+            case TINYGLTF_COMPONENT_TYPE_BYTE: { const int8_t v = int8_t(p[0]); return normalized ? std::max(v / 127.0, -1.0) : v; }
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { uint16_t v; std::memcpy(&v, p, 2); return normalized ? v / 65535.0 : v; }
+            case TINYGLTF_COMPONENT_TYPE_SHORT: { int16_t v; std::memcpy(&v, p, 2); return normalized ? std::max(v / 32767.0, -1.0) : v; }
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: { uint32_t v; std::memcpy(&v, p, 4); return v; }
+            default: return NAN;
+        }
+    }
+
+    const tinygltf::Model& model_;
+    std::string file_;
+};
+
+struct PrimitiveData {
+    size_t node = 0;
+    size_t vertex_base = 0, vertex_count = 0;
+    std::vector<double> positions;            // V × 3
+    std::vector<std::vector<double>> targets;  // per morph target: V × 3 deltas
+    std::vector<uint16_t> joints;              // V × influences
+    std::vector<float> weights;                // V × influences
+    size_t influences = 0;
+};
+
+struct NodePose {
+    std::array<double, 3> t{0, 0, 0}, s{1, 1, 1};
+    Quat r{0, 0, 0, 1};
+    std::vector<double> weights;
+    bool has_matrix = false;
+    Mat matrix = identity();
+};
+
+std::vector<uint32_t> triangle_list(const std::vector<double>& raw, int mode, size_t vertex_count, const Reader& reader,
+                                    const std::string& where) {
+    std::vector<uint32_t> idx(raw.size());
+    for (size_t i = 0; i < raw.size(); ++i) {
+        if (raw[i] >= double(vertex_count))
+            reader.fail(where + ": index " + std::to_string(i) + " is " + std::to_string(uint64_t(raw[i])) + ", but there are " +
+                        std::to_string(vertex_count) + " vertices");
+        idx[i] = uint32_t(raw[i]);
+    }
+    std::vector<uint32_t> out;
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+        if (idx.size() % 3) reader.fail(where + ": " + std::to_string(idx.size()) + " indices are not whole triangles");
+        return idx;
+    }
+    if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {  // every other triangle flipped to keep the winding
+        for (size_t i = 2; i < idx.size(); ++i)
+            if (i % 2 == 0) out.insert(out.end(), {idx[i - 2], idx[i - 1], idx[i]});
+            else out.insert(out.end(), {idx[i - 1], idx[i - 2], idx[i]});
+        return out;
+    }
+    if (mode == TINYGLTF_MODE_TRIANGLE_FAN) {
+        for (size_t i = 2; i < idx.size(); ++i) out.insert(out.end(), {idx[0], idx[i - 1], idx[i]});
+        return out;
+    }
+    reader.fail(where + ": points and lines cannot be reordered for overdraw (mode " + std::to_string(mode) + ")");
+}
+
+Quat slerp(Quat a, Quat b, double t) {
+    double d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
+    if (d < 0) {
+        for (double& v : b) v = -v;
+        d = -d;
+    }
+    Quat q;
+    if (d > 0.9995) {
+        for (int i = 0; i < 4; ++i) q[i] = a[i] + t * (b[i] - a[i]);
+    } else {
+        const double theta = std::acos(d), s = std::sin(theta);
+        const double wa = std::sin((1 - t) * theta) / s, wb = std::sin(t * theta) / s;
+        for (int i = 0; i < 4; ++i) q[i] = wa * a[i] + wb * b[i];
+    }
+    const double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    for (double& v : q) v /= n;
+    return q;
+}
+
+// One animation channel's value at time t (components values per key; rotations slerped).
+std::vector<double> sample(const std::vector<double>& times, const std::vector<double>& values, size_t components,
+                           const std::string& interpolation, bool rotation, double t) {
+    const bool cubic = interpolation == "CUBICSPLINE";
+    const size_t stride = cubic ? 3 * components : components;  // in-tangent, value, out-tangent
+    auto value = [&](size_t key, size_t part) {
+        return std::vector<double>(values.begin() + ptrdiff_t(key * stride + part * components),
+                                   values.begin() + ptrdiff_t(key * stride + (part + 1) * components));
+    };
+    const size_t mid = cubic ? 1 : 0;
+    if (t <= times.front()) return value(0, mid);
+    if (t >= times.back()) return value(times.size() - 1, mid);
+    const size_t k = size_t(std::upper_bound(times.begin(), times.end(), t) - times.begin()) - 1;
+    const double dt = times[k + 1] - times[k], u = dt > 0 ? (t - times[k]) / dt : 0.0;
+    if (interpolation == "STEP") return value(k, 0);
+    std::vector<double> out(components);
+    if (cubic) {
+        const auto p0 = value(k, 1), m0 = value(k, 2), p1 = value(k + 1, 1), m1 = value(k + 1, 0);
+        const double u2 = u * u, u3 = u2 * u;
+        for (size_t c = 0; c < components; ++c)
+            out[c] = (2 * u3 - 3 * u2 + 1) * p0[c] + (u3 - 2 * u2 + u) * dt * m0[c] + (-2 * u3 + 3 * u2) * p1[c] +
+                     (u3 - u2) * dt * m1[c];
+        if (rotation) {
+            const double n = std::sqrt(out[0] * out[0] + out[1] * out[1] + out[2] * out[2] + out[3] * out[3]);
+            for (double& v : out) v /= n;
+        }
+        return out;
+    }
+    const auto a = value(k, 0), b = value(k + 1, 0);
+    if (rotation) {
+        const Quat q = slerp({a[0], a[1], a[2], a[3]}, {b[0], b[1], b[2], b[3]}, u);
+        return {q[0], q[1], q[2], q[3]};
+    }
+    for (size_t c = 0; c < components; ++c) out[c] = a[c] + u * (b[c] - a[c]);
+    return out;
+}
+
+struct Channel {
+    size_t node;
+    std::string path;
+    std::vector<double> times, values;
+    std::string interpolation;
+};
+
+}  // namespace
+
+AnimatedMesh load_gltf(const std::string& path, const LoadOptions& options) {
+    if (!(options.sample_rate > 0 && options.sample_rate <= 1000)) throw LoadError(path + ": sample rate must be in (0, 1000]");
+    tinygltf::Model model;
+    tinygltf::TinyGLTF loader;
+    loader.SetImageLoader([](tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int,
+                             void*) { return true; },  // textures pass through untouched: never decoded
+                          nullptr);
+    std::string error, warning;
+    std::string magic(4, '\0');
+    if (FILE* f = std::fopen(path.c_str(), "rb")) {
+        const size_t got = std::fread(magic.data(), 1, 4, f);
+        std::fclose(f);
+        if (got < 4) throw LoadError(path + ": file is empty or truncated");
+    } else {
+        throw LoadError(path + ": cannot open file");
+    }
+    const bool ok = magic == "glTF" ? loader.LoadBinaryFromFile(&model, &error, &warning, path)
+                                     : loader.LoadASCIIFromFile(&model, &error, &warning, path);
+    if (!ok) {
+        std::replace(error.begin(), error.end(), '\n', ' ');
+        throw LoadError(path + ": not a readable glTF 2.0 file: " + error);
+    }
+    const Reader reader(model, path);
+
+    // Parents and the nodes of the scene, depth first (parents before children).
+    std::vector<int> parent(model.nodes.size(), -1);
+    for (size_t n = 0; n < model.nodes.size(); ++n)
+        for (int c : model.nodes[n].children) {
+            if (c < 0 || size_t(c) >= model.nodes.size() || parent[size_t(c)] >= 0) reader.fail("node hierarchy is not a tree");
+            parent[size_t(c)] = int(n);
+        }
+    std::vector<size_t> order;
+    std::vector<int> roots;
+    const int scene = model.defaultScene >= 0 ? model.defaultScene : 0;
+    if (size_t(scene) < model.scenes.size()) roots = model.scenes[size_t(scene)].nodes;
+    else
+        for (size_t n = 0; n < model.nodes.size(); ++n)
+            if (parent[n] < 0) roots.push_back(int(n));
+    std::vector<int> stack(roots.rbegin(), roots.rend());
+    std::vector<uint8_t> seen(model.nodes.size(), 0);
+    while (!stack.empty()) {
+        const int n = stack.back();
+        stack.pop_back();
+        if (n < 0 || size_t(n) >= model.nodes.size() || seen[size_t(n)]) reader.fail("scene names a bad or repeated node");
+        seen[size_t(n)] = 1;
+        order.push_back(size_t(n));
+        const auto& children = model.nodes[size_t(n)].children;
+        for (auto it = children.rbegin(); it != children.rend(); ++it) stack.push_back(*it);
+    }
+
+    // Primitives of the mesh nodes, in scene order.
+    AnimatedMesh mesh;
+    mesh.name = path;
+    std::vector<PrimitiveData> prims;
+    size_t joint_total = 0;
+    for (size_t n : order) {
+        const tinygltf::Node& node = model.nodes[n];
+        if (node.mesh < 0) continue;
+        if (size_t(node.mesh) >= model.meshes.size()) reader.fail("node " + std::to_string(n) + " names a missing mesh");
+        const tinygltf::Mesh& m = model.meshes[size_t(node.mesh)];
+        for (size_t p = 0; p < m.primitives.size(); ++p) {
+            const tinygltf::Primitive& prim = m.primitives[p];
+            const std::string where = "mesh '" + m.name + "' primitive " + std::to_string(p);
+            if (prim.mode == TINYGLTF_MODE_POINTS || prim.mode == TINYGLTF_MODE_LINE || prim.mode == TINYGLTF_MODE_LINE_LOOP ||
+                prim.mode == TINYGLTF_MODE_LINE_STRIP)
+                reader.fail(where + ": points and lines cannot be reordered for overdraw");
+            const auto position = prim.attributes.find("POSITION");
+            if (position == prim.attributes.end()) reader.fail(where + " has no POSITION");
+            PrimitiveData d;
+            d.node = n;
+            d.positions = reader.read(position->second, 3);
+            d.vertex_count = d.positions.size() / 3;
+            d.vertex_base = mesh.vertex_count;
+            std::vector<double> raw;
+            if (prim.indices >= 0) raw = reader.read(prim.indices, 1);
+            else for (size_t i = 0; i < d.vertex_count; ++i) raw.push_back(double(i));  // non-indexed
+            const std::vector<uint32_t> local = triangle_list(raw, prim.mode, d.vertex_count, reader, where);
+            Primitive out;
+            out.name = m.name.empty() ? "primitive" + std::to_string(prims.size()) : m.name + "/" + std::to_string(p);
+            out.first_index = mesh.indices.size();
+            out.index_count = local.size();
+            for (uint32_t i : local) mesh.indices.push_back(uint32_t(d.vertex_base + i));
+            mesh.primitives.push_back(out);
+            for (const auto& target : prim.targets) {
+                const auto t = target.find("POSITION");
+                d.targets.push_back(t == target.end() ? std::vector<double>(d.positions.size(), 0.0) : reader.read(t->second, 3));
+                if (d.targets.back().size() != d.positions.size()) reader.fail(where + ": a morph target has the wrong size");
+            }
+            mesh.morph_target_count = std::max(mesh.morph_target_count, d.targets.size());
+            if (node.skin >= 0) {
+                if (size_t(node.skin) >= model.skins.size()) reader.fail(where + ": the node names a missing skin");
+                const size_t joint_count = model.skins[size_t(node.skin)].joints.size();
+                joint_total = std::max(joint_total, joint_count);
+                for (int set = 0;; ++set) {
+                    const auto j = prim.attributes.find("JOINTS_" + std::to_string(set));
+                    const auto w = prim.attributes.find("WEIGHTS_" + std::to_string(set));
+                    if (j == prim.attributes.end() || w == prim.attributes.end()) break;
+                    const std::vector<double> jv = reader.read(j->second, 4), wv = reader.read(w->second, 4);
+                    if (jv.size() != 4 * d.vertex_count || wv.size() != 4 * d.vertex_count)
+                        reader.fail(where + ": joints or weights do not match the vertex count");
+                    std::vector<uint16_t> joints(d.joints.size() + jv.size());
+                    std::vector<float> weights(d.weights.size() + wv.size());
+                    for (size_t v = 0; v < d.vertex_count; ++v) {  // interleave sets: influences per vertex grow by 4
+                        for (size_t i = 0; i < d.influences; ++i) {
+                            joints[v * (d.influences + 4) + i] = d.joints[v * d.influences + i];
+                            weights[v * (d.influences + 4) + i] = d.weights[v * d.influences + i];
+                        }
+                        for (size_t i = 0; i < 4; ++i) {
+                            const double joint = jv[4 * v + i];
+                            if (joint >= double(joint_count) && wv[4 * v + i] > 0)
+                                reader.fail(where + ": vertex " + std::to_string(v) + " names joint " +
+                                            std::to_string(uint64_t(joint)) + ", the skin has " + std::to_string(joint_count));
+                            joints[v * (d.influences + 4) + d.influences + i] = uint16_t(std::min(joint, 65535.0));
+                            weights[v * (d.influences + 4) + d.influences + i] = float(wv[4 * v + i]);
+                        }
+                    }
+                    d.joints = std::move(joints);
+                    d.weights = std::move(weights);
+                    d.influences += 4;
+                }
+                if (d.influences == 0) reader.fail(where + ": skinned without JOINTS_0/WEIGHTS_0");
+            }
+            mesh.vertex_count += d.vertex_count;
+            prims.push_back(std::move(d));
+        }
+    }
+    if (prims.empty()) reader.fail("no triangle mesh in the scene");
+    mesh.joint_count = joint_total;
+
+    // Rest pose of every node.
+    std::vector<NodePose> rest(model.nodes.size());
+    for (size_t n = 0; n < model.nodes.size(); ++n) {
+        const tinygltf::Node& node = model.nodes[n];
+        NodePose& p = rest[n];
+        if (node.matrix.size() == 16) {
+            p.has_matrix = true;
+            std::copy(node.matrix.begin(), node.matrix.end(), p.matrix.begin());
+        }
+        if (node.translation.size() == 3) std::copy(node.translation.begin(), node.translation.end(), p.t.begin());
+        if (node.rotation.size() == 4) std::copy(node.rotation.begin(), node.rotation.end(), p.r.begin());
+        if (node.scale.size() == 3) std::copy(node.scale.begin(), node.scale.end(), p.s.begin());
+        if (node.mesh >= 0 && size_t(node.mesh) < model.meshes.size()) p.weights = model.meshes[size_t(node.mesh)].weights;
+        if (!node.weights.empty()) p.weights = node.weights;
+    }
+    std::vector<Mat> inverse_bind;  // per skin, concatenated
+    std::vector<size_t> skin_first;
+    for (const tinygltf::Skin& skin : model.skins) {
+        skin_first.push_back(inverse_bind.size());
+        std::vector<double> m;
+        if (skin.inverseBindMatrices >= 0) m = reader.read(skin.inverseBindMatrices, 16);
+        for (size_t j = 0; j < skin.joints.size(); ++j) {
+            if (skin.joints[j] < 0 || size_t(skin.joints[j]) >= model.nodes.size()) reader.fail("a skin names a missing joint node");
+            Mat ibm = identity();
+            if (!m.empty()) {
+                if (m.size() < 16 * (j + 1)) reader.fail("a skin has fewer inverse bind matrices than joints");
+                std::copy(m.begin() + ptrdiff_t(16 * j), m.begin() + ptrdiff_t(16 * j + 16), ibm.begin());
+            }
+            inverse_bind.push_back(ibm);
+        }
+    }
+
+    auto evaluate = [&](std::vector<NodePose> pose, float* out) {
+        std::vector<Mat> global(model.nodes.size(), identity());
+        for (size_t n : order) {
+            const NodePose& p = pose[n];
+            const Mat local = p.has_matrix ? p.matrix : trs(p.t, p.r, p.s);
+            global[n] = parent[n] >= 0 ? mul(global[size_t(parent[n])], local) : local;
+        }
+        for (const PrimitiveData& d : prims) {
+            const tinygltf::Node& node = model.nodes[d.node];
+            std::vector<float> morphed(d.positions.size());
+            const std::vector<double>& w = pose[d.node].weights;
+            for (size_t i = 0; i < d.positions.size(); ++i) {
+                double v = d.positions[i];
+                for (size_t t = 0; t < d.targets.size() && t < w.size(); ++t) v += w[t] * d.targets[t][i];
+                morphed[i] = float(v);
+            }
+            float* dst = out + 3 * d.vertex_base;
+            if (node.skin >= 0) {
+                const tinygltf::Skin& skin = model.skins[size_t(node.skin)];
+                std::vector<Mat4> joints(skin.joints.size());
+                for (size_t j = 0; j < skin.joints.size(); ++j) {
+                    const Mat m = mul(global[size_t(skin.joints[j])], inverse_bind[skin_first[size_t(node.skin)] + j]);
+                    for (int k = 0; k < 16; ++k) joints[j][size_t(k)] = float(m[size_t(k)]);
+                }
+                try {
+                    skin_positions(dst, morphed.data(), d.vertex_count, d.joints.data(), d.weights.data(), d.influences,
+                                   joints.data(), joints.size());
+                } catch (const InvalidInput& e) {
+                    reader.fail(e.what());
+                }
+            } else {
+                const Mat& m = global[d.node];
+                for (size_t v = 0; v < d.vertex_count; ++v) {
+                    const double x = morphed[3 * v], y = morphed[3 * v + 1], z = morphed[3 * v + 2];
+                    for (int r = 0; r < 3; ++r) dst[3 * v + size_t(r)] = float(m[size_t(r)] * x + m[size_t(4 + r)] * y + m[size_t(8 + r)] * z + m[size_t(12 + r)]);
+                }
+            }
+        }
+    };
+
+    auto add_keyframe = [&](const std::vector<NodePose>& pose) {
+        const size_t first = mesh.keyframe_positions.size();
+        mesh.keyframe_positions.resize(first + mesh.vertex_count * 3);
+        evaluate(pose, mesh.keyframe_positions.data() + first);
+    };
+
+    if (model.animations.empty()) {
+        add_keyframe(rest);
+        mesh.clips.push_back({"static", 0.0, options.sample_rate, 0, 1});
+    }
+    for (size_t a = 0; a < model.animations.size(); ++a) {
+        const tinygltf::Animation& anim = model.animations[a];
+        const std::string name = anim.name.empty() ? "animation" + std::to_string(a) : anim.name;
+        std::vector<Channel> channels;
+        for (const tinygltf::AnimationChannel& ch : anim.channels) {
+            if (ch.target_node < 0 || size_t(ch.target_node) >= model.nodes.size()) continue;
+            if (ch.sampler < 0 || size_t(ch.sampler) >= anim.samplers.size()) reader.fail("clip '" + name + "' names a missing sampler");
+            const tinygltf::AnimationSampler& s = anim.samplers[size_t(ch.sampler)];
+            Channel c;
+            c.node = size_t(ch.target_node);
+            c.path = ch.target_path;
+            c.interpolation = s.interpolation;
+            c.times = reader.read(s.input, 1);
+            c.values = reader.read(s.output);
+            if (c.times.empty()) reader.fail("clip '" + name + "' has a channel without keys");
+            if (!std::is_sorted(c.times.begin(), c.times.end())) reader.fail("clip '" + name + "' has key times out of order");
+            const size_t components = c.path == "rotation" ? 4 : c.path == "weights" ? rest[c.node].weights.size() : 3;
+            const size_t per_key = (c.interpolation == "CUBICSPLINE" ? 3 : 1) * components;
+            if (components == 0 || c.values.size() != per_key * c.times.size())
+                reader.fail("clip '" + name + "' channel for node " + std::to_string(c.node) + " (" + c.path +
+                            ") has the wrong number of values");
+            channels.push_back(std::move(c));
+        }
+        if (channels.empty()) reader.fail("clip '" + name + "' animates nothing");
+        double t0 = INFINITY, t1 = -INFINITY;
+        for (const Channel& c : channels) t0 = std::min(t0, c.times.front()), t1 = std::max(t1, c.times.back());
+        Clip clip;
+        clip.name = name;
+        clip.duration_s = t1 - t0;
+        clip.sample_rate = options.sample_rate;
+        clip.first_keyframe = mesh.keyframe_count();
+        clip.keyframe_count = size_t(std::llround(clip.duration_s * options.sample_rate)) + 1;
+        if (clip.keyframe_count > 100000) reader.fail("clip '" + name + "' is absurdly long");
+        for (size_t f = 0; f < clip.keyframe_count; ++f) {
+            const double t = std::min(t0 + double(f) / options.sample_rate, t1);
+            std::vector<NodePose> pose = rest;
+            for (const Channel& c : channels) {
+                const bool rotation = c.path == "rotation";
+                const size_t components = rotation ? 4 : c.path == "weights" ? rest[c.node].weights.size() : 3;
+                const std::vector<double> v = sample(c.times, c.values, components, c.interpolation, rotation, t);
+                NodePose& p = pose[c.node];
+                if (c.path == "translation") std::copy(v.begin(), v.end(), p.t.begin());
+                else if (rotation) std::copy(v.begin(), v.end(), p.r.begin());
+                else if (c.path == "scale") std::copy(v.begin(), v.end(), p.s.begin());
+                else if (c.path == "weights") p.weights = v;
+                p.has_matrix = p.has_matrix && c.path == "weights";  // an animated TRS replaces a matrix
+            }
+            add_keyframe(pose);
+        }
+        mesh.clips.push_back(clip);
+    }
+    try {
+        validate_animated_mesh(mesh);
+    } catch (const InvalidInput& e) {
+        reader.fail(e.what());
+    }
+    return mesh;
+}
+
+}  // namespace animorder

@@ -1,0 +1,295 @@
+// The glTF loader: small files built here whose keyframes are worked out by hand (skins, morph
+// targets with sparse accessors, LINEAR/STEP/CUBICSPLINE), one-line errors for broken files, and
+// every glTF character of ../shared/data.
+#include "animorder/animorder.h"
+#include "animorder/io.h"
+#include "animorder/overdraw.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+using namespace animorder;
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string base64(const std::string& in) {
+    static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    size_t i = 0;
+    for (; i + 2 < in.size(); i += 3) {
+        const uint32_t v = uint32_t(uint8_t(in[i])) << 16 | uint32_t(uint8_t(in[i + 1])) << 8 | uint8_t(in[i + 2]);
+        for (int s = 18; s >= 0; s -= 6) out.push_back(table[(v >> s) & 63]);
+    }
+    if (i + 1 == in.size()) {
+        const uint32_t v = uint32_t(uint8_t(in[i])) << 16;
+        out += {table[(v >> 18) & 63], table[(v >> 12) & 63], '=', '='};
+    } else if (i + 2 == in.size()) {
+        const uint32_t v = uint32_t(uint8_t(in[i])) << 16 | uint32_t(uint8_t(in[i + 1])) << 8;
+        out += {table[(v >> 18) & 63], table[(v >> 12) & 63], table[(v >> 6) & 63], '='};
+    }
+    return out;
+}
+
+// A glTF document with one embedded buffer, accessors appended as they are added.
+struct Gltf {
+    json doc = {{"asset", {{"version", "2.0"}}}, {"accessors", json::array()}, {"bufferViews", json::array()}};
+    std::string bin;
+
+    int add(const void* data, size_t bytes, size_t count, const char* type, int component) {
+        while (bin.size() % 4) bin.push_back('\0');
+        doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", bin.size()}, {"byteLength", bytes}});
+        bin.append(static_cast<const char*>(data), bytes);
+        doc["accessors"].push_back(
+            {{"bufferView", doc["bufferViews"].size() - 1}, {"componentType", component}, {"count", count}, {"type", type}});
+        return int(doc["accessors"].size() - 1);
+    }
+    int floats(const std::vector<float>& v, const char* type, size_t per) { return add(v.data(), v.size() * 4, v.size() / per, type, 5126); }
+    int u16(const std::vector<uint16_t>& v, const char* type, size_t per) { return add(v.data(), v.size() * 2, v.size() / per, type, 5123); }
+    std::string text() {
+        json d = doc;
+        d["buffers"] = json::array({{{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + base64(bin)}}});
+        return d.dump();
+    }
+};
+
+class GltfLoader : public ::testing::Test {
+protected:
+    void SetUp() override {
+        dir_ = fs::temp_directory_path() / ("animorder-gltf-" + std::to_string(::getpid()) + "-" +
+                                            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        fs::create_directories(dir_);
+    }
+    void TearDown() override { fs::remove_all(dir_); }
+    std::string write(const std::string& name, const std::string& content) {
+        const fs::path p = dir_ / name;
+        std::ofstream(p, std::ios::binary) << content;
+        return p.string();
+    }
+    fs::path dir_;
+};
+
+// A bar of two triangles along +Y from 0 to 2, skinned to two joints (root at 0, child at 1);
+// vertices at y = 2 follow the child only. Clip: the child rotates 90° about Z from t=0 to t=1.
+Gltf skinned_bar(const std::string& interpolation = "LINEAR") {
+    Gltf g;
+    const std::vector<float> pos = {0, 0, 0, 1, 0, 0, 1, 2, 0, 0, 2, 0};
+    const std::vector<uint16_t> idx = {0, 1, 2, 0, 2, 3};
+    const std::vector<uint16_t> joints = {0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+    const std::vector<float> weights = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+    const std::vector<float> ibm = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1,    // root at the origin
+                                    1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, -1, 0, 1};  // child at y = 1
+    const int p = g.floats(pos, "VEC3", 3), i = g.u16(idx, "SCALAR", 1), j = g.u16(joints, "VEC4", 4),
+              w = g.floats(weights, "VEC4", 4), m = g.floats(ibm, "MAT4", 16);
+    const double s = std::sqrt(0.5);
+    std::vector<float> times = {0, 1}, rot = {0, 0, 0, 1, 0, 0, float(s), float(s)};
+    if (interpolation == "CUBICSPLINE") rot = {0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, float(s), float(s), 0, 0, 0, 0};
+    const int t = g.floats(times, "SCALAR", 1), r = g.floats(rot, "VEC4", 4);
+    json primitive = {{"attributes", {{"POSITION", p}, {"JOINTS_0", j}, {"WEIGHTS_0", w}}}, {"indices", i}};
+    g.doc["meshes"] = json::array({json{{"name", "bar"}, {"primitives", json::array({primitive})}}});
+    g.doc["nodes"] = json::array({json{{"name", "root"}, {"children", {1}}},
+                                  json{{"name", "child"}, {"translation", {0, 1, 0}}},
+                                  // The skinned node's own transform must be ignored (glTF §3.7.3).
+                                  json{{"name", "skinned"}, {"mesh", 0}, {"skin", 0}, {"translation", {100, 0, 0}}}});
+    g.doc["skins"] = json::array({json{{"joints", {0, 1}}, {"inverseBindMatrices", m}}});
+    g.doc["scenes"] = json::array({json{{"nodes", {0, 2}}}});
+    g.doc["scene"] = 0;
+    json sampler = {{"input", t}, {"output", r}, {"interpolation", interpolation}};
+    json channel = {{"sampler", 0}, {"target", {{"node", 1}, {"path", "rotation"}}}};
+    json animation = {{"name", "bend"}, {"samplers", json::array({sampler})}, {"channels", json::array({channel})}};
+    g.doc["animations"] = json::array({animation});
+    return g;
+}
+
+void expect_position(const AnimatedMesh& m, size_t keyframe, size_t v, double x, double y, double z) {
+    const float* p = m.keyframe(keyframe) + 3 * v;
+    EXPECT_NEAR(p[0], x, 1e-4) << "keyframe " << keyframe << " vertex " << v;
+    EXPECT_NEAR(p[1], y, 1e-4) << "keyframe " << keyframe << " vertex " << v;
+    EXPECT_NEAR(p[2], z, 1e-4) << "keyframe " << keyframe << " vertex " << v;
+}
+
+}  // namespace
+
+TEST_F(GltfLoader, SkinnedBarBendsAsWorkedOutByHand) {
+    const AnimatedMesh m = load_gltf(write("bar.gltf", skinned_bar().text()));
+    ASSERT_EQ(m.clips.size(), 1u);
+    EXPECT_EQ(m.clips[0].name, "bend");
+    EXPECT_EQ(m.clips[0].keyframe_count, 31u);  // 1 s at 30/s, both ends
+    EXPECT_EQ(m.joint_count, 2u);
+    EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3}));
+    // t = 0: bind pose (the skinned node's own translation is ignored, as the spec says).
+    expect_position(m, 0, 2, 1, 2, 0);
+    // t = 1: the child turned 90° about Z around (0, 1, 0): (1, 2) → (0, 1) + (−1, 1) = (−1, 2).
+    expect_position(m, 30, 2, -1, 2, 0);
+    expect_position(m, 30, 3, -1, 1, 0);
+    expect_position(m, 30, 1, 1, 0, 0);  // the root's vertices stay
+    // t = 0.5: slerp halfway, 45°: (1, 1) relative → (0, √2).
+    expect_position(m, 15, 2, 0, 1 + std::sqrt(2.0), 0);
+}
+
+TEST_F(GltfLoader, StepAndCubicSplineInterpolation) {
+    const AnimatedMesh step = load_gltf(write("step.gltf", skinned_bar("STEP").text()));
+    expect_position(step, 29, 2, 1, 2, 0);   // holds the first key until t = 1
+    expect_position(step, 30, 2, -1, 2, 0);
+    // Zero tangents: Hermite gives 3u² − 2u³ of the way; at u = 0.5 exactly halfway (then normalised).
+    const AnimatedMesh cubic = load_gltf(write("cubic.gltf", skinned_bar("CUBICSPLINE").text()));
+    expect_position(cubic, 30, 2, -1, 2, 0);
+    const float* p = cubic.keyframe(15) + 6;
+    EXPECT_NEAR(std::hypot(p[0], p[1] - 1), std::sqrt(2.0), 1e-4);  // a rigid rotation about the joint
+    EXPECT_LT(p[0], 0.99);
+    EXPECT_GT(p[0], -0.99);
+}
+
+TEST_F(GltfLoader, SparseMorphTargetWithAnimatedWeights) {
+    Gltf g;
+    const std::vector<float> pos = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    const std::vector<uint16_t> idx = {0, 1, 2};
+    const int p = g.floats(pos, "VEC3", 3), i = g.u16(idx, "SCALAR", 1);
+    // Sparse target: only vertex 2 moves, by (0, 0, 2).
+    const std::vector<uint16_t> sparse_index = {2};
+    const std::vector<float> sparse_value = {0, 0, 2};
+    g.u16(sparse_index, "SCALAR", 1);
+    g.floats(sparse_value, "VEC3", 3);
+    json sparse = {{"count", 1},
+                   {"indices", {{"bufferView", 2}, {"componentType", 5123}}},
+                   {"values", {{"bufferView", 3}}}};
+    g.doc["accessors"].push_back({{"componentType", 5126}, {"count", 3}, {"type", "VEC3"}, {"sparse", sparse}});
+    const int target = int(g.doc["accessors"].size() - 1);
+    const std::vector<float> times = {0, 2}, weights = {0, 1};
+    const int t = g.floats(times, "SCALAR", 1), w = g.floats(weights, "SCALAR", 1);
+    json primitive = {{"attributes", {{"POSITION", p}}}, {"indices", i},
+                      {"targets", json::array({json{{"POSITION", target}}})}};
+    g.doc["meshes"] = json::array({json{{"primitives", json::array({primitive})}, {"weights", json::array({0.0})}}});
+    g.doc["nodes"] = json::array({json{{"mesh", 0}, {"translation", {0, 0, 5}}}});
+    g.doc["scenes"] = json::array({json{{"nodes", json::array({0})}}});
+    json sampler = {{"input", t}, {"output", w}};
+    json channel = {{"sampler", 0}, {"target", {{"node", 0}, {"path", "weights"}}}};
+    g.doc["animations"] = json::array({json{{"samplers", json::array({sampler})}, {"channels", json::array({channel})}}});
+    const AnimatedMesh m = load_gltf(write("morph.gltf", g.text()));
+    EXPECT_EQ(m.morph_target_count, 1u);
+    EXPECT_EQ(m.clips[0].keyframe_count, 61u);
+    expect_position(m, 0, 2, 0, 1, 5);   // node translation applies (not skinned)
+    expect_position(m, 30, 2, 0, 1, 6);  // weight 0.5 → +1
+    expect_position(m, 60, 2, 0, 1, 7);
+    expect_position(m, 60, 1, 1, 0, 5);  // untouched by the sparse target
+}
+
+TEST_F(GltfLoader, BrokenFilesGiveOneLineErrorsNamingTheFile) {
+    auto expect_error = [&](const std::string& name, const std::string& content, const std::string& message) {
+        const std::string path = write(name, content);
+        try {
+            load_gltf(path);
+            ADD_FAILURE() << name << ": no error";
+        } catch (const LoadError& e) {
+            const std::string what = e.what();
+            EXPECT_EQ(what.rfind(path, 0), 0u) << what;
+            EXPECT_NE(what.find(message), std::string::npos) << name << ": " << what;
+            EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+        }
+    };
+    expect_error("empty.gltf", "", "empty or truncated");
+    expect_error("junk.gltf", "this is not json", "not a readable glTF");
+    expect_error("truncated.glb", "glTF\x02\0\0\0\xff\xff\0\0", "not a readable glTF");
+    {
+        Gltf g = skinned_bar();
+        g.doc["buffers"] = json::array({{{"byteLength", 4000}, {"uri", "missing.bin"}}});
+        json d = g.doc;
+        expect_error("missing.gltf", d.dump(), "not a readable glTF");
+    }
+    {
+        Gltf g = skinned_bar();
+        g.doc["accessors"][1]["count"] = 600;  // indices past their buffer view
+        expect_error("range.gltf", g.text(), "runs past the end");
+    }
+    {
+        Gltf g = skinned_bar();
+        const std::vector<uint16_t> bad = {0, 1, 9};
+        g.doc["meshes"][0]["primitives"][0]["indices"] = g.u16(bad, "SCALAR", 1);
+        expect_error("index.gltf", g.text(), "is 9, but there are 4 vertices");
+    }
+    {
+        Gltf g = skinned_bar();
+        const std::vector<float> nan = {0, 0, 0, 1, 0, 0, NAN, 2, 0, 0, 2, 0};
+        g.doc["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = g.floats(nan, "VEC3", 3);
+        expect_error("nan.gltf", g.text(), "NaN or infinite");
+    }
+    {
+        Gltf g = skinned_bar();
+        g.doc["meshes"][0]["primitives"][0]["mode"] = 1;  // LINES
+        expect_error("lines.gltf", g.text(), "points and lines");
+    }
+    {
+        Gltf g = skinned_bar();
+        g.doc["animations"][0]["channels"] = json::array();
+        expect_error("still.gltf", g.text(), "animates nothing");
+    }
+    {
+        Gltf g = skinned_bar();
+        const std::vector<uint16_t> joints = {0, 0, 0, 0, 0, 0, 0, 0, 7, 0, 0, 0, 1, 0, 0, 0};
+        g.doc["meshes"][0]["primitives"][0]["attributes"]["JOINTS_0"] = g.u16(joints, "VEC4", 4);
+        expect_error("joint.gltf", g.text(), "names joint 7");
+    }
+    try {
+        load_gltf((dir_ / "nowhere.glb").string());
+        ADD_FAILURE();
+    } catch (const LoadError& e) {
+        EXPECT_NE(std::string(e.what()).find("cannot open"), std::string::npos);
+    }
+}
+
+namespace {
+std::string shared_data(const std::string& relative) {
+    return (fs::path(ANIMORDER_SOURCE_DIR) / ".." / "shared" / "data" / relative).string();
+}
+}  // namespace
+
+TEST(GltfCharacters, EveryGltfInSharedDataLoads) {
+    const char* files[] = {"mixamo-ganfaul/Ganfaul.gltf",     "glb-xbot/Xbot.glb",
+                           "gltf-cesiumman/CesiumMan.glb",     "gltf-fox/Fox.glb",
+                           "glb-robot-expressive/RobotExpressive.glb", "gltf-morph-stress-test/MorphStressTest.gltf",
+                           "gltf-animated-morph-sphere/AnimatedMorphSphere.gltf", "glb-horse-morph/Horse.glb",
+                           "glb-flamingo-morph/Flamingo.glb"};
+    if (!fs::exists(shared_data(""))) GTEST_SKIP() << "../shared/data is absent: real characters not checked";
+    for (const char* f : files) {
+        SCOPED_TRACE(f);
+        AnimatedMesh m;
+        ASSERT_NO_THROW(m = load_gltf(shared_data(f)));
+        EXPECT_GT(m.triangle_count(), 100u);
+        EXPECT_GE(m.clips.size(), 1u);
+        EXPECT_NO_THROW(validate_animated_mesh(m));
+        std::printf("%-52s %6zu triangles %6zu vertices %3zu joints %2zu morph targets %2zu clips %5zu keyframes\n", f,
+                    m.triangle_count(), m.vertex_count, m.joint_count, m.morph_target_count, m.clips.size(), m.keyframe_count());
+    }
+}
+
+TEST(GltfCharacters, GanfaulSkinsWithoutStretching) {
+    const std::string path = shared_data("mixamo-ganfaul/Ganfaul.gltf");
+    if (!fs::exists(path)) GTEST_SKIP() << path << " is absent";
+    const AnimatedMesh m = load_gltf(path);
+    EXPECT_NEAR(double(m.triangle_count()), 13802.0, 5.0);
+    EXPECT_EQ(m.clips.size(), 12u);
+    // Edge lengths over a whole clip relative to its first keyframe: median within 1% of 1.
+    const Clip& c = m.clips[0];
+    std::vector<double> ratios;
+    for (size_t f = 1; f < c.keyframe_count; f += 7)
+        for (size_t t = 0; t < m.indices.size(); t += 3)
+            for (int i = 0; i < 3; ++i) {
+                const uint32_t a = m.indices[t + size_t(i)], b = m.indices[t + size_t(i + 1) % 3];
+                auto length = [&](size_t k) {
+                    const float *p = m.keyframe(k) + 3 * a, *q = m.keyframe(k) + 3 * b;
+                    return std::sqrt(double(p[0] - q[0]) * (p[0] - q[0]) + double(p[1] - q[1]) * (p[1] - q[1]) +
+                                     double(p[2] - q[2]) * (p[2] - q[2]));
+                };
+                const double base = length(c.first_keyframe);
+                if (base > 0) ratios.push_back(length(c.first_keyframe + f) / base);
+            }
+    std::nth_element(ratios.begin(), ratios.begin() + ptrdiff_t(ratios.size() / 2), ratios.end());
+    EXPECT_NEAR(ratios[ratios.size() / 2], 1.0, 0.01);
+}

@@ -51,6 +51,10 @@ struct AnimatedMesh {
 // keyframes, a keyframe array of the wrong size, or a non-finite position.
 void validate_animated_mesh(const AnimatedMesh& mesh);
 
+// The mesh with only the named clips (in the order named) and their keyframes. Throws
+// InvalidInput naming a clip that does not exist and the clips that do.
+AnimatedMesh select_clips(const AnimatedMesh& mesh, const std::vector<std::string>& names);
+
 // ---------------------------------------------------------------------------------------------
 // Linear blend skinning (skinning.cpp).
 

@@ -192,6 +192,9 @@ ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patc
     if (kept.empty())
         say(settings, "node fragments exceed the cache budget: rasterising again every iteration");
 
+    double best_ovr = INFINITY;
+    std::vector<std::vector<uint32_t>> best_orders;
+    std::vector<uint32_t> best_assignment;
     for (size_t iteration = 0;; ++iteration) {
         ClusteringIteration log;
         // Step 1: node assignment by measured overdraw.
@@ -224,13 +227,27 @@ ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patc
         log.mean_ovr = counted ? ovr_sum / double(counted) : 0.0;
         log.seconds_raster = seconds_since(raster_start);
 
+        // Keep the best state (its orders produced this assignment), so cycling never loses it.
+        if (log.mean_ovr < best_ovr) {
+            best_ovr = log.mean_ovr;
+            best_orders = result.patch_orders;
+            best_assignment = result.assignment;
+            result.best_iteration = iteration;
+        }
         const bool settled = iteration > 0 && log.reassigned == 0;
-        if (settled || iteration + 1 >= settings.max_iterations) {
+        const bool stalled = iteration >= result.best_iteration + settings.patience;
+        if (settled || stalled || iteration + 1 >= settings.max_iterations) {
             result.converged = settled;
+            result.stop_reason = settled ? "converged" : stalled ? "stalled" : "iteration cap";
             result.iterations.push_back(log);
             say(settings, "iteration " + std::to_string(iteration + 1) + ": mean OVR " + std::to_string(log.mean_ovr) +
-                              ", " + std::to_string(log.reassigned) + " nodes reassigned" +
-                              (settled ? " — converged" : " — iteration cap reached"));
+                              ", " + std::to_string(log.reassigned) + " nodes reassigned — " + result.stop_reason +
+                              "; keeping iteration " + std::to_string(result.best_iteration + 1) + " (mean OVR " +
+                              std::to_string(best_ovr) + ")");
+            result.patch_orders = best_orders;
+            result.assignment = best_assignment;
+            result.triangle_orders.clear();
+            for (const auto& o : result.patch_orders) result.triangle_orders.push_back(patch_order_to_triangle_order(patches, o));
             break;
         }
 

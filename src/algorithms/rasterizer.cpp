@@ -348,6 +348,54 @@ void replay_pixel(const uint32_t* fragments, uint32_t count, const uint32_t* ran
     }
 }
 
+// The hot loop of k-means: all multi-fragment pixels of a node for K orders at once. Pixels
+// without equal depths (nearly all) take a branch-free path the compiler vectorises across the K
+// orders: a fragment passes under order o iff its rank is below the running minimum.
+template <size_t K>
+void replay_all(uint64_t* passed, const uint32_t* starts, size_t pixels, const uint32_t* fragments, const uint32_t* ranks) {
+    uint64_t count[K] = {};
+    uint32_t scratch[2 * K] = {};
+    for (size_t m = 0; m < pixels; ++m) {
+        const uint32_t* f = fragments + starts[m];
+        const uint32_t n = starts[m + 1] - starts[m];
+        uint32_t ties = 0;
+        for (uint32_t j = 0; j < n; ++j) ties |= f[j];
+        if (ties & kTieBit) {
+            replay_pixel(f, n, ranks, K, scratch, scratch + K, [&](size_t o) { ++count[o]; });
+            continue;
+        }
+        uint32_t running[K];
+        for (size_t o = 0; o < K; ++o) running[o] = UINT32_MAX;
+        for (uint32_t j = 0; j < n; ++j) {
+            const uint32_t* r = ranks + size_t(f[j]) * K;
+            for (size_t o = 0; o < K; ++o) {
+                count[o] += r[o] < running[o];
+                running[o] = std::min(running[o], r[o]);
+            }
+        }
+    }
+    for (size_t o = 0; o < K; ++o) passed[o] += count[o];
+}
+
+void replay_all_any(uint64_t* passed, const uint32_t* starts, size_t pixels, const uint32_t* fragments,
+                    const uint32_t* ranks, size_t order_count) {
+    switch (order_count) {
+        case 1: return replay_all<1>(passed, starts, pixels, fragments, ranks);
+        case 2: return replay_all<2>(passed, starts, pixels, fragments, ranks);
+        case 3: return replay_all<3>(passed, starts, pixels, fragments, ranks);
+        case 4: return replay_all<4>(passed, starts, pixels, fragments, ranks);
+        case 5: return replay_all<5>(passed, starts, pixels, fragments, ranks);
+        case 6: return replay_all<6>(passed, starts, pixels, fragments, ranks);
+        case 7: return replay_all<7>(passed, starts, pixels, fragments, ranks);
+        case 8: return replay_all<8>(passed, starts, pixels, fragments, ranks);
+        default: break;
+    }
+    std::vector<uint32_t> scratch(2 * order_count);
+    for (size_t m = 0; m < pixels; ++m)
+        replay_pixel(fragments + starts[m], starts[m + 1] - starts[m], ranks, order_count, scratch.data(),
+                     scratch.data() + order_count, [&](size_t o) { ++passed[o]; });
+}
+
 }  // namespace
 
 NodeFragments NodeRasterizer::export_fragments() const {
@@ -363,24 +411,15 @@ NodeFragments NodeRasterizer::export_fragments() const {
 }
 
 void score_fragments(uint64_t* passed, const NodeFragments& node, const uint32_t* ranks, size_t order_count) {
-    std::vector<uint32_t> scratch(2 * order_count);
-    for (size_t o = 0; o < order_count; ++o) passed[o] = node.single;
-    for (size_t m = 0; m + 1 < node.starts.size(); ++m) {
-        const uint32_t begin = node.starts[m];
-        replay_pixel(node.fragments.data() + begin, node.starts[m + 1] - begin, ranks, order_count, scratch.data(),
-                     scratch.data() + order_count, [&](size_t o) { ++passed[o]; });
-    }
+    for (size_t o = 0; o < order_count; ++o) passed[o] = node.single;  // a lone fragment always passes
+    if (node.starts.size() > 1)
+        replay_all_any(passed, node.starts.data(), node.starts.size() - 1, node.fragments.data(), ranks, order_count);
 }
 
 void NodeRasterizer::score(uint64_t* passed, const uint32_t* ranks, size_t order_count) const {
     const State& s = *state_;
-    std::vector<uint32_t> scratch(2 * order_count);
     for (size_t o = 0; o < order_count; ++o) passed[o] = s.single;  // a lone fragment always passes
-    for (size_t m = 0; m < s.multi_count; ++m) {
-        const uint32_t begin = s.multi_start[m];
-        replay_pixel(s.multi_fragment.data() + begin, s.multi_start[m + 1] - begin, ranks, order_count, scratch.data(),
-                     scratch.data() + order_count, [&](size_t o) { ++passed[o]; });
-    }
+    replay_all_any(passed, s.multi_start.data(), s.multi_count, s.multi_fragment.data(), ranks, order_count);
 }
 
 std::vector<uint32_t> NodeRasterizer::passed_per_pixel(const uint32_t* ranks, size_t order_count,

@@ -42,4 +42,28 @@ void validate_animated_mesh(const AnimatedMesh& mesh) {
                                std::to_string(i / 3 % mesh.vertex_count) + " is not finite");
 }
 
+AnimatedMesh select_clips(const AnimatedMesh& mesh, const std::vector<std::string>& names) {
+    AnimatedMesh out = mesh;
+    out.clips.clear();
+    out.keyframe_positions.clear();
+    const size_t frame_floats = mesh.vertex_count * 3;
+    for (const std::string& name : names) {
+        const Clip* found = nullptr;
+        for (const Clip& c : mesh.clips) found = c.name == name ? &c : found;
+        if (!found) {
+            std::string known;
+            for (const Clip& c : mesh.clips) known += (known.empty() ? "" : ", ") + c.name;
+            throw InvalidInput("no clip named '" + name + "' (clips: " + known + ")");
+        }
+        Clip c = *found;
+        c.first_keyframe = out.keyframe_count();
+        out.keyframe_positions.insert(out.keyframe_positions.end(),
+                                      mesh.keyframe_positions.begin() + ptrdiff_t(found->first_keyframe * frame_floats),
+                                      mesh.keyframe_positions.begin() +
+                                          ptrdiff_t((found->first_keyframe + found->keyframe_count) * frame_floats));
+        out.clips.push_back(c);
+    }
+    return out;
+}
+
 }  // namespace animorder

@@ -156,6 +156,7 @@ TEST_F(Cli, BadInputAndOptionsGiveOneLineErrors) {
         {"optimize --method single --distance far", "--distance"},
         {"optimize --method single --min-separation 400", "min-separation"},
         {"evaluate --methods original,best", "unknown method 'best'"},
+        {"inspect --clip run", "no clip named 'run' (clips: walk, wave)"},
     };
     for (const Case& c : cases) {
         const Outcome o = run(c.args + " --quiet");  // errors print even when quiet

@@ -38,7 +38,15 @@ void note(const CommonOptions& common, const std::string& text) {
     if (!common.quiet) std::fprintf(stderr, "animorder: %s\n", text.c_str());
 }
 
+AnimatedMesh load_file(const CommonOptions& common, std::string& input_name);
+
+// The input named on the command line (or the bundled character), keeping only --clip clips.
 AnimatedMesh load_input(const CommonOptions& common, std::string& input_name) {
+    AnimatedMesh mesh = load_file(common, input_name);
+    return common.clips.empty() ? mesh : select_clips(mesh, common.clips);
+}
+
+AnimatedMesh load_file(const CommonOptions& common, std::string& input_name) {
     if (common.input.empty()) {
         note(common, "no input file given: using the bundled procedural character");
         input_name = kBundledName;
@@ -57,6 +65,19 @@ AnimatedMesh load_input(const CommonOptions& common, std::string& input_name) {
                              "' files yet (glTF 2.0 .gltf/.glb only; FBX, Collada, MD2/MD5, .X, .b3d come with assimp)");
 }
 
+// The view radius R of every clip (DESIGN.md framing): the largest per-keyframe bounding radius.
+std::vector<float> clip_radii(const AnimatedMesh& mesh) {
+    const Framing all = frame_keyframes(mesh.keyframe_positions.data(), mesh.keyframe_count(), mesh.vertex_count,
+                                        mesh.indices.data(), mesh.indices.size());
+    std::vector<float> radii;
+    for (const Clip& c : mesh.clips) {
+        float r = 0;
+        for (size_t f = 0; f < c.keyframe_count; ++f) r = std::max(r, all.radii[c.first_keyframe + f]);
+        radii.push_back(r);
+    }
+    return radii;
+}
+
 void print_inspect_text(const AnimatedMesh& mesh, const std::string& input_name, const VertexCacheStats& cache,
                         unsigned cache_size) {
     std::printf("%s\n", input_name.c_str());
@@ -66,9 +87,12 @@ void print_inspect_text(const AnimatedMesh& mesh, const std::string& input_name,
     std::printf("  ACMR %.4f  ATVR %.4f  (FIFO cache of %u, current order)\n", cache.acmr, cache.atvr, cache_size);
     for (const Primitive& p : mesh.primitives)
         std::printf("  primitive %-12s triangles %zu\n", p.name.c_str(), p.index_count / 3);
-    for (const Clip& c : mesh.clips)
-        std::printf("  clip %-12s %.3f s  %zu keyframes at %g/s\n", c.name.c_str(), c.duration_s, c.keyframe_count,
-                    c.sample_rate);
+    const std::vector<float> radii = clip_radii(mesh);
+    for (size_t i = 0; i < mesh.clips.size(); ++i) {
+        const Clip& c = mesh.clips[i];
+        std::printf("  clip %-12s %.3f s  %zu keyframes at %g/s  bounding radius %.4g\n", c.name.c_str(), c.duration_s,
+                    c.keyframe_count, c.sample_rate, radii[i]);
+    }
 }
 
 }  // namespace
@@ -88,13 +112,20 @@ int run_inspect(const InspectOptions& options) {
     report["keyframes"] = mesh.keyframe_count();
     report["cache_size"] = options.common.cache_size;
     report["input_order"] = cache_stats_json(cache);
-    for (const Primitive& p : mesh.primitives)
-        report["primitives"].push_back({{"name", p.name}, {"triangles", p.index_count / 3}});
-    for (const Clip& c : mesh.clips)
-        report["clips"].push_back({{"name", c.name},
-                                   {"duration_s", c.duration_s},
-                                   {"keyframes", c.keyframe_count},
-                                   {"sample_rate", c.sample_rate}});
+    for (const Primitive& p : mesh.primitives) {
+        std::vector<uint8_t> used(mesh.vertex_count, 0);
+        size_t vertices = 0;
+        for (size_t i = p.first_index; i < p.first_index + p.index_count; ++i)
+            vertices += used[mesh.indices[i]] ? 0 : (used[mesh.indices[i]] = 1);
+        report["primitives"].push_back({{"name", p.name}, {"triangles", p.index_count / 3}, {"vertices", vertices}});
+    }
+    const std::vector<float> radii = clip_radii(mesh);
+    for (size_t i = 0; i < mesh.clips.size(); ++i)
+        report["clips"].push_back({{"name", mesh.clips[i].name},
+                                   {"duration_s", mesh.clips[i].duration_s},
+                                   {"keyframes", mesh.clips[i].keyframe_count},
+                                   {"sample_rate", mesh.clips[i].sample_rate},
+                                   {"bounding_radius", radii[i]}});
     std::fputs(report_text(report).c_str(), stdout);
     return 0;
 }
@@ -195,6 +226,8 @@ MethodRun run_method(const AnimatedMesh& mesh, const std::string& name, const Me
                             {"nodes", r.runs[i].assignment.size()},
                             {"view_radius", r.run_radius[i]},
                             {"converged", r.runs[i].converged},
+                            {"stop", r.runs[i].stop_reason},
+                            {"best_iteration", r.runs[i].best_iteration + 1},
                             {"iterations", iterations}});
         }
         run.details = {{"clusters", m.clusters},

@@ -10,6 +10,7 @@ namespace animorder::tool {
 struct CommonOptions {
     std::string input;   // empty: the bundled procedural character
     bool quiet = false;  // no progress on stderr
+    std::vector<std::string> clips;  // --clip: only these clips (all when empty)
     unsigned cache_size = 16;
 };
 

@@ -38,22 +38,26 @@ struct WindowVertex {
     float x, y, z;
 };
 
+struct Fragment {
+    uint32_t pixel;
+    uint32_t triangle;
+    float depth;
+};
+
 constexpr uint32_t kTieBit = 0x80000000u;
 constexpr uint32_t kTriangleMask = 0x7fffffffu;
 
 struct NodeRasterizer::State {
     unsigned resolution = 0;
     // Raw fragments, in rasterisation order: the first raw_count entries are this node's.
-    std::vector<uint32_t> raw_pixel, raw_triangle;
-    std::vector<float> raw_depth;
+    std::vector<Fragment> raw, sorted;
     size_t raw_count = 0;
+    std::vector<uint32_t> single_pixels;  // pixels with exactly one fragment
     // Per pixel fragment count; start of the pixel's slots among the multi-fragment pixels.
-    std::vector<uint32_t> pixel_count, pixel_start, pixel_cursor;
     // Pixels with two or more fragments, their fragments nearest first: what scoring walks.
     // A fragment is its triangle index, with kTieBit set when its depth equals the previous one's.
     size_t multi_count = 0;
     std::vector<uint32_t> multi_pixel, multi_start, multi_fragment;
-    std::vector<float> multi_depth;
     uint64_t visible = 0, single = 0;
     // Per-vertex setup, done once per node rather than once per triangle corner.
     std::vector<WindowVertex> window;
@@ -78,26 +82,16 @@ int64_t ceil_div(int64_t a, int64_t b) { return -floor_div(-a, b); }
 
 // Where the rasteriser puts fragments: three parallel arrays (pixel, triangle, depth).
 // Capacity is ensured once per triangle (its bounding box bounds its fragments), so adding a
-// fragment is three plain stores.
+// fragment is one plain store.
 struct FragmentSink {
-    std::vector<uint32_t>& pixel;
-    std::vector<uint32_t>& triangle;
-    std::vector<float>& depth;
+    std::vector<Fragment>& fragments;
     size_t count = 0;
 
-    void reserve_more(size_t fragments) {
-        if (count + fragments <= pixel.size()) return;
-        const size_t size = std::max(2 * pixel.size(), count + fragments);
-        pixel.resize(size);
-        triangle.resize(size);
-        depth.resize(size);
+    void reserve_more(size_t more) {
+        if (count + more <= fragments.size()) return;
+        fragments.resize(std::max(2 * fragments.size(), count + more));
     }
-    void add(uint32_t p, uint32_t t, float z) {
-        pixel[count] = p;
-        triangle[count] = t;
-        depth[count] = z;
-        ++count;
-    }
+    void add(uint32_t p, uint32_t t, float z) { fragments[count++] = {p, t, z}; }
 };
 
 void project(const ClipVertex& v, unsigned resolution, WindowVertex& out) {
@@ -211,70 +205,61 @@ void rasterize_clipped_triangle(const ClipVertex (&v)[3], uint32_t triangle, uns
     for (int i = 1; i + 1 < n; ++i) rasterize_window_triangle(w[0], w[i], w[i + 1], triangle, resolution, sink);
 }
 
-// Groups the node's fragments by pixel (a counting sort), then sorts each pixel with two or more
-// fragments by depth into the compact list that scoring walks. Single-fragment pixels only count:
-// their fragment passes under every order.
+// Groups the node's fragments by pixel with an LSD radix sort on the pixel index (two passes of
+// 11 bits up to 2048² pixels): linear in the fragments, never a loop over every pixel of the
+// viewport. Each pixel with two or more fragments is then sorted by depth into the compact list
+// that scoring walks; a single-fragment pixel only counts, its fragment passes under every order.
 void group_fragments(NodeRasterizer::State& s) {
-    const size_t pixels = size_t(s.resolution) * s.resolution;
-    s.pixel_count.assign(pixels, 0);
-    for (size_t f = 0; f < s.raw_count; ++f) ++s.pixel_count[s.raw_pixel[f]];
-    s.pixel_start.resize(pixels + 1);
-    uint32_t running = 0;
-    s.visible = s.single = 0;
-    size_t multi_pixels = 0;
-    for (size_t p = 0; p < pixels; ++p) {
-        const uint32_t n = s.pixel_count[p];
-        s.pixel_start[p] = running;
-        // Only pixels with several fragments get slots: singles need no sorting or replay.
-        running += n > 1 ? n : 0;
-        s.visible += n > 0;
-        s.single += n == 1;
-        multi_pixels += n > 1;
+    const size_t n = s.raw_count;
+    s.sorted.resize(std::max(s.sorted.size(), n));
+    const uint32_t pixels = s.resolution * s.resolution;
+    int bits = 0;
+    while ((uint64_t(1) << bits) < pixels) ++bits;
+    Fragment* from = s.raw.data();
+    Fragment* to = s.sorted.data();
+    for (int shift = 0; shift < bits; shift += 11) {
+        uint32_t histogram[2049] = {};
+        for (size_t f = 0; f < n; ++f) ++histogram[((from[f].pixel >> shift) & 2047) + 1];
+        for (int d = 0; d < 2048; ++d) histogram[d + 1] += histogram[d];
+        for (size_t f = 0; f < n; ++f) to[histogram[(from[f].pixel >> shift) & 2047]++] = from[f];
+        std::swap(from, to);
     }
-    s.pixel_start[pixels] = running;
-    if (s.multi_fragment.size() < running) {
-        s.multi_fragment.resize(running);
-        s.multi_depth.resize(running);
-    }
-    std::vector<uint32_t>& cursor = s.pixel_cursor;
-    cursor.assign(s.pixel_start.begin(), s.pixel_start.end() - 1);
-    for (size_t f = 0; f < s.raw_count; ++f) {
-        const uint32_t p = s.raw_pixel[f];
-        if (s.pixel_count[p] < 2) continue;
-        const uint32_t slot = cursor[p]++;
-        s.multi_fragment[slot] = s.raw_triangle[f];
-        s.multi_depth[slot] = s.raw_depth[f];
-    }
-
-    // Per multi pixel: insertion sort by (depth, triangle) — a handful of entries — then mark
-    // each fragment whose depth equals its predecessor's.
-    s.multi_count = multi_pixels;
-    s.multi_pixel.resize(multi_pixels);
-    s.multi_start.resize(multi_pixels + 1);
-    size_t m = 0;
-    for (size_t p = 0; p < pixels; ++p) {
-        if (s.pixel_count[p] < 2) continue;
-        const uint32_t begin = s.pixel_start[p], end = begin + s.pixel_count[p];
-        uint32_t* tri = s.multi_fragment.data();
-        float* depth = s.multi_depth.data();
-        for (uint32_t i = begin + 1; i < end; ++i) {
-            const float d = depth[i];
-            const uint32_t t = tri[i];
-            uint32_t j = i;
-            for (; j > begin && (depth[j - 1] > d || (depth[j - 1] == d && tri[j - 1] > t)); --j) {
-                depth[j] = depth[j - 1];
-                tri[j] = tri[j - 1];
+    // `from` now holds the fragments by pixel (rasterisation order kept within a pixel).
+    s.visible = 0;
+    s.single_pixels.clear();
+    s.multi_pixel.clear();
+    s.multi_start.clear();
+    if (s.multi_fragment.size() < n) s.multi_fragment.resize(n);
+    uint32_t* out = s.multi_fragment.data();
+    uint32_t written = 0;
+    for (size_t i = 0; i < n;) {
+        size_t end = i + 1;
+        while (end < n && from[end].pixel == from[i].pixel) ++end;
+        ++s.visible;
+        if (end - i == 1) {
+            s.single_pixels.push_back(from[i].pixel);
+        } else {
+            // Insertion sort in place by (depth, triangle): a handful of fragments, deterministic.
+            for (size_t j = i + 1; j < end; ++j) {
+                const Fragment f = from[j];
+                size_t k = j;
+                for (; k > i && (from[k - 1].depth > f.depth ||
+                                 (from[k - 1].depth == f.depth && from[k - 1].triangle > f.triangle));
+                     --k)
+                    from[k] = from[k - 1];
+                from[k] = f;
             }
-            depth[j] = d;
-            tri[j] = t;
+            s.multi_pixel.push_back(from[i].pixel);
+            s.multi_start.push_back(written);
+            out[written++] = from[i].triangle;
+            for (size_t j = i + 1; j < end; ++j)
+                out[written++] = from[j].triangle | (from[j].depth == from[j - 1].depth ? kTieBit : 0);
         }
-        for (uint32_t i = begin + 1; i < end; ++i)
-            if (depth[i] == depth[i - 1]) tri[i] |= kTieBit;
-        s.multi_pixel[m] = uint32_t(p);
-        s.multi_start[m] = begin;
-        ++m;
+        i = end;
     }
-    s.multi_start[multi_pixels] = running;
+    s.multi_count = s.multi_pixel.size();
+    s.multi_start.push_back(written);
+    s.single = s.single_pixels.size();
 }
 
 }  // namespace
@@ -290,7 +275,7 @@ uint64_t NodeRasterizer::fragments() const { return state_->raw_count; }
 
 void NodeRasterizer::visit_fragments(const std::function<void(uint32_t, uint32_t, float)>& visit) const {
     const State& s = *state_;
-    for (size_t f = 0; f < s.raw_count; ++f) visit(s.raw_pixel[f], s.raw_triangle[f], s.raw_depth[f]);
+    for (size_t f = 0; f < s.raw_count; ++f) visit(s.raw[f].pixel, s.raw[f].triangle, s.raw[f].depth);
 }
 
 void NodeRasterizer::rasterize(const float* clip_xyzw, size_t vertex_count, const uint32_t* indices,
@@ -309,7 +294,7 @@ void NodeRasterizer::rasterize(const float* clip_xyzw, size_t vertex_count, cons
         if (s.unclipped[v]) project(cv[v], resolution, s.window[v]);
     }
 
-    FragmentSink sink{s.raw_pixel, s.raw_triangle, s.raw_depth};
+    FragmentSink sink{s.raw};
     for (size_t t = 0; t < index_count / 3; ++t) {
         const uint32_t a = indices[3 * t], b = indices[3 * t + 1], c = indices[3 * t + 2];
         if (s.unclipped[a] & s.unclipped[b] & s.unclipped[c]) {
@@ -427,7 +412,7 @@ std::vector<uint32_t> NodeRasterizer::passed_per_pixel(const uint32_t* ranks, si
     const State& s = *state_;
     if (order_index >= order_count) throw InvalidInput("order index out of range");
     std::vector<uint32_t> image(size_t(s.resolution) * s.resolution, 0);
-    for (size_t p = 0; p < image.size(); ++p) image[p] = s.pixel_count[p] == 1 ? 1 : 0;
+    for (uint32_t p : s.single_pixels) image[p] = 1;
     std::vector<uint32_t> scratch(2 * order_count);
     for (size_t m = 0; m < s.multi_count; ++m) {
         const uint32_t begin = s.multi_start[m];

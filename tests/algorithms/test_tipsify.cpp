@@ -3,6 +3,7 @@
 // (meshopt_optimizeVertexCacheFifo).
 #include "animorder/animated_mesh.h"
 #include "animorder/animorder.h"
+#include "animorder/io.h"
 #include "support/meshes.h"
 
 #include <gtest/gtest.h>
@@ -137,6 +138,21 @@ TEST(Tipsify, AcmrWithinTwoPercentOfMeshoptimizerOnTorusKnots) {
 
 TEST(Tipsify, AcmrWithinTwoPercentOfMeshoptimizerOnTheCharacter) {
     expect_within_two_percent_of_meshoptimizer(make_procedural_character());
+}
+
+TEST(Tipsify, AcmrWithinTwoPercentOfMeshoptimizerOnRealCharacters) {
+    const std::string data = std::string(ANIMORDER_SOURCE_DIR) + "/../shared/data/";
+    const char* files[] = {"mixamo-ganfaul/Ganfaul.gltf", "gltf-cesiumman/CesiumMan.glb", "glb-xbot/Xbot.glb"};
+    for (const char* f : files) {
+        AnimatedMesh mesh;
+        try {
+            mesh = load_gltf(data + f);
+        } catch (const LoadError& e) {
+            GTEST_SKIP() << "../shared/data is absent (" << e.what() << ")";
+        }
+        mesh.name = f;
+        expect_within_two_percent_of_meshoptimizer(mesh);
+    }
 }
 
 TEST(Tipsify, SmallerCacheNeverHelpsAndAllSizesBeatRandom) {

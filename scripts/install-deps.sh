@@ -15,15 +15,29 @@ packages=(
   libtinygltf-dev                          # reading ../shared/data characters in tests
 )
 
+# Node.js runs the Khronos glTF Validator in the tests; any node >= 12 will do (the machine's own
+# counts), else Debian's.
+command -v node >/dev/null 2>&1 && command -v npm >/dev/null 2>&1 || packages+=(nodejs npm)
+
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
-[ ${#missing[@]} -eq 0 ] && exit 0
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "install-deps: installing ${missing[*]}" >&2
+  SUDO=""
+  [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
 
-echo "install-deps: installing ${missing[*]}" >&2
-SUDO=""
-[ "$(id -u)" -eq 0 ] || SUDO="sudo"
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+# The Khronos glTF Validator (npm), pinned, into .tools/ of the repository (ignored by git).
+validator_version=2.0.0-dev.3.10
+here="$(cd "$(dirname "$0")/.." && pwd)"
+if [ ! -f "$here/.tools/node_modules/gltf-validator/package.json" ] ||
+   ! grep -q "\"version\": \"$validator_version\"" "$here/.tools/node_modules/gltf-validator/package.json"; then
+  echo "install-deps: installing gltf-validator $validator_version (npm)" >&2
+  mkdir -p "$here/.tools"
+  npm install --silent --no-audit --no-fund --prefix "$here/.tools" "gltf-validator@$validator_version" >/dev/null
+fi

@@ -18,6 +18,12 @@ struct Primitive {
     std::string name;
     size_t first_index = 0;  // into AnimatedMesh::indices
     size_t index_count = 0;  // multiple of 3
+    // Where it came from, for writers: the file's mesh and primitive, and the mesh vertex of its
+    // vertex 0 (its vertices are vertex_base .. vertex_base + vertex_count − 1). −1: generated.
+    int source_mesh = -1;
+    int source_primitive = -1;
+    size_t vertex_base = 0;
+    size_t vertex_count = 0;
 };
 
 struct Clip {

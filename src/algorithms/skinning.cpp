@@ -22,6 +22,8 @@ void skin_positions(float* out_positions, const float* bind_positions, size_t ve
             const float w = weights[slot];
             if (!std::isfinite(w) || w < 0)
                 throw InvalidInput("vertex " + std::to_string(v) + " has an invalid skin weight");
+            // A zero-weight slot's joint is never read: glTF only says unused joints SHOULD be 0,
+            // and exporters pad with arbitrary ones, so only influences that count are checked.
             if (w == 0) continue;
             if (joints[slot] >= joint_count)
                 throw InvalidInput("vertex " + std::to_string(v) + " names joint " + std::to_string(joints[slot]) +

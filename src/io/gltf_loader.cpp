@@ -322,6 +322,10 @@ AnimatedMesh load_gltf(const std::string& path, const LoadOptions& options) {
             out.name = m.name.empty() ? "primitive" + std::to_string(prims.size()) : m.name + "/" + std::to_string(p);
             out.first_index = mesh.indices.size();
             out.index_count = local.size();
+            out.source_mesh = node.mesh;
+            out.source_primitive = int(p);
+            out.vertex_base = d.vertex_base;
+            out.vertex_count = d.vertex_count;
             for (uint32_t i : local) mesh.indices.push_back(uint32_t(d.vertex_base + i));
             mesh.primitives.push_back(out);
             for (const auto& target : prim.targets) {

@@ -131,6 +131,31 @@ TEST_F(Cli, SingleWritesKBuffersPerClipAndReportsIterations) {
     EXPECT_EQ(nlohmann::json::parse(slurp(path("j.json")))["methods"][0]["buffers"], 3);
 }
 
+TEST_F(Cli, GltfInGltfOut) {
+    const std::string fox = std::string(ANIMORDER_SOURCE_DIR) + "/../shared/data/gltf-fox/Fox.glb";
+    if (!fs::exists(fox)) GTEST_SKIP() << "../shared/data is absent";
+    const std::string fast = " -q -k 2 --views 12 --resolution 32 --max-iterations 2";
+    ASSERT_EQ(run("optimize " + fox + " --method single" + fast + " -o " + path("fox.glb").string() + " --report " +
+                  path("r.json").string()).exit_code, 0);
+    EXPECT_TRUE(fs::exists(path("fox.glb")));
+    EXPECT_TRUE(fs::exists(path("fox.animorder.bin")));
+    const nlohmann::json j = nlohmann::json::parse(slurp(path("r.json")));
+    EXPECT_EQ(j["outputs"]["gltf"], path("fox.glb").string());
+    EXPECT_EQ(j["methods"][0]["buffers"], 6);  // 2 per clip, 3 clips
+    // The written file reads back with the same triangles.
+    const Outcome again = run("inspect --json -q " + path("fox.glb").string());
+    ASSERT_EQ(again.exit_code, 0) << again.err;
+    EXPECT_EQ(nlohmann::json::parse(again.out)["triangles"], 576);
+    // Never over the input; never glTF out of a non-glTF input.
+    fs::copy_file(fox, path("copy.glb"));
+    const Outcome same = run("optimize -q " + path("copy.glb").string() + " -o " + path("copy.glb").string());
+    EXPECT_NE(same.exit_code, 0);
+    EXPECT_NE(same.err.find("refusing to overwrite the input"), std::string::npos) << same.err;
+    const Outcome procedural = run("optimize -q -o " + path("x.glb").string());
+    EXPECT_NE(procedural.exit_code, 0);
+    EXPECT_NE(procedural.err.find("needs a glTF input"), std::string::npos) << procedural.err;
+}
+
 TEST_F(Cli, LambdaChangesTheAcmrTheWayThePaperSays) {
     ASSERT_EQ(run("optimize -q --lambda 0 --report " + path("r0.json").string()).exit_code, 0);
     ASSERT_EQ(run("optimize -q --lambda 3 --report " + path("r3.json").string()).exit_code, 0);

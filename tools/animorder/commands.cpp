@@ -168,6 +168,7 @@ struct MethodRun {
     VertexCacheStats cache;  // of the first buffer; "acmr" in reports is the mean over buffers
     double acmr_mean = 0, atvr_mean = 0;
     double seconds = 0;
+    uint32_t fallback = 0;  // the buffer most nodes chose: what viewers without the table draw
     nlohmann::ordered_json details;
 };
 
@@ -206,6 +207,10 @@ MethodRun run_method(const AnimatedMesh& mesh, const std::string& name, const Me
         const AnimatedMethodResult r = run_han_sander(mesh, name == "joint", m.lambda, common.cache_size, settings);
         run.buffers = r.buffers;
         run.framing = r.framing;
+        std::vector<size_t> chosen(r.buffers.orders.size(), 0);
+        for (size_t i = 0; i < r.runs.size(); ++i)
+            for (uint32_t c : r.runs[i].assignment) ++chosen[(name == "joint" ? 0 : i * m.clusters) + c];
+        run.fallback = uint32_t(std::max_element(chosen.begin(), chosen.end()) - chosen.begin());
         double raster = 0, update = 0, rasterization = 0;
         nlohmann::ordered_json runs = nlohmann::ordered_json::array();
         for (size_t i = 0; i < r.runs.size(); ++i) {
@@ -296,6 +301,7 @@ std::string sidecar_json(const AnimatedMesh& mesh, const MethodRun& run, const s
     j["binary"] = binary_name;
     j["method"] = run.name;
     j["buffers"] = run.buffers.orders.size();
+    j["fallback"] = run.fallback;
     j["index_count"] = mesh.indices.size();
     j["primitives"] = nlohmann::ordered_json::array();
     for (const Primitive& p : mesh.primitives)
@@ -334,13 +340,29 @@ int run_optimize(const OptimizeOptions& options) {
     const MethodRun run = run_method(mesh, method, options.settings, options.common);
     const VertexCacheStats before = analyze_mesh_vertex_cache(mesh, mesh.indices, options.common.cache_size);
 
-    nlohmann::ordered_json outputs = {{"sidecar", nullptr}, {"sidecar_json", nullptr}};
+    nlohmann::ordered_json outputs = {{"gltf", nullptr}, {"sidecar", nullptr}, {"sidecar_json", nullptr}};
     if (!options.output.empty()) {
-        const std::string binary = options.output + ".animorder.bin", json = options.output + ".animorder.json";
+        std::string stem = options.output;
+        const std::string extension = std::filesystem::path(options.output).extension().string();
+        if (extension == ".glb" || extension == ".gltf") {
+            const std::string in_ext = std::filesystem::path(options.common.input).extension().string();
+            if (in_ext != ".glb" && in_ext != ".gltf")
+                throw std::runtime_error(options.output + ": glTF output needs a glTF input (the sidecar works for any input)");
+            std::error_code same_error;
+            if (std::filesystem::equivalent(options.output, options.common.input, same_error))
+                throw std::runtime_error(options.output + ": refusing to overwrite the input; name another output");
+            write_file_atomically(options.output, gltf_with_orders(options.common.input, options.output, mesh, run.buffers, run.fallback,
+                                                                   run.framing, method, extension == ".glb"));
+            outputs["gltf"] = options.output;
+            note(options.common, "wrote " + options.output);
+            stem = options.output.substr(0, options.output.size() - extension.size());
+        }
+        const std::string binary = stem + ".animorder.bin", json = stem + ".animorder.json";
         write_file_atomically(binary, serialize_sidecar(mesh, run.buffers, run.framing));
         const size_t slash = binary.find_last_of('/');
         write_file_atomically(json, sidecar_json(mesh, run, slash == std::string::npos ? binary : binary.substr(slash + 1)));
-        outputs = {{"sidecar", binary}, {"sidecar_json", json}};
+        outputs["sidecar"] = binary;
+        outputs["sidecar_json"] = json;
         note(options.common, "wrote " + binary + " and " + json);
     }
 

@@ -67,7 +67,8 @@ int main(int argc, char** argv) {
     optimize_cmd->add_flag("--joint", optimize.joint, "One set of buffers for all clips (same as --method joint)");
     add_method_options(*optimize_cmd, optimize.settings);
     optimize_cmd->add_option("-o,--output", optimize.output,
-                             "Write OUT.animorder.bin (buffers + lookup tables) and OUT.animorder.json");
+                             "Write OUT.animorder.bin (buffers + lookup tables) and OUT.animorder.json; "
+                             "OUT.glb or OUT.gltf (glTF input) also writes the glTF with the orders");
     optimize_cmd->add_option("-r,--report", optimize.report_path, "Write the JSON report to this file");
 
     EvaluateOptions evaluate;

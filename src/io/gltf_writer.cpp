@@ -1,0 +1,197 @@
+// glTF output: the input file with its primitives drawn in the new orders.
+//
+// Every viewer draws a primitive's `indices`: that accessor now holds the fallback order (the
+// buffer most nodes chose). All k orders of the primitive are further accessors listed in the
+// primitive's `extras.animorder.orders`; the runtime lookup tables and frame centres are
+// accessors named in the root `extras.animorder.clips`. `extras` rather than a vendor extension:
+// nothing has to be declared, no viewer warns, and a loader that knows nothing of animorder
+// still gets a valid, better-ordered file. Everything else — materials, textures, skins,
+// animations, other extras and extensions, vertex arrays — is written back as read: the new
+// indices refer to the file's own vertices. New bytes are appended to buffer 0.
+#include "animorder/io.h"
+
+#include "animorder/animorder.h"
+#include "animorder/clustering.h"
+#include "animorder/evaluation.h"
+
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <cstring>
+#include <map>
+#include <sstream>
+
+namespace animorder {
+namespace {
+
+tinygltf::Model read_model(const std::string& path) {
+    tinygltf::Model model;
+    tinygltf::TinyGLTF loader;
+    loader.SetImageLoader([](tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int,
+                             void*) { return true; },
+                          nullptr);
+    std::string error, warning;
+    std::string magic(4, '\0');
+    if (FILE* f = std::fopen(path.c_str(), "rb")) {
+        if (std::fread(magic.data(), 1, 4, f) != 4) magic.clear();
+        std::fclose(f);
+    }
+    const bool ok = magic == "glTF" ? loader.LoadBinaryFromFile(&model, &error, &warning, path)
+                                     : loader.LoadASCIIFromFile(&model, &error, &warning, path);
+    if (!ok) throw LoadError(path + ": not a readable glTF 2.0 file: " + error);
+    return model;
+}
+
+// Appends bytes to buffer 0 (4-byte aligned) as a new buffer view; returns its index.
+int append_view(tinygltf::Model& model, const void* data, size_t bytes, int target) {
+    if (model.buffers.empty()) model.buffers.emplace_back();
+    std::vector<unsigned char>& buffer = model.buffers[0].data;
+    while (buffer.size() % 4) buffer.push_back(0);
+    tinygltf::BufferView view;
+    view.buffer = 0;
+    view.byteOffset = buffer.size();
+    view.byteLength = bytes;
+    view.target = target;
+    const unsigned char* p = static_cast<const unsigned char*>(data);
+    buffer.insert(buffer.end(), p, p + bytes);
+    model.bufferViews.push_back(view);
+    return int(model.bufferViews.size() - 1);
+}
+
+int append_accessor(tinygltf::Model& model, int view, int component, int type, size_t count, const std::string& name) {
+    tinygltf::Accessor a;
+    a.bufferView = view;
+    a.byteOffset = 0;
+    a.componentType = component;
+    a.type = type;
+    a.count = count;
+    a.name = name;
+    model.accessors.push_back(a);
+    return int(model.accessors.size() - 1);
+}
+
+// The indices of one primitive in one order, local to the primitive's vertices, as the smallest
+// component type that holds them.
+int append_indices(tinygltf::Model& model, const std::vector<uint32_t>& global, const Primitive& p, const std::string& name) {
+    std::vector<uint32_t> local(p.index_count);
+    uint32_t largest = 0;
+    for (size_t i = 0; i < p.index_count; ++i) {
+        local[i] = uint32_t(global[p.first_index + i] - p.vertex_base);
+        largest = std::max(largest, local[i]);
+    }
+    int view;
+    int component;
+    if (largest < 65535) {  // 65535 is the primitive-restart value: never used as an index
+        std::vector<uint16_t> shorts(local.begin(), local.end());
+        view = append_view(model, shorts.data(), shorts.size() * 2, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+        component = TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
+    } else {
+        view = append_view(model, local.data(), local.size() * 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+        component = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+    }
+    const int accessor = append_accessor(model, view, component, TINYGLTF_TYPE_SCALAR, local.size(), name);
+    model.accessors[size_t(accessor)].minValues = {double(*std::min_element(local.begin(), local.end()))};
+    model.accessors[size_t(accessor)].maxValues = {double(largest)};
+    return accessor;
+}
+
+tinygltf::Value with_key(const tinygltf::Value& extras, const std::string& key, tinygltf::Value value) {
+    tinygltf::Value::Object object;
+    if (extras.IsObject()) object = extras.Get<tinygltf::Value::Object>();
+    object[key] = std::move(value);
+    return tinygltf::Value(object);
+}
+
+}  // namespace
+
+std::string gltf_with_orders(const std::string& input_path, const std::string& output_path, const AnimatedMesh& mesh,
+                             const MethodBuffers& buffers, uint32_t fallback, const Framing& framing,
+                             const std::string& method, bool binary) {
+    if (fallback >= buffers.orders.size()) throw LoadError(input_path + ": no buffer " + std::to_string(fallback));
+    tinygltf::Model model = read_model(input_path);
+    std::map<std::pair<int, int>, size_t> seen;
+    for (size_t i = 0; i < mesh.primitives.size(); ++i) {
+        const Primitive& p = mesh.primitives[i];
+        if (p.source_mesh < 0) throw LoadError(input_path + ": the mesh was not read from this file");
+        if (!seen.emplace(std::make_pair(p.source_mesh, p.source_primitive), i).second)
+            throw LoadError(input_path + ": mesh " + std::to_string(p.source_mesh) +
+                            " is drawn by several nodes; glTF output needs one node per mesh (use the sidecar)");
+    }
+    std::vector<std::vector<uint32_t>> index_buffers(buffers.orders.size(), std::vector<uint32_t>(mesh.indices.size()));
+    for (size_t b = 0; b < buffers.orders.size(); ++b)
+        apply_triangle_order(index_buffers[b].data(), mesh.indices.data(), buffers.orders[b].data(), mesh.triangle_count());
+
+    for (const Primitive& p : mesh.primitives) {
+        tinygltf::Primitive& prim = model.meshes[size_t(p.source_mesh)].primitives[size_t(p.source_primitive)];
+        tinygltf::Value::Array orders;
+        int fallback_accessor = -1;
+        for (size_t b = 0; b < buffers.orders.size(); ++b) {
+            const int a = append_indices(model, index_buffers[b], p, "animorder order " + std::to_string(b));
+            orders.push_back(tinygltf::Value(a));
+            if (b == fallback) fallback_accessor = a;
+        }
+        prim.indices = fallback_accessor;
+        prim.mode = TINYGLTF_MODE_TRIANGLES;  // strips and fans were converted to lists
+        tinygltf::Value::Object ours;
+        ours["orders"] = tinygltf::Value(orders);
+        ours["fallback"] = tinygltf::Value(int(fallback));
+        prim.extras = with_key(prim.extras, "animorder", tinygltf::Value(ours));
+    }
+
+    tinygltf::Value::Array clips;
+    for (size_t c = 0; c < mesh.clips.size() && c < buffers.tables.size(); ++c) {
+        const SelectionTable& t = buffers.tables[c];
+        const int cells = append_accessor(model, append_view(model, t.cells.data(), t.cells.size(), 0),
+                                          TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_TYPE_SCALAR, t.cells.size(),
+                                          "animorder table " + mesh.clips[c].name);
+        std::vector<float> centres(framing.centres.begin() + ptrdiff_t(3 * mesh.clips[c].first_keyframe),
+                                   framing.centres.begin() + ptrdiff_t(3 * (mesh.clips[c].first_keyframe + mesh.clips[c].keyframe_count)));
+        const int centre = append_accessor(model, append_view(model, centres.data(), centres.size() * 4, 0),
+                                           TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, mesh.clips[c].keyframe_count,
+                                           "animorder centres " + mesh.clips[c].name);
+        tinygltf::Value::Object clip;
+        clip["name"] = tinygltf::Value(mesh.clips[c].name);
+        clip["keyframes"] = tinygltf::Value(int(t.keyframes));
+        clip["sample_rate"] = tinygltf::Value(mesh.clips[c].sample_rate);
+        clip["buffer_base"] = tinygltf::Value(int(buffers.table_base[c]));
+        clip["theta_steps"] = tinygltf::Value(int(t.theta_steps));
+        clip["phi_steps"] = tinygltf::Value(int(t.phi_steps));
+        clip["table"] = tinygltf::Value(cells);
+        clip["centres"] = tinygltf::Value(centre);
+        clips.push_back(tinygltf::Value(clip));
+    }
+    tinygltf::Value::Object root;
+    root["version"] = tinygltf::Value(1);
+    root["method"] = tinygltf::Value(method);
+    root["buffers"] = tinygltf::Value(int(buffers.orders.size()));
+    root["fallback"] = tinygltf::Value(int(fallback));
+    root["clips"] = tinygltf::Value(clips);
+    root["table_layout"] = tinygltf::Value(std::string(
+        "cell (f, i, j) at f*theta_steps*phi_steps + i*phi_steps + j: theta = i*pi/(theta_steps-1) from +Y, "
+        "phi = j*2*pi/phi_steps from +Z towards +X; order = buffer_base + cell (see animorder_runtime.h)"));
+    model.extras = with_key(model.extras, "animorder", tinygltf::Value(root));
+    model.buffers[0].uri.clear();  // embedded: the output stands alone
+    // Image files stay where they are: a relative URI is re-expressed from the output's folder.
+    namespace fs = std::filesystem;
+    const fs::path from = fs::absolute(fs::path(input_path)).parent_path();
+    const fs::path to = fs::absolute(fs::path(output_path)).parent_path();
+    for (tinygltf::Image& image : model.images)
+        if (!image.uri.empty() && image.uri.rfind("data:", 0) != 0 && image.uri.find("://") == std::string::npos &&
+            fs::path(image.uri).is_relative() && from != to)
+            image.uri = fs::relative(from / image.uri, to).generic_string();
+
+    tinygltf::TinyGLTF writer;
+    writer.SetImageWriter([](const std::string*, const std::string*, const tinygltf::Image* image, bool, std::string* uri,
+                             void*) {
+        *uri = image->uri;  // never decoded, never rewritten: external images keep their URIs
+        return true;
+    },
+                          nullptr);
+    std::ostringstream out;
+    if (!writer.WriteGltfSceneToStream(&model, out, !binary, binary))
+        throw LoadError(input_path + ": writing the glTF output failed");
+    return out.str();
+}
+
+}  // namespace animorder

@@ -12,7 +12,8 @@ packages=(
   libbenchmark-dev                         # benchmarks
   libmeshoptimizer-dev                     # independent reference in tests and benchmarks
   libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri  # OpenGL reference (llvmpipe)
-  libtinygltf-dev                          # reading ../shared/data characters in tests
+  libtinygltf-dev                          # glTF 2.0 in and out
+  libassimp-dev                            # FBX, Collada, .X, .b3d, MD5, ...
 )
 
 # Node.js runs the Khronos glTF Validator in the tests; any node >= 12 will do (the machine's own

@@ -7,6 +7,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace animorder {
 
@@ -29,6 +30,19 @@ struct LoadOptions {
 // inverse bind matrices, weights normalised), morph target weights (default, node, animated;
 // sparse accessors). A file without animation is one clip "static" of one keyframe.
 AnimatedMesh load_gltf(const std::string& path, const LoadOptions& options = {});
+
+// Any format assimp reads (FBX, Collada, .X, .b3d, MD5, OBJ, …): meshes in node order with their
+// own vertices (identical vertices joined), bones (8 strongest weights, normalised), node
+// animations sampled at sample_rate. clip_files: Mixamo-style animation-only files whose
+// channels drive the character's joints by node name; each adds its animations as clips (named
+// after the file), and a file none of whose joints the character has is an error.
+AnimatedMesh load_assimp(const std::string& path, const std::vector<std::string>& clip_files = {},
+                         const LoadOptions& options = {});
+
+// By extension: .gltf/.glb → load_gltf (no clip files), anything else → load_assimp. A folder in
+// clip_files stands for the files in it, in name order.
+AnimatedMesh load_character(const std::string& path, const std::vector<std::string>& clip_files = {},
+                            const LoadOptions& options = {});
 
 // The glTF file `input_path` (which `mesh` was loaded from) with the method's orders: each
 // primitive's `indices` holds buffer `fallback`, `extras.animorder.orders` lists an accessor per

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 #include <vector>
 
 using namespace animorder;
@@ -27,6 +28,16 @@ TEST(Skinning, IdentityKeepsBindPositions) {
     std::vector<float> out(6);
     skin_positions(out.data(), bind.data(), 2, joints.data(), weights.data(), 1, &m, 1);
     EXPECT_EQ(out, bind);
+}
+
+TEST(Skinning, SingleTranslatingJointMovesEveryVertex) {
+    const std::vector<float> bind{0, 0, 0, 1, -2, 0.5f, -3, 4, 10};
+    const std::vector<uint16_t> joints{0, 0, 0};
+    const std::vector<float> weights{1, 1, 1};
+    const Mat4 m = translate(1, 2, 3);
+    std::vector<float> out(9);
+    skin_positions(out.data(), bind.data(), 3, joints.data(), weights.data(), 1, &m, 1);
+    EXPECT_EQ(out, (std::vector<float>{1, 2, 3, 2, 0, 3.5f, -2, 6, 13}));
 }
 
 TEST(Skinning, BlendsTwoJointsByWeight) {
@@ -65,4 +76,22 @@ TEST(Skinning, RejectsBadJointsAndWeights) {
     const std::vector<uint16_t> ok{0};
     const std::vector<float> nan{std::nanf("")};
     EXPECT_THROW(skin_positions(out.data(), bind.data(), 1, ok.data(), nan.data(), 1, &m, 1), InvalidInput);
+    const std::vector<float> infinite{INFINITY};
+    EXPECT_THROW(skin_positions(out.data(), bind.data(), 1, ok.data(), infinite.data(), 1, &m, 1), InvalidInput);
+    try {
+        skin_positions(out.data(), bind.data(), 1, bad_joint.data(), one.data(), 1, &m, 1);
+    } catch (const InvalidInput& e) {
+        EXPECT_NE(std::string(e.what()).find("joint 3"), std::string::npos) << e.what();
+    }
+}
+
+TEST(Skinning, IgnoresTheJointOfAZeroWeightSlot) {
+    // glTF pads unused influences with any joint and weight 0; only slots that count are checked.
+    const std::vector<float> bind{1, 0, 0};
+    const std::vector<uint16_t> joints{0, 9};
+    const std::vector<float> weights{1, 0};
+    const Mat4 m = translate(0, 0, 5);
+    std::vector<float> out(3);
+    skin_positions(out.data(), bind.data(), 1, joints.data(), weights.data(), 2, &m, 1);
+    EXPECT_EQ(out, (std::vector<float>{1, 0, 5}));
 }

@@ -33,13 +33,26 @@ void expect_rejected(const std::function<void(AnimatedMesh&)>& damage, const std
 }
 }  // namespace
 
-TEST(AnimatedMesh, AcceptsAConsistentMesh) { EXPECT_NO_THROW(validate_animated_mesh(good())); }
+TEST(AnimatedMesh, AcceptsAConsistentMesh) {
+    EXPECT_NO_THROW(validate_animated_mesh(good()));
+    AnimatedMesh spare = good();  // keyframes no clip uses are allowed
+    spare.keyframe_positions.resize(3 * 4 * 3, 0.25f);
+    EXPECT_NO_THROW(validate_animated_mesh(spare));
+}
 
 TEST(AnimatedMesh, NamesEachDefect) {
-    expect_rejected([](AnimatedMesh& m) { m.indices[5] = 9; }, "primitive 'b' is 9");
+    expect_rejected([](AnimatedMesh& m) { m.indices[5] = 9; }, "index 2 of primitive 'b' is 9, vertex count is 4");
+    expect_rejected(
+        [](AnimatedMesh& m) {
+            m.indices.push_back(0);
+            m.primitives[1].index_count = 4;
+        },
+        "not a multiple of 3");
     expect_rejected([](AnimatedMesh& m) { m.primitives[1].first_index = 2; }, "does not continue");
     expect_rejected([](AnimatedMesh& m) { m.primitives.pop_back(); }, "cover 3 of 6");
     expect_rejected([](AnimatedMesh& m) { m.keyframe_positions.pop_back(); }, "not a whole number of keyframes");
     expect_rejected([](AnimatedMesh& m) { m.clips[0].keyframe_count = 3; }, "clip 'clip'");
+    expect_rejected([](AnimatedMesh& m) { m.clips[0].first_keyframe = 2; }, "clip 'clip' spans keyframes 2..4");
+    expect_rejected([](AnimatedMesh& m) { m.clips[0].keyframe_count = 0; }, "clip 'clip'");
     expect_rejected([](AnimatedMesh& m) { m.keyframe_positions[13] = NAN; }, "keyframe 1: position of vertex 0");
 }

@@ -27,6 +27,22 @@ double mean_displacement(const AnimatedMesh& m, size_t a, size_t b) {
     }
     return sum / double(m.vertex_count);
 }
+
+// Connected components of the index buffer (union-find over triangle corners): the parts.
+std::vector<uint32_t> component_of_vertex(const AnimatedMesh& m) {
+    std::vector<uint32_t> parent(m.vertex_count);
+    for (uint32_t v = 0; v < parent.size(); ++v) parent[v] = v;
+    auto root = [&](uint32_t v) {
+        while (parent[v] != v) v = parent[v] = parent[parent[v]];
+        return v;
+    };
+    for (size_t t = 0; t < m.indices.size(); t += 3) {
+        parent[root(m.indices[t])] = root(m.indices[t + 1]);
+        parent[root(m.indices[t + 1])] = root(m.indices[t + 2]);
+    }
+    for (uint32_t v = 0; v < parent.size(); ++v) parent[v] = root(v);
+    return parent;
+}
 }  // namespace
 
 TEST(ProceduralCharacter, SizeAndStructure) {
@@ -64,6 +80,24 @@ TEST(ProceduralCharacter, EveryKeyframeIsClosedAndOutward) {
         }
         EXPECT_GT(volume, 0.05) << "keyframe " << k;  // a body of tens of litres, outward
         EXPECT_LT(volume, 0.2) << "keyframe " << k;
+    }
+}
+
+TEST(ProceduralCharacter, EveryPartIsOutwardInEveryKeyframe) {
+    // Per part, not just in total: one part wound inward would hide inside a positive sum.
+    const AnimatedMesh& m = character();
+    const std::vector<uint32_t> component = component_of_vertex(m);
+    for (size_t k = 0; k < m.keyframe_count(); ++k) {
+        const float* p = m.keyframe(k);
+        std::map<uint32_t, double> volume;
+        for (size_t t = 0; t < m.indices.size(); t += 3) {
+            const float *a = p + 3 * m.indices[t], *b = p + 3 * m.indices[t + 1], *c = p + 3 * m.indices[t + 2];
+            volume[component[m.indices[t]]] += (double(a[0]) * (double(b[1]) * c[2] - double(b[2]) * c[1]) -
+                                                double(a[1]) * (double(b[0]) * c[2] - double(b[2]) * c[0]) +
+                                                double(a[2]) * (double(b[0]) * c[1] - double(b[1]) * c[0])) / 6.0;
+        }
+        ASSERT_GE(volume.size(), 7u);  // torso, head, two arms, two legs, shield at least
+        for (const auto& [part, v] : volume) EXPECT_GT(v, 1e-4) << "keyframe " << k << ", part of vertex " << part;
     }
 }
 

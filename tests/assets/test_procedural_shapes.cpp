@@ -1,5 +1,6 @@
 // The procedural test meshes: sizes, closed manifolds, outward winding, no degenerate triangles.
 #include "animorder/animated_mesh.h"
+#include "animorder/animorder.h"
 
 #include <gtest/gtest.h>
 
@@ -42,7 +43,23 @@ double smallest_area(const AnimatedMesh& m) {
     }
     return smallest;
 }
+
+// One primitive over the whole buffer and one clip "static" of one keyframe, valid.
+void expect_static_layout(const AnimatedMesh& m) {
+    EXPECT_NO_THROW(validate_animated_mesh(m));
+    ASSERT_EQ(m.primitives.size(), 1u);
+    EXPECT_EQ(m.primitives[0].index_count, m.indices.size());
+    ASSERT_EQ(m.clips.size(), 1u);
+    EXPECT_EQ(m.clips[0].name, "static");
+    EXPECT_EQ(m.clips[0].keyframe_count, 1u);
+    EXPECT_EQ(m.keyframe_count(), 1u);
+}
 }  // namespace
+
+TEST(ProceduralShapes, StaticLayout) {
+    expect_static_layout(make_uv_sphere(1000));
+    expect_static_layout(make_torus_knot(1000, 3, 5));
+}
 
 TEST(ProceduralShapes, SphereIsClosedOutwardAndNearTheTargetSize) {
     for (size_t target : {10000u, 50000u, 200000u}) {

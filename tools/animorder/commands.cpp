@@ -38,31 +38,25 @@ void note(const CommonOptions& common, const std::string& text) {
     if (!common.quiet) std::fprintf(stderr, "animorder: %s\n", text.c_str());
 }
 
-AnimatedMesh load_file(const CommonOptions& common, std::string& input_name);
-
-// The input named on the command line (or the bundled character), keeping only --clip clips.
+// The input named on the command line (or the bundled character). --clip values that exist on
+// disk are clip files or folders (Mixamo style); the others name the clips to keep.
 AnimatedMesh load_input(const CommonOptions& common, std::string& input_name) {
-    AnimatedMesh mesh = load_file(common, input_name);
-    return common.clips.empty() ? mesh : select_clips(mesh, common.clips);
-}
-
-AnimatedMesh load_file(const CommonOptions& common, std::string& input_name) {
+    std::vector<std::string> clip_files, clip_names;
+    for (const std::string& c : common.clips) (std::filesystem::exists(c) ? clip_files : clip_names).push_back(c);
+    AnimatedMesh mesh;
     if (common.input.empty()) {
+        if (!clip_files.empty()) throw std::runtime_error("clip files need an input character file");
         note(common, "no input file given: using the bundled procedural character");
         input_name = kBundledName;
-        return make_procedural_character();
-    }
-    input_name = common.input;
-    std::string extension = std::filesystem::path(common.input).extension().string();
-    std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    if (extension == ".gltf" || extension == ".glb") {
-        AnimatedMesh mesh = load_gltf(common.input);
+        mesh = make_procedural_character();
+    } else {
+        input_name = common.input;
+        mesh = load_character(common.input, clip_files);
         note(common, "loaded " + common.input + ": " + std::to_string(mesh.triangle_count()) + " triangles, " +
-                         std::to_string(mesh.clips.size()) + " clips, " + std::to_string(mesh.keyframe_count()) + " keyframes");
-        return mesh;
+                         std::to_string(mesh.clips.size()) + " clips, " + std::to_string(mesh.keyframe_count()) +
+                         " keyframes");
     }
-    throw std::runtime_error(common.input + ": cannot read '" + extension +
-                             "' files yet (glTF 2.0 .gltf/.glb only; FBX, Collada, MD2/MD5, .X, .b3d come with assimp)");
+    return clip_names.empty() ? mesh : select_clips(mesh, clip_names);
 }
 
 // The view radius R of every clip (DESIGN.md framing): the largest per-keyframe bounding radius.

@@ -12,7 +12,8 @@ namespace {
 void add_common(CLI::App& command, animorder::tool::CommonOptions& common) {
     command.add_option("input", common.input, "Input mesh (default: the bundled procedural character)");
     command.add_flag("-q,--quiet", common.quiet, "No progress or notes on stderr");
-    command.add_option("--clip", common.clips, "Only this clip (repeat for several)");
+    command.add_option("--clip", common.clips,
+                       "A clip to keep (by name), or a clip file / folder of clip files to add (Mixamo style); repeatable");
     command.add_option("--cache-size", common.cache_size, "FIFO vertex cache entries for ACMR and Tipsify")
         ->check(CLI::Range(3u, 1024u));
 }

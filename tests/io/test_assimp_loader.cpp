@@ -1,0 +1,105 @@
+// The assimp loader on every non-glTF character of ../shared/data (skipped with a message when
+// the folder is absent): triangle counts of shared/data/README.md, Mixamo clip folders matched by
+// joint name, skin that stretches without tearing, and one-line errors.
+#include "animorder/io.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+using namespace animorder;
+namespace fs = std::filesystem;
+
+namespace {
+const std::string kData = std::string(ANIMORDER_SOURCE_DIR) + "/../shared/data/";
+
+// Median over a clip's keyframes of edge length / edge length at its first keyframe.
+double median_stretch(const AnimatedMesh& m, const Clip& c) {
+    std::vector<double> ratios;
+    const size_t step = std::max<size_t>(1, c.keyframe_count / 6);
+    for (size_t f = step; f < c.keyframe_count; f += step)
+        for (size_t t = 0; t < m.indices.size(); t += 3)
+            for (int i = 0; i < 3; ++i) {
+                const uint32_t a = m.indices[t + size_t(i)], b = m.indices[t + size_t(i + 1) % 3];
+                auto length = [&](size_t k) {
+                    const float *p = m.keyframe(k) + 3 * a, *q = m.keyframe(k) + 3 * b;
+                    return std::sqrt(double(p[0] - q[0]) * (p[0] - q[0]) + double(p[1] - q[1]) * (p[1] - q[1]) +
+                                     double(p[2] - q[2]) * (p[2] - q[2]));
+                };
+                const double base = length(c.first_keyframe);
+                if (base > 0) ratios.push_back(length(c.first_keyframe + f) / base);
+            }
+    if (ratios.empty()) return 1.0;
+    std::nth_element(ratios.begin(), ratios.begin() + ptrdiff_t(ratios.size() / 2), ratios.end());
+    return ratios[ratios.size() / 2];
+}
+}  // namespace
+
+TEST(AssimpCharacters, EveryCharacterInSharedDataLoadsWithItsClips) {
+    if (!fs::exists(kData)) GTEST_SKIP() << "../shared/data is absent: real characters not checked";
+    struct Case {
+        const char* file;
+        const char* clips;  // folder of Mixamo-style clip files, or ""
+        size_t triangles;
+        size_t min_clips;
+    };
+    const Case cases[] = {{"pg-barbarian/model.fbx", "pg-barbarian/anims", 6520, 11},
+                          {"pg-goblin/model.fbx", "pg-goblin/anims", 7820, 5},
+                          {"pg-witch/model.fbx", "pg-witch/anims", 7592, 7},
+                          {"x-wuson/Testwuson.X", "", 3732, 3},
+                          {"x-dwarf/dwarf.x", "", 1896, 1},
+                          {"b3d-dwarf2/dwarf2.b3d", "", 1896, 1},
+                          {"md5-bob/Bob.md5mesh", "", 1027, 1},
+                          {"x-bcn-epileptic/BCN_Epileptic.X", "", 5126, 1},
+                          {"iqm-mrfixit/mrfixit.iqm", "", 2988, 1},
+                          {"md2-dolphin/dolphin.md2", "", 500, 1},
+                          {"md2-sydney/sydney.md2", "", 679, 1},
+                          {"md2-faerie/faerie.md2", "", 654, 1}};
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.file);
+        std::vector<std::string> clips;
+        if (*c.clips) clips.push_back(kData + c.clips);
+        AnimatedMesh m;
+        ASSERT_NO_THROW(m = load_character(kData + c.file, clips));
+        EXPECT_EQ(m.triangle_count(), c.triangles);
+        EXPECT_GE(m.clips.size(), c.min_clips);
+        EXPECT_NO_THROW(validate_animated_mesh(m));
+        for (const Clip& clip : m.clips)
+            if (m.joint_count > 0 && clip.keyframe_count > 2) {
+                EXPECT_NEAR(median_stretch(m, clip), 1.0, 0.03) << clip.name;
+            }
+        std::printf("%-34s %5zu triangles %3zu joints %2zu clips %4zu keyframes\n", c.file, m.triangle_count(),
+                    m.joint_count, m.clips.size(), m.keyframe_count());
+    }
+}
+
+TEST(AssimpCharacters, ClipFilesOfAnotherSkeletonAreRefused) {
+    if (!fs::exists(kData)) GTEST_SKIP() << "../shared/data is absent";
+    try {
+        load_character(kData + "pg-barbarian/model.fbx", {kData + "x-dwarf/dwarf.x"});
+        FAIL() << "no error";
+    } catch (const LoadError& e) {
+        EXPECT_NE(std::string(e.what()).find("is a joint of"), std::string::npos) << e.what();
+    }
+}
+
+TEST(AssimpLoader, BrokenFilesGiveOneLineErrors) {
+    const fs::path dir = fs::temp_directory_path() / ("animorder-assimp-" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    const fs::path junk = dir / "junk.fbx";
+    std::ofstream(junk) << "Kaydara FBX Binary  \x00\x1a\x00 truncated";
+    for (const fs::path& p : {junk, dir / "missing.x"}) {
+        try {
+            load_character(p.string());
+            ADD_FAILURE() << p << ": no error";
+        } catch (const LoadError& e) {
+            const std::string what = e.what();
+            EXPECT_EQ(what.rfind(p.string(), 0), 0u) << what;
+            EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+        }
+    }
+    fs::remove_all(dir);
+}

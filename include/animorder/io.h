@@ -39,7 +39,12 @@ AnimatedMesh load_gltf(const std::string& path, const LoadOptions& options = {})
 AnimatedMesh load_assimp(const std::string& path, const std::vector<std::string>& clip_files = {},
                          const LoadOptions& options = {});
 
-// By extension: .gltf/.glb → load_gltf (no clip files), anything else → load_assimp. A folder in
+// Quake II MD2 with every frame (assimp reads only the first): frames grouped into clips by name
+// ("run1".."run6" → "run"), played at MD2's 10 frames per second and resampled at sample_rate.
+AnimatedMesh load_md2(const std::string& path, const LoadOptions& options = {});
+
+// By extension: .gltf/.glb → load_gltf and .md2 → load_md2 (no clip files), anything else →
+// load_assimp. A folder in
 // clip_files stands for the files in it, in name order.
 AnimatedMesh load_character(const std::string& path, const std::vector<std::string>& clip_files = {},
                             const LoadOptions& options = {});

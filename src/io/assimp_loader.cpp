@@ -270,9 +270,9 @@ AnimatedMesh load_character(const std::string& path, const std::vector<std::stri
     }
     std::string extension = std::filesystem::path(path).extension().string();
     std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char ch) { return char(std::tolower(ch)); });
-    if (extension == ".gltf" || extension == ".glb") {
-        if (!files.empty()) throw LoadError(path + ": clip files apply to assimp formats (glTF files carry their clips)");
-        return load_gltf(path, options);
+    if (extension == ".gltf" || extension == ".glb" || extension == ".md2") {
+        if (!files.empty()) throw LoadError(path + ": clip files apply to assimp formats (this file carries its clips)");
+        return extension == ".md2" ? load_md2(path, options) : load_gltf(path, options);
     }
     return load_assimp(path, files, options);
 }

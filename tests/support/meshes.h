@@ -5,6 +5,7 @@
 #include "animorder/animorder.h"
 
 #include <algorithm>
+#include <cmath>
 #include <array>
 #include <cstdint>
 #include <random>
@@ -56,6 +57,30 @@ inline std::vector<uint32_t> applied(const std::vector<uint32_t>& indices, const
     std::vector<uint32_t> out(indices.size());
     apply_triangle_order(out.data(), indices.data(), order.data(), order.size());
     return out;
+}
+
+// Edge length at keyframe b over edge length at keyframe a, for every corner edge of every
+// triangle whose edge has non-zero length at a.
+inline std::vector<double> edge_stretch(const AnimatedMesh& m, size_t a, size_t b) {
+    std::vector<double> ratios;
+    for (size_t t = 0; t < m.indices.size(); t += 3)
+        for (int i = 0; i < 3; ++i) {
+            const uint32_t u = m.indices[t + size_t(i)], v = m.indices[t + size_t(i + 1) % 3];
+            auto length = [&](size_t k) {
+                const float *p = m.keyframe(k) + 3 * u, *q = m.keyframe(k) + 3 * v;
+                return std::sqrt(double(p[0] - q[0]) * (p[0] - q[0]) + double(p[1] - q[1]) * (p[1] - q[1]) +
+                                 double(p[2] - q[2]) * (p[2] - q[2]));
+            };
+            const double base = length(a);
+            if (base > 0) ratios.push_back(length(b) / base);
+        }
+    return ratios;
+}
+
+inline double median(std::vector<double> values) {
+    if (values.empty()) return 0.0;
+    std::nth_element(values.begin(), values.begin() + ptrdiff_t(values.size() / 2), values.end());
+    return values[values.size() / 2];
 }
 
 }  // namespace animorder::test

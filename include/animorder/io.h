@@ -43,8 +43,11 @@ AnimatedMesh load_assimp(const std::string& path, const std::vector<std::string>
 // ("run1".."run6" → "run"), played at MD2's 10 frames per second and resampled at sample_rate.
 AnimatedMesh load_md2(const std::string& path, const LoadOptions& options = {});
 
-// By extension: .gltf/.glb → load_gltf and .md2 → load_md2 (no clip files), anything else →
-// load_assimp. A folder in
+// Inter-Quake Models (IQM v2) with their skeletal animations (assimp reads only the mesh).
+AnimatedMesh load_iqm(const std::string& path, const LoadOptions& options = {});
+
+// By extension: .gltf/.glb → load_gltf, .md2 → load_md2, .iqm → load_iqm (no clip files),
+// anything else → load_assimp. A folder in
 // clip_files stands for the files in it, in name order.
 AnimatedMesh load_character(const std::string& path, const std::vector<std::string>& clip_files = {},
                             const LoadOptions& options = {});

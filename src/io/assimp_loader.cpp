@@ -270,9 +270,11 @@ AnimatedMesh load_character(const std::string& path, const std::vector<std::stri
     }
     std::string extension = std::filesystem::path(path).extension().string();
     std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char ch) { return char(std::tolower(ch)); });
-    if (extension == ".gltf" || extension == ".glb" || extension == ".md2") {
+    if (extension == ".gltf" || extension == ".glb" || extension == ".md2" || extension == ".iqm") {
         if (!files.empty()) throw LoadError(path + ": clip files apply to assimp formats (this file carries its clips)");
-        return extension == ".md2" ? load_md2(path, options) : load_gltf(path, options);
+        if (extension == ".md2") return load_md2(path, options);
+        if (extension == ".iqm") return load_iqm(path, options);
+        return load_gltf(path, options);
     }
     return load_assimp(path, files, options);
 }

@@ -11,6 +11,7 @@
 #include "animorder/io.h"
 
 #include "animorder/animorder.h"
+#include "transform.h"
 
 #include <tiny_gltf.h>
 
@@ -23,30 +24,11 @@
 namespace animorder {
 namespace {
 
-using Mat = std::array<double, 16>;  // column-major
-using Quat = std::array<double, 4>;  // x, y, z, w
-
-Mat identity() { return {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}; }
-Mat mul(const Mat& a, const Mat& b) {
-    Mat r{};
-    for (int c = 0; c < 4; ++c)
-        for (int row = 0; row < 4; ++row) {
-            double s = 0;
-            for (int k = 0; k < 4; ++k) s += a[k * 4 + row] * b[c * 4 + k];
-            r[c * 4 + row] = s;
-        }
-    return r;
-}
-Mat trs(const std::array<double, 3>& t, const Quat& q, const std::array<double, 3>& s) {
-    const double x = q[0], y = q[1], z = q[2], w = q[3];
-    Mat m = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w), 2 * (x * z - y * w), 0,
-             2 * (x * y - z * w), 1 - 2 * (x * x + z * z), 2 * (y * z + x * w), 0,
-             2 * (x * z + y * w), 2 * (y * z - x * w), 1 - 2 * (x * x + y * y), 0,
-             t[0], t[1], t[2], 1};
-    for (int c = 0; c < 3; ++c)
-        for (int r = 0; r < 3; ++r) m[c * 4 + r] *= s[c];
-    return m;
-}
+using io::Mat;
+using io::Quat;
+using io::identity;
+using io::mul;
+using io::trs;
 
 class Reader {
 public:

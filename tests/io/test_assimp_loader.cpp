@@ -46,7 +46,7 @@ TEST(AssimpCharacters, EveryCharacterInSharedDataLoadsWithItsClips) {
                           {"b3d-dwarf2/dwarf2.b3d", "", 1896, 1},
                           {"md5-bob/Bob.md5mesh", "", 1027, 1},
                           {"x-bcn-epileptic/BCN_Epileptic.X", "", 5126, 1},
-                          {"iqm-mrfixit/mrfixit.iqm", "", 2988, 1},
+                          {"iqm-mrfixit/mrfixit.iqm", "", 2988, 1},  // own reader: skeletal idle of 101 frames
                           {"md2-dolphin/dolphin.md2", "", 500, 1},
                           {"md2-sydney/sydney.md2", "", 679, 16},
                           {"md2-faerie/faerie.md2", "", 654, 16}};
@@ -96,6 +96,32 @@ TEST(Md2, EveryFrameIsAKeyframeAndFrontsFaceOut) {
     std::ofstream(cut, std::ios::binary) << bytes.substr(0, bytes.size() / 2);
     EXPECT_THROW(load_character(cut.string()), LoadError);
     fs::remove(cut);
+}
+
+TEST(Iqm, SkeletalAnimationMovesAndFrontsFaceOut) {
+    const std::string path = kData + "iqm-mrfixit/mrfixit.iqm";
+    if (!fs::exists(path)) GTEST_SKIP() << "../shared/data is absent";
+    const AnimatedMesh m = load_character(path);
+    ASSERT_EQ(m.clips.size(), 1u);
+    EXPECT_EQ(m.joint_count, 75u);
+    EXPECT_GT(m.keyframe_count(), 50u);
+    // Real motion, no tearing.
+    const Clip& c = m.clips[0];
+    const std::vector<double> r = test::edge_stretch(m, c.first_keyframe, c.first_keyframe + c.keyframe_count / 2);
+    EXPECT_NEAR(test::median(r), 1.0, 0.03);
+    double moved = 0;
+    for (size_t i = 0; i < m.vertex_count * 3; ++i)
+        moved = std::max(moved, double(std::fabs(m.keyframe(c.keyframe_count / 2)[i] - m.keyframe(0)[i])));
+    EXPECT_GT(moved, 0.01);
+    double volume = 0;
+    const float* p = m.keyframe(0);
+    for (size_t t = 0; t < m.indices.size(); t += 3) {
+        const float *a = p + 3 * m.indices[t], *b = p + 3 * m.indices[t + 1], *d = p + 3 * m.indices[t + 2];
+        volume += (double(a[0]) * (double(b[1]) * d[2] - double(b[2]) * d[1]) -
+                   double(a[1]) * (double(b[0]) * d[2] - double(b[2]) * d[0]) +
+                   double(a[2]) * (double(b[0]) * d[1] - double(b[1]) * d[0])) / 6.0;
+    }
+    EXPECT_GT(volume, 0.0);
 }
 
 TEST(AssimpCharacters, ClipFilesOfAnotherSkeletonAreRefused) {

@@ -156,6 +156,21 @@ TEST_F(Cli, GltfInGltfOut) {
     EXPECT_NE(procedural.err.find("needs a glTF input"), std::string::npos) << procedural.err;
 }
 
+TEST_F(Cli, ZeroAreaMeshIsAnError) {
+    // One triangle with collinear corners, in an embedded-buffer glTF.
+    const std::string gltf =
+        R"({"asset":{"version":"2.0"},"buffers":[{"byteLength":44,"uri":"data:application/octet-stream;base64,)"
+        R"(AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAQAAAAAAAAAAAAAABAAIAAAA="}],)"
+        R"("bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":36},{"buffer":0,"byteOffset":36,"byteLength":6}],)"
+        R"("accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"},)"
+        R"({"bufferView":1,"componentType":5123,"count":3,"type":"SCALAR"}],)"
+        R"("meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}],"nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}]})";
+    std::ofstream(path("flat.gltf")) << gltf;
+    const Outcome o = run("optimize -q " + path("flat.gltf").string());
+    EXPECT_NE(o.exit_code, 0);
+    EXPECT_NE(o.err.find("zero area"), std::string::npos) << o.err;
+}
+
 TEST_F(Cli, LambdaChangesTheAcmrTheWayThePaperSays) {
     ASSERT_EQ(run("optimize -q --lambda 0 --report " + path("r0.json").string()).exit_code, 0);
     ASSERT_EQ(run("optimize -q --lambda 3 --report " + path("r3.json").string()).exit_code, 0);

@@ -56,7 +56,17 @@ AnimatedMesh load_input(const CommonOptions& common, std::string& input_name) {
                          std::to_string(mesh.clips.size()) + " clips, " + std::to_string(mesh.keyframe_count()) +
                          " keyframes");
     }
-    return clip_names.empty() ? mesh : select_clips(mesh, clip_names);
+    if (!clip_names.empty()) mesh = select_clips(mesh, clip_names);
+    // A mesh with no area at its first keyframe has nothing to draw, so nothing to reorder.
+    double area = 0;
+    const float* p = mesh.keyframe_count() ? mesh.keyframe(0) : nullptr;
+    for (size_t t = 0; p && t < mesh.indices.size() && area == 0; t += 3) {
+        const float *a = p + 3 * mesh.indices[t], *b = p + 3 * mesh.indices[t + 1], *c = p + 3 * mesh.indices[t + 2];
+        const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+        area += std::fabs(u[1] * v[2] - u[2] * v[1]) + std::fabs(u[2] * v[0] - u[0] * v[2]) + std::fabs(u[0] * v[1] - u[1] * v[0]);
+    }
+    if (area == 0) throw std::runtime_error(input_name + ": every triangle has zero area: nothing to reorder");
+    return mesh;
 }
 
 // The view radius R of every clip (DESIGN.md framing): the largest per-keyframe bounding radius.

@@ -45,6 +45,12 @@ enum class DistanceVariant {
     I3d,   // the I3D poster: skip nodes where p faces wholly away, divide by the nodes that see it
 };
 
+enum class UpdateRule {
+    Paper,     // JCGT 2017 Algorithm 1: every cluster takes its new integrated-distance order
+    Monotone,  // the same, but a cluster keeps its old order unless the new one lowers the mean
+               // OVR of its own nodes (measured): the mean node OVR never rises, k-means settles
+};
+
 struct ClusteringSettings {
     size_t clusters = 5;               // k
     size_t views = 162;                // icosphere viewpoints (12, 42, 162, 642)
@@ -58,6 +64,7 @@ struct ClusteringSettings {
     // iteration's buffers and assignment are returned.
     size_t patience = 4;
     DistanceVariant distance = DistanceVariant::Jcgt;
+    UpdateRule update = UpdateRule::Monotone;
     unsigned threads = 0;
     // Nodes' fragments are kept between iterations (orders change, fragments do not) while they
     // fit in this many bytes; beyond, every iteration rasterises again (slower, same result).
@@ -70,6 +77,7 @@ struct ClusteringIteration {
     double mean_ovr = 0;        // mean node OVR with every node drawn by its assigned buffer
     size_t reassigned = 0;      // nodes whose cluster changed in this assignment step
     size_t reseeded = 0;        // clusters that were empty and got re-seeded
+    size_t accepted = 0;        // Monotone rule: clusters whose new order was kept
     double seconds_raster = 0;  // assignment step (scoring k orders at every node)
     double seconds_update = 0;  // integrated-distance update
 };

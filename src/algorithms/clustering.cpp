@@ -17,6 +17,10 @@
 #include "animorder/clustering.h"
 
 #include <algorithm>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 #include <chrono>
 #include <cmath>
 #include <numeric>
@@ -270,6 +274,8 @@ ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patc
             }
         }
         std::vector<uint8_t> used_as_seed(node_count, 0);
+        std::vector<uint8_t> reseeded(k, 0);
+        const std::vector<std::vector<uint32_t>> previous_orders = result.patch_orders;
         for (size_t c = 0; c < k; ++c) {
             if (members[c] == 0) {
                 // Re-seed from the worst-served node not used yet.
@@ -279,6 +285,7 @@ ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patc
                     if (!used_as_seed[n] && node_ovr[n] > worst_ovr) worst_ovr = node_ovr[n], worst = n;
                 used_as_seed[worst] = 1;
                 result.patch_orders[c] = front_to_back(patches, average, &eyes[3 * (worst % views)]);
+                reseeded[c] = 1;
                 ++log.reseeded;
                 say(settings, "cluster " + std::to_string(c) + " was empty: re-seeded from the viewpoint of node " +
                                   std::to_string(worst) + " (OVR " + std::to_string(worst_ovr) + ")");
@@ -290,10 +297,65 @@ ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patc
                     d[c][p] = seen[c][p] > 0 ? d[c][p] / seen[c][p] : INFINITY;
             result.patch_orders[c] = sort_patches(patches, d[c]);
         }
+        if (settings.update == UpdateRule::Monotone) {
+            // Keep a cluster's new order only if its own nodes' mean OVR does not rise: with the
+            // assignment step (each node to its best buffer) the mean node OVR can then only fall,
+            // so k-means settles instead of cycling. Scored from the kept fragments.
+            std::vector<const uint32_t*> pointers;
+            std::vector<std::vector<uint32_t>> candidate;
+            for (size_t c = 0; c < k; ++c) candidate.push_back(patch_order_to_triangle_order(patches, result.patch_orders[c]));
+            for (const auto& o : candidate) pointers.push_back(o.data());
+            std::vector<uint64_t> candidate_visible(node_count), candidate_passed(node_count * k);
+            if (kept.empty()) {
+                const std::vector<uint32_t> candidate_ranks = make_rank_table(pointers, mesh.triangle_count());
+                score_nodes(candidate_visible.data(), candidate_passed.data(), mesh.keyframe_positions.data(),
+                            mesh.vertex_count, framing, mesh.indices.data(), mesh.indices.size(), nodes.data(), node_count,
+                            candidate_ranks.data(), k, score);
+            } else {
+                // Each node only needs its own cluster's candidate: one order per node, not k.
+                std::vector<std::vector<uint32_t>> single_ranks;
+                for (const uint32_t* o : pointers) single_ranks.push_back(make_rank_table({o}, mesh.triangle_count()));
+                const int threads = settings.threads ? int(settings.threads) : tbb::this_task_arena::max_concurrency();
+                tbb::task_arena arena(threads);
+                arena.execute([&] {
+                    tbb::parallel_for(tbb::blocked_range<size_t>(0, node_count, 64), [&](const tbb::blocked_range<size_t>& r) {
+                        for (size_t n = r.begin(); n != r.end(); ++n) {
+                            const uint32_t c = result.assignment[n];
+                            score_fragments(&candidate_passed[n * k + c], kept[n], single_ranks[c].data(), 1);
+                        }
+                    });
+                });
+            }
+            std::vector<double> before(k, 0.0), after(k, 0.0);
+            for (size_t n = 0; n < node_count; ++n) {
+                if (visible[n] == 0) continue;
+                const uint32_t c = result.assignment[n];
+                before[c] += double(passed[n * k + c]) / double(visible[n]);
+                after[c] += double(candidate_passed[n * k + c]) / double(visible[n]);
+            }
+            for (size_t c = 0; c < k; ++c) {
+                if (reseeded[c]) continue;
+                if (after[c] < before[c]) ++log.accepted;
+                else result.patch_orders[c] = previous_orders[c];  // no better: keep the old buffer
+            }
+        }
         log.seconds_update = seconds_since(update_start);
         result.iterations.push_back(log);
         say(settings, "iteration " + std::to_string(iteration + 1) + ": mean OVR " + std::to_string(log.mean_ovr) + ", " +
-                          std::to_string(log.reassigned) + " nodes reassigned");
+                          std::to_string(log.reassigned) + " nodes reassigned" +
+                          (settings.update == UpdateRule::Monotone
+                               ? ", " + std::to_string(log.accepted) + " of " + std::to_string(k) + " buffers improved"
+                               : std::string()));
+        if (settings.update == UpdateRule::Monotone && log.accepted == 0 && log.reseeded == 0) {
+            // Same buffers, so the next assignment would be this one: k-means has settled.
+            result.converged = true;
+            result.stop_reason = "converged";
+            result.patch_orders = best_orders;
+            result.assignment = best_assignment;
+            result.triangle_orders.clear();
+            for (const auto& o : result.patch_orders) result.triangle_orders.push_back(patch_order_to_triangle_order(patches, o));
+            break;
+        }
     }
     return result;
 }

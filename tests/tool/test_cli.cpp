@@ -194,6 +194,7 @@ TEST_F(Cli, BadInputAndOptionsGiveOneLineErrors) {
         {"optimize -o " + path("no/such/folder/out").string(), "does not exist"},
         {"optimize --method single --views 100", "icosphere"},
         {"optimize --method single --distance far", "--distance"},
+        {"optimize --method single --update fast", "--update"},
         {"optimize --method single --min-separation 400", "min-separation"},
         {"evaluate --methods original,best", "unknown method 'best'"},
         {"inspect --clip run", "no clip named 'run' (clips: walk, wave)"},

@@ -182,6 +182,12 @@ DistanceVariant parse_distance(const std::string& name) {
     throw std::runtime_error("--distance must be jcgt or i3d, not '" + name + "'");
 }
 
+UpdateRule parse_update(const std::string& name) {
+    if (name == "monotone") return UpdateRule::Monotone;
+    if (name == "paper") return UpdateRule::Paper;
+    throw std::runtime_error("--update must be monotone or paper, not '" + name + "'");
+}
+
 void check_method_options(const MethodOptions& m) {
     check_lambda(m.lambda);
     if (m.clusters == 0 || m.clusters > 255) throw std::runtime_error("-k/--clusters must be between 1 and 255");
@@ -189,6 +195,7 @@ void check_method_options(const MethodOptions& m) {
         throw std::runtime_error("--min-separation must be between 0 and 180 degrees");
     icosphere_subdivisions_for(m.views);  // throws for a count that is no icosphere
     parse_distance(m.distance);
+    parse_update(m.update);
 }
 
 MethodRun run_method(const AnimatedMesh& mesh, const std::string& name, const MethodOptions& m,
@@ -205,6 +212,7 @@ MethodRun run_method(const AnimatedMesh& mesh, const std::string& name, const Me
         settings.min_separation_deg = m.min_separation;
         settings.max_iterations = m.max_iterations;
         settings.distance = parse_distance(m.distance);
+        settings.update = parse_update(m.update);
         settings.threads = m.threads;
         settings.log = [&common, name](const std::string& line) { note(common, name + ": " + line); };
         settings.progress = progress_printer(common, name + ": assigning nodes");
@@ -228,6 +236,7 @@ MethodRun run_method(const AnimatedMesh& mesh, const std::string& name, const Me
                                       {"mean_ovr", x.mean_ovr},
                                       {"reassigned", x.reassigned},
                                       {"reseeded", x.reseeded},
+                                      {"improved_buffers", x.accepted},
                                       {"seconds_assignment", x.seconds_raster},
                                       {"seconds_update", x.seconds_update}});
             }
@@ -244,6 +253,7 @@ MethodRun run_method(const AnimatedMesh& mesh, const std::string& name, const Me
                        {"resolution", m.resolution},
                        {"seed", m.seed},
                        {"distance", m.distance},
+                       {"update", m.update},
                        {"patches", r.patches.patch_count()},
                        {"runs", runs},
                        {"stages_s",
@@ -382,6 +392,7 @@ int run_optimize(const OptimizeOptions& options) {
                           {"min_separation_deg", options.settings.min_separation},
                           {"max_iterations", options.settings.max_iterations},
                           {"distance", options.settings.distance},
+                          {"update", options.settings.update},
                           {"threads", options.settings.threads}};
     report["input_order"] = cache_stats_json(before);
     report["methods"] = nlohmann::ordered_json::array({method_entry(run, options.settings)});

@@ -30,6 +30,7 @@ struct MethodOptions {
     double min_separation = 30;
     size_t max_iterations = 30;
     std::string distance = "jcgt";
+    std::string update = "monotone";
     unsigned threads = 0;
 };
 

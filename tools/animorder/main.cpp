@@ -41,6 +41,9 @@ void add_method_options(CLI::App& command, animorder::tool::MethodOptions& m) {
         ->check(CLI::Range(size_t(1), size_t(1000)));
     command.add_option("--distance", m.distance, "single/joint: jcgt (sum) or i3d (visible-only mean)")
         ->capture_default_str();
+    command.add_option("--update", m.update,
+                       "single/joint: monotone (keep a cluster's new order only if its nodes' OVR falls) or paper")
+        ->capture_default_str();
     command.add_option("--threads", m.threads, "Worker threads (0: all cores)")
         ->capture_default_str()
         ->check(CLI::Range(0u, 1024u));

@@ -36,26 +36,22 @@ aiMatrix4x4 interpolate(const aiNodeAnim* channel, double tick, const aiMatrix4x
         return i;
     };
     auto blend = [tick](double t0, double t1) { return t1 > t0 ? std::clamp((tick - t0) / (t1 - t0), 0.0, 1.0) : 0.0; };
-    if (channel->mNumPositionKeys) {
-        const unsigned i = key_index(channel->mPositionKeys, channel->mNumPositionKeys);
-        const aiVectorKey& a = channel->mPositionKeys[i];
-        const aiVectorKey& b = channel->mPositionKeys[std::min(i + 1, channel->mNumPositionKeys - 1)];
-        const float u = float(blend(a.mTime, b.mTime));
-        t = a.mValue + (b.mValue - a.mValue) * u;
-    }
+    // Position and scaling keys interpolate alike; rotations slerp.
+    auto vector_at = [&](const aiVectorKey* keys, unsigned count, aiVector3D& out) {
+        if (!count) return;
+        const unsigned i = key_index(keys, count);
+        const aiVectorKey& a = keys[i];
+        const aiVectorKey& b = keys[std::min(i + 1, count - 1)];
+        out = a.mValue + (b.mValue - a.mValue) * float(blend(a.mTime, b.mTime));
+    };
+    vector_at(channel->mPositionKeys, channel->mNumPositionKeys, t);
+    vector_at(channel->mScalingKeys, channel->mNumScalingKeys, s);
     if (channel->mNumRotationKeys) {
         const unsigned i = key_index(channel->mRotationKeys, channel->mNumRotationKeys);
         const aiQuatKey& a = channel->mRotationKeys[i];
         const aiQuatKey& b = channel->mRotationKeys[std::min(i + 1, channel->mNumRotationKeys - 1)];
         aiQuaternion::Interpolate(r, a.mValue, b.mValue, float(blend(a.mTime, b.mTime)));
         r.Normalize();
-    }
-    if (channel->mNumScalingKeys) {
-        const unsigned i = key_index(channel->mScalingKeys, channel->mNumScalingKeys);
-        const aiVectorKey& a = channel->mScalingKeys[i];
-        const aiVectorKey& b = channel->mScalingKeys[std::min(i + 1, channel->mNumScalingKeys - 1)];
-        const float u = float(blend(a.mTime, b.mTime));
-        s = a.mValue + (b.mValue - a.mValue) * u;
     }
     return aiMatrix4x4(s, r, t);
 }

@@ -10,7 +10,7 @@ packages=(
   libstb-dev                               # PNG heatmaps
   libgtest-dev libgmock-dev                # tests
   libbenchmark-dev                         # benchmarks
-  libmeshoptimizer-dev                     # independent reference in tests and benchmarks
+  libmeshoptimizer-dev                     # the meshopt baseline; an independent reference in tests
   libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri  # OpenGL reference (llvmpipe)
   libtinygltf-dev                          # glTF 2.0 in and out
   libassimp-dev                            # FBX, Collada, .X, .b3d, MD5, ...

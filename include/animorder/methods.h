@@ -15,8 +15,9 @@
 
 namespace animorder {
 
-// Methods available so far (DESIGN.md names): "original" (Tipsify only) and "static-sander07".
-enum class StaticMethod { Original, StaticSander07 };
+// Single-buffer methods (DESIGN.md names): "original" (Tipsify only), "static-sander07", and
+// "meshopt" (meshoptimizer's optimizeVertexCache + optimizeOverdraw(1.05), the users' baseline).
+enum class StaticMethod { Original, StaticSander07, Meshopt };
 
 // Parses a DESIGN.md method name; throws InvalidInput listing the known names otherwise.
 StaticMethod parse_static_method(const std::string& name);
@@ -36,6 +37,10 @@ struct StaticMethodResult {
     size_t patch_count = 0;         // summed over primitives (static-sander07)
     size_t hard_boundary_count = 0;
 };
+
+// meshoptimizer's vertex cache + overdraw optimisation of one index buffer as a face permutation.
+std::vector<uint32_t> meshopt_order(const uint32_t* indices, size_t index_count, const float* positions,
+                                    size_t vertex_count, unsigned cache_size);
 
 // Runs the method on every primitive. Throws InvalidInput for an invalid mesh or settings.
 StaticMethodResult run_static_method(const AnimatedMesh& mesh, StaticMethod method,

@@ -2,6 +2,7 @@
 //
 // original:        Tipsify (Sander, Nehab & Barczak 2007, §3) — the vertex cache order alone.
 // static-sander07: Tipsify + fast linear clustering (§4) + sort by occlusion potential (§5).
+// meshopt:         meshoptimizer's vertex cache + overdraw optimisers (meshopt_method.cpp).
 // Both run per primitive: a character's primitives are separate draws.
 #include "animorder/methods.h"
 
@@ -13,11 +14,17 @@ namespace animorder {
 StaticMethod parse_static_method(const std::string& name) {
     if (name == "original") return StaticMethod::Original;
     if (name == "static-sander07") return StaticMethod::StaticSander07;
-    throw InvalidInput("unknown method '" + name + "' (available: original, static-sander07)");
+    if (name == "meshopt") return StaticMethod::Meshopt;
+    throw InvalidInput("unknown method '" + name + "' (available: original, static-sander07, meshopt, single, joint)");
 }
 
 const char* method_name(StaticMethod method) {
-    return method == StaticMethod::Original ? "original" : "static-sander07";
+    switch (method) {
+        case StaticMethod::Original: return "original";
+        case StaticMethod::StaticSander07: return "static-sander07";
+        case StaticMethod::Meshopt: return "meshopt";
+    }
+    return "?";
 }
 
 StaticMethodResult run_static_method(const AnimatedMesh& mesh, StaticMethod method,
@@ -26,8 +33,8 @@ StaticMethodResult run_static_method(const AnimatedMesh& mesh, StaticMethod meth
     if (mesh.keyframe_count() > 0 && settings.keyframe >= mesh.keyframe_count())
         throw InvalidInput("keyframe " + std::to_string(settings.keyframe) + " does not exist (the mesh has " +
                            std::to_string(mesh.keyframe_count()) + ")");
-    if (method == StaticMethod::StaticSander07 && mesh.keyframe_count() == 0 && mesh.triangle_count() > 0)
-        throw InvalidInput("static-sander07 needs positions, and the mesh has no keyframe");
+    if (method != StaticMethod::Original && mesh.keyframe_count() == 0 && mesh.triangle_count() > 0)
+        throw InvalidInput(std::string(method_name(method)) + " needs positions, and the mesh has no keyframe");
 
     StaticMethodResult result;
     result.indices.resize(mesh.indices.size());
@@ -40,6 +47,9 @@ StaticMethodResult run_static_method(const AnimatedMesh& mesh, StaticMethod meth
             result.hard_boundary_count +=
                 tipsify(order.data(), source, primitive.index_count, mesh.vertex_count, settings.cache_size)
                     .hard_boundaries.size();
+        } else if (method == StaticMethod::Meshopt) {
+            order = meshopt_order(source, primitive.index_count, mesh.keyframe(settings.keyframe), mesh.vertex_count,
+                                  settings.cache_size);
         } else {
             const StaticOrderResult r = order_static_sander07(
                 order.data(), source, primitive.index_count, mesh.keyframe(settings.keyframe), mesh.vertex_count,

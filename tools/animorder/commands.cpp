@@ -296,7 +296,8 @@ MethodRun run_method(const AnimatedMesh& mesh, const std::string& name, const Me
 
 nlohmann::ordered_json method_entry(const MethodRun& run, const MethodOptions& m) {
     nlohmann::ordered_json entry = {{"name", run.name},
-                                    {"lambda", run.name == "original" ? nlohmann::ordered_json(nullptr)
+                                    {"lambda", run.name == "original" || run.name == "meshopt"
+                                                   ? nlohmann::ordered_json(nullptr)
                                                                       : nlohmann::ordered_json(m.lambda)},
                                     {"buffers", run.buffers.orders.size()},
                                     {"acmr", run.acmr_mean},

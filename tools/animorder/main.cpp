@@ -66,7 +66,7 @@ int main(int argc, char** argv) {
     OptimizeOptions optimize;
     CLI::App* optimize_cmd = app.add_subcommand("optimize", "Reorder triangles with a method; write buffers, table, report");
     add_common(*optimize_cmd, optimize.common);
-    optimize_cmd->add_option("-m,--method", optimize.method, "original | static-sander07 | single | joint")
+    optimize_cmd->add_option("-m,--method", optimize.method, "original | static-sander07 | meshopt | single | joint")
         ->capture_default_str();
     optimize_cmd->add_flag("--joint", optimize.joint, "One set of buffers for all clips (same as --method joint)");
     add_method_options(*optimize_cmd, optimize.settings);
@@ -79,7 +79,7 @@ int main(int argc, char** argv) {
     CLI::App* evaluate_cmd =
         app.add_subcommand("evaluate", "Score methods' overdraw (OVR) and ACMR over the evaluation nodes (DESIGN.md)");
     add_common(*evaluate_cmd, evaluate.common);
-    evaluate_cmd->add_option("--methods", evaluate.methods, "Comma-separated: original, static-sander07, single, joint")
+    evaluate_cmd->add_option("--methods", evaluate.methods, "Comma-separated: original, static-sander07, meshopt, single, joint")
         ->capture_default_str();
     add_method_options(*evaluate_cmd, evaluate.settings);
     evaluate_cmd->add_option("--eval-views", evaluate.views, "Random viewpoints per keyframe")

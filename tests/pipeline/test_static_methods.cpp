@@ -1,0 +1,38 @@
+// The single-buffer methods over a whole character: per-primitive orders that keep primitives'
+// ranges and triangles' winding; the meshopt baseline reproduces meshoptimizer's own buffers.
+#include "animorder/methods.h"
+#include "support/meshes.h"
+
+#include <gtest/gtest.h>
+#include <meshoptimizer.h>
+
+using namespace animorder;
+
+TEST(StaticMethods, EveryMethodKeepsPrimitivesAndWinding) {
+    const AnimatedMesh mesh = make_procedural_character();
+    for (const char* name : {"original", "static-sander07", "meshopt"}) {
+        SCOPED_TRACE(name);
+        const StaticMethodResult r = run_static_method(mesh, parse_static_method(name), StaticMethodSettings{});
+        EXPECT_TRUE(test::is_permutation_of_iota(r.order));
+        EXPECT_TRUE(test::same_triangles_same_winding(mesh.indices, r.indices));
+        EXPECT_EQ(test::applied(mesh.indices, r.order), r.indices);
+        for (const Primitive& p : mesh.primitives) {  // triangles never leave their primitive
+            std::vector<uint32_t> a(mesh.indices.begin() + ptrdiff_t(p.first_index),
+                                    mesh.indices.begin() + ptrdiff_t(p.first_index + p.index_count));
+            std::vector<uint32_t> b(r.indices.begin() + ptrdiff_t(p.first_index),
+                                    r.indices.begin() + ptrdiff_t(p.first_index + p.index_count));
+            EXPECT_TRUE(test::same_triangles_same_winding(a, b)) << p.name;
+        }
+    }
+    EXPECT_THROW(parse_static_method("fastest"), InvalidInput);
+}
+
+TEST(StaticMethods, MeshoptIsExactlyMeshoptimizersBuffer) {
+    const AnimatedMesh mesh = make_torus_knot(6000);
+    std::vector<uint32_t> cache(mesh.indices.size()), expected(mesh.indices.size());
+    meshopt_optimizeVertexCache(cache.data(), mesh.indices.data(), mesh.indices.size(), mesh.vertex_count);
+    meshopt_optimizeOverdraw(expected.data(), cache.data(), cache.size(), mesh.keyframe(0), mesh.vertex_count, 12, 1.05f);
+    const std::vector<uint32_t> order =
+        meshopt_order(mesh.indices.data(), mesh.indices.size(), mesh.keyframe(0), mesh.vertex_count, 16);
+    EXPECT_EQ(test::applied(mesh.indices, order), expected);
+}

@@ -197,6 +197,9 @@ TEST_F(Cli, BadInputAndOptionsGiveOneLineErrors) {
         {"optimize --method single --update fast", "--update"},
         {"optimize --method single --min-separation 400", "min-separation"},
         {"evaluate --methods original,best", "unknown method 'best'"},
+        {"optimize --method oracle", "oracle is a bound"},
+        {"evaluate --methods single --views 12,100", "icosphere"},
+        {"evaluate --methods single -k 2,0", "clusters"},
         {"inspect --clip run", "no clip named 'run' (clips: walk, wave)"},
     };
     for (const Case& c : cases) {
@@ -207,6 +210,33 @@ TEST_F(Cli, BadInputAndOptionsGiveOneLineErrors) {
         EXPECT_GE(line_count(o.err), 1u) << c.args;
         EXPECT_LE(line_count(o.err), 2u) << c.args << " → " << o.err;
     }
+}
+
+TEST_F(Cli, EvaluateReportHasARowPerMethodAndSweptValue) {
+    const Outcome o = run("evaluate -q --methods original,tipsify-per-frame,single,oracle --lambda 0.85,3 -k 2 "
+                          "--views 12 --resolution 64 --max-iterations 2 --eval-views 2 --eval-resolution 64 -r " +
+                          path("e.json").string() + " --csv " + path("e.csv").string());
+    ASSERT_EQ(o.exit_code, 0) << o.err;
+    const nlohmann::json report = nlohmann::json::parse(slurp(path("e.json")));
+    const nlohmann::json& methods = report["methods"];
+    ASSERT_EQ(methods.size(), 7u);  // original once, the others at both lambdas
+    EXPECT_EQ(methods[0]["name"], "original");
+    EXPECT_TRUE(methods[0]["lambda"].is_null());
+    const size_t keyframes = 77, nodes = keyframes * 2;
+    EXPECT_EQ(report["nodes"], nodes);
+    for (size_t i = 1; i < methods.size(); ++i) {
+        const nlohmann::json& m = methods[i];
+        EXPECT_EQ(m["lambda"], i % 2 ? 0.85 : 3.0) << m["name"];
+        const std::string name = m["name"];
+        const size_t buffers = name == "tipsify-per-frame" ? keyframes : name == "single" ? 2 * 2 : nodes;
+        EXPECT_EQ(m["buffers"], buffers) << name;
+        EXPECT_EQ(m["per_clip"].size(), 2u);
+        EXPECT_GE(m["ovr_mean"].get<double>(), 1.0);
+        EXPECT_EQ(m["clusters"].is_null(), name != "single");
+        EXPECT_EQ(m["per_clip"][0]["time_s"].is_null(), name != "single");
+    }
+    EXPECT_EQ(line_count(slurp(path("e.csv"))), 8u);
+    EXPECT_EQ(line_count(o.out), 9u);  // Markdown header, rule, 7 rows
 }
 
 TEST_F(Cli, FailedWriteLeavesNoFileBehind) {

@@ -22,6 +22,7 @@
 #include <stdexcept>
 #include <sstream>
 #include <string>
+#include <thread>
 
 namespace animorder::tool {
 namespace {
@@ -160,6 +161,29 @@ std::function<void(size_t, size_t)> progress_printer(const CommonOptions& common
     };
 }
 
+// Numbers in labels and tables: the shortest form that reads back the same ("0.85", "3").
+std::string format_number(double value) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.4g", value);
+    return text;
+}
+
+// The DESIGN.md method names; oracle is a bound evaluated per node, so optimize has no output for it.
+void check_method_name(const std::string& name, bool for_optimize) {
+    if (name == "oracle") {
+        if (for_optimize) throw std::runtime_error("oracle is a bound (a new order at every node), not an order to ship; use evaluate --methods oracle");
+        return;
+    }
+    if (name == "single" || name == "joint" || name == "tipsify-per-frame") return;
+    try {
+        parse_static_method(name);
+    } catch (const InvalidInput&) {
+        throw std::runtime_error("unknown method '" + name +
+                                 "' (known: original, static-sander07, static-nehab06, tipsify-per-frame, meshopt, "
+                                 "single, joint, oracle)");
+    }
+}
+
 void check_lambda(double lambda) {
     if (!std::isfinite(lambda)) throw std::runtime_error("--lambda must be a finite number");
 }
@@ -174,7 +198,12 @@ struct MethodRun {
     double seconds = 0;
     uint32_t fallback = 0;  // the buffer most nodes chose: what viewers without the table draw
     nlohmann::ordered_json details;
+    MethodOptions options;              // the settings it ran with
+    std::vector<double> clip_seconds;   // single: each clip's k-means run
 };
+
+bool uses_lambda(const std::string& name) { return name != "original" && name != "meshopt" && name != "static-nehab06"; }
+bool uses_clusters(const std::string& name) { return name == "single" || name == "joint"; }
 
 DistanceVariant parse_distance(const std::string& name) {
     if (name == "jcgt") return DistanceVariant::Jcgt;
@@ -202,6 +231,7 @@ MethodRun run_method(const AnimatedMesh& mesh, const std::string& name, const Me
                      const CommonOptions& common) {
     MethodRun run;
     run.name = name;
+    run.options = m;
     const Clock::time_point start = Clock::now();
     if (name == "single" || name == "joint") {
         ClusteringSettings settings;
@@ -227,6 +257,9 @@ MethodRun run_method(const AnimatedMesh& mesh, const std::string& name, const Me
         nlohmann::ordered_json runs = nlohmann::ordered_json::array();
         for (size_t i = 0; i < r.runs.size(); ++i) {
             rasterization += r.runs[i].seconds_rasterization;
+            double run_seconds = r.runs[i].seconds_rasterization;
+            for (const ClusteringIteration& x : r.runs[i].iterations) run_seconds += x.seconds_raster + x.seconds_update;
+            run.clip_seconds.push_back(run_seconds);
             nlohmann::ordered_json iterations = nlohmann::ordered_json::array();
             for (size_t it = 0; it < r.runs[i].iterations.size(); ++it) {
                 const ClusteringIteration& x = r.runs[i].iterations[it];
@@ -261,6 +294,66 @@ MethodRun run_method(const AnimatedMesh& mesh, const std::string& name, const Me
                          {"rasterization", rasterization},
                          {"assignment", raster},
                          {"update", update}}}};
+    } else if (name == "tipsify-per-frame") {
+        // static-sander07 sorted at every keyframe: the paper's "Tipsify" column. A keyframe's table
+        // cell names its own buffer, so the sidecar and glTF writers take it as they are (clips of up
+        // to 256 keyframes; the table cells are bytes).
+        StaticMethodSettings settings;
+        settings.lambda = m.lambda;
+        settings.cache_size = common.cache_size;
+        size_t patches = 0;
+        for (size_t f = 0; f < mesh.keyframe_count(); ++f) {
+            settings.keyframe = f;
+            StaticMethodResult r = run_static_method(mesh, StaticMethod::StaticSander07, settings);
+            patches = r.patch_count;
+            run.buffers.orders.push_back(std::move(r.order));
+            run.buffers.keyframe_buffer.push_back(uint32_t(f));
+        }
+        run.framing = frame_keyframes(mesh.keyframe_positions.data(), mesh.keyframe_count(), mesh.vertex_count,
+                                      mesh.indices.data(), mesh.indices.size());
+        bool fits = true;
+        for (const Clip& c : mesh.clips) fits = fits && c.keyframe_count <= 256;
+        for (size_t c = 0; fits && c < mesh.clips.size(); ++c) {
+            SelectionTable t;
+            t.keyframes = uint32_t(mesh.clips[c].keyframe_count);
+            t.theta_steps = 2;
+            t.phi_steps = 1;
+            for (uint32_t f = 0; f < t.keyframes; ++f) t.cells.insert(t.cells.end(), 2, uint8_t(f));
+            run.buffers.tables.push_back(t);
+            run.buffers.table_base.push_back(uint32_t(mesh.clips[c].first_keyframe));
+        }
+        run.details = {{"patches", patches}};
+    } else if (name == "oracle") {
+        // A bound, not a product: every evaluation node draws the patches sorted front-to-back for
+        // itself (evaluation.cpp). Its ACMR is the mean over the orders of 12 icosahedron views at
+        // each clip's first keyframe.
+        auto patches = std::make_shared<MeshPatches>(build_mesh_patches(mesh, m.lambda, common.cache_size));
+        run.buffers.front_to_back = patches;
+        run.framing = frame_keyframes(mesh.keyframe_positions.data(), mesh.keyframe_count(), mesh.vertex_count,
+                                      mesh.indices.data(), mesh.indices.size());
+        const std::vector<float> views = icosphere_directions(0);
+        std::vector<uint32_t> indices(mesh.indices.size());
+        size_t samples = 0;
+        for (const Clip& clip : mesh.clips) {
+            const std::vector<uint32_t> first = {uint32_t(clip.first_keyframe)};
+            const std::vector<float> centroids = patch_centroids(mesh, *patches, run.framing, first);
+            for (size_t v = 0; v < views.size() / 3; ++v) {
+                const float eye[3] = {3 * run.framing.radius * views[3 * v], 3 * run.framing.radius * views[3 * v + 1],
+                                      3 * run.framing.radius * views[3 * v + 2]};
+                const std::vector<uint32_t> order = patch_order_to_triangle_order(
+                    *patches, front_to_back_patch_order(centroids.data(), patches->patch_count(), eye));
+                apply_triangle_order(indices.data(), mesh.indices.data(), order.data(), mesh.triangle_count());
+                const VertexCacheStats s = analyze_mesh_vertex_cache(mesh, indices, common.cache_size);
+                run.acmr_mean += s.acmr;
+                run.atvr_mean += s.atvr;
+                ++samples;
+            }
+        }
+        run.acmr_mean /= double(std::max<size_t>(1, samples));
+        run.atvr_mean /= double(std::max<size_t>(1, samples));
+        run.details = {{"patches", patches->patch_count()}};
+        run.seconds = seconds_since(start);
+        return run;
     } else {
         StaticMethodSettings settings;
         settings.lambda = m.lambda;
@@ -294,17 +387,19 @@ MethodRun run_method(const AnimatedMesh& mesh, const std::string& name, const Me
     return run;
 }
 
-nlohmann::ordered_json method_entry(const MethodRun& run, const MethodOptions& m) {
-    nlohmann::ordered_json entry = {{"name", run.name},
-                                    {"lambda", run.name == "original" || run.name == "meshopt"
-                                                   ? nlohmann::ordered_json(nullptr)
-                                                                      : nlohmann::ordered_json(m.lambda)},
-                                    {"buffers", run.buffers.orders.size()},
-                                    {"acmr", run.acmr_mean},
-                                    {"atvr", run.atvr_mean},
-                                    {"ovr_mean", nullptr},
-                                    {"ovr_pooled", nullptr},
-                                    {"time_s", run.seconds}};
+nlohmann::ordered_json method_entry(const MethodRun& run) {
+    using json = nlohmann::ordered_json;
+    const bool clustered = uses_clusters(run.name);
+    json entry = {{"name", run.name},
+                  {"lambda", uses_lambda(run.name) ? json(run.options.lambda) : json(nullptr)},
+                  {"clusters", clustered ? json(run.options.clusters) : json(nullptr)},
+                  {"views", clustered ? json(run.options.views) : json(nullptr)},
+                  {"buffers", run.buffers.orders.size()},
+                  {"acmr", run.acmr_mean},
+                  {"atvr", run.atvr_mean},
+                  {"ovr_mean", nullptr},
+                  {"ovr_pooled", nullptr},
+                  {"time_s", run.seconds}};
     for (auto it = run.details.begin(); it != run.details.end(); ++it) entry[it.key()] = it.value();
     return entry;
 }
@@ -342,7 +437,7 @@ int run_optimize(const OptimizeOptions& options) {
     const std::string method = options.joint ? "joint" : options.method;
     if (options.joint && options.method != "single" && options.method != "joint" && options.method != "static-sander07")
         throw std::runtime_error("--joint applies to the single method, not " + options.method);
-    if (method != "single" && method != "joint") parse_static_method(method);  // reject unknown names early
+    check_method_name(method, true);  // reject unknown names early
 
     std::string input_name;
     const AnimatedMesh mesh = load_input(options.common, input_name);
@@ -396,7 +491,7 @@ int run_optimize(const OptimizeOptions& options) {
                           {"update", options.settings.update},
                           {"threads", options.settings.threads}};
     report["input_order"] = cache_stats_json(before);
-    report["methods"] = nlohmann::ordered_json::array({method_entry(run, options.settings)});
+    report["methods"] = nlohmann::ordered_json::array({method_entry(run)});
     report["outputs"] = outputs;
     report["timings_s"] = {{"load", load_s}, {"method", run.seconds}, {"total", seconds_since(start)}};
     if (!options.report_path.empty()) {
@@ -410,27 +505,49 @@ int run_optimize(const OptimizeOptions& options) {
 }
 
 int run_evaluate(const EvaluateOptions& options) {
+    using json = nlohmann::ordered_json;
     const Clock::time_point start = Clock::now();
-    check_method_options(options.settings);
+    const MethodOptions& base = options.settings;
     const std::vector<std::string> names = split_list(options.methods);
     if (names.empty()) throw std::runtime_error("--methods names no method");
+    for (const std::string& n : names) check_method_name(n, false);
+    // Every combination of the swept settings, for the methods that use them.
+    std::vector<MethodOptions> variants;
+    const std::vector<double> lambdas = base.lambdas.empty() ? std::vector<double>{base.lambda} : base.lambdas;
+    const std::vector<size_t> ks = base.cluster_list.empty() ? std::vector<size_t>{base.clusters} : base.cluster_list;
+    const std::vector<size_t> views = base.view_list.empty() ? std::vector<size_t>{base.views} : base.view_list;
+    std::vector<std::pair<std::string, MethodOptions>> plan;
     for (const std::string& n : names)
-        if (n != "single" && n != "joint") parse_static_method(n);
+        for (size_t li = 0; li < (uses_lambda(n) ? lambdas.size() : 1); ++li)
+            for (size_t ki = 0; ki < (uses_clusters(n) ? ks.size() : 1); ++ki)
+                for (size_t vi = 0; vi < (uses_clusters(n) ? views.size() : 1); ++vi) {
+                    MethodOptions m = base;
+                    m.lambda = lambdas[li];
+                    m.clusters = ks[ki];
+                    m.views = views[vi];
+                    check_method_options(m);
+                    plan.emplace_back(n, m);
+                }
 
     std::string input_name;
     const AnimatedMesh mesh = load_input(options.common, input_name);
     validate_animated_mesh(mesh);
     std::vector<MethodRun> runs;
-    for (const std::string& n : names) {
-        note(options.common, "running " + n);
-        runs.push_back(run_method(mesh, n, options.settings, options.common));
+    for (const auto& [n, m] : plan) {
+        std::string label = n;
+        if (uses_lambda(n) && lambdas.size() > 1) label += " lambda=" + format_number(m.lambda);
+        if (uses_clusters(n) && ks.size() > 1) label += " k=" + std::to_string(m.clusters);
+        if (uses_clusters(n) && views.size() > 1) label += " views=" + std::to_string(m.views);
+        note(options.common, "running " + label);
+        runs.push_back(run_method(mesh, n, m, options.common));
     }
+    const double methods_s = seconds_since(start);
 
     EvaluationSettings eval;
     eval.views = options.views;
     eval.seed = options.seed;
     eval.resolution = options.resolution;
-    eval.threads = options.settings.threads;
+    eval.threads = base.threads;
     eval.progress = progress_printer(options.common, "evaluating");
     note(options.common, "evaluating " + std::to_string(runs.size()) + " methods at " +
                              std::to_string(mesh.keyframe_count() * options.views) + " nodes (" +
@@ -441,47 +558,76 @@ int run_evaluate(const EvaluateOptions& options) {
     const Clock::time_point eval_start = Clock::now();
     const std::vector<OrderEvaluation> results = evaluate_methods(mesh, buffers, eval);
     const double eval_s = seconds_since(eval_start);
+    const size_t nodes = mesh.keyframe_count() * options.views;
 
-    nlohmann::ordered_json report = report_header(mesh, input_name);
-    report["settings"] = {{"methods", options.methods},       {"lambda", options.settings.lambda},
-                          {"clusters", options.settings.clusters}, {"views", options.settings.views},
-                          {"resolution", options.settings.resolution}, {"cache_size", options.common.cache_size},
-                          {"eval_views", options.views},       {"eval_resolution", options.resolution},
-                          {"eval_seed", options.seed},         {"seed", options.settings.seed}};
-    report["methods"] = nlohmann::ordered_json::array();
-    std::printf("| method | buffers | ACMR | ATVR | OVR mean | OVR pooled |");
-    for (const Clip& c : mesh.clips) std::printf(" %s |", c.name.c_str());
-    std::printf("\n|---|---|---|---|---|---|");
-    for (size_t c = 0; c < mesh.clips.size(); ++c) std::printf("---|");
-    std::printf("\n");
-    std::string csv = "method,lambda,buffers,acmr,atvr,ovr_mean,ovr_pooled,time_s\n";
+    json report = report_header(mesh, input_name);
+    report["settings"] = {{"methods", names},
+                          {"lambda", lambdas},
+                          {"clusters", ks},
+                          {"views", views},
+                          {"resolution", base.resolution},
+                          {"seed", base.seed},
+                          {"cache_size", options.common.cache_size},
+                          {"eval_views", options.views},
+                          {"eval_resolution", options.resolution},
+                          {"eval_seed", options.seed},
+                          {"clips", options.common.clips}};
+    report["clips"] = json::array();
+    for (const Clip& c : mesh.clips) report["clips"].push_back({{"name", c.name}, {"keyframes", c.keyframe_count}});
+    report["methods"] = json::array();
+    std::string table = "| method | lambda | k | views | buffers | ACMR | ATVR | OVR mean | OVR pooled | time s |";
+    std::string rule = "|---|---|---|---|---|---|---|---|---|---|";
+    for (const Clip& c : mesh.clips) {
+        table += " " + c.name + " |";
+        rule += "---|";
+    }
+    table += "\n" + rule + "\n";
+    std::string csv = "method,lambda,clusters,views,buffers,acmr,atvr,ovr_mean,ovr_pooled,time_s\n";
     for (size_t m = 0; m < runs.size(); ++m) {
+        const MethodRun& run = runs[m];
         const OrderEvaluation& r = results[m];
-        nlohmann::ordered_json entry = method_entry(runs[m], options.settings);
+        json entry = method_entry(run);
+        const bool per_node = run.name == "oracle";
+        entry["buffers"] = per_node ? nodes : run.buffers.orders.size();
         entry["ovr_mean"] = r.overall.ovr_mean;
         entry["ovr_pooled"] = r.overall.ovr_pooled;
-        entry["per_clip"] = nlohmann::ordered_json::array();
-        std::printf("| %s | %zu | %.3f | %.3f | %.3f | %.3f |", runs[m].name.c_str(), runs[m].buffers.orders.size(),
-                    runs[m].acmr_mean, runs[m].atvr_mean, r.overall.ovr_mean, r.overall.ovr_pooled);
-        for (size_t c = 0; c < mesh.clips.size(); ++c) {
+        entry["per_clip"] = json::array();
+        for (size_t c = 0; c < mesh.clips.size(); ++c)
             entry["per_clip"].push_back({{"clip", mesh.clips[c].name},
                                          {"ovr_mean", r.per_clip[c].ovr_mean},
                                          {"ovr_pooled", r.per_clip[c].ovr_pooled},
-                                         {"nodes", r.per_clip[c].nodes}});
-            std::printf(" %.3f |", r.per_clip[c].ovr_mean);
+                                         {"nodes", r.per_clip[c].nodes},
+                                         {"time_s", run.name == "single" && c < run.clip_seconds.size()
+                                                        ? json(run.clip_seconds[c])
+                                                        : json(nullptr)}});
+        const std::string lambda = uses_lambda(run.name) ? format_number(run.options.lambda) : "";
+        const std::string k = uses_clusters(run.name) ? std::to_string(run.options.clusters) : "";
+        const std::string v = uses_clusters(run.name) ? std::to_string(run.options.views) : "";
+        const std::string count = per_node ? "per node" : std::to_string(run.buffers.orders.size());
+        char cells[256];
+        std::snprintf(cells, sizeof cells, "| %s | %s | %s | %s | %s | %.3f | %.3f | %.3f | %.3f | %.1f |",
+                      run.name.c_str(), lambda.c_str(), k.c_str(), v.c_str(), count.c_str(), run.acmr_mean,
+                      run.atvr_mean, r.overall.ovr_mean, r.overall.ovr_pooled, run.seconds);
+        table += cells;
+        for (size_t c = 0; c < mesh.clips.size(); ++c) {
+            std::snprintf(cells, sizeof cells, " %.3f |", r.per_clip[c].ovr_mean);
+            table += cells;
         }
-        std::printf("\n");
+        table += "\n";
+        std::snprintf(cells, sizeof cells, "%s,%s,%s,%s,%zu,%.6f,%.6f,%.6f,%.6f,%.6f\n", run.name.c_str(),
+                      lambda.c_str(), k.c_str(), v.c_str(), per_node ? nodes : run.buffers.orders.size(), run.acmr_mean,
+                      run.atvr_mean, r.overall.ovr_mean, r.overall.ovr_pooled, run.seconds);
+        csv += cells;
         report["methods"].push_back(entry);
-        char line[256];
-        std::snprintf(line, sizeof line, "%s,%g,%zu,%.6f,%.6f,%.6f,%.6f,%.6f\n", runs[m].name.c_str(),
-                      options.settings.lambda, runs[m].buffers.orders.size(), runs[m].acmr_mean, runs[m].atvr_mean,
-                      r.overall.ovr_mean, r.overall.ovr_pooled, runs[m].seconds);
-        csv += line;
     }
-    report["nodes"] = mesh.keyframe_count() * options.views;
-    report["timings_s"] = {{"evaluation", eval_s}, {"total", seconds_since(start)}};
+    std::fputs(table.c_str(), stdout);
+    report["nodes"] = nodes;
+    report["timings_s"] = {{"methods", methods_s}, {"evaluation", eval_s}, {"total", seconds_since(start)}};
+    report["machine"] = {{"threads", base.threads ? base.threads : std::thread::hardware_concurrency()}};
     if (!options.report_path.empty()) write_file_atomically(options.report_path, report_text(report));
     if (!options.csv_path.empty()) write_file_atomically(options.csv_path, csv);
+    note(options.common, "evaluation took " + format_number(eval_s) + " s (" + format_number(seconds_since(start)) +
+                             " s in all)");
     return 0;
 }
 

@@ -32,6 +32,10 @@ struct MethodOptions {
     std::string distance = "jcgt";
     std::string update = "monotone";
     unsigned threads = 0;
+    // evaluate only: every value of each list is run (methods that use it get a row per value).
+    std::vector<double> lambdas;
+    std::vector<size_t> cluster_list;
+    std::vector<size_t> view_list;
 };
 
 struct OptimizeOptions {

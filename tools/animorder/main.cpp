@@ -18,18 +18,36 @@ void add_common(CLI::App& command, animorder::tool::CommonOptions& common) {
         ->check(CLI::Range(3u, 1024u));
 }
 
-void add_method_options(CLI::App& command, animorder::tool::MethodOptions& m) {
-    command.add_option("-l,--lambda", m.lambda,
-                       "Patch threshold: soft boundary when a patch's local ACMR < lambda "
-                       "(<0.5: hard boundaries only, >=3: single triangles)")
-        ->capture_default_str()
-        ->check(CLI::Range(0.0, 1000.0));
+// sweep: -l, -k and --views take comma-separated lists (evaluate runs every combination).
+void add_method_options(CLI::App& command, animorder::tool::MethodOptions& m, bool sweep = false) {
+    const char* lambda_help = "Patch threshold: soft boundary when a patch's local ACMR < lambda "
+                              "(<0.5: hard boundaries only, >=3: single triangles)";
+    if (sweep) {
+        m.lambdas = {m.lambda};
+        m.cluster_list = {m.clusters};
+        m.view_list = {m.views};
+        command.add_option("-l,--lambda", m.lambdas, std::string(lambda_help) + "; a list runs each value")
+            ->delimiter(',')
+            ->capture_default_str()
+            ->check(CLI::Range(0.0, 1000.0));
+        command.add_option("-k,--clusters", m.cluster_list, "single/joint: number of buffers k; a list runs each value")
+            ->delimiter(',')
+            ->capture_default_str()
+            ->check(CLI::Range(size_t(1), size_t(255)));
+        command.add_option("--views", m.view_list,
+                           "single/joint: clustering viewpoints (12, 42, 162, 642); a list runs each value")
+            ->delimiter(',')
+            ->capture_default_str();
+    } else {
+        command.add_option("-l,--lambda", m.lambda, lambda_help)->capture_default_str()->check(CLI::Range(0.0, 1000.0));
+        command.add_option("-k,--clusters", m.clusters, "single/joint: number of buffers k")
+            ->capture_default_str()
+            ->check(CLI::Range(size_t(1), size_t(255)));
+        command.add_option("--views", m.views, "single/joint: clustering viewpoints (12, 42, 162, 642)")
+            ->capture_default_str();
+    }
     command.add_option("--frame", m.keyframe, "static-sander07: keyframe whose positions it sorts with")
         ->capture_default_str();
-    command.add_option("-k,--clusters", m.clusters, "single/joint: number of buffers k")
-        ->capture_default_str()
-        ->check(CLI::Range(size_t(1), size_t(255)));
-    command.add_option("--views", m.views, "single/joint: clustering viewpoints (12, 42, 162, 642)")->capture_default_str();
     command.add_option("--resolution", m.resolution, "single/joint: clustering viewport in pixels")
         ->capture_default_str()
         ->check(CLI::Range(8u, 4096u));
@@ -79,9 +97,11 @@ int main(int argc, char** argv) {
     CLI::App* evaluate_cmd =
         app.add_subcommand("evaluate", "Score methods' overdraw (OVR) and ACMR over the evaluation nodes (DESIGN.md)");
     add_common(*evaluate_cmd, evaluate.common);
-    evaluate_cmd->add_option("--methods", evaluate.methods, "Comma-separated: original, static-sander07, meshopt, single, joint")
+    evaluate_cmd
+        ->add_option("--methods", evaluate.methods,
+                     "Comma-separated: original, static-sander07, tipsify-per-frame, meshopt, single, joint, oracle")
         ->capture_default_str();
-    add_method_options(*evaluate_cmd, evaluate.settings);
+    add_method_options(*evaluate_cmd, evaluate.settings, true);
     evaluate_cmd->add_option("--eval-views", evaluate.views, "Random viewpoints per keyframe")
         ->capture_default_str()
         ->check(CLI::Range(size_t(1), size_t(100000)));

@@ -62,4 +62,13 @@ std::string gltf_with_orders(const std::string& input_path, const std::string& o
                              const MethodBuffers& buffers, uint32_t fallback, const Framing& framing,
                              const std::string& method, bool binary);
 
+// A new glTF file holding the whole animated mesh (gltf_animated_writer.cpp; what `animorder
+// subdivide` writes): one node and mesh, one glTF primitive per Primitive (its vertices, uint32
+// indices), POSITION = keyframe 0, one morph target per keyframe (deltas from keyframe 0), and
+// one animation per clip driving the morph weights (LINEAR, keys at j / sample_rate, one-hot on
+// the clip's keyframe), so load_gltf at the clip's rate gives the keyframes back. Deterministic.
+// Returns GLB bytes when `binary`, else glTF JSON text with the buffer embedded. Throws
+// InvalidInput for an invalid mesh, LoadError when serialising fails.
+std::string gltf_animated_mesh(const AnimatedMesh& mesh, bool binary);
+
 }  // namespace animorder

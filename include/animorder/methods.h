@@ -15,9 +15,10 @@
 
 namespace animorder {
 
-// Single-buffer methods (DESIGN.md names): "original" (Tipsify only), "static-sander07", and
-// "meshopt" (meshoptimizer's optimizeVertexCache + optimizeOverdraw(1.05), the users' baseline).
-enum class StaticMethod { Original, StaticSander07, Meshopt };
+// Single-buffer methods (DESIGN.md names): "original" (Tipsify only), "static-sander07",
+// "meshopt" (meshoptimizer's optimizeVertexCache + optimizeOverdraw(1.05), the users' baseline)
+// and "static-nehab06" (planar clusters ordered by a measured overdraw graph, nehab06.h).
+enum class StaticMethod { Original, StaticSander07, Meshopt, StaticNehab06 };
 
 // Parses a DESIGN.md method name; throws InvalidInput listing the known names otherwise.
 StaticMethod parse_static_method(const std::string& name);
@@ -27,6 +28,15 @@ struct StaticMethodSettings {
     double lambda = kDefaultLambda;
     unsigned cache_size = kDefaultCacheSize;
     size_t keyframe = 0;  // the keyframe whose positions static-sander07 sorts with
+    // static-nehab06: clusters (0: automatic, powers of two), icosphere views, resolution of the
+    // graph's rasterisation, and whether its graph sums over the whole animation: `keyframe`
+    // and every ceil(F / 8)-th keyframe from 0, so that at most 9 keyframes are rasterised (else
+    // only `keyframe`). Clusters always come from the normals of `keyframe`.
+    size_t nehab_clusters = 0;
+    size_t nehab_views = 162;
+    unsigned nehab_resolution = 256;
+    bool nehab_all_keyframes = false;
+    unsigned threads = 0;  // static-nehab06's rasterisation; 0: all hardware threads
 };
 
 struct StaticMethodResult {
@@ -34,7 +44,7 @@ struct StaticMethodResult {
     // The same as a face permutation of the whole mesh (primitives drawn in file order), which
     // is what the overdraw engine's rank tables take.
     std::vector<uint32_t> order;
-    size_t patch_count = 0;         // summed over primitives (static-sander07)
+    size_t patch_count = 0;         // summed over primitives (static-sander07; static-nehab06: clusters)
     size_t hard_boundary_count = 0;
 };
 

@@ -3,9 +3,13 @@
 // original:        Tipsify (Sander, Nehab & Barczak 2007, §3) — the vertex cache order alone.
 // static-sander07: Tipsify + fast linear clustering (§4) + sort by occlusion potential (§5).
 // meshopt:         meshoptimizer's vertex cache + overdraw optimisers (meshopt_method.cpp).
-// Both run per primitive: a character's primitives are separate draws.
+// static-nehab06:  Nehab, Barczak & Sander 2006 (nehab06.cpp): normal clusters, measured overdraw
+//                  graph, feedback-arc-set order; each primitive framed and measured on its own.
+// All run per primitive: a character's primitives are separate draws.
 #include "animorder/methods.h"
+#include "animorder/nehab06.h"
 
+#include <algorithm>
 #include <chrono>
 #include <string>
 
@@ -15,7 +19,9 @@ StaticMethod parse_static_method(const std::string& name) {
     if (name == "original") return StaticMethod::Original;
     if (name == "static-sander07") return StaticMethod::StaticSander07;
     if (name == "meshopt") return StaticMethod::Meshopt;
-    throw InvalidInput("unknown method '" + name + "' (available: original, static-sander07, meshopt, single, joint)");
+    if (name == "static-nehab06") return StaticMethod::StaticNehab06;
+    throw InvalidInput("unknown method '" + name +
+                       "' (available: original, static-sander07, static-nehab06, meshopt, single, joint)");
 }
 
 const char* method_name(StaticMethod method) {
@@ -23,6 +29,7 @@ const char* method_name(StaticMethod method) {
         case StaticMethod::Original: return "original";
         case StaticMethod::StaticSander07: return "static-sander07";
         case StaticMethod::Meshopt: return "meshopt";
+        case StaticMethod::StaticNehab06: return "static-nehab06";
     }
     return "?";
 }
@@ -50,6 +57,24 @@ StaticMethodResult run_static_method(const AnimatedMesh& mesh, StaticMethod meth
         } else if (method == StaticMethod::Meshopt) {
             order = meshopt_order(source, primitive.index_count, mesh.keyframe(settings.keyframe), mesh.vertex_count,
                                   settings.cache_size);
+        } else if (method == StaticMethod::StaticNehab06) {
+            Nehab06Settings nehab;
+            nehab.clusters = std::min(settings.nehab_clusters, triangles);  // small primitives: fewer
+            nehab.views = settings.nehab_views;
+            nehab.resolution = settings.nehab_resolution;
+            nehab.cache_size = settings.cache_size;
+            nehab.threads = settings.threads;
+            // The clustering keyframe first: clusters come from the first listed keyframe.
+            std::vector<uint32_t> keyframes{uint32_t(settings.keyframe)};
+            if (settings.nehab_all_keyframes) {
+                const size_t count = mesh.keyframe_count(), stride = (count + 7) / 8;
+                for (size_t f = 0; f < count; f += stride)
+                    if (f != settings.keyframe) keyframes.push_back(uint32_t(f));
+            }
+            result.patch_count += order_static_nehab06(order.data(), source, primitive.index_count,
+                                                       mesh.keyframe_positions.data(), mesh.keyframe_count(),
+                                                       mesh.vertex_count, keyframes.data(), keyframes.size(), nehab)
+                                      .cluster_count;
         } else {
             const StaticOrderResult r = order_static_sander07(
                 order.data(), source, primitive.index_count, mesh.keyframe(settings.keyframe), mesh.vertex_count,

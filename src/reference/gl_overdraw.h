@@ -1,8 +1,11 @@
 // The OpenGL reference for the overdraw engine: the same node drawn by a real OpenGL (Mesa's
 // llvmpipe over EGL without a display here, a GPU driver where there is one), counting the
 // fragments that pass the depth test with occlusion queries (GL_SAMPLES_PASSED), as Han &
-// Sander 2017 measured. Kept apart from the library: only tests and benchmarks use it.
+// Sander 2017 measured, in a GlContext (gl_context.h) with the flat fragment shader. Kept apart
+// from the library: only tests and benchmarks use it.
 #pragma once
+
+#include "gl_context.h"
 
 #include <cstddef>
 #include <cstdint>
@@ -34,8 +37,8 @@ public:
                        const std::vector<std::vector<uint32_t>>& index_buffers);
 
 private:
-    struct Context;
-    std::unique_ptr<Context> context_;
+    std::unique_ptr<GlContext> context_;
+    size_t scratch_ = 0;  // the index buffer each order is copied into
 };
 
 }  // namespace animorder

@@ -201,6 +201,8 @@ TEST_F(Cli, BadInputAndOptionsGiveOneLineErrors) {
         {"evaluate --methods single --views 12,100", "icosphere"},
         {"evaluate --methods single -k 2,0", "clusters"},
         {"inspect --clip run", "no clip named 'run' (clips: walk, wave)"},
+        {"optimize --method static-nehab06 --nehab-views 13", "icosphere"},
+        {"optimize --method static-nehab06 --nehab-clusters 99999999", "nehab-clusters"},
     };
     for (const Case& c : cases) {
         const Outcome o = run(c.args + " --quiet");  // errors print even when quiet
@@ -237,6 +239,28 @@ TEST_F(Cli, EvaluateReportHasARowPerMethodAndSweptValue) {
     }
     EXPECT_EQ(line_count(slurp(path("e.csv"))), 8u);
     EXPECT_EQ(line_count(o.out), 9u);  // Markdown header, rule, 7 rows
+}
+
+TEST_F(Cli, Nehab06RunsInOptimizeAndEvaluateAndBeatsTheOriginalOrder) {
+    const std::string fast = " -q --nehab-views 42 --resolution 96 --nehab-clusters 16";
+    ASSERT_EQ(run("optimize --method static-nehab06" + fast + " --threads 1 -o " + path("n1").string() + " -r " +
+                  path("r.json").string()).exit_code, 0);
+    ASSERT_EQ(run("optimize --method static-nehab06" + fast + " --threads 2 -o " + path("n2").string()).exit_code, 0);
+    EXPECT_EQ(slurp(path("n1.animorder.bin")), slurp(path("n2.animorder.bin")));  // thread count changes nothing
+    const nlohmann::json j = nlohmann::json::parse(slurp(path("r.json")));
+    EXPECT_EQ(j["methods"][0]["name"], "static-nehab06");
+    EXPECT_EQ(j["methods"][0]["planar_clusters"], 16 * 2);  // 16 per primitive; the character has 2
+    EXPECT_EQ(j["settings"]["nehab_views"], 42);
+    const Outcome e = run("evaluate --methods original,static-nehab06" + fast + " --eval-views 2 --eval-resolution 96 -r " +
+                          path("e.json").string());
+    ASSERT_EQ(e.exit_code, 0) << e.err;
+    const nlohmann::json report = nlohmann::json::parse(slurp(path("e.json")));
+    const nlohmann::json& methods = report["methods"];
+    ASSERT_EQ(methods.size(), 2u);
+    EXPECT_EQ(methods[1]["name"], "static-nehab06");
+    EXPECT_TRUE(methods[1]["lambda"].is_null());
+    // The whole point of the method: less overdraw than the input order.
+    EXPECT_LT(methods[1]["ovr_mean"].get<double>(), methods[0]["ovr_mean"].get<double>());
 }
 
 TEST_F(Cli, FailedWriteLeavesNoFileBehind) {

@@ -359,6 +359,11 @@ MethodRun run_method(const AnimatedMesh& mesh, const std::string& name, const Me
         settings.lambda = m.lambda;
         settings.cache_size = common.cache_size;
         settings.keyframe = m.keyframe;
+        settings.nehab_clusters = m.nehab_clusters;
+        settings.nehab_views = m.nehab_views;
+        settings.nehab_resolution = m.resolution;
+        settings.nehab_all_keyframes = m.nehab_all_keyframes;
+        settings.threads = m.threads;
         const StaticMethod method = parse_static_method(name);
         StaticMethodResult r = run_static_method(mesh, method, settings);
         run.buffers.orders.push_back(std::move(r.order));
@@ -373,7 +378,10 @@ MethodRun run_method(const AnimatedMesh& mesh, const std::string& name, const Me
             run.buffers.tables.push_back(t);
             run.buffers.table_base.push_back(0);
         }
-        run.details = {{"patches", r.patch_count}, {"hard_boundaries", r.hard_boundary_count}};
+        if (method == StaticMethod::StaticNehab06)
+            run.details = {{"planar_clusters", r.patch_count}};
+        else
+            run.details = {{"patches", r.patch_count}, {"hard_boundaries", r.hard_boundary_count}};
     }
     run.seconds = seconds_since(start);
     std::vector<uint32_t> indices(mesh.indices.size());
@@ -489,6 +497,9 @@ int run_optimize(const OptimizeOptions& options) {
                           {"max_iterations", options.settings.max_iterations},
                           {"distance", options.settings.distance},
                           {"update", options.settings.update},
+                          {"nehab_clusters", options.settings.nehab_clusters},
+                          {"nehab_views", options.settings.nehab_views},
+                          {"nehab_all_keyframes", options.settings.nehab_all_keyframes},
                           {"threads", options.settings.threads}};
     report["input_order"] = cache_stats_json(before);
     report["methods"] = nlohmann::ordered_json::array({method_entry(run)});
@@ -567,6 +578,9 @@ int run_evaluate(const EvaluateOptions& options) {
                           {"views", views},
                           {"resolution", base.resolution},
                           {"seed", base.seed},
+                          {"nehab_clusters", base.nehab_clusters},
+                          {"nehab_views", base.nehab_views},
+                          {"nehab_all_keyframes", base.nehab_all_keyframes},
                           {"cache_size", options.common.cache_size},
                           {"eval_views", options.views},
                           {"eval_resolution", options.resolution},

@@ -32,6 +32,11 @@ struct MethodOptions {
     std::string distance = "jcgt";
     std::string update = "monotone";
     unsigned threads = 0;
+    // static-nehab06: clusters (0: automatic), measuring views, and whether 8 keyframes spread over
+    // the clips are measured too (default: the --frame keyframe only).
+    size_t nehab_clusters = 0;
+    size_t nehab_views = 162;
+    bool nehab_all_keyframes = false;
     // evaluate only: every value of each list is run (methods that use it get a row per value).
     std::vector<double> lambdas;
     std::vector<size_t> cluster_list;

@@ -1,6 +1,7 @@
 // animorder — command-line entry point: parses options, dispatches to a subcommand, and turns
 // every failure into one line on stderr and a non-zero exit code (never a crash).
 #include "commands.h"
+#include "subdivide_command.h"
 
 #include <CLI/CLI.hpp>
 
@@ -48,7 +49,7 @@ void add_method_options(CLI::App& command, animorder::tool::MethodOptions& m, bo
     }
     command.add_option("--frame", m.keyframe, "static-sander07: keyframe whose positions it sorts with")
         ->capture_default_str();
-    command.add_option("--resolution", m.resolution, "single/joint: clustering viewport in pixels")
+    command.add_option("--resolution", m.resolution, "single/joint/static-nehab06: clustering viewport in pixels")
         ->capture_default_str()
         ->check(CLI::Range(8u, 4096u));
     command.add_option("--seed", m.seed, "single/joint: seed of the bootstrap viewpoints")->capture_default_str();
@@ -62,6 +63,13 @@ void add_method_options(CLI::App& command, animorder::tool::MethodOptions& m, bo
     command.add_option("--update", m.update,
                        "single/joint: monotone (keep a cluster's new order only if its nodes' OVR falls) or paper")
         ->capture_default_str();
+    command.add_option("--nehab-clusters", m.nehab_clusters, "static-nehab06: planar clusters (0: automatic)")
+        ->capture_default_str()
+        ->check(CLI::Range(size_t(0), size_t(1) << 20));
+    command.add_option("--nehab-views", m.nehab_views, "static-nehab06: measuring viewpoints (12, 42, 162, 642)")
+        ->capture_default_str();
+    command.add_flag("--nehab-all-keyframes", m.nehab_all_keyframes,
+                     "static-nehab06: measure also at 8 keyframes spread over the clips (default: --frame only)");
     command.add_option("--threads", m.threads, "Worker threads (0: all cores)")
         ->capture_default_str()
         ->check(CLI::Range(0u, 1024u));
@@ -84,7 +92,7 @@ int main(int argc, char** argv) {
     OptimizeOptions optimize;
     CLI::App* optimize_cmd = app.add_subcommand("optimize", "Reorder triangles with a method; write buffers, table, report");
     add_common(*optimize_cmd, optimize.common);
-    optimize_cmd->add_option("-m,--method", optimize.method, "original | static-sander07 | meshopt | single | joint")
+    optimize_cmd->add_option("-m,--method", optimize.method, "original | static-sander07 | static-nehab06 | meshopt | single | joint")
         ->capture_default_str();
     optimize_cmd->add_flag("--joint", optimize.joint, "One set of buffers for all clips (same as --method joint)");
     add_method_options(*optimize_cmd, optimize.settings);
@@ -99,7 +107,7 @@ int main(int argc, char** argv) {
     add_common(*evaluate_cmd, evaluate.common);
     evaluate_cmd
         ->add_option("--methods", evaluate.methods,
-                     "Comma-separated: original, static-sander07, tipsify-per-frame, meshopt, single, joint, oracle")
+                     "Comma-separated: original, static-sander07, static-nehab06, tipsify-per-frame, meshopt, single, joint, oracle")
         ->capture_default_str();
     add_method_options(*evaluate_cmd, evaluate.settings, true);
     evaluate_cmd->add_option("--eval-views", evaluate.views, "Random viewpoints per keyframe")
@@ -128,6 +136,18 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(16u, 8192u));
     heatmap_cmd->add_option("-o,--output", heatmap.output, "PNG file to write")->required();
 
+    SubdivideOptions subdivide;
+    CLI::App* subdivide_cmd = app.add_subcommand(
+        "subdivide", "Loop-subdivide every keyframe; write a new glTF/GLB (keyframes as morph targets)");
+    add_common(*subdivide_cmd, subdivide.common);
+    subdivide_cmd->add_option("-n,--levels", subdivide.levels, "Levels of Loop subdivision (each: 4x the triangles)")
+        ->required();
+    subdivide_cmd
+        ->add_option("-o,--output", subdivide.output,
+                     "OUT.glb or OUT.gltf; one morph target per keyframe, so the file is large "
+                     "(vertices x keyframes x 12 bytes): keep fewer clips with --clip NAME")
+        ->required();
+
     if (argc == 1) {  // no arguments: the basics, and where to look next (gltfpack style)
         std::fputs(app.help().c_str(), stderr);
         return 2;
@@ -143,6 +163,7 @@ int main(int argc, char** argv) {
         if (*optimize_cmd) return run_optimize(optimize);
         if (*evaluate_cmd) return run_evaluate(evaluate);
         if (*heatmap_cmd) return run_heatmap(heatmap);
+        if (*subdivide_cmd) return run_subdivide(subdivide);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "animorder: error: %s\n", e.what());
         return 1;

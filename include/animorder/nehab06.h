@@ -1,0 +1,169 @@
+// animorder — static-nehab06: Nehab, Barczak & Sander, "Triangle Order Optimization for
+// Graphics Hardware Computation Culling", I3D 2006.
+//
+// Planar clusters by normals (§3), a partial-order graph of the overdraw every pair of clusters
+// causes over many viewpoints (§4), a cluster order from the greedy minimum feedback-arc-set
+// heuristic (§5), each cluster Tipsified inside. One view-independent order, one index buffer.
+// Plain arrays in and out; the overdraw is measured with the project's own rasteriser
+// (overdraw.h), under DESIGN.md's framing and camera. No file I/O here.
+#pragma once
+
+#include "animorder/animorder.h"
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace animorder {
+
+// ---------------------------------------------------------------------------------------------
+// Planar clusters (planar_clusters.cpp) — Nehab et al. 2006 §3, adapting Sander et al. 2003.
+
+// The tie-breaking constant ε of the edge cost 1 − n̄c·nf + ε (a small cost per step, so that in
+// flat regions a face goes to the nearest seed).
+constexpr double kPlanarClusterEpsilon = 1e-3;
+
+// Clusters the triangles into min(cluster_count, triangle count) regions of similar normal,
+// grown over the edge adjacency (triangles sharing an undirected edge; vertices at bit-identical
+// positions count as one, so seams do not cut the surface). Seeds are placed one at a time: in
+// the connected component with most triangles that has no seed yet (at its lowest triangle),
+// while any is left, then at the face farthest (in accumulated edge cost) from the seeds so far;
+// then Lloyd iterations (at most max_iterations) alternate growing every cluster from its seed
+// (Dijkstra with edge cost 1 − n̄c·nf + ε, n̄c the cluster's area-weighted mean normal) and moving
+// each seed to the face of its cluster farthest (in steps) from the cluster's boundary, until the
+// seeds stop moving. A component that got no seed joins, whole, the cluster whose normal is
+// closest to the component's area-weighted mean normal. Returns one cluster id per triangle;
+// every id below the cluster count is used.
+// positions: vertex_count xyz floats. Deterministic. Throws InvalidInput for bad indices, a
+// non-finite position or cluster_count == 0 with triangles present.
+std::vector<uint32_t> cluster_by_normals(const uint32_t* indices, size_t index_count, const float* positions,
+                                         size_t vertex_count, size_t cluster_count, unsigned max_iterations = 8);
+
+// The same clustering for several counts of one mesh: normals and adjacency are computed once,
+// and seeding for a larger count resumes from the last one's seeds (identical results to
+// cluster_by_normals). The arrays are read in the constructor only.
+class PlanarClusterer {
+public:
+    PlanarClusterer(const uint32_t* indices, size_t index_count, const float* positions, size_t vertex_count);
+    ~PlanarClusterer();
+    PlanarClusterer(const PlanarClusterer&) = delete;
+    PlanarClusterer& operator=(const PlanarClusterer&) = delete;
+    std::vector<uint32_t> cluster(size_t cluster_count, unsigned max_iterations = 8);
+
+private:
+    struct State;
+    std::unique_ptr<State> state_;
+};
+
+// Writes a face permutation grouping triangles by cluster (ascending id), each cluster in Tipsify
+// order (its triangles Tipsified on their own, vertices renumbered locally so the cost is linear
+// in the cluster). Returns cluster_starts: cluster c occupies [starts[c], starts[c+1]) of order.
+std::vector<uint32_t> tipsify_clusters(uint32_t* order, const uint32_t* indices, size_t index_count,
+                                       size_t vertex_count, const uint32_t* cluster_of, size_t cluster_count,
+                                       unsigned cache_size = kDefaultCacheSize);
+
+// ---------------------------------------------------------------------------------------------
+// The partial-order graph and its order (nehab06.cpp) — §4 and §5.
+
+// A weighted arc: drawing `from` before `to` saves `weight` fragments.
+struct Arc {
+    uint32_t from = 0;
+    uint32_t to = 0;
+    uint64_t weight = 0;
+};
+
+// A node order from the greedy minimum feedback-arc-set heuristic of Eades, Lin & Smyth (1993;
+// Skiena, The Algorithm Design Manual), with the weighted rule of Nehab et al. §5: repeatedly
+// move every sink to the front of the tail and every source to the end of the head; when only
+// cycles remain, remove the node with the largest |Σ out-weights − Σ in-weights| and put it on
+// the winning side (head when out ≥ in, else tail); ties go to the lowest node id. Sources and
+// sinks are taken first-found-first (FIFO, initial ones in id order), so an acyclic graph comes
+// out in a topological order. Parallel arcs add up. Returns the nodes in drawing order.
+// O((V + E) log V): the bucket queue of the unit-weight heuristic would need a bucket per
+// possible weight difference, so the greedy choice uses an ordered set instead. Throws
+// InvalidInput for a node id >= node_count, a self-loop or a zero weight.
+std::vector<uint32_t> order_feedback_arc_set(size_t node_count, const Arc* arcs, size_t arc_count);
+
+struct FeedbackArcs {
+    size_t count = 0;     // arcs whose `to` comes before their `from` in the order
+    uint64_t weight = 0;  // their total weight
+};
+// The arcs a node order violates. node_order must be a permutation of 0..node_count-1.
+FeedbackArcs count_feedback_arcs(const uint32_t* node_order, size_t node_count, const Arc* arcs, size_t arc_count);
+
+struct OverdrawGraphSettings {
+    size_t views = 162;        // icosphere directions (12, 42, 162, 642, ...)
+    unsigned resolution = 256;  // square viewport
+    unsigned threads = 0;       // 0: all hardware threads; the result does not depend on it
+};
+
+// The partial-order graph of §4. For every node (each listed keyframe × each icosphere view,
+// framed and seen with DESIGN.md's camera; R is the largest radius over the listed keyframes),
+// one rasterisation keeps every pixel's fragments; then for every pair of clusters a < b and
+// every pixel both cover, the fragments passing the depth test when a alone is drawn and then b
+// alone is compared with b then a, each cluster drawn in the sequence `draw_order` gives its
+// triangles (a face permutation: only the order within each cluster matters). The net saving of
+// a-before-b summed over all nodes gives an arc a→b (or b→a when negative; none when zero).
+// Exactly passed(b, a) − passed(a, b) of the two-cluster draw, as score_nodes would count it.
+// Arcs come sorted by (min(a,b), max(a,b)). keyframes empty → keyframe 0. Deterministic whatever
+// the thread count (integer sums). cluster_count <= kMaxNehabClusters.
+std::vector<Arc> build_overdraw_graph(const uint32_t* indices, size_t index_count, const float* keyframe_positions,
+                                      size_t keyframe_count, size_t vertex_count, const uint32_t* keyframes,
+                                      size_t keyframes_count, const uint32_t* cluster_of, size_t cluster_count,
+                                      const uint32_t* draw_order, const OverdrawGraphSettings& settings);
+
+// The graph keeps a dense triangular matrix of pair sums per worker: 4096 clusters take 64 MiB.
+constexpr size_t kMaxNehabClusters = 4096;
+
+// ---------------------------------------------------------------------------------------------
+// The whole method (nehab06.cpp).
+
+struct Nehab06Settings {
+    // Clusters; 0 chooses automatically as the paper suggests (§6: "trying the method on
+    // successive powers of two, until the average overdraw stops improving consistently", and
+    // the count is reached "long before [it] starts to harm the vertex cache performance"):
+    // 2, 4, 8, ... clusters, each scored by its mean OVR over the graph's own nodes, stopping
+    // after two doublings in a row that lower the best mean OVR by less than 0.5%, at 1024 or the
+    // triangle count, or at the first count whose ACMR (clusters Tipsified) exceeds Tipsify's on
+    // the whole mesh by more than 10% (that count is not eligible); of the eligible counts, the
+    // smallest within 0.5% of their best mean OVR wins (the first count if none is eligible).
+    size_t clusters = 0;
+    size_t views = 162;
+    unsigned resolution = 256;
+    unsigned cache_size = kDefaultCacheSize;
+    unsigned threads = 0;
+};
+
+struct Nehab06Candidate {
+    size_t clusters = 0;
+    double mean_ovr = 0;  // over the graph's nodes, of that candidate's final order
+    double acmr = 0;      // of its clusters Tipsified (the cluster order does not change it much)
+};
+
+struct Nehab06Result {
+    size_t cluster_count = 0;
+    size_t arc_count = 0;
+    size_t feedback_arc_count = 0;
+    double feedback_weight = 0;  // fragments the violated arcs would have saved
+    std::vector<Nehab06Candidate> candidates;  // automatic choice only: every count tried
+    double seconds_clustering = 0;     // clustering and Tipsify inside clusters, all candidates
+    double seconds_rasterization = 0;  // rasterising the nodes (part of seconds_graph)
+    double seconds_graph = 0;          // rasterisation + pair sums, all candidates
+    double seconds_ordering = 0;       // feedback-arc-set ordering, all candidates
+    double seconds_selection = 0;      // scoring candidates (automatic choice only)
+};
+
+// static-nehab06: writes a face permutation of index_count/3 triangles to order. Clusters are
+// built on the normals of the first listed keyframe; the graph sums over every listed keyframe
+// (one buffer for the whole animation). keyframe_positions: keyframe_count × vertex_count × xyz.
+// keyframes empty → keyframe 0. A cluster count above the triangle count is lowered to it.
+// Throws InvalidInput for bad indices, missing or non-finite positions, a keyframe out of range,
+// a view count that is no icosphere, resolution 0 or above 8192, cache_size < 3, or more than
+// kMaxNehabClusters clusters.
+Nehab06Result order_static_nehab06(uint32_t* order, const uint32_t* indices, size_t index_count,
+                                   const float* keyframe_positions, size_t keyframe_count, size_t vertex_count,
+                                   const uint32_t* keyframes, size_t keyframes_count,
+                                   const Nehab06Settings& settings);
+
+}  // namespace animorder

@@ -1,0 +1,571 @@
+// make_results end to end (crafted report files in, docs/RESULTS.md and SVG charts out: exact table
+// rows, "not run" lines, byte-identical reruns, well-formed SVG with a point per value, clean
+// failure on malformed input) and its SVG chart writer (tools/results/svg_chart.h).
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "svg_chart.h"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using namespace animorder::results;
+
+namespace {
+
+std::string slurp(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+void spit(const fs::path& path, const std::string& text) {
+    fs::create_directories(path.parent_path());
+    std::ofstream(path, std::ios::binary) << text;
+}
+
+size_t occurrences(const std::string& text, const std::string& needle) {
+    size_t n = 0;
+    for (size_t at = text.find(needle); at != std::string::npos; at = text.find(needle, at + needle.size())) ++n;
+    return n;
+}
+
+// The text of section `title` (from its "## " heading to the next one).
+std::string section(const std::string& md, const std::string& title) {
+    const size_t start = md.find("\n## " + title + "\n");
+    if (start == std::string::npos) return "";
+    const size_t end = md.find("\n## ", start + 4);
+    return md.substr(start, end == std::string::npos ? std::string::npos : end - start);
+}
+
+// A simple well-formedness check: starts with <svg, every tag closed in order, nothing after the
+// root, no raw '<' or '>' in text, '&' only as an entity.
+::testing::AssertionResult well_formed_svg(const std::string& svg) {
+    if (svg.rfind("<svg", 0) != 0) return ::testing::AssertionFailure() << "does not start with <svg";
+    std::vector<std::string> open;
+    size_t i = 0;
+    bool closed_root = false;
+    while (i < svg.size()) {
+        if (svg[i] == '<') {
+            if (closed_root) return ::testing::AssertionFailure() << "content after the root element";
+            const size_t end = svg.find('>', i);
+            if (end == std::string::npos) return ::testing::AssertionFailure() << "unterminated tag at " << i;
+            const std::string tag = svg.substr(i + 1, end - i - 1);
+            if (tag.find('<') != std::string::npos) return ::testing::AssertionFailure() << "'<' inside tag at " << i;
+            if (tag[0] == '/') {
+                const std::string name = tag.substr(1);
+                if (open.empty() || open.back() != name)
+                    return ::testing::AssertionFailure()
+                           << "</" << name << "> closes " << (open.empty() ? "nothing" : open.back());
+                open.pop_back();
+                if (open.empty()) closed_root = true;
+            } else if (tag.back() != '/') {
+                open.push_back(tag.substr(0, tag.find_first_of(" \n")));
+            }
+            i = end + 1;
+        } else {
+            if (svg[i] == '>') return ::testing::AssertionFailure() << "raw '>' in text at " << i;
+            if (svg[i] == '&') {
+                const size_t semi = svg.find(';', i);
+                const std::string entity = svg.substr(i, semi == std::string::npos ? 1 : semi - i + 1);
+                if (entity != "&amp;" && entity != "&lt;" && entity != "&gt;" && entity != "&quot;" &&
+                    entity != "&apos;")
+                    return ::testing::AssertionFailure() << "bad entity " << entity;
+            }
+            if (closed_root && !std::isspace(static_cast<unsigned char>(svg[i])))
+                return ::testing::AssertionFailure() << "text after the root element";
+            ++i;
+        }
+    }
+    if (!open.empty()) return ::testing::AssertionFailure() << "<" << open.back() << "> never closed";
+    if (!closed_root) return ::testing::AssertionFailure() << "no root element";
+    return ::testing::AssertionSuccess();
+}
+
+// --- Crafted `animorder evaluate --report` files. ---------------------------------------------
+
+json method(const std::string& name, json lambda, json clusters, json views, int buffers, double acmr, double ovr,
+            json time_s, const std::vector<std::pair<std::string, double>>& per_clip = {{"Idle", 0.0}},
+            json clip_times = nullptr) {
+    json m = {{"name", name},       {"lambda", lambda},         {"clusters", clusters},
+              {"views", views},     {"buffers", buffers},       {"acmr", acmr},
+              {"atvr", acmr * 1.5}, {"ovr_mean", ovr},          {"ovr_pooled", ovr - 0.01},
+              {"time_s", time_s},   {"per_clip", json::array()}};
+    for (size_t c = 0; c < per_clip.size(); ++c)
+        m["per_clip"].push_back({{"clip", per_clip[c].first},
+                                 {"ovr_mean", per_clip[c].second == 0.0 ? ovr : per_clip[c].second},
+                                 {"ovr_pooled", ovr - 0.01},
+                                 {"nodes", 100},
+                                 {"time_s", clip_times.is_array() ? clip_times[c] : json(nullptr)}});
+    return m;
+}
+
+json report(const std::string& input, int triangles, std::vector<std::pair<std::string, int>> clips, json methods,
+            int eval_views = 300, int eval_resolution = 512) {
+    json r = {{"tool", "animorder"},
+              {"version", "0.1.0"},
+              {"input", input},
+              {"triangles", triangles},
+              {"vertices", triangles / 2},
+              {"settings",
+               {{"eval_views", eval_views},
+                {"eval_resolution", eval_resolution},
+                {"eval_seed", 20170501},
+                {"clusters", {5}},
+                {"lambda", {0.85, 3}},
+                {"views", {162}},
+                {"resolution", 256},
+                {"seed", 1},
+                {"cache_size", 16},
+                {"clips", json::array()}}},
+              {"clips", json::array()},
+              {"methods", methods},
+              {"nodes", 18000},
+              {"timings_s", {{"methods", 30.1}, {"evaluation", 95.0}, {"total", 126.0}}},
+              {"machine", {{"threads", 2}}}};
+    for (const auto& [name, keyframes] : clips) r["clips"].push_back({{"name", name}, {"keyframes", keyframes}});
+    return r;
+}
+
+json ganfaul_idle() {
+    json m = json::array();
+    m.push_back(method("original", nullptr, nullptr, nullptr, 1, 0.74049, 1.35849, 0.01));
+    m.push_back(method("static-sander07", 0.85, nullptr, nullptr, 1, 0.93751, 1.28149, 0.005));
+    m.push_back(method("static-nehab06", nullptr, nullptr, nullptr, 1, 0.71, 1.30, 2.04));
+    m.push_back(method("tipsify-per-frame", 0.85, nullptr, nullptr, 60, 0.9375, 1.2876, 1.5));
+    m.push_back(method("tipsify-per-frame", 3, nullptr, nullptr, 60, 2.9129, 1.2581, 1.6));
+    m.push_back(method("single", 0.85, 5, 162, 5, 0.93321, 1.12872, 18.24, {{"Idle", 0.0}}, json::array({18.2})));
+    m.push_back(method("single", 3, 5, 162, 5, 2.81671, 1.02918, 16.76, {{"Idle", 0.0}}, json::array({16.7})));
+    m.push_back(method("oracle", 0.85, nullptr, nullptr, 18000, 0.9326, 1.1008, 0.0094));
+    return report("../shared/data/mixamo-ganfaul/Ganfaul.gltf", 13810, {{"Idle", 60}}, m);
+}
+
+class MakeResults : public ::testing::Test {
+protected:
+    void SetUp() override {
+        dir_ = fs::temp_directory_path() / ("animorder-make-results-" + std::to_string(::getpid()) + "-" +
+                                            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        fs::remove_all(dir_);
+        fs::create_directories(dir_ / "in");
+    }
+    void TearDown() override { fs::remove_all(dir_); }
+
+    struct Outcome {
+        int exit_code = -1;
+        std::string err;
+    };
+    Outcome run(const fs::path& in, const fs::path& out) {
+        const fs::path err = dir_ / "stderr.txt";
+        const std::string command =
+            std::string(MAKE_RESULTS_EXE) + " " + in.string() + " " + out.string() + " 2>" + err.string();
+        const int status = std::system(command.c_str());
+        return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(err)};
+    }
+    void write(const std::string& name, const json& j) { spit(dir_ / "in" / name, j.dump(2)); }
+
+    // Every input file, with hand-picked numbers whose 3-decimal rounding is known.
+    void write_everything() {
+        write("ganfaul-idle.json", ganfaul_idle());
+        json sub1 = ganfaul_idle();
+        sub1["triangles"] = 55240;
+        sub1["methods"][5]["ovr_mean"] = 1.10149;
+        write("ganfaul-idle-sub1.json", sub1);
+        // sub2 left out: "not run".
+        for (const auto& [name, tris, ovr] : {std::tuple<std::string, int, double>{"fox", 576, 1.20049},
+                                              std::tuple<std::string, int, double>{"xbot", 30000, 1.33351}}) {
+            json m = json::array();
+            m.push_back(method("original", nullptr, nullptr, nullptr, 1, 0.7, ovr, 0.0, {{"Walk", 0.0}}));
+            m.push_back(method("single", 0.85, 5, 162, 10, 0.9, ovr - 0.2, 4.0, {{"Walk", 0.0}}, json::array({4.0})));
+            m.push_back(method("single", 3, 5, 162, 10, 2.9, ovr - 0.25, 5.0, {{"Walk", 0.0}}, json::array({5.0})));
+            write("characters/" + name + ".json", report("data/" + name + ".glb", tris, {{"Walk", 24}}, m, 60, 256));
+        }
+        {
+            json m = json::array();
+            const int views[] = {12, 42, 162, 642};
+            for (int i = 0; i < 4; ++i)
+                m.push_back(method("single", 0.85, 5, views[i], 5, 0.93, 1.14 - 0.004 * i, 1.0 + 20.0 * i));
+            write("sweep-views.json", report("g.gltf", 13810, {{"Idle", 60}}, m, 100, 256));
+        }
+        {
+            json m = json::array();
+            m.push_back(method("original", nullptr, nullptr, nullptr, 1, 0.747, 1.360, 0.0));
+            m.push_back(method("static-nehab06", nullptr, nullptr, nullptr, 1, 0.70, 1.30, 2.0));
+            const double lambdas[] = {0.7, 0.85, 1, 1.5, 2, 3};
+            for (const char* name : {"static-sander07", "single", "oracle"})
+                for (int i = 0; i < 6; ++i)
+                    m.push_back(method(name, lambdas[i], std::string(name) == "single" ? json(5) : json(nullptr),
+                                       std::string(name) == "single" ? json(162) : json(nullptr), 5, lambdas[i],
+                                       1.3 - 0.02 * i - (std::string(name) == "static-sander07" ? 0.0 : 0.15), 1.0));
+            write("sweep-lambda.json", report("g.gltf", 13810, {{"Idle", 60}}, m, 100, 256));
+        }
+        {
+            json m = json::array();
+            const int ks[] = {1, 2, 3, 5, 7, 10};
+            for (int i = 0; i < 6; ++i)
+                m.push_back(method("single", 0.85, ks[i], 162, ks[i], 0.93, 1.45 - 0.05 * i, 10.0 + i));
+            write("sweep-k.json", report("g.gltf", 13810, {{"Idle", 60}}, m, 100, 256));
+        }
+        {
+            const std::vector<std::pair<std::string, double>> clips = {
+                {"Idle", 1.38449}, {"Running", 1.41249}, {"Jump", 1.40}};
+            json m = json::array();
+            m.push_back(method("original", nullptr, nullptr, nullptr, 1, 0.747, 1.391, 0.1, clips));
+            m.push_back(method("single", 0.85, 5, 162, 15, 0.933, 1.149, 40.0,
+                               {{"Idle", 1.12249}, {"Running", 1.152}, {"Jump", 1.161}},
+                               json::array({5.18, 2.26, 3.14})));
+            m.back()["runs"] = json::array({{{"clips", "Idle"}, {"iterations", json::array({1, 2, 3, 4})}},
+                                            {{"clips", "Running"}, {"iterations", json::array({1, 2})}},
+                                            {{"clips", "Jump"}, {"iterations", json::array({1, 2, 3})}}});
+            m.push_back(method("joint", 0.85, 5, 162, 5, 0.933, 1.161, 102.94,
+                               {{"Idle", 1.134}, {"Running", 1.169}, {"Jump", 1.171}}));
+            m.back()["runs"] = json::array({{{"clips", "all"}, {"iterations", json::array({1, 2, 3, 4, 5})}}});
+            write("ganfaul-clips.json",
+                  report("g.gltf", 13810, {{"Idle", 60}, {"Running", 20}, {"Jump", 31}}, m, 60, 256));
+        }
+        write("render-time.json", {{"tool", "render_time"},
+                                   {"input", "g.gltf"},
+                                   {"renderer", "llvmpipe (LLVM 15.0.6, 256 bits)"},
+                                   {"nodes", 600},
+                                   {"resolution", 512},
+                                   {"shader_iterations", 64},
+                                   {"methods",
+                                    {{{"name", "original"}, {"buffers", 1}, {"ovr", 1.35849}, {"seconds", 12.34}},
+                                     {{"name", "single"}, {"buffers", 5}, {"ovr", 1.06949}, {"seconds", 9.87}}}},
+                                   {"time_ratio", 0.79984},
+                                   {"ovr_ratio", 0.78726},
+                                   {"correlation", 0.92153}});
+        spit(dir_ / "in" / "nehab06-bench.txt", "knot 2k   0.41 s\nknot 10k  1.20 s\n");
+        spit(dir_ / "in" / "notes-table1.md", "The lead's note on Table 1.\n");
+    }
+
+    fs::path dir_;
+};
+
+const char* const kSections[] = {
+    "Table 1: Ganfaul against the paper", "Every skinned character",
+    "Clustering viewpoints (Fig. 3)",     "Patch threshold lambda (Fig. 6)",
+    "Number of clusters k (Fig. 7)",      "Per clip: overdraw (Fig. 8) and preprocessing time (Fig. 5)",
+    "Rendering time in OpenGL",           "Nehab et al. 2006 preprocessing benchmark"};
+
+}  // namespace
+
+// --- The chart writer. -----------------------------------------------------------------------
+
+TEST(SvgChart, FixedFormattingHasNoNegativeZero) {
+    EXPECT_EQ(format_fixed(1.35849, 3), "1.358");
+    EXPECT_EQ(format_fixed(1.3585001, 3), "1.359");
+    EXPECT_EQ(format_fixed(-0.0004, 3), "0.000");
+    EXPECT_EQ(format_fixed(-0.04, 1), "0.0");
+    EXPECT_EQ(format_fixed(-0.06, 1), "-0.1");
+    EXPECT_EQ(format_fixed(18.24, 1), "18.2");
+}
+
+TEST(SvgChart, LineChartTicksMarkersAndEscaping) {
+    LineChart chart;
+    chart.title = "A <b> & \"c\"";
+    chart.x_label = "x";
+    chart.y_label = "y";
+    chart.series.push_back({"first", {1, 2, 3}, {1.0, 1.5, 1.2}});
+    chart.series.push_back({"second", {1, 2, 3}, {1.1, std::nan(""), 1.3}});
+    chart.series.push_back({"reference", {1, 3}, {1.25, 1.25}, true, false});
+    const std::string svg = render_line_chart(chart);
+    EXPECT_TRUE(well_formed_svg(svg));
+    EXPECT_NE(svg.find("A &lt;b&gt; &amp; &quot;c&quot;"), std::string::npos);
+    // Every finite point has a marker with its values; the NaN point and the reference line have none.
+    EXPECT_EQ(occurrences(svg, "<title>first: x="), 3u);
+    EXPECT_NE(svg.find("<title>first: x=2, y=1.500</title>"), std::string::npos);
+    EXPECT_EQ(occurrences(svg, "<title>second: x="), 2u);
+    EXPECT_EQ(occurrences(svg, "<title>reference: x="), 0u);
+    EXPECT_NE(svg.find("stroke-dasharray"), std::string::npos);
+    // y data 1.0..1.5, padded 4% to 0.98..1.52: span 0.54 / 5 -> step 0.2, axis 0.8..1.6 (worked by hand).
+    for (const char* tick : {">0.8<", ">1.0<", ">1.2<", ">1.4<", ">1.6<"})
+        EXPECT_NE(svg.find(tick), std::string::npos) << tick;
+    EXPECT_EQ(svg.find(">1.8<"), std::string::npos);
+    EXPECT_EQ(svg, render_line_chart(chart));  // deterministic
+}
+
+TEST(SvgChart, LogAxisAndExplicitTicks) {
+    LineChart chart;
+    chart.title = "views";
+    chart.series.push_back({"single", {12, 42, 162, 642}, {1.14, 1.136, 1.132, 1.128}});
+    chart.log_x = true;
+    chart.x_ticks = {12, 42, 162, 642};
+    const std::string svg = render_line_chart(chart);
+    EXPECT_TRUE(well_formed_svg(svg));
+    for (const char* tick : {">12<", ">42<", ">162<", ">642<"}) EXPECT_NE(svg.find(tick), std::string::npos) << tick;
+    EXPECT_EQ(occurrences(svg, "<title>single: x="), 4u);
+    chart.series[0].x[0] = 0;
+    EXPECT_THROW(render_line_chart(chart), std::invalid_argument);
+}
+
+TEST(SvgChart, BadChartsThrow) {
+    LineChart empty;
+    EXPECT_THROW(render_line_chart(empty), std::invalid_argument);
+    LineChart mismatched;
+    mismatched.series.push_back({"s", {1, 2}, {1}});
+    EXPECT_THROW(render_line_chart(mismatched), std::invalid_argument);
+    LineChart all_nan;
+    all_nan.series.push_back({"s", {1}, {std::nan("")}});
+    EXPECT_THROW(render_line_chart(all_nan), std::invalid_argument);
+    BarChart bars;
+    bars.categories = {"A", "B"};
+    bars.series.push_back({"s", {1.0}});
+    EXPECT_THROW(render_bar_chart(bars), std::invalid_argument);
+    bars.series[0].values = {1.0, 2.0};
+    bars.width = 100;
+    EXPECT_THROW(render_bar_chart(bars), std::invalid_argument);
+}
+
+TEST(SvgChart, GroupedBarsStartAtTheBaseline) {
+    BarChart chart;
+    chart.title = "OVR per clip";
+    chart.categories = {"A", "B", "C"};
+    chart.series.push_back({"original", {1.38, 1.41, 1.40}});
+    chart.series.push_back({"single", {1.12, std::nan(""), 1.16}});
+    chart.baseline = 1.0;
+    const std::string svg = render_bar_chart(chart);
+    EXPECT_TRUE(well_formed_svg(svg));
+    EXPECT_EQ(occurrences(svg, "<title>original, "), 3u);
+    EXPECT_EQ(occurrences(svg, "<title>single, "), 2u);
+    EXPECT_NE(svg.find("<title>single, C: 1.160</title>"), std::string::npos);
+    EXPECT_NE(svg.find(">1.0<"), std::string::npos);  // the axis starts at the baseline...
+    EXPECT_EQ(svg.find(">0.9<"), std::string::npos);  // ...not below it
+    EXPECT_EQ(svg.find(">0.0<"), std::string::npos);
+}
+
+// --- The program. ----------------------------------------------------------------------------
+
+TEST_F(MakeResults, TablesHoldTheReportsNumbers) {
+    write_everything();
+    const Outcome o = run(dir_ / "in", dir_ / "docs");
+    ASSERT_EQ(o.exit_code, 0) << o.err;
+    const std::string md = slurp(dir_ / "docs" / "RESULTS.md");
+    ASSERT_EQ(md.rfind("# Results\n", 0), 0u);
+    EXPECT_NE(md.find("`bash scripts/results.sh`"), std::string::npos);
+    for (const char* title : kSections) {
+        EXPECT_NE(section(md, title), "") << title;
+        EXPECT_NE(md.find("- [" + std::string(title) + "](#"), std::string::npos) << title;  // contents list
+    }
+
+    // The settings of every report, from the reports themselves, in the document's order.
+    const std::string settings = section(md, "Inputs and settings");
+    EXPECT_NE(settings.find("| `ganfaul-idle.json` | `../shared/data/mixamo-ganfaul/Ganfaul.gltf` | 13810 | 1 (60) | "
+                            "300 × 512², seed 20170501 | 162 views × 256², seed 1 | 0.85, 3 | 2 | 2.1 |"),
+              std::string::npos)
+        << settings;
+    EXPECT_LT(settings.find("`ganfaul-idle.json`"), settings.find("`sweep-k.json`"));
+    EXPECT_LT(settings.find("`sweep-k.json`"), settings.find("`characters/fox.json`"));
+
+    // Table 1: the paper's Ganfaul row as printed (JCGT 2017 Table 1), ours beside it.
+    const std::string t1 = section(md, kSections[0]);
+    EXPECT_NE(
+        t1.find("| Ganfaul | paper, 12 animations | 13795 | 0.654 | 1.377 | 0.869 | 1.302 | 2.939 | 1.211 | 0.861 | "
+                "1.153 | 2.715 | 1.065 | 0.860 | 1.16624 | 2.698 | 1.0882 |"),
+        std::string::npos)
+        << t1;
+    EXPECT_NE(t1.find("| Ganfaul Δ2 | paper, 12 animations | 220720 | 0.618 | 1.376 | 0.849 | 1.248 | 2.875 | 1.209 | "
+                      "0.848 | 1.091 | 2.926 | 1.034 | 0.858 | 1.11241 | 2.925 | 1.05853 |"),
+              std::string::npos);
+    EXPECT_NE(
+        t1.find("| Ganfaul | ours, Idle | 13810 | 0.740 | 1.358 | 0.938 | 1.288 | 2.913 | 1.258 | 0.933 | 1.129 | "
+                "2.817 | 1.029 | — | — | — | — |"),
+        std::string::npos)
+        << t1;
+    EXPECT_NE(
+        t1.find("| Ganfaul Δ1 | ours, Idle | 55240 | 0.740 | 1.358 | 0.938 | 1.288 | 2.913 | 1.258 | 0.933 | 1.101 |"),
+        std::string::npos);
+    EXPECT_NE(t1.find("not run: ganfaul-idle-sub2.json missing"), std::string::npos);
+    // timings_s.total 126.0 s = 2.1 minutes; 6 distinct methods in 8 rows.
+    EXPECT_NE(
+        t1.find("with all 6 methods (8 rows) takes 2.1 minutes on 2 threads: 30.1 s to compute the orders, 95.0 s "
+                "to evaluate them."),
+        std::string::npos)
+        << t1;
+    // The compact table: method, λ, buffers, ACMR, ATVR (1.5 × ACMR here), OVR mean, pooled (mean − 0.01), time.
+    EXPECT_NE(t1.find("| single | 0.85 | 5 | 0.933 | 1.400 | 1.129 | 1.119 | 18.2 |"), std::string::npos) << t1;
+    EXPECT_NE(t1.find("| original | — | 1 | 0.740 | 1.111 | 1.358 | 1.348 | 0.0 |"), std::string::npos);
+    EXPECT_NE(t1.find("evaluation 300 random views × 512², seed 20170501"), std::string::npos);
+    // The lead's notes close their section.
+    EXPECT_NE(t1.find("The lead's note on Table 1.\n"), std::string::npos);
+    EXPECT_GT(t1.find("The lead's note on Table 1."), t1.find("### Ganfaul Δ2"));
+
+    // Characters: a table each and the summary at λ = 0.85 (single = OVR − 0.2).
+    const std::string ch = section(md, kSections[1]);
+    EXPECT_NE(ch.find("| fox | 576 | 1 | 24 | 1.200 | 1.000 |"), std::string::npos) << ch;
+    EXPECT_NE(ch.find("| xbot | 30000 | 1 | 24 | 1.334 | 1.134 |"), std::string::npos) << ch;
+    EXPECT_NE(ch.find("### xbot"), std::string::npos);
+    EXPECT_NE(ch.find("| single | 3 | 10 | 2.900 | 4.350 | 1.084 | 1.074 | 5.0 |"), std::string::npos) << ch;
+    EXPECT_NE(ch.find("evaluation 60 random views × 256²"), std::string::npos);
+    EXPECT_NE(ch.find("![Mean OVR per character and method at lambda 0.85](results/characters-ovr.svg)"),
+              std::string::npos);
+
+    // Per clip (Fig. 8) and k-means time per clip with its iterations (Fig. 5).
+    const std::string clips = section(md, kSections[5]);
+    EXPECT_NE(clips.find("| A Idle | 60 | 1.384 | 1.122 | 1.134 |"), std::string::npos) << clips;
+    EXPECT_NE(clips.find("| B Running | 20 | 1.412 | 1.152 | 1.169 |"), std::string::npos);
+    EXPECT_NE(clips.find("| A Idle | 60 | 5.2 | 4 |"), std::string::npos);
+    EXPECT_NE(clips.find("| C Jump | 31 | 3.1 | 3 |"), std::string::npos);
+    EXPECT_NE(clips.find("| joint (all clips) | 111 | 102.9 | 5 |"), std::string::npos);
+
+    // The rendering-time check states its renderer.
+    const std::string rt = section(md, kSections[6]);
+    EXPECT_NE(rt.find("Renderer: `llvmpipe (LLVM 15.0.6, 256 bits)`"), std::string::npos) << rt;
+    EXPECT_NE(rt.find("| original | 1 | 1.358 | 12.3 |"), std::string::npos);
+    EXPECT_NE(rt.find("| single | 5 | 1.069 | 9.9 |"), std::string::npos);
+    EXPECT_NE(rt.find("Time ratio 0.800 against OVR ratio 0.787 (per-node correlation of the two ratios 0.922)"),
+              std::string::npos);
+
+    // Benchmark text verbatim in a code block.
+    EXPECT_NE(section(md, kSections[7]).find("```text\nknot 2k   0.41 s\nknot 10k  1.20 s\n```\n"), std::string::npos);
+    // No date anywhere (determinism): this year is not written.
+    const std::time_t now = std::time(nullptr);
+    const std::string year = std::to_string(std::gmtime(&now)->tm_year + 1900);
+    EXPECT_EQ(md.find(year), std::string::npos) << year;
+}
+
+TEST_F(MakeResults, ChartsAreWellFormedWithAPointPerValue) {
+    write_everything();
+    ASSERT_EQ(run(dir_ / "in", dir_ / "docs").exit_code, 0);
+    const std::string md = slurp(dir_ / "docs" / "RESULTS.md");
+    size_t charts = 0;
+    for (const auto& entry : fs::directory_iterator(dir_ / "docs" / "results")) {
+        const std::string svg = slurp(entry.path());
+        EXPECT_TRUE(well_formed_svg(svg)) << entry.path();
+        EXPECT_NE(md.find("(results/" + entry.path().filename().string() + ")"), std::string::npos) << entry.path();
+        ++charts;
+    }
+    EXPECT_EQ(charts, 8u);  // characters, Fig. 3 (OVR, time), Fig. 6 (OVR, ACMR), Fig. 7, Fig. 8 (one λ), Fig. 5
+    const std::string lambda = slurp(dir_ / "docs" / "results" / "fig6-lambda-ovr.svg");
+    for (const char* name : {"static-sander07", "single k=5", "oracle"}) {
+        EXPECT_EQ(occurrences(lambda, "<title>" + std::string(name) + ": x="), 6u) << name;
+        for (const char* x : {"0.7", "0.85", "1", "1.5", "2", "3"})
+            EXPECT_NE(lambda.find("<title>" + std::string(name) + ": x=" + x + ", y="), std::string::npos) << name << x;
+    }
+    EXPECT_NE(lambda.find("<title>single k=5: x=0.85, y=1.130</title>"), std::string::npos);  // 1.3 − 0.02 − 0.15
+    EXPECT_NE(lambda.find("original (reference)"), std::string::npos);
+    EXPECT_NE(lambda.find("static-nehab06 (reference)"), std::string::npos);
+    const std::string views = slurp(dir_ / "docs" / "results" / "fig3-views-ovr.svg");
+    EXPECT_EQ(occurrences(views, "<title>single λ=0.85 k=5: x="), 4u);
+    const std::string k = slurp(dir_ / "docs" / "results" / "fig7-k-ovr.svg");
+    EXPECT_EQ(occurrences(k, "<title>single λ=0.85 views=162: x="), 6u);
+    const std::string bars = slurp(dir_ / "docs" / "results" / "fig8-clips-ovr-lambda-0.85.svg");
+    for (const char* name : {"original", "single", "joint"})
+        EXPECT_EQ(occurrences(bars, "<title>" + std::string(name) + ", "), 3u);
+    const std::string time = slurp(dir_ / "docs" / "results" / "fig5-clips-time.svg");
+    EXPECT_NE(time.find("<title>single λ=0.85, joint: 102.940</title>"), std::string::npos);
+    const std::string characters = slurp(dir_ / "docs" / "results" / "characters-ovr.svg");
+    EXPECT_NE(characters.find("<title>single, xbot: 1.134</title>"), std::string::npos);
+}
+
+TEST_F(MakeResults, OutputIsByteIdenticalAcrossRuns) {
+    write_everything();
+    ASSERT_EQ(run(dir_ / "in", dir_ / "a").exit_code, 0);
+    ASSERT_EQ(run(dir_ / "in", dir_ / "b").exit_code, 0);
+    EXPECT_EQ(slurp(dir_ / "a" / "RESULTS.md"), slurp(dir_ / "b" / "RESULTS.md"));
+    size_t compared = 0;
+    for (const auto& entry : fs::directory_iterator(dir_ / "a" / "results")) {
+        EXPECT_EQ(slurp(entry.path()), slurp(dir_ / "b" / "results" / entry.path().filename())) << entry.path();
+        ++compared;
+    }
+    EXPECT_GT(compared, 0u);
+    // No temporary files left behind.
+    for (const auto& entry : fs::recursive_directory_iterator(dir_ / "a"))
+        EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos) << entry.path();
+}
+
+TEST_F(MakeResults, MissingFilesSayNotRun) {
+    const Outcome o = run(dir_ / "in", dir_ / "docs");
+    ASSERT_EQ(o.exit_code, 0) << o.err;
+    const std::string md = slurp(dir_ / "docs" / "RESULTS.md");
+    for (const char* file : {"ganfaul-idle.json", "ganfaul-idle-sub1.json", "ganfaul-idle-sub2.json",
+                             "characters/*.json", "sweep-views.json", "sweep-lambda.json", "sweep-k.json",
+                             "ganfaul-clips.json", "render-time.json", "nehab06-bench.txt"})
+        EXPECT_NE(md.find(std::string("not run: ") + file + " missing"), std::string::npos) << file;
+    // The paper's rows are there even with nothing to compare them with.
+    EXPECT_NE(md.find("| Ganfaul | paper, 12 animations | 13795 |"), std::string::npos);
+    EXPECT_TRUE(fs::is_directory(dir_ / "docs" / "results"));
+    EXPECT_TRUE(fs::is_empty(dir_ / "docs" / "results"));
+}
+
+TEST_F(MakeResults, StaleChartsAreRemoved) {
+    write_everything();
+    spit(dir_ / "docs" / "results" / "fig9-old.svg", "<svg></svg>\n");
+    ASSERT_EQ(run(dir_ / "in", dir_ / "docs").exit_code, 0);
+    EXPECT_FALSE(fs::exists(dir_ / "docs" / "results" / "fig9-old.svg"));
+    EXPECT_TRUE(fs::exists(dir_ / "docs" / "results" / "fig7-k-ovr.svg"));
+}
+
+TEST_F(MakeResults, MalformedJsonFailsCleanlyWithoutOutput) {
+    write_everything();
+    spit(dir_ / "in" / "sweep-k.json", "{\"tool\": \"animorder\", \"methods\": [");
+    Outcome o = run(dir_ / "in", dir_ / "docs");
+    EXPECT_EQ(o.exit_code, 1);
+    EXPECT_NE(o.err.find("make_results: sweep-k.json: not valid JSON"), std::string::npos) << o.err;
+    EXPECT_EQ(std::count(o.err.begin(), o.err.end(), '\n'), 1) << o.err;
+    EXPECT_FALSE(fs::exists(dir_ / "docs"));
+
+    // A well-formed file with a wrong type names the key; an earlier RESULTS.md stays as it was.
+    spit(dir_ / "docs" / "RESULTS.md", "previous\n");
+    json k = ganfaul_idle();
+    k["methods"][2]["acmr"] = "low";
+    write("sweep-k.json", k);
+    o = run(dir_ / "in", dir_ / "docs");
+    EXPECT_EQ(o.exit_code, 1);
+    EXPECT_NE(o.err.find("sweep-k.json: methods[2].acmr: expected a number, got string"), std::string::npos) << o.err;
+    EXPECT_EQ(slurp(dir_ / "docs" / "RESULTS.md"), "previous\n");
+    EXPECT_FALSE(fs::exists(dir_ / "docs" / "results"));
+
+    // A missing required key, in a character file.
+    json c = ganfaul_idle();
+    c["methods"][0].erase("ovr_mean");
+    write("sweep-k.json", ganfaul_idle());
+    write("characters/fox.json", c);
+    o = run(dir_ / "in", dir_ / "docs");
+    EXPECT_EQ(o.exit_code, 1);
+    EXPECT_NE(o.err.find("characters/fox.json: methods[0].ovr_mean: missing"), std::string::npos) << o.err;
+}
+
+TEST_F(MakeResults, ChartsWithNothingToDrawAreSkippedWithANote) {
+    // A clips report whose methods have no per-clip values: the table says —, the chart is not drawn.
+    json m = json::array();
+    m.push_back(method("original", nullptr, nullptr, nullptr, 1, 0.747, 1.391, 0.1, {}));
+    write("ganfaul-clips.json", report("g.gltf", 13810, {{"Idle", 60}}, m, 60, 256));
+    const Outcome o = run(dir_ / "in", dir_ / "docs");
+    ASSERT_EQ(o.exit_code, 0) << o.err;
+    const std::string clips = section(slurp(dir_ / "docs" / "RESULTS.md"), kSections[5]);
+    EXPECT_NE(clips.find("(chart fig8-clips-ovr.svg not drawn: Overdraw per clip (Fig. 8): no finite values to draw)"),
+              std::string::npos)
+        << clips;
+    EXPECT_NE(clips.find("| A Idle | 60 | — |"), std::string::npos);
+    EXPECT_NE(clips.find("| all clips | 60 | 1.391 |"), std::string::npos);
+    EXPECT_FALSE(fs::exists(dir_ / "docs" / "results" / "fig8-clips-ovr.svg"));
+
+    // A settings entry that is not an object is an error, not silently ignored.
+    json bad = ganfaul_idle();
+    bad["settings"] = 3;
+    write("ganfaul-idle.json", bad);
+    const Outcome e = run(dir_ / "in", dir_ / "docs2");
+    EXPECT_EQ(e.exit_code, 1);
+    EXPECT_NE(e.err.find("ganfaul-idle.json: settings: expected an object, got number"), std::string::npos) << e.err;
+}
+
+TEST_F(MakeResults, UsageErrors) {
+    EXPECT_EQ(run(dir_ / "absent", dir_ / "docs").exit_code, 1);
+    const int status = std::system((std::string(MAKE_RESULTS_EXE) + " only-one-argument 2>/dev/null").c_str());
+    EXPECT_EQ(WEXITSTATUS(status), 2);
+    EXPECT_FALSE(fs::exists(dir_ / "docs"));
+}

@@ -1,0 +1,94 @@
+// `animorder subdivide`: load the input (or the bundled character), apply `--levels` levels of
+// Loop subdivision to every keyframe (subdivide_animated_mesh) and write the result as a new
+// glTF/GLB whose keyframes are morph targets (gltf_animated_mesh), atomically.
+#include "subdivide_command.h"
+
+#include "output.h"
+
+#include "animorder/io.h"
+#include "animorder/subdivision.h"
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+
+namespace animorder::tool {
+namespace {
+
+void note(const CommonOptions& common, const std::string& text) {
+    if (!common.quiet) std::fprintf(stderr, "animorder: %s\n", text.c_str());
+}
+
+// As commands.cpp loads every command's input: --clip values that exist on disk are clip files
+// or folders (Mixamo style); the others name the clips to keep.
+AnimatedMesh load_subdivide_input(const CommonOptions& common, std::string& input_name) {
+    std::vector<std::string> clip_files, clip_names;
+    for (const std::string& c : common.clips) (std::filesystem::exists(c) ? clip_files : clip_names).push_back(c);
+    AnimatedMesh mesh;
+    if (common.input.empty()) {
+        if (!clip_files.empty()) throw std::runtime_error("clip files need an input character file");
+        note(common, "no input file given: using the bundled procedural character");
+        input_name = "procedural-character (bundled)";
+        mesh = make_procedural_character();
+    } else {
+        input_name = common.input;
+        mesh = load_character(common.input, clip_files);
+        note(common, "loaded " + common.input + ": " + std::to_string(mesh.triangle_count()) + " triangles, " +
+                         std::to_string(mesh.clips.size()) + " clips, " + std::to_string(mesh.keyframe_count()) +
+                         " keyframes");
+    }
+    if (!clip_names.empty()) mesh = select_clips(mesh, clip_names);
+    return mesh;
+}
+
+std::string megabytes(size_t bytes) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.1f MB", double(bytes) / 1e6);
+    return text;
+}
+
+}  // namespace
+
+int run_subdivide(const SubdivideOptions& options) {
+    const auto start = std::chrono::steady_clock::now();
+    const std::string extension = std::filesystem::path(options.output).extension().string();
+    if (extension != ".glb" && extension != ".gltf")
+        throw std::runtime_error(options.output + ": the output must be a .glb or .gltf file");
+    if (options.levels > kMaxSubdivisionLevels)
+        throw std::runtime_error("--levels " + std::to_string(options.levels) + ": at most " +
+                                 std::to_string(kMaxSubdivisionLevels) + " (each level multiplies the triangles by 4)");
+    if (!options.common.input.empty()) {
+        std::error_code same_error;
+        if (std::filesystem::equivalent(options.output, options.common.input, same_error))
+            throw std::runtime_error(options.output + ": refusing to overwrite the input; name another output");
+    }
+
+    std::string input_name;
+    const AnimatedMesh mesh = load_subdivide_input(options.common, input_name);
+    AnimatedMesh result = subdivide_animated_mesh(mesh, options.levels);
+    if (!options.common.input.empty()) result.name = std::filesystem::path(options.common.input).stem().string();
+    // Every keyframe is a morph target of 12 bytes per vertex: say how big before building it.
+    const double estimate = double(result.vertex_count) * double(result.keyframe_count()) * 12.0;
+    if (estimate > 4.0e9)
+        throw std::runtime_error("the output would hold about " + megabytes(size_t(estimate)) + " of morph targets (" +
+                                 std::to_string(result.keyframe_count()) +
+                                 " keyframes), more than a GLB can; keep fewer clips with --clip NAME");
+    note(options.common, "subdivided " + std::to_string(options.levels) + " level(s); writing " +
+                             std::to_string(result.keyframe_count()) + " keyframes as morph targets (about " +
+                             megabytes(size_t(estimate)) + (estimate > 5e8 ? "; --clip NAME keeps fewer" : "") + ")");
+    const std::string bytes = gltf_animated_mesh(result, extension == ".glb");
+    write_file_atomically(options.output, bytes);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+    std::printf("%s: %u level(s) of Loop subdivision\n", input_name.c_str(), options.levels);
+    std::printf("  triangles %zu -> %zu\n", mesh.triangle_count(), result.triangle_count());
+    std::printf("  vertices  %zu -> %zu\n", mesh.vertex_count, result.vertex_count);
+    std::printf("  clips %zu  keyframes %zu\n", result.clips.size(), result.keyframe_count());
+    std::printf("  wrote %s (%s, %zu bytes) in %.2f s\n", options.output.c_str(), megabytes(bytes.size()).c_str(),
+                bytes.size(), seconds);
+    return 0;
+}
+
+}  // namespace animorder::tool

@@ -520,7 +520,8 @@ Nehab06Result order_static_nehab06(uint32_t* order, const uint32_t* indices, siz
     } else {
         // §6: powers of two until the mean OVR stops improving (see Nehab06Settings::clusters).
         constexpr double kGain = 0.005;
-        constexpr double kAcmrBudget = 1.10;
+        constexpr double kAcmrBudget = 1.25;
+        const size_t components = clusterer.component_count();
         constexpr size_t kLargest = 1024;
         Clock::time_point t0 = Clock::now();
         double tipsify_acmr = 0;
@@ -541,7 +542,9 @@ Nehab06Result order_static_nehab06(uint32_t* order, const uint32_t* indices, siz
             result.seconds_selection += seconds_since(t0);
             result.candidates.push_back({c.clusters, ovr, c.acmr});
             tried.push_back(std::move(c));
-            if (ovr < best * (1 - kGain)) stalled = 0;
+            // Below the component count clusters are unions of whole components: the mean OVR
+            // can sit on a plateau there and fall once components split, so no stall counts.
+            if (ovr < best * (1 - kGain) || k < components) stalled = 0;
             else ++stalled;
             best = std::min(best, ovr);
             if (stalled >= 2 || k >= kLargest || k >= triangles) break;

@@ -239,6 +239,8 @@ PlanarClusterer::PlanarClusterer(const uint32_t* indices, size_t index_count, co
 
 PlanarClusterer::~PlanarClusterer() = default;
 
+size_t PlanarClusterer::component_count() const { return state_->component_faces.size(); }
+
 std::vector<uint32_t> PlanarClusterer::cluster(size_t cluster_count, unsigned max_iterations) {
     State& st = *state_;
     const size_t triangles = st.triangles;

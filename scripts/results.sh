@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Reproduces docs/RESULTS.md: every table, sweep, chart and timing in it comes from this script.
 #
-#   bash scripts/results.sh            # everything from scratch (about an hour on 2 cores)
+#   bash scripts/results.sh            # everything from scratch (about 45 minutes on 2 cores)
 #   RESUME=1 bash scripts/results.sh   # keep the reports already in build/results, run the rest
 #   BIN=/some/dir SKIP_BUILD=1 ...     # run binaries copied elsewhere (rebuilding build/ meanwhile)
 #
@@ -79,6 +79,7 @@ character robot-expressive $DATA/glb-robot-expressive/RobotExpressive.glb
 character bob $DATA/md5-bob/Bob.md5mesh
 character wuson $DATA/x-wuson/Testwuson.X
 character dwarf $DATA/x-dwarf/dwarf.x
+character dwarf2-b3d $DATA/b3d-dwarf2/dwarf2.b3d
 character bcn-epileptic $DATA/x-bcn-epileptic/BCN_Epileptic.X
 character mrfixit $DATA/iqm-mrfixit/mrfixit.iqm
 # The OpenGL rendering-time check (original vs single, expensive fragment shader).

@@ -131,9 +131,9 @@ struct Nehab06Settings {
     // from the number of connected components on: below it clusters are unions of whole
     // components and the OVR can plateau before it falls), at 1024 or the triangle count, or at
     // the first count whose ACMR (clusters Tipsified) exceeds Tipsify's on the whole mesh by more
-    // than 25% (that count is not eligible; static-sander07 at λ = 0.85 costs 26–39% on the
-    // characters of ../shared/data, so the budget keeps the ACMR below it); of the eligible
-    // counts, the smallest within 0.5% of their best mean OVR wins (the first if none is).
+    // than 25% (that count is not eligible; static-sander07 at λ = 0.85 costs 12–39% on the
+    // characters of ../shared/data, and 10% left too few clusters to beat it on Xbot); of the
+    // eligible counts, the smallest within 0.5% of their best mean OVR wins (the first if none is).
     size_t clusters = 0;
     size_t views = 162;
     unsigned resolution = 256;

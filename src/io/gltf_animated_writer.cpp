@@ -10,6 +10,8 @@
 // back (up to the float rounding of base + delta). A mesh without clips gets no animation.
 #include "animorder/io.h"
 
+#include "gltf_buffer.h"
+
 #include "animorder/animorder.h"
 
 #include <tiny_gltf.h>
@@ -20,25 +22,11 @@
 namespace animorder {
 namespace {
 
-int add_view(tinygltf::Model& model, const void* data, size_t bytes, int target) {
-    std::vector<unsigned char>& buffer = model.buffers[0].data;
-    while (buffer.size() % 4) buffer.push_back(0);
-    tinygltf::BufferView view;
-    view.buffer = 0;
-    view.byteOffset = buffer.size();
-    view.byteLength = bytes;
-    view.target = target;
-    const unsigned char* p = static_cast<const unsigned char*>(data);
-    buffer.insert(buffer.end(), p, p + bytes);
-    model.bufferViews.push_back(view);
-    return int(model.bufferViews.size() - 1);
-}
-
 // A float accessor of count elements of `width` components; min and max per component when
 // `bounds` (glTF requires them for POSITION and animation inputs).
 int add_floats(tinygltf::Model& model, const std::vector<float>& values, int type, size_t width, int target, bool bounds) {
     tinygltf::Accessor a;
-    a.bufferView = add_view(model, values.data(), values.size() * sizeof(float), target);
+    a.bufferView = io::append_buffer_view(model, values.data(), values.size() * sizeof(float), target);
     a.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
     a.type = type;
     a.count = values.size() / width;
@@ -85,7 +73,7 @@ std::string gltf_animated_mesh(const AnimatedMesh& mesh, bool binary) {
         std::vector<uint32_t> ib(p.index_count);
         for (size_t i = 0; i < p.index_count; ++i) ib[i] = local[mesh.indices[p.first_index + i]];
         tinygltf::Accessor indices;
-        indices.bufferView = add_view(model, ib.data(), ib.size() * 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+        indices.bufferView = io::append_buffer_view(model, ib.data(), ib.size() * 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
         indices.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
         indices.type = TINYGLTF_TYPE_SCALAR;
         indices.count = ib.size();

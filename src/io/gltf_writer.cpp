@@ -10,6 +10,8 @@
 // indices refer to the file's own vertices. New bytes are appended to buffer 0.
 #include "animorder/io.h"
 
+#include "gltf_buffer.h"
+
 #include "animorder/animorder.h"
 #include "animorder/clustering.h"
 #include "animorder/evaluation.h"
@@ -43,22 +45,6 @@ tinygltf::Model read_model(const std::string& path) {
     return model;
 }
 
-// Appends bytes to buffer 0 (4-byte aligned) as a new buffer view; returns its index.
-int append_view(tinygltf::Model& model, const void* data, size_t bytes, int target) {
-    if (model.buffers.empty()) model.buffers.emplace_back();
-    std::vector<unsigned char>& buffer = model.buffers[0].data;
-    while (buffer.size() % 4) buffer.push_back(0);
-    tinygltf::BufferView view;
-    view.buffer = 0;
-    view.byteOffset = buffer.size();
-    view.byteLength = bytes;
-    view.target = target;
-    const unsigned char* p = static_cast<const unsigned char*>(data);
-    buffer.insert(buffer.end(), p, p + bytes);
-    model.bufferViews.push_back(view);
-    return int(model.bufferViews.size() - 1);
-}
-
 int append_accessor(tinygltf::Model& model, int view, int component, int type, size_t count, const std::string& name) {
     tinygltf::Accessor a;
     a.bufferView = view;
@@ -84,10 +70,10 @@ int append_indices(tinygltf::Model& model, const std::vector<uint32_t>& global, 
     int component;
     if (largest < 65535) {  // 65535 is the primitive-restart value: never used as an index
         std::vector<uint16_t> shorts(local.begin(), local.end());
-        view = append_view(model, shorts.data(), shorts.size() * 2, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+        view = io::append_buffer_view(model, shorts.data(), shorts.size() * 2, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
         component = TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
     } else {
-        view = append_view(model, local.data(), local.size() * 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+        view = io::append_buffer_view(model, local.data(), local.size() * 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
         component = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
     }
     const int accessor = append_accessor(model, view, component, TINYGLTF_TYPE_SCALAR, local.size(), name);
@@ -142,12 +128,12 @@ std::string gltf_with_orders(const std::string& input_path, const std::string& o
     tinygltf::Value::Array clips;
     for (size_t c = 0; c < mesh.clips.size() && c < buffers.tables.size(); ++c) {
         const SelectionTable& t = buffers.tables[c];
-        const int cells = append_accessor(model, append_view(model, t.cells.data(), t.cells.size(), 0),
+        const int cells = append_accessor(model, io::append_buffer_view(model, t.cells.data(), t.cells.size(), 0),
                                           TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_TYPE_SCALAR, t.cells.size(),
                                           "animorder table " + mesh.clips[c].name);
         std::vector<float> centres(framing.centres.begin() + ptrdiff_t(3 * mesh.clips[c].first_keyframe),
                                    framing.centres.begin() + ptrdiff_t(3 * (mesh.clips[c].first_keyframe + mesh.clips[c].keyframe_count)));
-        const int centre = append_accessor(model, append_view(model, centres.data(), centres.size() * 4, 0),
+        const int centre = append_accessor(model, io::append_buffer_view(model, centres.data(), centres.size() * 4, 0),
                                            TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, mesh.clips[c].keyframe_count,
                                            "animorder centres " + mesh.clips[c].name);
         tinygltf::Value::Object clip;

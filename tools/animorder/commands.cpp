@@ -34,30 +34,10 @@ double seconds_since(Clock::time_point start) {
 
 const char* const kBundledName = "procedural-character (bundled)";
 
-// Progress and notes go to stderr, so stdout stays clean for text or JSON a script may read.
-void note(const CommonOptions& common, const std::string& text) {
-    if (!common.quiet) std::fprintf(stderr, "animorder: %s\n", text.c_str());
-}
-
-// The input named on the command line (or the bundled character). --clip values that exist on
-// disk are clip files or folders (Mixamo style); the others name the clips to keep.
+// The input of the commands that reorder: load_animated_input's mesh, refused when it has
+// nothing to draw.
 AnimatedMesh load_input(const CommonOptions& common, std::string& input_name) {
-    std::vector<std::string> clip_files, clip_names;
-    for (const std::string& c : common.clips) (std::filesystem::exists(c) ? clip_files : clip_names).push_back(c);
-    AnimatedMesh mesh;
-    if (common.input.empty()) {
-        if (!clip_files.empty()) throw std::runtime_error("clip files need an input character file");
-        note(common, "no input file given: using the bundled procedural character");
-        input_name = kBundledName;
-        mesh = make_procedural_character();
-    } else {
-        input_name = common.input;
-        mesh = load_character(common.input, clip_files);
-        note(common, "loaded " + common.input + ": " + std::to_string(mesh.triangle_count()) + " triangles, " +
-                         std::to_string(mesh.clips.size()) + " clips, " + std::to_string(mesh.keyframe_count()) +
-                         " keyframes");
-    }
-    if (!clip_names.empty()) mesh = select_clips(mesh, clip_names);
+    const AnimatedMesh mesh = load_animated_input(common, input_name);
     // A mesh with no area at its first keyframe has nothing to draw, so nothing to reorder.
     double area = 0;
     const float* p = mesh.keyframe_count() ? mesh.keyframe(0) : nullptr;
@@ -101,6 +81,31 @@ void print_inspect_text(const AnimatedMesh& mesh, const std::string& input_name,
 }
 
 }  // namespace
+
+// Notes go to stderr, so stdout stays clean for text or JSON a script may read.
+void note(const CommonOptions& common, const std::string& text) {
+    if (!common.quiet) std::fprintf(stderr, "animorder: %s\n", text.c_str());
+}
+
+AnimatedMesh load_animated_input(const CommonOptions& common, std::string& input_name) {
+    std::vector<std::string> clip_files, clip_names;
+    for (const std::string& c : common.clips) (std::filesystem::exists(c) ? clip_files : clip_names).push_back(c);
+    AnimatedMesh mesh;
+    if (common.input.empty()) {
+        if (!clip_files.empty()) throw std::runtime_error("clip files need an input character file");
+        note(common, "no input file given: using the bundled procedural character");
+        input_name = kBundledName;
+        mesh = make_procedural_character();
+    } else {
+        input_name = common.input;
+        mesh = load_character(common.input, clip_files);
+        note(common, "loaded " + common.input + ": " + std::to_string(mesh.triangle_count()) + " triangles, " +
+                         std::to_string(mesh.clips.size()) + " clips, " + std::to_string(mesh.keyframe_count()) +
+                         " keyframes");
+    }
+    if (!clip_names.empty()) mesh = select_clips(mesh, clip_names);
+    return mesh;
+}
 
 int run_inspect(const InspectOptions& options) {
     std::string input_name;

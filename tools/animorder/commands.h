@@ -1,6 +1,8 @@
 // The subcommands of the animorder tool. Each returns the process exit code.
 #pragma once
 
+#include "animorder/animated_mesh.h"
+
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -72,6 +74,12 @@ struct HeatmapOptions {
     unsigned resolution = 512;
     std::string output;
 };
+
+// Progress and notes go to stderr ("animorder: TEXT"), unless --quiet.
+void note(const CommonOptions& common, const std::string& text);
+// The input named on the command line (or the bundled character, saying so). --clip values that
+// exist on disk are clip files or folders (Mixamo style); the others name the clips to keep.
+AnimatedMesh load_animated_input(const CommonOptions& common, std::string& input_name);
 
 int run_inspect(const InspectOptions& options);
 int run_optimize(const OptimizeOptions& options);

@@ -17,32 +17,6 @@
 namespace animorder::tool {
 namespace {
 
-void note(const CommonOptions& common, const std::string& text) {
-    if (!common.quiet) std::fprintf(stderr, "animorder: %s\n", text.c_str());
-}
-
-// As commands.cpp loads every command's input: --clip values that exist on disk are clip files
-// or folders (Mixamo style); the others name the clips to keep.
-AnimatedMesh load_subdivide_input(const CommonOptions& common, std::string& input_name) {
-    std::vector<std::string> clip_files, clip_names;
-    for (const std::string& c : common.clips) (std::filesystem::exists(c) ? clip_files : clip_names).push_back(c);
-    AnimatedMesh mesh;
-    if (common.input.empty()) {
-        if (!clip_files.empty()) throw std::runtime_error("clip files need an input character file");
-        note(common, "no input file given: using the bundled procedural character");
-        input_name = "procedural-character (bundled)";
-        mesh = make_procedural_character();
-    } else {
-        input_name = common.input;
-        mesh = load_character(common.input, clip_files);
-        note(common, "loaded " + common.input + ": " + std::to_string(mesh.triangle_count()) + " triangles, " +
-                         std::to_string(mesh.clips.size()) + " clips, " + std::to_string(mesh.keyframe_count()) +
-                         " keyframes");
-    }
-    if (!clip_names.empty()) mesh = select_clips(mesh, clip_names);
-    return mesh;
-}
-
 std::string megabytes(size_t bytes) {
     char text[32];
     std::snprintf(text, sizeof text, "%.1f MB", double(bytes) / 1e6);
@@ -66,7 +40,7 @@ int run_subdivide(const SubdivideOptions& options) {
     }
 
     std::string input_name;
-    const AnimatedMesh mesh = load_subdivide_input(options.common, input_name);
+    const AnimatedMesh mesh = load_animated_input(options.common, input_name);
     AnimatedMesh result = subdivide_animated_mesh(mesh, options.levels);
     if (!options.common.input.empty()) result.name = std::filesystem::path(options.common.input).stem().string();
     // Every keyframe is a morph target of 12 bytes per vertex: say how big before building it.

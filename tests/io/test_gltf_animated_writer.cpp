@@ -5,6 +5,8 @@
 #include "animorder/subdivision.h"
 
 #include <gtest/gtest.h>
+
+#include "support/files.h"
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -17,29 +19,6 @@ using namespace animorder;
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-// Runs the validator (installed by scripts/install-deps.sh into .tools/), as test_gltf_writer does.
-bool validate(const fs::path& file, std::string& report) {
-    const fs::path tools = fs::path(ANIMORDER_SOURCE_DIR) / ".tools" / "node_modules";
-    const fs::path script = fs::path(ANIMORDER_SOURCE_DIR) / "tools" / "validate" / "validate_gltf.js";
-    if (!fs::exists(tools / "gltf-validator")) {
-        report = "gltf-validator is not installed (run scripts/install-deps.sh)";
-        return false;
-    }
-    const fs::path out = file.string() + ".report";
-    const std::string command = "NODE_PATH='" + tools.string() + "' node '" + script.string() + "' '" + file.string() +
-                                "' > '" + out.string() + "' 2>&1";
-    const int status = std::system(command.c_str());
-    report = slurp(out);
-    return status == 0;
-}
 
 // A small animated mesh: two primitives (a tetrahedron and a lone triangle, sharing no vertex),
 // one unreferenced vertex, and three keyframes in two clips at different rates.
@@ -137,11 +116,11 @@ TEST_F(GltfAnimatedWriter, SmallMeshReadsBackExactlyInBothForms) {
 TEST_F(GltfAnimatedWriter, SubdividedCharacterRoundTripsDeterministicAndValid) {
     const AnimatedMesh m = subdivide_animated_mesh(make_procedural_character(), 1);
     const fs::path a = write(m, "a.glb"), b = write(m, "b.glb");
-    EXPECT_EQ(slurp(a), slurp(b));  // byte-deterministic
+    EXPECT_EQ(test::slurp(a), test::slurp(b));  // byte-deterministic
     expect_same_animation(m, load_gltf(a.string()));
 
     std::string report;
-    const bool valid = validate(a, report);
+    const bool valid = test::validate_gltf(a, report);
     if (report.find("not installed") != std::string::npos) {
         if (std::getenv("CI")) ADD_FAILURE() << report;
         GTEST_SKIP() << report;
@@ -154,7 +133,7 @@ TEST_F(GltfAnimatedWriter, SubdividedCharacterRoundTripsDeterministicAndValid) {
 TEST_F(GltfAnimatedWriter, SmallGltfPassesTheValidator) {
     const fs::path path = write(small_mesh(), "small.gltf");
     std::string report;
-    const bool valid = validate(path, report);
+    const bool valid = test::validate_gltf(path, report);
     if (report.find("not installed") != std::string::npos) GTEST_SKIP() << report;
     EXPECT_TRUE(valid) << report;
 }

@@ -7,6 +7,8 @@
 #include "support/meshes.h"
 
 #include <gtest/gtest.h>
+
+#include "support/files.h"
 #include <nlohmann/json.hpp>
 
 #include <cstdlib>
@@ -20,29 +22,6 @@ namespace fs = std::filesystem;
 namespace {
 
 const std::string kData = std::string(ANIMORDER_SOURCE_DIR) + "/../shared/data/";
-
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-// Runs the validator (installed by scripts/install-deps.sh into .tools/); in CI it must exist.
-bool validate(const fs::path& file, std::string& report) {
-    const fs::path tools = fs::path(ANIMORDER_SOURCE_DIR) / ".tools" / "node_modules";
-    const fs::path script = fs::path(ANIMORDER_SOURCE_DIR) / "tools" / "validate" / "validate_gltf.js";
-    if (!fs::exists(tools / "gltf-validator")) {
-        report = "gltf-validator is not installed (run scripts/install-deps.sh)";
-        return false;
-    }
-    const fs::path out = file.string() + ".report";
-    const std::string command = "NODE_PATH='" + tools.string() + "' node '" + script.string() + "' '" + file.string() +
-                                "' > '" + out.string() + "' 2>&1";
-    const int status = std::system(command.c_str());
-    report = slurp(out);
-    return status == 0;
-}
 
 struct Written {
     AnimatedMesh mesh;
@@ -89,12 +68,12 @@ TEST_F(GltfWriter, OutputValidatesAndReadsBackWithEveryOrder) {
         // The output may not add a single validator error to those of the input (MorphStressTest
         // in ../shared/data lacks its PNG files: the same missing-image errors in both).
         std::string report, input_report;
-        const bool valid = validate(out, report);
+        const bool valid = test::validate_gltf(out, report);
         if (report.find("not installed") != std::string::npos) {
             if (std::getenv("CI")) ADD_FAILURE() << report;
             GTEST_SKIP() << report;
         }
-        validate(kData + name, input_report);
+        test::validate_gltf(kData + name, input_report);
         std::printf("%s output: %sinput: %s", name, report.c_str(), input_report.c_str());
         const nlohmann::json r = nlohmann::json::parse(report), in = nlohmann::json::parse(input_report);
         if (!valid) {
@@ -118,8 +97,8 @@ TEST_F(GltfWriter, DeterministicAndLeavesTheRestAlone) {
     if (!fs::exists(input)) GTEST_SKIP() << "../shared/data is absent";
     const Written a = optimise_and_write(input, dir_ / "a.gltf");
     const Written b = optimise_and_write(input, dir_ / "b.gltf");
-    const std::string text = slurp(a.path);
-    EXPECT_EQ(text, slurp(b.path));
+    const std::string text = test::slurp(a.path);
+    EXPECT_EQ(text, test::slurp(b.path));
     // Materials, skins, animations and images are still there, and the extras describe the orders.
     for (const char* key : {"\"materials\"", "\"skins\"", "\"animations\"", "\"images\"", "\"animorder\"", "\"orders\""})
         EXPECT_NE(text.find(key), std::string::npos) << key;

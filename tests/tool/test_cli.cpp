@@ -1,6 +1,8 @@
 // The animorder tool end to end: exit codes, one-line errors for bad input and options, the JSON
 // report's schema, atomic and deterministic output.
 #include <gtest/gtest.h>
+
+#include "support/files.h"
 #include <nlohmann/json.hpp>
 
 #include <cstdio>
@@ -12,56 +14,20 @@
 #include <sys/wait.h>
 
 namespace fs = std::filesystem;
+namespace test = animorder::test;
 
 namespace {
 
-struct Outcome {
-    int exit_code = -1;
-    std::string out, err;
-};
-
-std::string slurp(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-class Cli : public ::testing::Test {
+class Cli : public test::ScratchFolderTest {
 protected:
-    void SetUp() override {
-        dir_ = fs::temp_directory_path() / ("animorder-cli-" + std::to_string(::getpid()) + "-" +
-                                            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
-
-    Outcome run(const std::string& args) {
-        const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-        const std::string command = std::string(ANIMORDER_EXE) + " " + args + " >" + out.string() + " 2>" + err.string();
-        const int status = std::system(command.c_str());
-        Outcome o;
-        o.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-        o.out = slurp(out);
-        o.err = slurp(err);
-        return o;
-    }
-    fs::path path(const std::string& name) const { return dir_ / name; }
-
-    fs::path dir_;
+    Cli() : ScratchFolderTest("animorder-cli") {}
+    test::Outcome run(const std::string& args) { return test::run_captured(std::string(ANIMORDER_EXE) + " " + args, dir_); }
 };
-
-size_t line_count(const std::string& text) {
-    size_t n = 0;
-    for (char c : text) n += c == '\n';
-    return n;
-}
 
 }  // namespace
 
 TEST_F(Cli, InspectUsesTheBundledCharacterAndSaysSo) {
-    const Outcome o = run("inspect --json");
+    const test::Outcome o = run("inspect --json");
     ASSERT_EQ(o.exit_code, 0) << o.err;
     EXPECT_NE(o.err.find("bundled procedural character"), std::string::npos) << o.err;
     const nlohmann::json j = nlohmann::json::parse(o.out);
@@ -72,17 +38,17 @@ TEST_F(Cli, InspectUsesTheBundledCharacterAndSaysSo) {
 }
 
 TEST_F(Cli, QuietSilencesStderr) {
-    const Outcome o = run("inspect --quiet");
+    const test::Outcome o = run("inspect --quiet");
     ASSERT_EQ(o.exit_code, 0);
     EXPECT_EQ(o.err, "");
     EXPECT_NE(o.out.find("ACMR"), std::string::npos);
 }
 
 TEST_F(Cli, OptimizeWritesIndicesAndReport) {
-    const Outcome o = run("optimize -q --method static-sander07 --lambda 0.85 -o " + path("ib").string() +
+    const test::Outcome o = run("optimize -q --method static-sander07 --lambda 0.85 -o " + path("ib").string() +
                           " --report " + path("report.json").string());
     ASSERT_EQ(o.exit_code, 0) << o.err;
-    const nlohmann::json j = nlohmann::json::parse(slurp(path("report.json")));
+    const nlohmann::json j = nlohmann::json::parse(test::slurp(path("report.json")));
     for (const char* key : {"tool", "version", "input", "triangles", "vertices", "settings", "methods", "timings_s"})
         EXPECT_TRUE(j.contains(key)) << key;
     const nlohmann::json& m = j["methods"][0];
@@ -95,7 +61,7 @@ TEST_F(Cli, OptimizeWritesIndicesAndReport) {
     EXPECT_TRUE(j["timings_s"].contains("total"));
     // The sidecar: one buffer of 3 little-endian uint32 per triangle, after a 20-byte header and
     // a 32-byte record per clip, then per clip a 2×1 table of zeros and 12 bytes of centre per keyframe.
-    const nlohmann::json side = nlohmann::json::parse(slurp(path("ib.animorder.json")));
+    const nlohmann::json side = nlohmann::json::parse(test::slurp(path("ib.animorder.json")));
     EXPECT_EQ(side["buffers"], 1);
     EXPECT_EQ(side["binary"], "ib.animorder.bin");
     size_t tables = 0;
@@ -107,7 +73,7 @@ TEST_F(Cli, OptimizeWritesIndicesAndReport) {
 TEST_F(Cli, OptimizeIsByteDeterministic) {
     ASSERT_EQ(run("optimize -q -o " + path("a").string()).exit_code, 0);
     ASSERT_EQ(run("optimize -q -o " + path("b").string()).exit_code, 0);
-    EXPECT_EQ(slurp(path("a.animorder.bin")), slurp(path("b.animorder.bin")));
+    EXPECT_EQ(test::slurp(path("a.animorder.bin")), test::slurp(path("b.animorder.bin")));
 }
 
 TEST_F(Cli, SingleWritesKBuffersPerClipAndReportsIterations) {
@@ -116,8 +82,8 @@ TEST_F(Cli, SingleWritesKBuffersPerClipAndReportsIterations) {
     ASSERT_EQ(run("optimize --method single" + fast + " --threads 1 -o " + path("s1").string() + " --report " +
                   path("r.json").string()).exit_code, 0);
     ASSERT_EQ(run("optimize --method single" + fast + " --threads 2 -o " + path("s2").string()).exit_code, 0);
-    EXPECT_EQ(slurp(path("s1.animorder.bin")), slurp(path("s2.animorder.bin")));  // thread count changes nothing
-    const nlohmann::json j = nlohmann::json::parse(slurp(path("r.json")));
+    EXPECT_EQ(test::slurp(path("s1.animorder.bin")), test::slurp(path("s2.animorder.bin")));  // thread count changes nothing
+    const nlohmann::json j = nlohmann::json::parse(test::slurp(path("r.json")));
     const nlohmann::json& m = j["methods"][0];
     EXPECT_EQ(m["name"], "single");
     EXPECT_EQ(m["buffers"], 6);  // 3 per clip, 2 clips
@@ -128,7 +94,7 @@ TEST_F(Cli, SingleWritesKBuffersPerClipAndReportsIterations) {
         EXPECT_TRUE(r["iterations"][0].contains("reassigned"));
     }
     ASSERT_EQ(run("optimize --joint" + fast + " --report " + path("j.json").string()).exit_code, 0);
-    EXPECT_EQ(nlohmann::json::parse(slurp(path("j.json")))["methods"][0]["buffers"], 3);
+    EXPECT_EQ(nlohmann::json::parse(test::slurp(path("j.json")))["methods"][0]["buffers"], 3);
 }
 
 TEST_F(Cli, GltfInGltfOut) {
@@ -139,19 +105,19 @@ TEST_F(Cli, GltfInGltfOut) {
                   path("r.json").string()).exit_code, 0);
     EXPECT_TRUE(fs::exists(path("fox.glb")));
     EXPECT_TRUE(fs::exists(path("fox.animorder.bin")));
-    const nlohmann::json j = nlohmann::json::parse(slurp(path("r.json")));
+    const nlohmann::json j = nlohmann::json::parse(test::slurp(path("r.json")));
     EXPECT_EQ(j["outputs"]["gltf"], path("fox.glb").string());
     EXPECT_EQ(j["methods"][0]["buffers"], 6);  // 2 per clip, 3 clips
     // The written file reads back with the same triangles.
-    const Outcome again = run("inspect --json -q " + path("fox.glb").string());
+    const test::Outcome again = run("inspect --json -q " + path("fox.glb").string());
     ASSERT_EQ(again.exit_code, 0) << again.err;
     EXPECT_EQ(nlohmann::json::parse(again.out)["triangles"], 576);
     // Never over the input; never glTF out of a non-glTF input.
     fs::copy_file(fox, path("copy.glb"));
-    const Outcome same = run("optimize -q " + path("copy.glb").string() + " -o " + path("copy.glb").string());
+    const test::Outcome same = run("optimize -q " + path("copy.glb").string() + " -o " + path("copy.glb").string());
     EXPECT_NE(same.exit_code, 0);
     EXPECT_NE(same.err.find("refusing to overwrite the input"), std::string::npos) << same.err;
-    const Outcome procedural = run("optimize -q -o " + path("x.glb").string());
+    const test::Outcome procedural = run("optimize -q -o " + path("x.glb").string());
     EXPECT_NE(procedural.exit_code, 0);
     EXPECT_NE(procedural.err.find("needs a glTF input"), std::string::npos) << procedural.err;
 }
@@ -166,7 +132,7 @@ TEST_F(Cli, ZeroAreaMeshIsAnError) {
         R"({"bufferView":1,"componentType":5123,"count":3,"type":"SCALAR"}],)"
         R"("meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1}]}],"nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}]})";
     std::ofstream(path("flat.gltf")) << gltf;
-    const Outcome o = run("optimize -q " + path("flat.gltf").string());
+    const test::Outcome o = run("optimize -q " + path("flat.gltf").string());
     EXPECT_NE(o.exit_code, 0);
     EXPECT_NE(o.err.find("zero area"), std::string::npos) << o.err;
 }
@@ -174,8 +140,8 @@ TEST_F(Cli, ZeroAreaMeshIsAnError) {
 TEST_F(Cli, LambdaChangesTheAcmrTheWayThePaperSays) {
     ASSERT_EQ(run("optimize -q --lambda 0 --report " + path("r0.json").string()).exit_code, 0);
     ASSERT_EQ(run("optimize -q --lambda 3 --report " + path("r3.json").string()).exit_code, 0);
-    const double a0 = nlohmann::json::parse(slurp(path("r0.json")))["methods"][0]["acmr"];
-    const double a3 = nlohmann::json::parse(slurp(path("r3.json")))["methods"][0]["acmr"];
+    const double a0 = nlohmann::json::parse(test::slurp(path("r0.json")))["methods"][0]["acmr"];
+    const double a3 = nlohmann::json::parse(test::slurp(path("r3.json")))["methods"][0]["acmr"];
     EXPECT_LT(a0, 0.9);
     EXPECT_GT(a3, a0 + 0.5);  // single triangles: far worse for the vertex cache
 }
@@ -205,21 +171,21 @@ TEST_F(Cli, BadInputAndOptionsGiveOneLineErrors) {
         {"optimize --method static-nehab06 --nehab-clusters 99999999", "nehab-clusters"},
     };
     for (const Case& c : cases) {
-        const Outcome o = run(c.args + " --quiet");  // errors print even when quiet
+        const test::Outcome o = run(c.args + " --quiet");  // errors print even when quiet
         EXPECT_NE(o.exit_code, 0) << c.args;
         EXPECT_NE(o.err.find(c.expect), std::string::npos) << c.args << " → " << o.err;
         // One line; option errors from the parser add a pointer to --help.
-        EXPECT_GE(line_count(o.err), 1u) << c.args;
-        EXPECT_LE(line_count(o.err), 2u) << c.args << " → " << o.err;
+        EXPECT_GE(test::line_count(o.err), 1u) << c.args;
+        EXPECT_LE(test::line_count(o.err), 2u) << c.args << " → " << o.err;
     }
 }
 
 TEST_F(Cli, EvaluateReportHasARowPerMethodAndSweptValue) {
-    const Outcome o = run("evaluate -q --methods original,tipsify-per-frame,single,oracle --lambda 0.85,3 -k 2 "
+    const test::Outcome o = run("evaluate -q --methods original,tipsify-per-frame,single,oracle --lambda 0.85,3 -k 2 "
                           "--views 12 --resolution 64 --max-iterations 2 --eval-views 2 --eval-resolution 64 -r " +
                           path("e.json").string() + " --csv " + path("e.csv").string());
     ASSERT_EQ(o.exit_code, 0) << o.err;
-    const nlohmann::json report = nlohmann::json::parse(slurp(path("e.json")));
+    const nlohmann::json report = nlohmann::json::parse(test::slurp(path("e.json")));
     const nlohmann::json& methods = report["methods"];
     ASSERT_EQ(methods.size(), 7u);  // original once, the others at both lambdas
     EXPECT_EQ(methods[0]["name"], "original");
@@ -237,8 +203,8 @@ TEST_F(Cli, EvaluateReportHasARowPerMethodAndSweptValue) {
         EXPECT_EQ(m["clusters"].is_null(), name != "single");
         EXPECT_EQ(m["per_clip"][0]["time_s"].is_null(), name != "single");
     }
-    EXPECT_EQ(line_count(slurp(path("e.csv"))), 8u);
-    EXPECT_EQ(line_count(o.out), 9u);  // Markdown header, rule, 7 rows
+    EXPECT_EQ(test::line_count(test::slurp(path("e.csv"))), 8u);
+    EXPECT_EQ(test::line_count(o.out), 9u);  // Markdown header, rule, 7 rows
 }
 
 TEST_F(Cli, Nehab06RunsInOptimizeAndEvaluateAndBeatsTheOriginalOrder) {
@@ -246,15 +212,15 @@ TEST_F(Cli, Nehab06RunsInOptimizeAndEvaluateAndBeatsTheOriginalOrder) {
     ASSERT_EQ(run("optimize --method static-nehab06" + fast + " --threads 1 -o " + path("n1").string() + " -r " +
                   path("r.json").string()).exit_code, 0);
     ASSERT_EQ(run("optimize --method static-nehab06" + fast + " --threads 2 -o " + path("n2").string()).exit_code, 0);
-    EXPECT_EQ(slurp(path("n1.animorder.bin")), slurp(path("n2.animorder.bin")));  // thread count changes nothing
-    const nlohmann::json j = nlohmann::json::parse(slurp(path("r.json")));
+    EXPECT_EQ(test::slurp(path("n1.animorder.bin")), test::slurp(path("n2.animorder.bin")));  // thread count changes nothing
+    const nlohmann::json j = nlohmann::json::parse(test::slurp(path("r.json")));
     EXPECT_EQ(j["methods"][0]["name"], "static-nehab06");
     EXPECT_EQ(j["methods"][0]["planar_clusters"], 16 * 2);  // 16 per primitive; the character has 2
     EXPECT_EQ(j["settings"]["nehab_views"], 42);
-    const Outcome e = run("evaluate --methods original,static-nehab06" + fast + " --eval-views 2 --eval-resolution 96 -r " +
+    const test::Outcome e = run("evaluate --methods original,static-nehab06" + fast + " --eval-views 2 --eval-resolution 96 -r " +
                           path("e.json").string());
     ASSERT_EQ(e.exit_code, 0) << e.err;
-    const nlohmann::json report = nlohmann::json::parse(slurp(path("e.json")));
+    const nlohmann::json report = nlohmann::json::parse(test::slurp(path("e.json")));
     const nlohmann::json& methods = report["methods"];
     ASSERT_EQ(methods.size(), 2u);
     EXPECT_EQ(methods[1]["name"], "static-nehab06");
@@ -264,7 +230,7 @@ TEST_F(Cli, Nehab06RunsInOptimizeAndEvaluateAndBeatsTheOriginalOrder) {
 }
 
 TEST_F(Cli, FailedWriteLeavesNoFileBehind) {
-    const Outcome o = run("optimize -q -o " + path("no/such/out").string());
+    const test::Outcome o = run("optimize -q -o " + path("no/such/out").string());
     EXPECT_NE(o.exit_code, 0);
     size_t entries = 0;
     for (const auto& entry : fs::directory_iterator(dir_)) entries += entry.path().filename().string()[0] == '.';
@@ -272,7 +238,7 @@ TEST_F(Cli, FailedWriteLeavesNoFileBehind) {
 }
 
 TEST_F(Cli, NoSubcommandPrintsUsage) {
-    const Outcome o = run("");
+    const test::Outcome o = run("");
     EXPECT_NE(o.exit_code, 0);
     EXPECT_NE((o.out + o.err).find("inspect"), std::string::npos);
 }

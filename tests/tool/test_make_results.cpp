@@ -18,20 +18,15 @@
 #include <tuple>
 #include <vector>
 
+#include "support/files.h"
 #include "svg_chart.h"
 
 namespace fs = std::filesystem;
+namespace test = animorder::test;
 using nlohmann::json;
 using namespace animorder::results;
 
 namespace {
-
-std::string slurp(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
 
 void spit(const fs::path& path, const std::string& text) {
     fs::create_directories(path.parent_path());
@@ -154,26 +149,16 @@ json ganfaul_idle() {
     return report("../shared/data/mixamo-ganfaul/Ganfaul.gltf", 13810, {{"Idle", 60}}, m);
 }
 
-class MakeResults : public ::testing::Test {
+class MakeResults : public test::ScratchFolderTest {
 protected:
+    MakeResults() : ScratchFolderTest("animorder-make-results") {}
     void SetUp() override {
-        dir_ = fs::temp_directory_path() / ("animorder-make-results-" + std::to_string(::getpid()) + "-" +
-                                            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(dir_);
+        ScratchFolderTest::SetUp();
         fs::create_directories(dir_ / "in");
     }
-    void TearDown() override { fs::remove_all(dir_); }
 
-    struct Outcome {
-        int exit_code = -1;
-        std::string err;
-    };
-    Outcome run(const fs::path& in, const fs::path& out) {
-        const fs::path err = dir_ / "stderr.txt";
-        const std::string command =
-            std::string(MAKE_RESULTS_EXE) + " " + in.string() + " " + out.string() + " 2>" + err.string();
-        const int status = std::system(command.c_str());
-        return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(err)};
+    test::Outcome run(const fs::path& in, const fs::path& out) {
+        return test::run_captured(std::string(MAKE_RESULTS_EXE) + " " + in.string() + " " + out.string(), dir_);
     }
     void write(const std::string& name, const json& j) { spit(dir_ / "in" / name, j.dump(2)); }
 
@@ -251,8 +236,6 @@ protected:
         spit(dir_ / "in" / "nehab06-bench.txt", "knot 2k   0.41 s\nknot 10k  1.20 s\n");
         spit(dir_ / "in" / "notes-table1.md", "The lead's note on Table 1.\n");
     }
-
-    fs::path dir_;
 };
 
 const char* const kSections[] = {
@@ -351,9 +334,9 @@ TEST(SvgChart, GroupedBarsStartAtTheBaseline) {
 
 TEST_F(MakeResults, TablesHoldTheReportsNumbers) {
     write_everything();
-    const Outcome o = run(dir_ / "in", dir_ / "docs");
+    const test::Outcome o = run(dir_ / "in", dir_ / "docs");
     ASSERT_EQ(o.exit_code, 0) << o.err;
-    const std::string md = slurp(dir_ / "docs" / "RESULTS.md");
+    const std::string md = test::slurp(dir_ / "docs" / "RESULTS.md");
     ASSERT_EQ(md.rfind("# Results\n", 0), 0u);
     EXPECT_NE(md.find("`bash scripts/results.sh`"), std::string::npos);
     for (const char* title : kSections) {
@@ -449,16 +432,16 @@ TEST_F(MakeResults, TablesHoldTheReportsNumbers) {
 TEST_F(MakeResults, ChartsAreWellFormedWithAPointPerValue) {
     write_everything();
     ASSERT_EQ(run(dir_ / "in", dir_ / "docs").exit_code, 0);
-    const std::string md = slurp(dir_ / "docs" / "RESULTS.md");
+    const std::string md = test::slurp(dir_ / "docs" / "RESULTS.md");
     size_t charts = 0;
     for (const auto& entry : fs::directory_iterator(dir_ / "docs" / "results")) {
-        const std::string svg = slurp(entry.path());
+        const std::string svg = test::slurp(entry.path());
         EXPECT_TRUE(well_formed_svg(svg)) << entry.path();
         EXPECT_NE(md.find("(results/" + entry.path().filename().string() + ")"), std::string::npos) << entry.path();
         ++charts;
     }
     EXPECT_EQ(charts, 8u);  // characters, Fig. 3 (OVR, time), Fig. 6 (OVR, ACMR), Fig. 7, Fig. 8 (one λ), Fig. 5
-    const std::string lambda = slurp(dir_ / "docs" / "results" / "fig6-lambda-ovr.svg");
+    const std::string lambda = test::slurp(dir_ / "docs" / "results" / "fig6-lambda-ovr.svg");
     for (const char* name : {"static-sander07", "single k=5", "oracle"}) {
         EXPECT_EQ(occurrences(lambda, "<title>" + std::string(name) + ": x="), 6u) << name;
         for (const char* x : {"0.7", "0.85", "1", "1.5", "2", "3"})
@@ -467,16 +450,16 @@ TEST_F(MakeResults, ChartsAreWellFormedWithAPointPerValue) {
     EXPECT_NE(lambda.find("<title>single k=5: x=0.85, y=1.130</title>"), std::string::npos);  // 1.3 − 0.02 − 0.15
     EXPECT_NE(lambda.find("original (reference)"), std::string::npos);
     EXPECT_NE(lambda.find("static-nehab06 (reference)"), std::string::npos);
-    const std::string views = slurp(dir_ / "docs" / "results" / "fig3-views-ovr.svg");
+    const std::string views = test::slurp(dir_ / "docs" / "results" / "fig3-views-ovr.svg");
     EXPECT_EQ(occurrences(views, "<title>single λ=0.85 k=5: x="), 4u);
-    const std::string k = slurp(dir_ / "docs" / "results" / "fig7-k-ovr.svg");
+    const std::string k = test::slurp(dir_ / "docs" / "results" / "fig7-k-ovr.svg");
     EXPECT_EQ(occurrences(k, "<title>single λ=0.85 views=162: x="), 6u);
-    const std::string bars = slurp(dir_ / "docs" / "results" / "fig8-clips-ovr-lambda-0.85.svg");
+    const std::string bars = test::slurp(dir_ / "docs" / "results" / "fig8-clips-ovr-lambda-0.85.svg");
     for (const char* name : {"original", "single", "joint"})
         EXPECT_EQ(occurrences(bars, "<title>" + std::string(name) + ", "), 3u);
-    const std::string time = slurp(dir_ / "docs" / "results" / "fig5-clips-time.svg");
+    const std::string time = test::slurp(dir_ / "docs" / "results" / "fig5-clips-time.svg");
     EXPECT_NE(time.find("<title>single λ=0.85, joint: 102.940</title>"), std::string::npos);
-    const std::string characters = slurp(dir_ / "docs" / "results" / "characters-ovr.svg");
+    const std::string characters = test::slurp(dir_ / "docs" / "results" / "characters-ovr.svg");
     EXPECT_NE(characters.find("<title>single, xbot: 1.134</title>"), std::string::npos);
 }
 
@@ -484,10 +467,10 @@ TEST_F(MakeResults, OutputIsByteIdenticalAcrossRuns) {
     write_everything();
     ASSERT_EQ(run(dir_ / "in", dir_ / "a").exit_code, 0);
     ASSERT_EQ(run(dir_ / "in", dir_ / "b").exit_code, 0);
-    EXPECT_EQ(slurp(dir_ / "a" / "RESULTS.md"), slurp(dir_ / "b" / "RESULTS.md"));
+    EXPECT_EQ(test::slurp(dir_ / "a" / "RESULTS.md"), test::slurp(dir_ / "b" / "RESULTS.md"));
     size_t compared = 0;
     for (const auto& entry : fs::directory_iterator(dir_ / "a" / "results")) {
-        EXPECT_EQ(slurp(entry.path()), slurp(dir_ / "b" / "results" / entry.path().filename())) << entry.path();
+        EXPECT_EQ(test::slurp(entry.path()), test::slurp(dir_ / "b" / "results" / entry.path().filename())) << entry.path();
         ++compared;
     }
     EXPECT_GT(compared, 0u);
@@ -497,9 +480,9 @@ TEST_F(MakeResults, OutputIsByteIdenticalAcrossRuns) {
 }
 
 TEST_F(MakeResults, MissingFilesSayNotRun) {
-    const Outcome o = run(dir_ / "in", dir_ / "docs");
+    const test::Outcome o = run(dir_ / "in", dir_ / "docs");
     ASSERT_EQ(o.exit_code, 0) << o.err;
-    const std::string md = slurp(dir_ / "docs" / "RESULTS.md");
+    const std::string md = test::slurp(dir_ / "docs" / "RESULTS.md");
     for (const char* file : {"ganfaul-idle.json", "ganfaul-idle-sub1.json", "ganfaul-idle-sub2.json",
                              "characters/*.json", "sweep-views.json", "sweep-lambda.json", "sweep-k.json",
                              "ganfaul-clips.json", "render-time.json", "nehab06-bench.txt"})
@@ -521,7 +504,7 @@ TEST_F(MakeResults, StaleChartsAreRemoved) {
 TEST_F(MakeResults, MalformedJsonFailsCleanlyWithoutOutput) {
     write_everything();
     spit(dir_ / "in" / "sweep-k.json", "{\"tool\": \"animorder\", \"methods\": [");
-    Outcome o = run(dir_ / "in", dir_ / "docs");
+    test::Outcome o = run(dir_ / "in", dir_ / "docs");
     EXPECT_EQ(o.exit_code, 1);
     EXPECT_NE(o.err.find("make_results: sweep-k.json: not valid JSON"), std::string::npos) << o.err;
     EXPECT_EQ(std::count(o.err.begin(), o.err.end(), '\n'), 1) << o.err;
@@ -535,7 +518,7 @@ TEST_F(MakeResults, MalformedJsonFailsCleanlyWithoutOutput) {
     o = run(dir_ / "in", dir_ / "docs");
     EXPECT_EQ(o.exit_code, 1);
     EXPECT_NE(o.err.find("sweep-k.json: methods[2].acmr: expected a number, got string"), std::string::npos) << o.err;
-    EXPECT_EQ(slurp(dir_ / "docs" / "RESULTS.md"), "previous\n");
+    EXPECT_EQ(test::slurp(dir_ / "docs" / "RESULTS.md"), "previous\n");
     EXPECT_FALSE(fs::exists(dir_ / "docs" / "results"));
 
     // A missing required key, in a character file.
@@ -553,9 +536,9 @@ TEST_F(MakeResults, ChartsWithNothingToDrawAreSkippedWithANote) {
     json m = json::array();
     m.push_back(method("original", nullptr, nullptr, nullptr, 1, 0.747, 1.391, 0.1, {}));
     write("ganfaul-clips.json", report("g.gltf", 13810, {{"Idle", 60}}, m, 60, 256));
-    const Outcome o = run(dir_ / "in", dir_ / "docs");
+    const test::Outcome o = run(dir_ / "in", dir_ / "docs");
     ASSERT_EQ(o.exit_code, 0) << o.err;
-    const std::string clips = section(slurp(dir_ / "docs" / "RESULTS.md"), kSections[5]);
+    const std::string clips = section(test::slurp(dir_ / "docs" / "RESULTS.md"), kSections[5]);
     EXPECT_NE(clips.find("(chart fig8-clips-ovr.svg not drawn: Overdraw per clip (Fig. 8): no finite values to draw)"),
               std::string::npos)
         << clips;
@@ -567,7 +550,7 @@ TEST_F(MakeResults, ChartsWithNothingToDrawAreSkippedWithANote) {
     json bad = ganfaul_idle();
     bad["settings"] = 3;
     write("ganfaul-idle.json", bad);
-    const Outcome e = run(dir_ / "in", dir_ / "docs2");
+    const test::Outcome e = run(dir_ / "in", dir_ / "docs2");
     EXPECT_EQ(e.exit_code, 1);
     EXPECT_NE(e.err.find("ganfaul-idle.json: settings: expected an object, got number"), std::string::npos) << e.err;
 }

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "support/files.h"
+
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -12,56 +14,20 @@
 #include <sys/wait.h>
 
 namespace fs = std::filesystem;
+namespace test = animorder::test;
 
 namespace {
 
-struct Outcome {
-    int exit_code = -1;
-    std::string out, err;
-};
-
-std::string slurp(const fs::path& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-size_t line_count(const std::string& text) {
-    size_t n = 0;
-    for (char c : text) n += c == '\n';
-    return n;
-}
-
-class SubdivideCli : public ::testing::Test {
+class SubdivideCli : public test::ScratchFolderTest {
 protected:
-    void SetUp() override {
-        dir_ = fs::temp_directory_path() / ("animorder-subdivide-cli-" + std::to_string(::getpid()) + "-" +
-                                            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override { fs::remove_all(dir_); }
-
-    Outcome run(const std::string& args) {
-        const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-        const std::string command = std::string(ANIMORDER_EXE) + " " + args + " >" + out.string() + " 2>" + err.string();
-        const int status = std::system(command.c_str());
-        Outcome o;
-        o.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-        o.out = slurp(out);
-        o.err = slurp(err);
-        return o;
-    }
-    fs::path path(const std::string& name) const { return dir_ / name; }
-
-    fs::path dir_;
+    SubdivideCli() : ScratchFolderTest("animorder-subdivide-cli") {}
+    test::Outcome run(const std::string& args) { return test::run_captured(std::string(ANIMORDER_EXE) + " " + args, dir_); }
 };
 
 }  // namespace
 
 TEST_F(SubdivideCli, BundledCharacterOneLevelWritesTheCounts) {
-    const Outcome o = run("subdivide --levels 1 --clip wave -o " + path("c1.glb").string());
+    const test::Outcome o = run("subdivide --levels 1 --clip wave -o " + path("c1.glb").string());
     ASSERT_EQ(o.exit_code, 0) << o.err;
     EXPECT_NE(o.err.find("bundled procedural character"), std::string::npos) << o.err;
     EXPECT_NE(o.out.find("triangles 10776 -> 43104"), std::string::npos) << o.out;
@@ -82,16 +48,16 @@ TEST_F(SubdivideCli, BundledCharacterOneLevelWritesTheCounts) {
 TEST_F(SubdivideCli, TwoLevelsOfAGltfInputAndQuiet) {
     // A subdivided file is itself an input: subdivide it once more.
     ASSERT_EQ(run("subdivide -q --levels 1 --clip wave -o " + path("c1.gltf").string()).exit_code, 0);
-    const Outcome o = run("subdivide --quiet " + path("c1.gltf").string() + " --levels 1 -o " + path("c2.glb").string());
+    const test::Outcome o = run("subdivide --quiet " + path("c1.gltf").string() + " --levels 1 -o " + path("c2.glb").string());
     ASSERT_EQ(o.exit_code, 0) << o.err;
     EXPECT_EQ(o.err, "");
     EXPECT_NE(o.out.find("triangles 43104 -> 172416"), std::string::npos) << o.out;
 }
 
 TEST_F(SubdivideCli, TooManyLevelsIsAClearError) {
-    const Outcome o = run("subdivide --levels 9 -o " + path("x.glb").string());
+    const test::Outcome o = run("subdivide --levels 9 -o " + path("x.glb").string());
     EXPECT_NE(o.exit_code, 0);
-    EXPECT_EQ(line_count(o.err), 1u) << o.err;
+    EXPECT_EQ(test::line_count(o.err), 1u) << o.err;
     EXPECT_NE(o.err.find("--levels 9"), std::string::npos) << o.err;
     EXPECT_NE(o.err.find("at most 4"), std::string::npos) << o.err;
     EXPECT_FALSE(fs::exists(path("x.glb")));
@@ -99,14 +65,14 @@ TEST_F(SubdivideCli, TooManyLevelsIsAClearError) {
 
 TEST_F(SubdivideCli, RefusesToOverwriteTheInputAndOtherExtensions) {
     ASSERT_EQ(run("subdivide -q --levels 1 --clip wave -o " + path("in.glb").string()).exit_code, 0);
-    const std::string before = slurp(path("in.glb"));
-    const Outcome same = run("subdivide -q " + path("in.glb").string() + " --levels 1 -o " + path("in.glb").string());
+    const std::string before = test::slurp(path("in.glb"));
+    const test::Outcome same = run("subdivide -q " + path("in.glb").string() + " --levels 1 -o " + path("in.glb").string());
     EXPECT_NE(same.exit_code, 0);
     EXPECT_NE(same.err.find("refusing to overwrite the input"), std::string::npos) << same.err;
-    EXPECT_EQ(slurp(path("in.glb")), before);
-    const Outcome obj = run("subdivide -q --levels 1 -o " + path("x.obj").string());
+    EXPECT_EQ(test::slurp(path("in.glb")), before);
+    const test::Outcome obj = run("subdivide -q --levels 1 -o " + path("x.obj").string());
     EXPECT_NE(obj.exit_code, 0);
     EXPECT_NE(obj.err.find(".glb or .gltf"), std::string::npos) << obj.err;
-    const Outcome missing = run("subdivide -q --levels 1");
+    const test::Outcome missing = run("subdivide -q --levels 1");
     EXPECT_NE(missing.exit_code, 0);
 }

@@ -20,6 +20,10 @@ public:
 
 struct LoadOptions {
     double sample_rate = 30;  // keyframes per second of every clip (DESIGN.md)
+    // Budget for the sampled animation: keyframes × vertices × 12 bytes of positions. A file
+    // whose clips would need more fails with a LoadError naming the need and this budget before
+    // anything that size is allocated (`--max-memory` raises it).
+    size_t max_keyframe_bytes = size_t(4) << 30;
 };
 
 // glTF 2.0 (.gltf with its buffers, or .glb): every TRIANGLES (strips and fans converted)

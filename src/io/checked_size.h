@@ -1,0 +1,37 @@
+// Overflow-checked size arithmetic for every size, count and offset read from a file (they are
+// hostile: a count near 2^64 must fail, not wrap), and the loading memory budget.
+#pragma once
+
+#include "animorder/io.h"
+
+#include <cstddef>
+#include <string>
+
+namespace animorder::io {
+
+// out = a · b / a + b; false (out unspecified) when the result does not fit in size_t.
+inline bool checked_mul(size_t a, size_t b, size_t& out) { return !__builtin_mul_overflow(a, b, &out); }
+inline bool checked_add(size_t a, size_t b, size_t& out) { return !__builtin_add_overflow(a, b, &out); }
+
+// a · b · c, or throws LoadError("<what>: <a> x <b> x <c> overflows") — for sizes that must
+// fit before anything is allocated or read.
+inline size_t mul_or_throw(const std::string& what, size_t a, size_t b, size_t c = 1) {
+    size_t ab = 0, abc = 0;
+    if (!checked_mul(a, b, ab) || !checked_mul(ab, c, abc))
+        throw LoadError(what + ": " + std::to_string(a) + " x " + std::to_string(b) + " x " + std::to_string(c) +
+                        " does not fit in memory arithmetic");
+    return abc;
+}
+
+// Throws LoadError, before any allocation, when keyframes × vertices × 12 bytes of positions
+// exceed options.max_keyframe_bytes (or overflow).
+inline void check_keyframe_budget(const std::string& path, size_t keyframes, size_t vertices,
+                                  const LoadOptions& options) {
+    size_t kv = 0, bytes = 0;
+    if (!checked_mul(keyframes, vertices, kv) || !checked_mul(kv, 12, bytes) || bytes > options.max_keyframe_bytes)
+        throw LoadError(path + ": the animation needs " + std::to_string(keyframes) + " keyframes x " +
+                        std::to_string(vertices) + " vertices x 12 bytes, more than the loading budget of " +
+                        std::to_string(options.max_keyframe_bytes) + " bytes (raise it with --max-memory)");
+}
+
+}  // namespace animorder::io

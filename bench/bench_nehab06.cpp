@@ -7,10 +7,16 @@
 //
 //   build/bench/bench_nehab06 [--quick]     (--quick: knots of 2k and 10k only, 42 views)
 #include "animorder/animated_mesh.h"
-#include "animorder/animorder.h"
-#include "animorder/io.h"
+#include "animorder/load.h"
 #include "animorder/nehab06.h"
 #include "animorder/overdraw.h"
+#include "animorder/procedural_character.h"
+#include "animorder/procedural_shapes.h"
+#include "animorder/static_sander07.h"
+#include "animorder/tipsify.h"
+#include "animorder/triangle_order.h"
+#include "animorder/vertex_cache.h"
+#include "animorder/viewpoints.h"
 
 #include <chrono>
 #include <cstdio>

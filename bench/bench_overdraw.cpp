@@ -4,8 +4,12 @@
 //
 //   build/bench/bench_overdraw            (Ganfaul from ../shared/data is used when present)
 #include "animorder/animated_mesh.h"
-#include "animorder/animorder.h"
+#include "animorder/camera.h"
 #include "animorder/overdraw.h"
+#include "animorder/procedural_character.h"
+#include "animorder/procedural_shapes.h"
+#include "animorder/triangle_order.h"
+#include "animorder/viewpoints.h"
 #ifdef ANIMORDER_HAVE_GL
 #include "gl_overdraw.h"
 #endif

@@ -6,7 +6,11 @@
 //
 //   build/bench/bench_tipsify --benchmark_repetitions=5 --benchmark_enable_random_interleaving=true
 #include "animorder/animated_mesh.h"
-#include "animorder/animorder.h"
+#include "animorder/procedural_character.h"
+#include "animorder/procedural_shapes.h"
+#include "animorder/tipsify.h"
+#include "animorder/triangle_order.h"
+#include "animorder/vertex_cache.h"
 
 #include <benchmark/benchmark.h>
 #include <meshoptimizer.h>

@@ -35,12 +35,18 @@
 #include "gl_context.h"
 
 #include "animorder/animated_mesh.h"
-#include "animorder/animorder.h"
+#include "animorder/camera.h"
 #include "animorder/clustering.h"
 #include "animorder/evaluation.h"
-#include "animorder/io.h"
+#include "animorder/invalid_input.h"
+#include "animorder/load.h"
 #include "animorder/methods.h"
-#include "animorder/overdraw.h"
+#include "animorder/patches.h"
+#include "animorder/procedural_character.h"
+#include "animorder/selection_table.h"
+#include "animorder/triangle_order.h"
+#include "animorder/vertex_cache.h"
+#include "animorder/viewpoints.h"
 
 #include <algorithm>
 #include <chrono>

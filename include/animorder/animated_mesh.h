@@ -6,7 +6,8 @@
 // its arrays. No file I/O here.
 #pragma once
 
-#include <array>
+#include "animorder/invalid_input.h"
+
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -60,33 +61,5 @@ void validate_animated_mesh(const AnimatedMesh& mesh);
 // The mesh with only the named clips (in the order named) and their keyframes. Throws
 // InvalidInput naming a clip that does not exist and the clips that do.
 AnimatedMesh select_clips(const AnimatedMesh& mesh, const std::vector<std::string>& names);
-
-// ---------------------------------------------------------------------------------------------
-// Linear blend skinning (skinning.cpp).
-
-// Column-major 4×4 matrix, as glTF stores them.
-using Mat4 = std::array<float, 16>;
-
-// For each vertex v: out[v] = Σ_i w[v][i] · (joint_matrices[j[v][i]] · bind[v]), over
-// influences_per_vertex influences. Weights are normalised by their sum when it is not 1 (and a
-// vertex whose weights sum to 0 keeps its bind position). joints and weights are
-// vertex_count × influences_per_vertex arrays. Throws InvalidInput for a joint index >=
-// joint_count or a non-finite weight.
-void skin_positions(float* out_positions, const float* bind_positions, size_t vertex_count,
-                    const uint16_t* joints, const float* weights, size_t influences_per_vertex,
-                    const Mat4* joint_matrices, size_t joint_count);
-
-// ---------------------------------------------------------------------------------------------
-// Procedural inputs (procedural_character.cpp, procedural_shapes.cpp): no external file needed.
-
-// The bundled default input: a skinned humanoid-like character of about 10k triangles with
-// limbs that occlude one another (torso, head, two arms, two legs, a shield), and two clips with
-// different motion ("walk", "wave"), sampled at 30 keyframes per second. Deterministic.
-AnimatedMesh make_procedural_character();
-
-// Static test meshes (one clip of one keyframe), closed and consistently wound (CCW outward).
-// The triangle count is close to target_triangles (within a few percent).
-AnimatedMesh make_uv_sphere(size_t target_triangles);
-AnimatedMesh make_torus_knot(size_t target_triangles, int p = 2, int q = 3);
 
 }  // namespace animorder

@@ -4,8 +4,8 @@
 #pragma once
 
 #include "animorder/animated_mesh.h"
-#include "animorder/animorder.h"
-#include "animorder/overdraw.h"
+#include "animorder/mesh_patches.h"
+#include "animorder/viewpoints.h"
 
 #include <cstdint>
 #include <functional>
@@ -13,32 +13,6 @@
 #include <vector>
 
 namespace animorder {
-
-// ---------------------------------------------------------------------------------------------
-// Patches of a whole character (mesh_patches.cpp)
-
-// Every primitive Tipsified and cut into patches on its own; patches never straddle primitives.
-struct MeshPatches {
-    std::vector<uint32_t> cache_order;      // face permutation: primitives in file order, each Tipsified
-    std::vector<uint32_t> patch_starts;     // positions in cache_order; patch_count() + 1 entries
-    std::vector<uint32_t> patch_primitive;  // primitive of each patch
-    size_t patch_count() const { return patch_primitive.size(); }
-};
-
-MeshPatches build_mesh_patches(const AnimatedMesh& mesh, double lambda, unsigned cache_size = kDefaultCacheSize);
-
-// A face permutation of the whole mesh from a patch permutation: primitives stay in file order
-// (patches of a primitive keep their relative order from patch_order), triangles inside a patch
-// keep their Tipsify order.
-std::vector<uint32_t> patch_order_to_triangle_order(const MeshPatches& patches, const std::vector<uint32_t>& patch_order);
-
-// Area-weighted centroid of every patch at every keyframe of the list, after framing (the
-// keyframe's centre subtracted): centroids[(i · patch_count + p) · 3 + c] for keyframes[i].
-std::vector<float> patch_centroids(const AnimatedMesh& mesh, const MeshPatches& patches, const Framing& framing,
-                                   const std::vector<uint32_t>& keyframes);
-
-// ---------------------------------------------------------------------------------------------
-// k-means over nodes (clustering.cpp)
 
 enum class DistanceVariant {
     Jcgt,  // d(p) = Σ over the cluster's nodes of |viewpoint − centroid(p, keyframe)| (JCGT 2017)
@@ -99,30 +73,5 @@ struct ClusteringResult {
 // Han & Sander 2017, Algorithm 1, over the nodes keyframes × icosphere viewpoints.
 ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patches, const Framing& framing,
                                const std::vector<uint32_t>& keyframes, const ClusteringSettings& settings);
-
-// ---------------------------------------------------------------------------------------------
-// The runtime lookup table (selection_table.cpp)
-
-// Per keyframe of the clip, a grid over the view direction's polar angle θ ∈ [0, π] (from +Y)
-// and azimuth φ ∈ [0, 2π) (from +Z towards +X). Cell (f, i, j) stands for θ = i·π/(theta_steps−1)
-// and φ = j·2π/phi_steps, and holds the buffer of the clustering viewpoint nearest to it at
-// keyframe f. Lookup rounds f, θ and φ to the nearest cell (φ wraps around).
-struct SelectionTable {
-    uint32_t keyframes = 0;
-    uint32_t theta_steps = 0;
-    uint32_t phi_steps = 0;
-    std::vector<uint8_t> cells;  // [(f · theta_steps + i) · phi_steps + j]
-};
-
-// With theta_steps = phi_steps = 0 the grid is chosen from the viewpoint count: 5° cells for up
-// to 162 viewpoints (37 × 72), 2.5° for 642, 1.25° beyond. A cell is then always much closer to
-// its rounding viewpoint than neighbouring viewpoints are (162: 15.9° apart), so a clustering
-// viewpoint looks up exactly its own node.
-SelectionTable build_selection_table(const ClusteringResult& clustering, size_t keyframe_begin, size_t keyframe_count,
-                                     uint32_t theta_steps = 0, uint32_t phi_steps = 0);
-
-// The buffer for keyframe f (clip-local) and a unit view direction (from the frame's centre
-// to the camera, in the mesh's space).
-uint32_t select_buffer(const SelectionTable& table, size_t keyframe, const float direction[3]);
 
 }  // namespace animorder

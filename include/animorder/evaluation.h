@@ -4,8 +4,8 @@
 #pragma once
 
 #include "animorder/animated_mesh.h"
-#include "animorder/clustering.h"
-#include "animorder/overdraw.h"
+#include "animorder/methods.h"
+#include "animorder/viewpoints.h"
 
 #include <cstdint>
 #include <functional>
@@ -37,23 +37,8 @@ struct OrderEvaluation {
     std::vector<OverdrawSummary> per_clip;  // mesh.clips order
 };
 
-// A method under evaluation: its buffers (face permutations of the whole mesh, primitives drawn
-// in file order) and how it picks one at a node, in this order of precedence:
-// - front_to_back (the "oracle" bound): no stored buffer; at every node the patches are sorted by
-//   the distance from that node's eye to their centroid at that node's keyframe, nearest first;
-// - keyframe_buffer (tipsify-per-frame): a node draws keyframe_buffer[its keyframe];
-// - tables (one per clip, mesh.clips order): a node draws buffer table_base[clip] + the table's
-//   cell for (keyframe in the clip, view direction): exactly what an application does at run time;
-// - otherwise orders[0] at every node.
-struct MethodBuffers {
-    std::vector<std::vector<uint32_t>> orders;
-    std::vector<SelectionTable> tables;
-    std::vector<uint32_t> table_base;
-    std::vector<uint32_t> keyframe_buffer;             // one entry per keyframe of the mesh
-    std::shared_ptr<const MeshPatches> front_to_back;  // the oracle's patches
-};
 
-// The oracle's order at one node: patches by ascending distance from the eye (eye: a point, in
+// The oracle's order (MethodBuffers::front_to_back) at one node: patches by ascending distance from the eye (eye: a point, in
 // the same framed space as centroids, which holds 3 floats per patch), ties by patch id.
 std::vector<uint32_t> front_to_back_patch_order(const float* centroids, size_t patch_count, const float eye[3]);
 

@@ -1,28 +1,136 @@
-// animorder — the named methods of DESIGN.md applied to a whole AnimatedMesh.
+// animorder — the named methods of DESIGN.md applied to a whole AnimatedMesh (methods.cpp).
+//
+// A method turns a character into the buffers an application ships (face permutations of the
+// whole mesh), how it picks one at run time (lookup tables per clip), the fallback buffer a
+// viewer without the table draws, and their vertex-cache cost. `run_method` is what the tool,
+// the benchmarks and the tests call; the names below are spelled here and nowhere else.
 //
 // Each primitive is reordered on its own (primitives are separate draws with their own
-// materials, so triangles never move between them); the result keeps every primitive's index
-// range. This layer composes the algorithms of animorder.h; it does no file I/O either.
+// materials, so triangles never move between them). This layer composes the algorithms of
+// animorder.h; it does no file I/O either.
 #pragma once
 
 #include "animorder/animated_mesh.h"
-#include "animorder/animorder.h"
 #include "animorder/clustering.h"
-#include "animorder/evaluation.h"
+#include "animorder/mesh_patches.h"
+#include "animorder/patches.h"
+#include "animorder/selection_table.h"
+#include "animorder/vertex_cache.h"
+#include "animorder/viewpoints.h"
 
+#include <cstdint>
+#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace animorder {
 
-// Single-buffer methods (DESIGN.md names): "original" (Tipsify only), "static-sander07",
-// "meshopt" (meshoptimizer's optimizeVertexCache + optimizeOverdraw(1.05), the users' baseline)
-// and "static-nehab06" (planar clusters ordered by a measured overdraw graph, nehab06.h).
-enum class StaticMethod { Original, StaticSander07, Meshopt, StaticNehab06 };
+// ---------------------------------------------------------------------------------------------
+// Names
 
-// Parses a DESIGN.md method name; throws InvalidInput listing the known names otherwise.
-StaticMethod parse_static_method(const std::string& name);
-const char* method_name(StaticMethod method);
+// Every method of DESIGN.md. Original: Tipsify only. StaticSander07: Sander et al. 2007.
+// StaticNehab06: Nehab et al. 2006. Meshopt: meshoptimizer's optimisers (the users' baseline).
+// TipsifyPerFrame: static-sander07 sorted at every keyframe (one buffer each, the paper's
+// "Tipsify" column). Single / Joint: Han & Sander 2017 (k buffers per clip / for all clips).
+// Oracle: the patches sorted front-to-back at every evaluation node — a bound, not an order to
+// ship (it has no buffers).
+enum class Method { Original, StaticSander07, StaticNehab06, Meshopt, TipsifyPerFrame, Single, Joint, Oracle };
+
+// The method a user gets without asking (the paper's method).
+constexpr Method kDefaultMethod = Method::Single;
+
+// All methods in DESIGN.md's order.
+const std::vector<Method>& all_methods();
+
+// The DESIGN.md name ("static-sander07", ...) and back. parse_method throws InvalidInput naming
+// the unknown name and listing the known ones.
+const char* method_name(Method method);
+Method parse_method(const std::string& name);
+
+// Which settings a method reads (reports print the others as null): λ (the patch threshold), and
+// k / views / the k-means settings.
+bool method_uses_lambda(Method method);
+bool method_uses_clusters(Method method);
+// False for the oracle: a new order at every node, nothing an application can draw.
+bool method_has_buffers(Method method);
+
+// The names of the k-means variants ("jcgt", "i3d"; "monotone", "paper") and back; parse_*
+// throw InvalidInput for an unknown name.
+const char* distance_name(DistanceVariant variant);
+DistanceVariant parse_distance(const std::string& name);
+const char* update_name(UpdateRule rule);
+UpdateRule parse_update(const std::string& name);
+
+// ---------------------------------------------------------------------------------------------
+// Buffers and how a method picks one
+
+// A method's buffers (face permutations of the whole mesh, primitives drawn in file order) and
+// how it picks one at a node, in this order of precedence:
+// - front_to_back (the "oracle" bound): no stored buffer; at every node the patches are sorted by
+//   the distance from that node's eye to their centroid at that node's keyframe, nearest first;
+// - keyframe_buffer (tipsify-per-frame): a node draws keyframe_buffer[its keyframe];
+// - tables (one per clip, mesh.clips order): a node draws buffer table_base[clip] + the table's
+//   cell for (keyframe in the clip, view direction): exactly what an application does at run time;
+// - otherwise orders[0] at every node.
+struct MethodBuffers {
+    std::vector<std::vector<uint32_t>> orders;
+    std::vector<SelectionTable> tables;
+    std::vector<uint32_t> table_base;
+    std::vector<uint32_t> keyframe_buffer;             // one entry per keyframe of the mesh
+    std::shared_ptr<const MeshPatches> front_to_back;  // the oracle's patches
+};
+
+// ---------------------------------------------------------------------------------------------
+// Running a method on a whole character
+
+// Every setting of every method; each method reads those it uses. Defaults are the library's.
+struct MethodSettings {
+    double lambda = kDefaultLambda;        // patch threshold (static-sander07, tipsify-per-frame, single, joint, oracle)
+    unsigned cache_size = kDefaultCacheSize;
+    size_t keyframe = 0;                   // static methods: the keyframe whose positions they sort with
+    // single / joint: k-means (clusters is k; views, resolution, seed, ... as ClusteringSettings;
+    // its log and progress callbacks are passed on). The resolution is also static-nehab06's.
+    ClusteringSettings clustering;
+    // static-nehab06: planar clusters (0: automatic, powers of two), measuring views, and whether
+    // its graph also sums 8 keyframes spread over the animation (else `keyframe` only).
+    size_t nehab_clusters = 0;
+    size_t nehab_views = 162;
+    bool nehab_all_keyframes = false;
+};
+
+// Throws InvalidInput for settings no method can run with (non-finite λ, k outside 1..255, a
+// view count that is no icosphere, a separation outside 0..180°, ...).
+void validate_method_settings(const MethodSettings& settings);
+
+struct MethodResult {
+    Method method = Method::Original;
+    MethodBuffers buffers;
+    Framing framing;             // every keyframe: the sidecar's and glTF's frame centres
+    uint32_t fallback = 0;       // the buffer most clustering nodes chose: what viewers without the table draw
+    double acmr_mean = 0;        // mean over buffers (oracle: over 12 views at each clip's first keyframe)
+    double atvr_mean = 0;
+    double seconds = 0;          // the whole run_method
+    size_t patch_count = 0;      // patches (static-nehab06: planar clusters), summed over primitives
+    size_t hard_boundary_count = 0;  // original, static-sander07
+    // single / joint: the k-means runs (one per clip, or one for joint), each run's view radius,
+    // the seconds spent building patches, and each run's seconds.
+    std::vector<ClusteringResult> runs;
+    std::vector<float> run_radius;
+    double seconds_patches = 0;
+    std::vector<double> run_seconds;
+};
+
+// Runs the method on the whole mesh. Throws InvalidInput for an invalid mesh or settings.
+MethodResult run_method(const AnimatedMesh& mesh, Method method, const MethodSettings& settings = {});
+
+// ---------------------------------------------------------------------------------------------
+// The building blocks run_method composes (tests and benchmarks call them alone)
+
+// The single-buffer methods: Original, StaticSander07, Meshopt, StaticNehab06.
+using StaticMethod = Method;
+// parse_method restricted to the single-buffer methods (InvalidInput for the others).
+Method parse_static_method(const std::string& name);
 
 struct StaticMethodSettings {
     double lambda = kDefaultLambda;
@@ -34,7 +142,7 @@ struct StaticMethodSettings {
     // only `keyframe`). Clusters always come from the normals of `keyframe`.
     size_t nehab_clusters = 0;
     size_t nehab_views = 162;
-    unsigned nehab_resolution = 256;
+    unsigned nehab_resolution = ClusteringSettings{}.resolution;
     bool nehab_all_keyframes = false;
     unsigned threads = 0;  // static-nehab06's rasterisation; 0: all hardware threads
 };
@@ -48,13 +156,9 @@ struct StaticMethodResult {
     size_t hard_boundary_count = 0;
 };
 
-// meshoptimizer's vertex cache + overdraw optimisation of one index buffer as a face permutation.
-std::vector<uint32_t> meshopt_order(const uint32_t* indices, size_t index_count, const float* positions,
-                                    size_t vertex_count, unsigned cache_size);
-
-// Runs the method on every primitive. Throws InvalidInput for an invalid mesh or settings.
-StaticMethodResult run_static_method(const AnimatedMesh& mesh, StaticMethod method,
-                                     const StaticMethodSettings& settings);
+// One single-buffer method on every primitive. Throws InvalidInput for an invalid mesh or
+// settings, or a method that is not single-buffer.
+StaticMethodResult run_static_method(const AnimatedMesh& mesh, Method method, const StaticMethodSettings& settings);
 
 // Han & Sander 2017 over a whole character: "single" (one set of k buffers per clip) or "joint"
 // (one set for all clips). Buffers are face permutations of the whole mesh; tables pick them.

@@ -5,8 +5,9 @@
 // The matrices are the classic OpenGL lookAt and perspective (gluLookAt/gluPerspective), built
 // in double. Vertices are transformed in float, like a vertex shader, and the same clip-space
 // array feeds both our rasteriser and the OpenGL reference, so the two see identical input.
-#include "animorder/animorder.h"
-#include "animorder/overdraw.h"
+#include "animorder/camera.h"
+
+#include "animorder/invalid_input.h"
 
 #include <cmath>
 

@@ -16,6 +16,13 @@
 // sorts break ties by patch id, and the random viewpoints come from a seeded std::mt19937_64.
 #include "animorder/clustering.h"
 
+#include "animorder/animated_mesh.h"
+#include "animorder/invalid_input.h"
+#include "animorder/mesh_patches.h"
+#include "animorder/overdraw.h"
+#include "animorder/rasterizer.h"
+#include "animorder/viewpoints.h"
+
 #include <algorithm>
 
 #include <tbb/blocked_range.h>

@@ -25,9 +25,10 @@
 // every other edge vertex of {A, B}), so it never depends on later float positions.
 //
 // Levels compose: S = S_levels · … · S_1, accumulated in double.
-#include "animorder/subdivision.h"
+#include "animorder/loop_subdivision.h"
 
-#include "animorder/animorder.h"
+#include "animorder/invalid_input.h"
+#include "animorder/triangle_order.h"
 
 #include <algorithm>
 #include <cmath>

@@ -6,7 +6,14 @@
 // them and every order keeps the primitives in file order: a cluster's buffer is one patch order
 // per primitive. Centroids are area-weighted (a patch's surface centre, not its vertex average,
 // which over-weights finely tessellated corners) and framed per keyframe.
-#include "animorder/clustering.h"
+#include "animorder/mesh_patches.h"
+
+#include "animorder/animated_mesh.h"
+#include "animorder/invalid_input.h"
+#include "animorder/patches.h"
+#include "animorder/tipsify.h"
+#include "animorder/triangle_order.h"
+#include "animorder/viewpoints.h"
 
 #include <cmath>
 #include <string>

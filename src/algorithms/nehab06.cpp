@@ -27,9 +27,17 @@
 //   R the largest radius over them), so one buffer serves the whole animation.
 // Views run in parallel (oneTBB); each worker sums into its own integer matrix and the matrices
 // are added at the end, so the graph is identical for any thread count.
-#include "animorder/animorder.h"
 #include "animorder/nehab06.h"
+
+#include "animorder/camera.h"
+#include "animorder/invalid_input.h"
 #include "animorder/overdraw.h"
+#include "animorder/planar_clusters.h"
+#include "animorder/rasterizer.h"
+#include "animorder/tipsify.h"
+#include "animorder/triangle_order.h"
+#include "animorder/vertex_cache.h"
+#include "animorder/viewpoints.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>

@@ -5,8 +5,13 @@
 // one clip-space buffer and writes each node's counts into that node's own slot: the numbers do
 // not depend on the thread count or on scheduling, and memory grows with the workers, not with
 // the nodes.
-#include "animorder/animorder.h"
 #include "animorder/overdraw.h"
+
+#include "animorder/camera.h"
+#include "animorder/invalid_input.h"
+#include "animorder/rasterizer.h"
+#include "animorder/triangle_order.h"
+#include "animorder/viewpoints.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>

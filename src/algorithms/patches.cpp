@@ -17,7 +17,10 @@
 // on a manifold so λ < 0.5 never cuts, and any triangle sharing a vertex with the patch gives
 // M_i <= 2.5 < 3 so λ >= 3 cuts everywhere. Both limits are also enforced explicitly
 // (DESIGN.md), so degenerate or disconnected input cannot blur them.
-#include "animorder/animorder.h"
+#include "animorder/patches.h"
+
+#include "animorder/invalid_input.h"
+#include "animorder/triangle_order.h"
 
 #include <cmath>
 #include <string>

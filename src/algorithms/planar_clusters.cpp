@@ -18,8 +18,11 @@
 // the cluster closest to its mean normal); triangles are adjacent across a seam (vertices split
 // at one position count as one); n̄c is the area-weighted mean of unit normals, renormalised; all
 // ties go to the lower cluster id, then the lower triangle id, so the result is deterministic.
-#include "animorder/animorder.h"
-#include "animorder/nehab06.h"
+#include "animorder/planar_clusters.h"
+
+#include "animorder/invalid_input.h"
+#include "animorder/tipsify.h"
+#include "animorder/triangle_order.h"
 
 #include <algorithm>
 #include <cmath>

@@ -22,8 +22,10 @@
 // smaller or equal depth: one walk from the nearest fragment with a running minimum rank gives
 // the count for every order at once. Exact ties in depth form a group of which only the fragment
 // drawn first can pass.
-#include "animorder/animorder.h"
-#include "animorder/overdraw.h"
+#include "animorder/rasterizer.h"
+
+#include "animorder/invalid_input.h"
+#include "animorder/triangle_order.h"
 
 #include <algorithm>
 #include <cmath>

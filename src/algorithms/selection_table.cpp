@@ -5,7 +5,10 @@
 // buffer of the closest clustering viewpoint; lookup rounds f, θ and φ to the nearest cell. The
 // (θ, φ) grid is less uniform than the icosphere, but its lookup is two atan-free roundings away.
 // θ is measured from +Y (the usual up axis of characters), φ from +Z towards +X.
+#include "animorder/selection_table.h"
+
 #include "animorder/clustering.h"
+#include "animorder/invalid_input.h"
 
 #include <algorithm>
 #include <cmath>

@@ -4,8 +4,9 @@
 // Weights that do not sum to one (glTF allows, exporters produce them) are normalised rather than
 // trusted, so a character never shrinks towards the origin; a vertex without weight keeps its
 // bind position. Invalid joints and non-finite weights are errors, never silent garbage.
-#include "animorder/animated_mesh.h"
-#include "animorder/animorder.h"
+#include "animorder/skinning.h"
+
+#include "animorder/invalid_input.h"
 
 #include <cmath>
 #include <string>

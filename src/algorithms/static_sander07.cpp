@@ -10,7 +10,12 @@
 // normals (Σ a_t n_t / Σ a_t, i.e. Σ cross/2 / Σ area: large flat patches weigh more than
 // crumpled ones). Accumulation is in double so the order does not depend on summation noise;
 // ties keep patch id order, so the result is deterministic.
-#include "animorder/animorder.h"
+#include "animorder/static_sander07.h"
+
+#include "animorder/invalid_input.h"
+#include "animorder/patches.h"
+#include "animorder/tipsify.h"
+#include "animorder/triangle_order.h"
 
 #include <algorithm>
 #include <cmath>

@@ -17,7 +17,10 @@
 // tests and the run time is O(triangles), independent of k. One deviation from the pseudo-code,
 // for speed and not for results: the candidate set N of a fan is the stretch of the dead-end
 // stack that the fan pushed (the same vertices, possibly repeated), so no set is built.
-#include "animorder/animorder.h"
+#include "animorder/tipsify.h"
+
+#include "animorder/invalid_input.h"
+#include "animorder/triangle_order.h"
 
 #include <memory>
 #include <vector>

@@ -3,7 +3,9 @@
 // Following DirectXMesh (Microsoft): optimisers return a face permutation and a separate function
 // applies it, which maps cleanly onto the k alternative orders of one mesh that Han & Sander 2017
 // produce. Validation raises distinct, explicit errors instead of asserts that vanish in Release.
-#include "animorder/animorder.h"
+#include "animorder/triangle_order.h"
+
+#include "animorder/invalid_input.h"
 
 #include <string>
 #include <vector>

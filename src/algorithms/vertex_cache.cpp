@@ -6,7 +6,10 @@
 // not move the entry. Cache membership uses insertion time stamps, as Tipsify does: a vertex
 // is cached iff it was inserted fewer than k insertions ago, so the simulation is O(1) per corner
 // whatever k is.
-#include "animorder/animorder.h"
+#include "animorder/vertex_cache.h"
+
+#include "animorder/invalid_input.h"
+#include "animorder/triangle_order.h"
 
 #include <vector>
 

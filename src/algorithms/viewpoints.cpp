@@ -7,10 +7,13 @@
 // distributions' algorithms are implementation-defined), so they are the same everywhere.
 // Framing moves each keyframe's bounding-box centre to the origin so that the camera at 3R sees
 // the whole character at every keyframe; it never rotates.
-#include "animorder/animorder.h"
-#include "animorder/overdraw.h"
+#include "animorder/viewpoints.h"
+
+#include "animorder/invalid_input.h"
+#include "animorder/triangle_order.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <random>

@@ -7,8 +7,10 @@
 // clips with different motion. Parts are closed capsules (surfaces of revolution) around the
 // bones of a 13-joint skeleton, about 1.8 m tall, Y up, facing +Z, its left on +X. Keyframes are
 // skinned with skin_positions at 30 samples per second, as DESIGN.md says for clips.
+#include "animorder/procedural_character.h"
+
 #include "animorder/animated_mesh.h"
-#include "animorder/animorder.h"
+#include "animorder/skinning.h"
 #include "lathe.h"
 
 #include <algorithm>

@@ -1,8 +1,10 @@
 // Static procedural test meshes: a UV sphere and a (p, q) torus knot tube, closed, watertight and
 // wound counter-clockwise outward, at a requested triangle count. Vertices come in generation
 // order (ring after ring), which is the "input order" the vertex-cache tests start from.
+#include "animorder/procedural_shapes.h"
+
 #include "animorder/animated_mesh.h"
-#include "animorder/animorder.h"
+#include "animorder/invalid_input.h"
 #include "lathe.h"
 
 #include <cmath>

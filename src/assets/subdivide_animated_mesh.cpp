@@ -1,9 +1,11 @@
 // Loop subdivision of a whole animated mesh (the paper's "Ganfaul, 1 and 2 levels of Loop
 // subdivision" rows): the operator of loop_subdivision.cpp is built once on keyframe 0's welded
 // topology, all primitives together, and applied to every keyframe.
-#include "animorder/subdivision.h"
+#include "animorder/subdivide_animated_mesh.h"
 
-#include "animorder/animorder.h"
+#include "animorder/animated_mesh.h"
+#include "animorder/invalid_input.h"
+#include "animorder/loop_subdivision.h"
 
 #include <tbb/parallel_for.h>
 

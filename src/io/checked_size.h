@@ -2,7 +2,7 @@
 // hostile: a count near 2^64 must fail, not wrap), and the loading memory budget.
 #pragma once
 
-#include "animorder/io.h"
+#include "animorder/load.h"
 
 #include <cstddef>
 #include <string>

@@ -8,11 +8,13 @@
 // interpolation: key j at j / sample_rate holds weight 1 on target first_keyframe + j and 0
 // elsewhere. load_gltf sampling at the clip's rate lands on those keys and gives the keyframes
 // back (up to the float rounding of base + delta). A mesh without clips gets no animation.
-#include "animorder/io.h"
+#include "animorder/gltf_animated_writer.h"
+
+#include "animorder/animated_mesh.h"
+#include "animorder/invalid_input.h"
+#include "animorder/load.h"
 
 #include "gltf_buffer.h"
-
-#include "animorder/animorder.h"
 
 #include <tiny_gltf.h>
 

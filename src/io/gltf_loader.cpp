@@ -8,9 +8,13 @@
 // scaled by the key interval), sparse accessors. Parsing is tinygltf's (Debian's libtinygltf);
 // every access it leaves unchecked (accessor ranges, indices, joints) is checked here, so a
 // broken file is a one-line LoadError, never a crash.
-#include "animorder/io.h"
+#include "animorder/gltf_loader.h"
 
-#include "animorder/animorder.h"
+#include "animorder/animated_mesh.h"
+#include "animorder/invalid_input.h"
+#include "animorder/load.h"
+#include "animorder/skinning.h"
+
 #include "transform.h"
 
 #include <tiny_gltf.h>

@@ -8,13 +8,16 @@
 // still gets a valid, better-ordered file. Everything else — materials, textures, skins,
 // animations, other extras and extensions, vertex arrays — is written back as read: the new
 // indices refer to the file's own vertices. New bytes are appended to buffer 0.
-#include "animorder/io.h"
+#include "animorder/gltf_writer.h"
+
+#include "animorder/animated_mesh.h"
+#include "animorder/load.h"
+#include "animorder/methods.h"
+#include "animorder/selection_table.h"
+#include "animorder/triangle_order.h"
+#include "animorder/viewpoints.h"
 
 #include "gltf_buffer.h"
-
-#include "animorder/animorder.h"
-#include "animorder/clustering.h"
-#include "animorder/evaluation.h"
 
 #include <tiny_gltf.h>
 

@@ -10,9 +10,13 @@
 // IQM triangles face front clockwise (the reference viewer culls with glFrontFace(GL_CW)), so
 // corners 1 and 2 are swapped for DESIGN.md's counter-clockwise fronts. Each animation is sampled
 // at its own frame rate and resampled at sample_rate by linear interpolation of the positions.
-#include "animorder/io.h"
+#include "animorder/iqm_loader.h"
 
-#include "animorder/animorder.h"
+#include "animorder/animated_mesh.h"
+#include "animorder/invalid_input.h"
+#include "animorder/load.h"
+#include "animorder/skinning.h"
+
 #include "transform.h"
 
 #include <cmath>

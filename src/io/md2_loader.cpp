@@ -9,9 +9,11 @@
 // Triangles index the file's own vertex array (texture coordinates are separate in MD2), so
 // vertex identity is the file's; MD2 stores front faces clockwise, so corners 1 and 2 are
 // swapped to give DESIGN.md's counter-clockwise fronts.
-#include "animorder/io.h"
+#include "animorder/md2_loader.h"
 
-#include "animorder/animorder.h"
+#include "animorder/animated_mesh.h"
+#include "animorder/invalid_input.h"
+#include "animorder/load.h"
 
 #include <cctype>
 #include <cmath>

@@ -3,7 +3,14 @@
 // input and options.
 #include "animorder/sidecar.h"
 
-#include "animorder/animorder.h"
+#include "animorder/animated_mesh.h"
+#include "animorder/invalid_input.h"
+#include "animorder/methods.h"
+#include "animorder/selection_table.h"
+#include "animorder/triangle_order.h"
+#include "animorder/viewpoints.h"
+
+#include <nlohmann/json.hpp>
 
 #include <cstring>
 
@@ -58,6 +65,34 @@ std::string serialize_sidecar(const AnimatedMesh& mesh, const MethodBuffers& buf
     }
     if (out.size() > UINT32_MAX) throw InvalidInput("sidecar larger than 4 GiB");
     return out;
+}
+
+std::string sidecar_json(const AnimatedMesh& mesh, const MethodBuffers& buffers, const std::string& method,
+                         uint32_t fallback, const std::string& binary_name) {
+    if (buffers.tables.size() != mesh.clips.size() || buffers.table_base.size() != mesh.clips.size())
+        throw InvalidInput("the sidecar needs one lookup table per clip");
+    nlohmann::ordered_json j;
+    j["format"] = "animorder-sidecar";
+    j["version"] = 1;
+    j["binary"] = binary_name;
+    j["method"] = method;
+    j["buffers"] = buffers.orders.size();
+    j["fallback"] = fallback;
+    j["index_count"] = mesh.indices.size();
+    j["primitives"] = nlohmann::ordered_json::array();
+    for (const Primitive& p : mesh.primitives)
+        j["primitives"].push_back({{"name", p.name}, {"first_index", p.first_index}, {"index_count", p.index_count}});
+    j["clips"] = nlohmann::ordered_json::array();
+    for (size_t c = 0; c < mesh.clips.size(); ++c)
+        j["clips"].push_back({{"name", mesh.clips[c].name},
+                              {"keyframes", mesh.clips[c].keyframe_count},
+                              {"sample_rate", mesh.clips[c].sample_rate},
+                              {"buffer_base", buffers.table_base[c]},
+                              {"theta_steps", buffers.tables[c].theta_steps},
+                              {"phi_steps", buffers.tables[c].phi_steps}});
+    j["table"] = "cell (f, i, j): theta = i*pi/(theta_steps-1) from +Y, phi = j*2*pi/phi_steps from +Z towards +X; "
+                 "buffer = buffer_base + cell (see animorder_runtime.h)";
+    return j.dump(2) + "\n";
 }
 
 }  // namespace animorder

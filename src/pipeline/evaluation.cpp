@@ -9,7 +9,15 @@
 // the same pixels and a method with many buffers costs no more than one with a single buffer.
 #include "animorder/evaluation.h"
 
-#include "animorder/animorder.h"
+#include "animorder/animated_mesh.h"
+#include "animorder/camera.h"
+#include "animorder/invalid_input.h"
+#include "animorder/mesh_patches.h"
+#include "animorder/methods.h"
+#include "animorder/rasterizer.h"
+#include "animorder/selection_table.h"
+#include "animorder/triangle_order.h"
+#include "animorder/viewpoints.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>

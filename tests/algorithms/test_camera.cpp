@@ -1,7 +1,8 @@
 // The node camera: the bounding sphere exactly fits the square viewport, depth stays inside the
 // near/far range, and every view direction (poles included) gives a valid camera.
-#include "animorder/animorder.h"
-#include "animorder/overdraw.h"
+#include "animorder/camera.h"
+#include "animorder/invalid_input.h"
+#include "animorder/viewpoints.h"
 
 #include <gtest/gtest.h>
 

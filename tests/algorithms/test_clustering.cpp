@@ -3,6 +3,12 @@
 // re-seeding of empty clusters.
 #include "animorder/animated_mesh.h"
 #include "animorder/clustering.h"
+#include "animorder/invalid_input.h"
+#include "animorder/mesh_patches.h"
+#include "animorder/overdraw.h"
+#include "animorder/procedural_character.h"
+#include "animorder/selection_table.h"
+#include "animorder/viewpoints.h"
 #include "support/meshes.h"
 
 #include <gtest/gtest.h>

@@ -3,9 +3,14 @@
 // closed, winding, Euler characteristic), UV seams watertight in every keyframe, and the operator
 // against an independent direct implementation, against itself built afresh, and composed.
 #include "animorder/animated_mesh.h"
-#include "animorder/animorder.h"
-#include "animorder/overdraw.h"
-#include "animorder/subdivision.h"
+#include "animorder/camera.h"
+#include "animorder/invalid_input.h"
+#include "animorder/loop_subdivision.h"
+#include "animorder/procedural_character.h"
+#include "animorder/procedural_shapes.h"
+#include "animorder/rasterizer.h"
+#include "animorder/subdivide_animated_mesh.h"
+#include "animorder/viewpoints.h"
 
 #include <gtest/gtest.h>
 

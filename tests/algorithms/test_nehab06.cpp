@@ -3,11 +3,17 @@
 // drawing both cluster orders (exact integers), crafted scenes with a known right order, and the
 // whole method on the bundled character against static-sander07 and Tipsify.
 #include "animorder/animated_mesh.h"
-#include "animorder/animorder.h"
 #include "animorder/evaluation.h"
+#include "animorder/invalid_input.h"
 #include "animorder/methods.h"
 #include "animorder/nehab06.h"
 #include "animorder/overdraw.h"
+#include "animorder/planar_clusters.h"
+#include "animorder/procedural_character.h"
+#include "animorder/procedural_shapes.h"
+#include "animorder/tipsify.h"
+#include "animorder/vertex_cache.h"
+#include "animorder/viewpoints.h"
 #include "support/meshes.h"
 
 #include <gtest/gtest.h>

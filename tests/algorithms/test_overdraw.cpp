@@ -1,7 +1,10 @@
 // Scoring many nodes: deterministic whatever the thread count, and equal to node-by-node scoring.
 #include "animorder/animated_mesh.h"
-#include "animorder/animorder.h"
+#include "animorder/invalid_input.h"
 #include "animorder/overdraw.h"
+#include "animorder/procedural_character.h"
+#include "animorder/procedural_shapes.h"
+#include "animorder/viewpoints.h"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,13 @@
 // Patches (fast linear clustering): hand-worked cuts on a strip, the λ limits, and the ACMR
 // behaviour Sander et al. 2007 §4 describe.
 #include "animorder/animated_mesh.h"
-#include "animorder/animorder.h"
+#include "animorder/invalid_input.h"
+#include "animorder/patches.h"
+#include "animorder/procedural_character.h"
+#include "animorder/procedural_shapes.h"
+#include "animorder/static_sander07.h"
+#include "animorder/tipsify.h"
+#include "animorder/vertex_cache.h"
 #include "support/meshes.h"
 
 #include <gtest/gtest.h>

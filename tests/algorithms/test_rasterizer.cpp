@@ -1,8 +1,13 @@
 // The rasteriser on hand-worked scenes (coverage, fill rule, culling, clipping, depth order),
 // and its multi-order scoring against a brute-force z-buffer that draws each order separately.
 #include "animorder/animated_mesh.h"
-#include "animorder/animorder.h"
+#include "animorder/camera.h"
+#include "animorder/invalid_input.h"
 #include "animorder/overdraw.h"
+#include "animorder/procedural_character.h"
+#include "animorder/procedural_shapes.h"
+#include "animorder/rasterizer.h"
+#include "animorder/viewpoints.h"
 #include "support/meshes.h"
 
 #include <gtest/gtest.h>

@@ -1,6 +1,6 @@
 // Linear blend skinning against hand-computed positions.
-#include "animorder/animated_mesh.h"
-#include "animorder/animorder.h"
+#include "animorder/invalid_input.h"
+#include "animorder/skinning.h"
 
 #include <gtest/gtest.h>
 

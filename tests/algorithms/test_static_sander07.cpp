@@ -1,7 +1,9 @@
 // static-sander07: the occlusion-potential rank (Sander et al. 2007, equation 4) on hand-worked
 // patches, and the whole method's guarantees (permutation, winding, determinism, bad input).
 #include "animorder/animated_mesh.h"
-#include "animorder/animorder.h"
+#include "animorder/invalid_input.h"
+#include "animorder/procedural_character.h"
+#include "animorder/static_sander07.h"
 #include "support/meshes.h"
 
 #include <gtest/gtest.h>

@@ -2,8 +2,13 @@
 // ACMR against meshoptimizer's independent implementation of the same paper
 // (meshopt_optimizeVertexCacheFifo).
 #include "animorder/animated_mesh.h"
-#include "animorder/animorder.h"
-#include "animorder/io.h"
+#include "animorder/gltf_loader.h"
+#include "animorder/invalid_input.h"
+#include "animorder/load.h"
+#include "animorder/procedural_character.h"
+#include "animorder/procedural_shapes.h"
+#include "animorder/tipsify.h"
+#include "animorder/vertex_cache.h"
 #include "support/meshes.h"
 
 #include <gtest/gtest.h>

@@ -1,4 +1,5 @@
-#include "animorder/animorder.h"
+#include "animorder/invalid_input.h"
+#include "animorder/triangle_order.h"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,10 @@
 // ACMR/ATVR: hand-worked FIFO cases, then equality with meshoptimizer's analyser (an independent
 // implementation; its vertex-cache analyser is sound, unlike its 0.18 overdraw analyser).
 #include "animorder/animated_mesh.h"
-#include "animorder/animorder.h"
+#include "animorder/invalid_input.h"
+#include "animorder/procedural_character.h"
+#include "animorder/procedural_shapes.h"
+#include "animorder/vertex_cache.h"
 #include "support/meshes.h"
 
 #include <gtest/gtest.h>

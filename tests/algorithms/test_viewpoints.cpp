@@ -1,6 +1,6 @@
 // Viewpoints and framing: counts, uniformity and determinism; framing by hand.
-#include "animorder/animorder.h"
-#include "animorder/overdraw.h"
+#include "animorder/invalid_input.h"
+#include "animorder/viewpoints.h"
 
 #include <gtest/gtest.h>
 

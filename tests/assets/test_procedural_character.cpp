@@ -1,7 +1,7 @@
 // The bundled character: size, structure, closed outward parts, real and different motion per
 // clip, skin that stretches without tearing, determinism.
 #include "animorder/animated_mesh.h"
-#include "animorder/animorder.h"
+#include "animorder/procedural_character.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // The procedural test meshes: sizes, closed manifolds, outward winding, no degenerate triangles.
 #include "animorder/animated_mesh.h"
-#include "animorder/animorder.h"
+#include "animorder/procedural_shapes.h"
 
 #include <gtest/gtest.h>
 

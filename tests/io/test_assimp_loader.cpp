@@ -1,7 +1,8 @@
 // The assimp loader on every non-glTF character of ../shared/data (skipped with a message when
 // the folder is absent): triangle counts of shared/data/README.md, Mixamo clip folders matched by
 // joint name, skin that stretches without tearing, and one-line errors.
-#include "animorder/io.h"
+#include "animorder/animated_mesh.h"
+#include "animorder/load.h"
 #include "support/meshes.h"
 
 #include <gtest/gtest.h>

@@ -1,8 +1,13 @@
 // glTF output of a whole animated mesh (keyframes as morph targets driven by one-hot weights):
 // it must read back through load_gltf with the same triangles, clips and keyframes, be
 // byte-identical for the same mesh, and pass the Khronos glTF Validator.
-#include "animorder/io.h"
-#include "animorder/subdivision.h"
+#include "animorder/animated_mesh.h"
+#include "animorder/gltf_animated_writer.h"
+#include "animorder/gltf_loader.h"
+#include "animorder/invalid_input.h"
+#include "animorder/load.h"
+#include "animorder/procedural_character.h"
+#include "animorder/subdivide_animated_mesh.h"
 
 #include <gtest/gtest.h>
 

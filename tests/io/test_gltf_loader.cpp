@@ -1,9 +1,9 @@
 // The glTF loader: small files built here whose keyframes are worked out by hand (skins, morph
 // targets with sparse accessors, LINEAR/STEP/CUBICSPLINE), one-line errors for broken files, and
 // every glTF character of ../shared/data.
-#include "animorder/animorder.h"
-#include "animorder/io.h"
-#include "animorder/overdraw.h"
+#include "animorder/animated_mesh.h"
+#include "animorder/gltf_loader.h"
+#include "animorder/load.h"
 #include "support/meshes.h"
 
 #include <gtest/gtest.h>

@@ -2,8 +2,15 @@
 // glTF Validator, read back with the same vertices and keyframes, hold every order as a
 // permutation of the original triangles with their winding, keep what it does not touch, and be
 // byte-identical for the same input.
-#include "animorder/io.h"
+#include "animorder/animated_mesh.h"
+#include "animorder/clustering.h"
+#include "animorder/gltf_loader.h"
+#include "animorder/gltf_writer.h"
+#include "animorder/load.h"
 #include "animorder/methods.h"
+#include "animorder/procedural_character.h"
+#include "animorder/triangle_order.h"
+#include "animorder/viewpoints.h"
 #include "support/meshes.h"
 
 #include <gtest/gtest.h>

@@ -1,9 +1,15 @@
 // The evaluation harness: every way a method picks its buffer (fixed, per keyframe, per node for
 // the oracle) checked against the engine scoring the same buffers directly, and the oracle against
 // a scene where front-to-back is provably overdraw-free.
-#include "animorder/clustering.h"
+#include "animorder/animated_mesh.h"
 #include "animorder/evaluation.h"
+#include "animorder/invalid_input.h"
+#include "animorder/mesh_patches.h"
 #include "animorder/methods.h"
+#include "animorder/overdraw.h"
+#include "animorder/procedural_character.h"
+#include "animorder/procedural_shapes.h"
+#include "animorder/viewpoints.h"
 #include "support/meshes.h"
 
 #include <gtest/gtest.h>

@@ -1,11 +1,16 @@
 // The CPU rasteriser against real OpenGL (Mesa llvmpipe over EGL here; a GPU driver elsewhere):
 // the same clip-space vertices, the same orders, occlusion-query counts against ours.
 #include "gl_overdraw.h"
-#include "animorder/io.h"
-
 #include "animorder/animated_mesh.h"
-#include "animorder/animorder.h"
+#include "animorder/camera.h"
+#include "animorder/gltf_loader.h"
 #include "animorder/overdraw.h"
+#include "animorder/procedural_character.h"
+#include "animorder/procedural_shapes.h"
+#include "animorder/rasterizer.h"
+#include "animorder/tipsify.h"
+#include "animorder/triangle_order.h"
+#include "animorder/viewpoints.h"
 
 #include <gtest/gtest.h>
 

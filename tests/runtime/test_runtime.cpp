@@ -3,8 +3,12 @@
 // The implementation is compiled as C99 in runtime_c_check.c: the C++ side only includes it.
 #include "animorder_runtime.h"
 
+#include "animorder/animated_mesh.h"
+#include "animorder/clustering.h"
 #include "animorder/methods.h"
+#include "animorder/procedural_character.h"
 #include "animorder/sidecar.h"
+#include "animorder/triangle_order.h"
 
 #include <gtest/gtest.h>
 

@@ -2,7 +2,7 @@
 #pragma once
 
 #include "animorder/animated_mesh.h"
-#include "animorder/animorder.h"
+#include "animorder/triangle_order.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,6 +1,8 @@
 // `animorder subdivide` end to end: exit codes, the counts it prints and writes, one-line errors
 // for a bad level count or output, and never overwriting the input.
-#include "animorder/io.h"
+#include "animorder/animated_mesh.h"
+#include "animorder/gltf_loader.h"
+#include "animorder/procedural_character.h"
 
 #include <gtest/gtest.h>
 

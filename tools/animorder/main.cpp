@@ -1,12 +1,13 @@
 // animorder — command-line entry point: parses options, dispatches to a subcommand, and turns
 // every failure into one line on stderr and a non-zero exit code (never a crash).
 #include "commands.h"
-#include "subdivide_command.h"
 
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
 #include <exception>
+#include <limits>
+#include <string>
 
 namespace {
 
@@ -17,50 +18,56 @@ void add_common(CLI::App& command, animorder::tool::CommonOptions& common) {
                        "A clip to keep (by name), or a clip file / folder of clip files to add (Mixamo style); repeatable");
     command.add_option("--cache-size", common.cache_size, "FIFO vertex cache entries for ACMR and Tipsify")
         ->check(CLI::Range(3u, 1024u));
+    command.add_option("--max-memory", common.max_memory,
+                       "Loading budget in bytes for the sampled animation (keyframes x vertices x 12)")
+        ->capture_default_str()
+        ->check(CLI::Range(size_t(1) << 20, std::numeric_limits<size_t>::max()));
 }
 
 // sweep: -l, -k and --views take comma-separated lists (evaluate runs every combination).
-void add_method_options(CLI::App& command, animorder::tool::MethodOptions& m, bool sweep = false) {
+void add_method_options(CLI::App& command, animorder::tool::MethodOptions& options, bool sweep = false) {
+    animorder::MethodSettings& m = options.settings;
+    animorder::ClusteringSettings& c = m.clustering;
     const char* lambda_help = "Patch threshold: soft boundary when a patch's local ACMR < lambda "
                               "(<0.5: hard boundaries only, >=3: single triangles)";
     if (sweep) {
-        m.lambdas = {m.lambda};
-        m.cluster_list = {m.clusters};
-        m.view_list = {m.views};
-        command.add_option("-l,--lambda", m.lambdas, std::string(lambda_help) + "; a list runs each value")
+        options.lambdas = {m.lambda};
+        options.cluster_list = {c.clusters};
+        options.view_list = {c.views};
+        command.add_option("-l,--lambda", options.lambdas, std::string(lambda_help) + "; a list runs each value")
             ->delimiter(',')
             ->capture_default_str()
             ->check(CLI::Range(0.0, 1000.0));
-        command.add_option("-k,--clusters", m.cluster_list, "single/joint: number of buffers k; a list runs each value")
+        command.add_option("-k,--clusters", options.cluster_list, "single/joint: number of buffers k; a list runs each value")
             ->delimiter(',')
             ->capture_default_str()
             ->check(CLI::Range(size_t(1), size_t(255)));
-        command.add_option("--views", m.view_list,
+        command.add_option("--views", options.view_list,
                            "single/joint: clustering viewpoints (12, 42, 162, 642); a list runs each value")
             ->delimiter(',')
             ->capture_default_str();
     } else {
         command.add_option("-l,--lambda", m.lambda, lambda_help)->capture_default_str()->check(CLI::Range(0.0, 1000.0));
-        command.add_option("-k,--clusters", m.clusters, "single/joint: number of buffers k")
+        command.add_option("-k,--clusters", c.clusters, "single/joint: number of buffers k")
             ->capture_default_str()
             ->check(CLI::Range(size_t(1), size_t(255)));
-        command.add_option("--views", m.views, "single/joint: clustering viewpoints (12, 42, 162, 642)")
+        command.add_option("--views", c.views, "single/joint: clustering viewpoints (12, 42, 162, 642)")
             ->capture_default_str();
     }
-    command.add_option("--frame", m.keyframe, "static-sander07: keyframe whose positions it sorts with")
+    command.add_option("--frame", m.keyframe, "static methods: keyframe whose positions they sort with")
         ->capture_default_str();
-    command.add_option("--resolution", m.resolution, "single/joint/static-nehab06: clustering viewport in pixels")
+    command.add_option("--resolution", c.resolution, "single/joint/static-nehab06: clustering viewport in pixels")
         ->capture_default_str()
         ->check(CLI::Range(8u, 4096u));
-    command.add_option("--seed", m.seed, "single/joint: seed of the bootstrap viewpoints")->capture_default_str();
-    command.add_option("--min-separation", m.min_separation, "single/joint: degrees between bootstrap viewpoints")
+    command.add_option("--seed", c.seed, "single/joint: seed of the bootstrap viewpoints")->capture_default_str();
+    command.add_option("--min-separation", c.min_separation_deg, "single/joint: degrees between bootstrap viewpoints")
         ->capture_default_str();
-    command.add_option("--max-iterations", m.max_iterations, "single/joint: cap on k-means iterations")
+    command.add_option("--max-iterations", c.max_iterations, "single/joint: cap on k-means iterations")
         ->capture_default_str()
         ->check(CLI::Range(size_t(1), size_t(1000)));
-    command.add_option("--distance", m.distance, "single/joint: jcgt (sum) or i3d (visible-only mean)")
+    command.add_option("--distance", options.distance, "single/joint: jcgt (sum) or i3d (visible-only mean)")
         ->capture_default_str();
-    command.add_option("--update", m.update,
+    command.add_option("--update", options.update,
                        "single/joint: monotone (keep a cluster's new order only if its nodes' OVR falls) or paper")
         ->capture_default_str();
     command.add_option("--nehab-clusters", m.nehab_clusters, "static-nehab06: planar clusters (0: automatic)")
@@ -70,9 +77,18 @@ void add_method_options(CLI::App& command, animorder::tool::MethodOptions& m, bo
         ->capture_default_str();
     command.add_flag("--nehab-all-keyframes", m.nehab_all_keyframes,
                      "static-nehab06: measure also at 8 keyframes spread over the clips (default: --frame only)");
-    command.add_option("--threads", m.threads, "Worker threads (0: all cores)")
+    command.add_option("--threads", c.threads, "Worker threads (0: all cores)")
         ->capture_default_str()
         ->check(CLI::Range(0u, 1024u));
+}
+
+// The method names for help texts, from the library's one list.
+std::string method_list(bool shippable_only) {
+    std::string list;
+    for (animorder::Method m : animorder::all_methods())
+        if (!shippable_only || animorder::method_has_buffers(m))
+            list += std::string(list.empty() ? "" : ", ") + animorder::method_name(m);
+    return list;
 }
 
 }  // namespace
@@ -92,10 +108,10 @@ int main(int argc, char** argv) {
     OptimizeOptions optimize;
     CLI::App* optimize_cmd = app.add_subcommand("optimize", "Reorder triangles with a method; write buffers, table, report");
     add_common(*optimize_cmd, optimize.common);
-    optimize_cmd->add_option("-m,--method", optimize.method, "original | static-sander07 | static-nehab06 | meshopt | single | joint")
+    optimize_cmd->add_option("-m,--method", optimize.method, "One of: " + method_list(true))
         ->capture_default_str();
     optimize_cmd->add_flag("--joint", optimize.joint, "One set of buffers for all clips (same as --method joint)");
-    add_method_options(*optimize_cmd, optimize.settings);
+    add_method_options(*optimize_cmd, optimize.methods);
     optimize_cmd->add_option("-o,--output", optimize.output,
                              "Write OUT.animorder.bin (buffers + lookup tables) and OUT.animorder.json; "
                              "OUT.glb or OUT.gltf (glTF input) also writes the glTF with the orders");
@@ -107,23 +123,23 @@ int main(int argc, char** argv) {
     add_common(*evaluate_cmd, evaluate.common);
     evaluate_cmd
         ->add_option("--methods", evaluate.methods,
-                     "Comma-separated: original, static-sander07, static-nehab06, tipsify-per-frame, meshopt, single, joint, oracle")
+                     "Comma-separated, of: " + method_list(false))
         ->capture_default_str();
-    add_method_options(*evaluate_cmd, evaluate.settings, true);
-    evaluate_cmd->add_option("--eval-views", evaluate.views, "Random viewpoints per keyframe")
+    add_method_options(*evaluate_cmd, evaluate.method_options, true);
+    evaluate_cmd->add_option("--eval-views", evaluate.evaluation.views, "Random viewpoints per keyframe")
         ->capture_default_str()
         ->check(CLI::Range(size_t(1), size_t(100000)));
-    evaluate_cmd->add_option("--eval-resolution", evaluate.resolution, "Viewport size in pixels")
+    evaluate_cmd->add_option("--eval-resolution", evaluate.evaluation.resolution, "Viewport size in pixels")
         ->capture_default_str()
         ->check(CLI::Range(1u, 8192u));
-    evaluate_cmd->add_option("--eval-seed", evaluate.seed, "Seed of the evaluation viewpoints")->capture_default_str();
+    evaluate_cmd->add_option("--eval-seed", evaluate.evaluation.seed, "Seed of the evaluation viewpoints")->capture_default_str();
     evaluate_cmd->add_option("-r,--report", evaluate.report_path, "Write the JSON report to this file");
     evaluate_cmd->add_option("--csv", evaluate.csv_path, "Write the table as CSV to this file");
 
     HeatmapOptions heatmap;
     CLI::App* heatmap_cmd = app.add_subcommand("heatmap", "Draw a per-pixel overdraw image of one node as PNG");
     add_common(*heatmap_cmd, heatmap.common);
-    heatmap_cmd->add_option("--order", heatmap.method, "original | static-sander07")->capture_default_str();
+    heatmap_cmd->add_option("--order", heatmap.method, "A single-buffer method: original, static-sander07, ...")->capture_default_str();
     heatmap_cmd->add_option("-l,--lambda", heatmap.lambda, "Patch threshold for static-sander07")
         ->capture_default_str()
         ->check(CLI::Range(0.0, 1000.0));
@@ -154,8 +170,12 @@ int main(int argc, char** argv) {
     }
     try {
         app.parse(argc, argv);
-    } catch (const CLI::ParseError& e) {
+    } catch (const CLI::Success& e) {  // --help, --version
         return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        // Every option error the same way as every other error: one line, exit code 1.
+        std::fprintf(stderr, "animorder: error: %s\n", e.what());
+        return 1;
     }
 
     try {

@@ -1,5 +1,7 @@
 #include "report.h"
 
+#include "animorder/clustering.h"
+
 namespace animorder::tool {
 
 nlohmann::ordered_json report_header(const AnimatedMesh& mesh, const std::string& input_name) {
@@ -17,5 +19,77 @@ nlohmann::ordered_json cache_stats_json(const VertexCacheStats& stats) {
 }
 
 std::string report_text(const nlohmann::ordered_json& report) { return report.dump(2) + "\n"; }
+
+namespace {
+
+nlohmann::ordered_json clustering_details(const AnimatedMesh& mesh, const MethodResult& r, const MethodSettings& m) {
+    using json = nlohmann::ordered_json;
+    double assignment = 0, update = 0, rasterization = 0;
+    json runs = json::array();
+    for (size_t i = 0; i < r.runs.size(); ++i) {
+        rasterization += r.runs[i].seconds_rasterization;
+        json iterations = json::array();
+        for (size_t it = 0; it < r.runs[i].iterations.size(); ++it) {
+            const ClusteringIteration& x = r.runs[i].iterations[it];
+            assignment += x.seconds_raster;
+            update += x.seconds_update;
+            iterations.push_back({{"iteration", it + 1},
+                                  {"mean_ovr", x.mean_ovr},
+                                  {"reassigned", x.reassigned},
+                                  {"reseeded", x.reseeded},
+                                  {"improved_buffers", x.accepted},
+                                  {"seconds_assignment", x.seconds_raster},
+                                  {"seconds_update", x.seconds_update}});
+        }
+        runs.push_back({{"clips", r.method == Method::Joint ? json("all") : json(mesh.clips[i].name)},
+                        {"nodes", r.runs[i].assignment.size()},
+                        {"view_radius", r.run_radius[i]},
+                        {"converged", r.runs[i].converged},
+                        {"stop", r.runs[i].stop_reason},
+                        {"best_iteration", r.runs[i].best_iteration + 1},
+                        {"iterations", iterations}});
+    }
+    return {{"clusters", m.clustering.clusters},
+            {"views", m.clustering.views},
+            {"resolution", m.clustering.resolution},
+            {"seed", m.clustering.seed},
+            {"distance", distance_name(m.clustering.distance)},
+            {"update", update_name(m.clustering.update)},
+            {"patches", r.patch_count},
+            {"runs", runs},
+            {"stages_s",
+             {{"patches", r.seconds_patches},
+              {"rasterization", rasterization},
+              {"assignment", assignment},
+              {"update", update}}}};
+}
+
+}  // namespace
+
+nlohmann::ordered_json method_entry(const AnimatedMesh& mesh, const MethodResult& r, const MethodSettings& m) {
+    using json = nlohmann::ordered_json;
+    const bool clustered = method_uses_clusters(r.method);
+    json entry = {{"name", method_name(r.method)},
+                  {"lambda", method_uses_lambda(r.method) ? json(m.lambda) : json(nullptr)},
+                  {"clusters", clustered ? json(m.clustering.clusters) : json(nullptr)},
+                  {"views", clustered ? json(m.clustering.views) : json(nullptr)},
+                  {"buffers", r.buffers.orders.size()},
+                  {"acmr", r.acmr_mean},
+                  {"atvr", r.atvr_mean},
+                  {"ovr_mean", nullptr},
+                  {"ovr_pooled", nullptr},
+                  {"time_s", r.seconds}};
+    json details;
+    if (clustered)
+        details = clustering_details(mesh, r, m);
+    else if (r.method == Method::StaticNehab06)
+        details = {{"planar_clusters", r.patch_count}};
+    else if (r.method == Method::TipsifyPerFrame || r.method == Method::Oracle)
+        details = {{"patches", r.patch_count}};
+    else
+        details = {{"patches", r.patch_count}, {"hard_boundaries", r.hard_boundary_count}};
+    for (auto it = details.begin(); it != details.end(); ++it) entry[it.key()] = it.value();
+    return entry;
+}
 
 }  // namespace animorder::tool

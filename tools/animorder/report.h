@@ -7,7 +7,8 @@
 #pragma once
 
 #include "animorder/animated_mesh.h"
-#include "animorder/animorder.h"
+#include "animorder/methods.h"
+#include "animorder/vertex_cache.h"
 
 #include <nlohmann/json.hpp>
 
@@ -17,6 +18,11 @@ namespace animorder::tool {
 
 nlohmann::ordered_json report_header(const AnimatedMesh& mesh, const std::string& input_name);
 nlohmann::ordered_json cache_stats_json(const VertexCacheStats& stats);
+
+// A method's entry of "methods": name, the settings it used (null where it uses none), buffers,
+// ACMR/ATVR, OVR (null until evaluate fills it), time, and what the method reports of itself
+// (patches; single/joint: runs, iterations, stages).
+nlohmann::ordered_json method_entry(const AnimatedMesh& mesh, const MethodResult& result, const MethodSettings& settings);
 
 // Serialised with two-space indentation and a final newline.
 std::string report_text(const nlohmann::ordered_json& report);

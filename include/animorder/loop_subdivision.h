@@ -6,7 +6,7 @@
 // new_positions = S · old_positions. Definitions and rules: src/algorithms/loop_subdivision.cpp.
 #pragma once
 
-#include "animorder/animated_mesh.h"
+#include "animorder/invalid_input.h"
 
 #include <cstddef>
 #include <cstdint>
@@ -50,14 +50,5 @@ SubdivisionOperator build_loop_subdivision(const uint32_t* indices, size_t index
 // xyz floats, position_stride bytes apart). Sums in double. destination must not alias positions.
 void apply_subdivision(float* destination, const SubdivisionOperator& op, const float* positions,
                        size_t position_stride);
-
-// The mesh after `levels` levels of Loop subdivision (src/assets/subdivide_animated_mesh.cpp):
-// the operator is built on keyframe 0's welded topology and applied to every keyframe; clips,
-// keyframe counts and names, joint_count and morph_target_count (as information) are kept; each
-// child triangle stays in its parent's primitive, and primitives keep tiling the index buffer in
-// order (their index ranges × 4^levels; the vertices are generated, so source_mesh = −1).
-// levels 0 returns a copy. Throws InvalidInput for an invalid mesh, levels > 4 or more than 2^31
-// indices in the result.
-AnimatedMesh subdivide_animated_mesh(const AnimatedMesh& mesh, unsigned levels);
 
 }  // namespace animorder

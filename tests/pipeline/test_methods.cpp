@@ -1,6 +1,11 @@
 // The single-buffer methods over a whole character: per-primitive orders that keep primitives'
 // ranges and triangles' winding; the meshopt baseline reproduces meshoptimizer's own buffers.
+#include "animorder/animated_mesh.h"
+#include "animorder/invalid_input.h"
+#include "animorder/meshopt_order.h"
 #include "animorder/methods.h"
+#include "animorder/procedural_character.h"
+#include "animorder/procedural_shapes.h"
 #include "support/meshes.h"
 
 #include <gtest/gtest.h>

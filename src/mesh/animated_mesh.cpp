@@ -1,7 +1,7 @@
 // The invariants of an AnimatedMesh, checked once where a mesh enters the algorithms, so that a
 // loader's mistake or a corrupt file is an error naming the problem rather than a crash later.
 #include "animorder/animated_mesh.h"
-#include "animorder/animorder.h"
+#include "animorder/invalid_input.h"
 
 #include <cmath>
 #include <string>

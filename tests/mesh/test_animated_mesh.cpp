@@ -1,6 +1,6 @@
 // The AnimatedMesh invariants: a good mesh passes, each defect is named.
 #include "animorder/animated_mesh.h"
-#include "animorder/animorder.h"
+#include "animorder/invalid_input.h"
 
 #include <gtest/gtest.h>
 

@@ -1,12 +1,12 @@
 // `animorder subdivide`: load the input (or the bundled character), apply `--levels` levels of
 // Loop subdivision to every keyframe (subdivide_animated_mesh) and write the result as a new
 // glTF/GLB whose keyframes are morph targets (gltf_animated_mesh), atomically.
-#include "subdivide_command.h"
+#include "commands.h"
+#include "input.h"
 
-#include "output.h"
-
-#include "animorder/io.h"
-#include "animorder/subdivision.h"
+#include "animorder/atomic_write.h"
+#include "animorder/gltf_animated_writer.h"
+#include "animorder/subdivide_animated_mesh.h"
 
 #include <chrono>
 #include <cstdio>
@@ -33,11 +33,7 @@ int run_subdivide(const SubdivideOptions& options) {
     if (options.levels > kMaxSubdivisionLevels)
         throw std::runtime_error("--levels " + std::to_string(options.levels) + ": at most " +
                                  std::to_string(kMaxSubdivisionLevels) + " (each level multiplies the triangles by 4)");
-    if (!options.common.input.empty()) {
-        std::error_code same_error;
-        if (std::filesystem::equivalent(options.output, options.common.input, same_error))
-            throw std::runtime_error(options.output + ": refusing to overwrite the input; name another output");
-    }
+    check_output_paths({options.output}, {options.common.input});
 
     std::string input_name;
     const AnimatedMesh mesh = load_animated_input(options.common, input_name);

@@ -2,7 +2,10 @@
 // optimizeVertexCache (Forsyth-style) followed by optimizeOverdraw with threshold 1.05 (at most 5%
 // worse ACMR), on one keyframe's positions. It is a baseline, never scored by meshoptimizer's own
 // overdraw analyser (0.18's has a depth bug): the overdraw engine scores it like every method.
-#include "animorder/methods.h"
+#include "animorder/meshopt_order.h"
+
+#include "animorder/invalid_input.h"
+#include "animorder/triangle_order.h"
 
 #include <meshoptimizer.h>
 

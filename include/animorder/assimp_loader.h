@@ -1,0 +1,20 @@
+// animorder — every format assimp reads (assimp_loader.cpp).
+#pragma once
+
+#include "animorder/animated_mesh.h"
+#include "animorder/load.h"
+
+#include <string>
+#include <vector>
+
+namespace animorder {
+
+// Any format assimp reads (FBX, Collada, .X, .b3d, MD5, OBJ, …): meshes in node order with their
+// own vertices (identical vertices joined), bones (8 strongest weights, normalised), node
+// animations sampled at sample_rate. clip_files: Mixamo-style animation-only files whose
+// channels drive the character's joints by node name; each adds its animations as clips (named
+// after the file), and a file none of whose joints the character has is an error.
+AnimatedMesh load_assimp(const std::string& path, const std::vector<std::string>& clip_files = {},
+                         const LoadOptions& options = {});
+
+}  // namespace animorder

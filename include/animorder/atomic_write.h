@@ -1,0 +1,49 @@
+// animorder — writing outputs so that a run's files appear all together or not at all
+// (atomic_write.cpp): each file goes to a temporary in its target folder (flushed to disk), and
+// only when every file of the run is written are they renamed into place. Nothing the user named
+// as an input is ever replaced, and no two outputs of a run may be the same file.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace animorder {
+
+// Thrown when an output cannot be written or is refused; what() names the path, in one line.
+class OutputError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+// Throws OutputError unless every output path can be written as a new or replaced file: its folder
+// exists, it is not a folder, it is not (after resolving links) one of `inputs`, and no two
+// outputs are the same file. Call it before any long work, so a bad path fails at once.
+void check_output_paths(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs);
+
+// The outputs of one run. add() writes each to a temporary beside its target; commit() renames
+// them all into place. If any add() or the commit fails, or the set is destroyed uncommitted,
+// every temporary is removed and no target has been touched (a rename that fails mid-commit
+// restores the files already replaced from their backups).
+class OutputSet {
+public:
+    OutputSet() = default;
+    ~OutputSet();
+    OutputSet(const OutputSet&) = delete;
+    OutputSet& operator=(const OutputSet&) = delete;
+
+    void add(const std::string& path, const std::string& data);
+    void commit();
+
+private:
+    struct Pending {
+        std::string target, temp;
+    };
+    std::vector<Pending> pending_;
+    bool committed_ = false;
+};
+
+// One file written atomically: an OutputSet of one.
+void write_file_atomically(const std::string& path, const std::string& data);
+
+}  // namespace animorder

@@ -1,0 +1,21 @@
+// animorder — the camera of every node (camera.cpp; DESIGN.md "Camera").
+#pragma once
+
+#include <array>
+#include <cstddef>
+
+namespace animorder {
+
+using Mat4d = std::array<double, 16>;  // column-major, as OpenGL
+
+// Camera at distance 3R along the unit direction `view_direction` (from the origin towards the
+// eye), looking at the origin, square viewport, vertical field of view 2·asin(1/3) so the sphere
+// of radius R exactly fits, near plane at distance R, far at 5R. Up is +Y, or +Z when the view
+// direction is within ~2.6° of ±Y. Returns projection · view (OpenGL clip space, z in [−w, w]).
+Mat4d node_view_projection(const float view_direction[3], float radius);
+
+// clip[4v..4v+3] = view_projection · (positions[v] − centre, 1), in float as a vertex shader would.
+void transform_to_clip(float* clip_xyzw, const float* positions, size_t vertex_count, const float centre[3],
+                       const Mat4d& view_projection);
+
+}  // namespace animorder

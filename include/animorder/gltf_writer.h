@@ -1,0 +1,23 @@
+// animorder — a glTF file with a method's orders (gltf_writer.cpp).
+#pragma once
+
+#include "animorder/animated_mesh.h"
+#include "animorder/methods.h"
+#include "animorder/viewpoints.h"
+
+#include <cstdint>
+#include <string>
+
+namespace animorder {
+
+// The glTF file `input_path` (which `mesh` was loaded from) with the method's orders: each
+// primitive's `indices` holds buffer `fallback`, `extras.animorder.orders` lists an accessor per
+// buffer, and the root `extras.animorder` holds the clips' lookup tables and frame centres as
+// accessors. All other content is written back unchanged; buffers are embedded; relative image
+// URIs are rewritten to point, from output_path's folder, at the same files. Returns GLB bytes
+// when `binary`, else glTF JSON text.
+std::string gltf_with_orders(const std::string& input_path, const std::string& output_path, const AnimatedMesh& mesh,
+                             const MethodBuffers& buffers, uint32_t fallback, const Framing& framing,
+                             const std::string& method, bool binary);
+
+}  // namespace animorder

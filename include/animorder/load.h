@@ -1,0 +1,35 @@
+// animorder — reading characters from files into the AnimatedMesh every algorithm takes (load.cpp):
+// the error and options every loader shares, and the loader chosen by file extension.
+#pragma once
+
+#include "animorder/animated_mesh.h"
+
+#include <cstddef>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace animorder {
+
+// Thrown for a file that cannot be read as asked: what() starts with the file name and says
+// what is wrong, in one line.
+class LoadError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+struct LoadOptions {
+    double sample_rate = 30;  // keyframes per second of every clip (DESIGN.md)
+    // Budget for the sampled animation: keyframes × vertices × 12 bytes of positions. A file
+    // whose clips would need more fails with a LoadError naming the need and this budget before
+    // anything that size is allocated (`--max-memory` raises it).
+    size_t max_keyframe_bytes = size_t(4) << 30;
+};
+
+// By extension: .gltf/.glb → load_gltf (gltf_loader.h), .md2 → load_md2, .iqm → load_iqm (no
+// clip files), anything else → load_assimp. A folder in
+// clip_files stands for the files in it, in name order.
+AnimatedMesh load_character(const std::string& path, const std::vector<std::string>& clip_files = {},
+                            const LoadOptions& options = {});
+
+}  // namespace animorder

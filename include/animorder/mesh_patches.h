@@ -1,0 +1,34 @@
+// animorder — the patches of a whole character (mesh_patches.cpp): every primitive Tipsified and
+// cut into patches on its own (Han & Sander 2017, §3.1).
+#pragma once
+
+#include "animorder/animated_mesh.h"
+#include "animorder/vertex_cache.h"
+#include "animorder/viewpoints.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace animorder {
+
+// Every primitive Tipsified and cut into patches on its own; patches never straddle primitives.
+struct MeshPatches {
+    std::vector<uint32_t> cache_order;      // face permutation: primitives in file order, each Tipsified
+    std::vector<uint32_t> patch_starts;     // positions in cache_order; patch_count() + 1 entries
+    std::vector<uint32_t> patch_primitive;  // primitive of each patch
+    size_t patch_count() const { return patch_primitive.size(); }
+};
+
+MeshPatches build_mesh_patches(const AnimatedMesh& mesh, double lambda, unsigned cache_size = kDefaultCacheSize);
+
+// A face permutation of the whole mesh from a patch permutation: primitives stay in file order
+// (patches of a primitive keep their relative order from patch_order), triangles inside a patch
+// keep their Tipsify order.
+std::vector<uint32_t> patch_order_to_triangle_order(const MeshPatches& patches, const std::vector<uint32_t>& patch_order);
+
+// Area-weighted centroid of every patch at every keyframe of the list, after framing (the
+// keyframe's centre subtracted): centroids[(i · patch_count + p) · 3 + c] for keyframes[i].
+std::vector<float> patch_centroids(const AnimatedMesh& mesh, const MeshPatches& patches, const Framing& framing,
+                                   const std::vector<uint32_t>& keyframes);
+
+}  // namespace animorder

@@ -1,0 +1,74 @@
+// animorder — the rasteriser of one node (rasterizer.cpp; DESIGN.md "Rasterisation rules").
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <vector>
+
+namespace animorder {
+
+// One node's rasterisation under DESIGN.md's rules: pixel centres at +0.5, top-left fill rule
+// (after flipping OpenGL's window y to point down), vertices snapped to 1/256 pixel, depth
+// linear in screen space, LESS against a buffer cleared to 1, back faces (clockwise in OpenGL
+// window space) culled, triangles clipped against the near and far planes. It keeps, for every
+// pixel, the fragments of all front-facing triangles sorted by depth, so scoring an order never
+// needs another rasterisation. Reuse one instance across nodes: its buffers are kept.
+class NodeRasterizer {
+public:
+    NodeRasterizer();
+    ~NodeRasterizer();
+    NodeRasterizer(NodeRasterizer&&) noexcept;
+    NodeRasterizer& operator=(NodeRasterizer&&) noexcept;
+
+    // Rasterises the triangle list (clip-space positions, 4 floats per vertex) into a square
+    // viewport of resolution × resolution pixels. Replaces the previous node.
+    void rasterize(const float* clip_xyzw, size_t vertex_count, const uint32_t* indices, size_t index_count,
+                   unsigned resolution);
+
+    // Pixels covered by at least one fragment (what the depth buffer shows after any order).
+    uint64_t visible_pixels() const;
+    // Fragments generated (what a draw with the depth test off would shade).
+    uint64_t fragments() const;
+
+    // For each of order_count orders (rank table from make_rank_table), the fragments that pass
+    // the depth test when the triangles are drawn in that order.
+    void score(uint64_t* passed, const uint32_t* ranks, size_t order_count) const;
+
+    // Per pixel (row 0 at the top), fragments passing the depth test under one order
+    // (order_index of the rank table): the heatmap behind the paper's Figure 1.
+    std::vector<uint32_t> passed_per_pixel(const uint32_t* ranks, size_t order_count, size_t order_index) const;
+
+    unsigned resolution() const;
+
+    // Calls visit(pixel, triangle, depth) for every fragment of the node (pixel = row · resolution
+    // + column, row 0 at the top; triangle = index in the rasterised triangle list).
+    void visit_fragments(const std::function<void(uint32_t, uint32_t, float)>& visit) const;
+
+    // The node's fragments in the compact form scoring needs (see NodeFragments).
+    struct NodeFragments export_fragments() const;
+
+    struct State;  // defined in rasterizer.cpp only
+
+private:
+    std::unique_ptr<State> state_;
+};
+
+// What scoring needs of a rasterised node, and nothing more: the visible and single-fragment pixel
+// counts, and for each pixel with several fragments its triangles nearest first (the top bit marks
+// a depth equal to the previous fragment's). Orders never change it, so k-means keeps it between
+// iterations instead of rasterising the node again.
+struct NodeFragments {
+    uint64_t visible = 0;
+    uint64_t single = 0;
+    std::vector<uint32_t> starts;     // multi-fragment pixels + 1
+    std::vector<uint32_t> fragments;  // triangle | tie bit
+    size_t bytes() const { return (starts.size() + fragments.size()) * 4 + sizeof(*this); }
+};
+
+// passed[o] for each order of the rank table, from a node's fragments (NodeRasterizer::score
+// gives the same numbers).
+void score_fragments(uint64_t* passed, const NodeFragments& node, const uint32_t* ranks, size_t order_count);
+
+}  // namespace animorder

@@ -1,0 +1,114 @@
+// Outputs that appear all together or not at all: temporaries beside their targets, flushed to
+// disk, renamed into place only when every file of the run is written.
+#include "animorder/atomic_write.h"
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <unistd.h>
+
+namespace animorder {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The file a path names once links and "." / ".." are resolved (the path itself when it cannot
+// be resolved), so two spellings of one file compare equal.
+fs::path resolved(const std::string& path) {
+    std::error_code error;
+    fs::path p = fs::weakly_canonical(fs::absolute(path), error);
+    return error ? fs::path(path) : p;
+}
+
+bool same_file(const std::string& a, const std::string& b) {
+    std::error_code error;
+    if (fs::exists(a, error) && fs::exists(b, error) && fs::equivalent(a, b, error)) return true;
+    return resolved(a) == resolved(b);
+}
+
+void check_writable_target(const std::string& path) {
+    const fs::path target(path);
+    if (path.empty()) throw OutputError("an output path is empty");
+    if (fs::is_directory(target)) throw OutputError(path + ": is a directory, expected a file name");
+    const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
+    if (!fs::is_directory(folder)) throw OutputError(path + ": folder " + folder.string() + " does not exist");
+    if (::access(folder.c_str(), W_OK | X_OK) != 0)
+        throw OutputError(path + ": folder " + folder.string() + " is not writable");
+}
+
+std::string temporary_name(const fs::path& target, const char* kind) {
+    const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
+    // Unique per process, so concurrent runs never share a temporary.
+    return (folder / ("." + target.filename().string() + "." + kind + std::to_string(::getpid()))).string();
+}
+
+}  // namespace
+
+void check_output_paths(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs) {
+    for (size_t i = 0; i < outputs.size(); ++i) {
+        check_writable_target(outputs[i]);
+        for (const std::string& input : inputs)
+            if (!input.empty() && same_file(outputs[i], input))
+                throw OutputError(outputs[i] + ": is an input of this run: refusing to overwrite the input; name another output");
+        for (size_t j = 0; j < i; ++j)
+            if (same_file(outputs[i], outputs[j]))
+                throw OutputError(outputs[i] + ": named twice as an output (" + outputs[j] + ")");
+    }
+}
+
+OutputSet::~OutputSet() {
+    if (committed_) return;
+    for (const Pending& p : pending_) std::remove(p.temp.c_str());
+}
+
+void OutputSet::add(const std::string& path, const std::string& data) {
+    if (committed_) throw OutputError(path + ": the output set is already committed");
+    check_writable_target(path);
+    for (const Pending& p : pending_)
+        if (same_file(p.target, path)) throw OutputError(path + ": named twice as an output (" + p.target + ")");
+    const std::string temp = temporary_name(path, "tmp");
+    std::FILE* file = std::fopen(temp.c_str(), "wb");
+    if (!file) throw OutputError(path + ": cannot create " + temp + ": " + std::strerror(errno));
+    pending_.push_back({path, temp});
+    const bool written = std::fwrite(data.data(), 1, data.size(), file) == data.size();
+    const bool flushed = std::fflush(file) == 0 && ::fsync(::fileno(file)) == 0;
+    const bool closed = std::fclose(file) == 0;
+    if (!written || !flushed || !closed) throw OutputError(path + ": write failed: " + std::strerror(errno));
+}
+
+void OutputSet::commit() {
+    // Existing targets move aside first, so a failure part-way can put every one of them back.
+    std::vector<std::pair<std::string, std::string>> backups;  // target, backup
+    size_t placed = 0;
+    std::error_code error;
+    auto roll_back = [&](const std::string& why) {
+        for (size_t i = 0; i < placed; ++i) std::remove(pending_[i].target.c_str());
+        for (const auto& [target, backup] : backups) {
+            std::error_code ignored;
+            fs::rename(backup, target, ignored);
+        }
+        throw OutputError(why);
+    };
+    for (const Pending& p : pending_) {
+        if (!fs::exists(p.target)) continue;
+        const std::string backup = temporary_name(p.target, "old");
+        fs::rename(p.target, backup, error);
+        if (error) roll_back(p.target + ": cannot replace: " + error.message());
+        backups.emplace_back(p.target, backup);
+    }
+    for (; placed < pending_.size(); ++placed) {
+        fs::rename(pending_[placed].temp, pending_[placed].target, error);
+        if (error) roll_back(pending_[placed].target + ": cannot replace: " + error.message());
+    }
+    committed_ = true;
+    for (const auto& backup : backups) std::remove(backup.second.c_str());
+}
+
+void write_file_atomically(const std::string& path, const std::string& data) {
+    OutputSet set;
+    set.add(path, data);
+    set.commit();
+}
+
+}  // namespace animorder

@@ -1,0 +1,392 @@
+// The named methods of DESIGN.md over a whole character, and the one place their names are spelled.
+//
+// original:          Tipsify (Sander, Nehab & Barczak 2007, §3) — the vertex cache order alone.
+// static-sander07:   Tipsify + fast linear clustering (§4) + sort by occlusion potential (§5).
+// static-nehab06:    Nehab, Barczak & Sander 2006 (nehab06.cpp): normal clusters, measured overdraw
+//                    graph, feedback-arc-set order; each primitive framed and measured on its own.
+// meshopt:           meshoptimizer's vertex cache + overdraw optimisers (meshopt_order.cpp).
+// tipsify-per-frame: static-sander07 at every keyframe, one buffer each (the paper's "Tipsify").
+// single, joint:     Han & Sander 2017 (clustering.cpp): k-means over (keyframe, view) nodes.
+// oracle:            per evaluation node, the patches front-to-back (evaluation.cpp): a bound.
+// All run per primitive: a character's primitives are separate draws.
+#include "animorder/methods.h"
+
+#include "animorder/animated_mesh.h"
+#include "animorder/clustering.h"
+#include "animorder/evaluation.h"
+#include "animorder/invalid_input.h"
+#include "animorder/mesh_patches.h"
+#include "animorder/meshopt_order.h"
+#include "animorder/nehab06.h"
+#include "animorder/selection_table.h"
+#include "animorder/static_sander07.h"
+#include "animorder/tipsify.h"
+#include "animorder/triangle_order.h"
+#include "animorder/vertex_cache.h"
+#include "animorder/viewpoints.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <string>
+
+namespace animorder {
+
+namespace {
+
+struct MethodInfo {
+    Method method;
+    const char* name;
+    bool lambda, clusters, buffers, single_buffer;
+};
+
+// The table every name, parse and property comes from.
+constexpr MethodInfo kMethods[] = {
+    {Method::Original, "original", false, false, true, true},
+    {Method::StaticSander07, "static-sander07", true, false, true, true},
+    {Method::StaticNehab06, "static-nehab06", false, false, true, true},
+    {Method::Meshopt, "meshopt", false, false, true, true},
+    {Method::TipsifyPerFrame, "tipsify-per-frame", true, false, true, false},
+    {Method::Single, "single", true, true, true, false},
+    {Method::Joint, "joint", true, true, true, false},
+    {Method::Oracle, "oracle", true, false, false, false},
+};
+
+const MethodInfo& info(Method method) {
+    for (const MethodInfo& m : kMethods)
+        if (m.method == method) return m;
+    throw InvalidInput("unknown method value " + std::to_string(int(method)));
+}
+
+std::string known_names(bool single_buffer_only) {
+    std::string names;
+    for (const MethodInfo& m : kMethods)
+        if (!single_buffer_only || m.single_buffer) names += std::string(names.empty() ? "" : ", ") + m.name;
+    return names;
+}
+
+}  // namespace
+
+const std::vector<Method>& all_methods() {
+    static const std::vector<Method> methods = [] {
+        std::vector<Method> all;
+        for (const MethodInfo& m : kMethods) all.push_back(m.method);
+        return all;
+    }();
+    return methods;
+}
+
+const char* method_name(Method method) { return info(method).name; }
+
+Method parse_method(const std::string& name) {
+    for (const MethodInfo& m : kMethods)
+        if (name == m.name) return m.method;
+    throw InvalidInput("unknown method '" + name + "' (known: " + known_names(false) + ")");
+}
+
+Method parse_static_method(const std::string& name) {
+    for (const MethodInfo& m : kMethods)
+        if (name == m.name && m.single_buffer) return m.method;
+    throw InvalidInput("unknown single-buffer method '" + name + "' (known: " + known_names(true) + ")");
+}
+
+bool method_uses_lambda(Method method) { return info(method).lambda; }
+bool method_uses_clusters(Method method) { return info(method).clusters; }
+bool method_has_buffers(Method method) { return info(method).buffers; }
+
+const char* distance_name(DistanceVariant variant) { return variant == DistanceVariant::Jcgt ? "jcgt" : "i3d"; }
+DistanceVariant parse_distance(const std::string& name) {
+    if (name == "jcgt") return DistanceVariant::Jcgt;
+    if (name == "i3d") return DistanceVariant::I3d;
+    throw InvalidInput("the distance must be jcgt or i3d, not '" + name + "'");
+}
+const char* update_name(UpdateRule rule) { return rule == UpdateRule::Monotone ? "monotone" : "paper"; }
+UpdateRule parse_update(const std::string& name) {
+    if (name == "monotone") return UpdateRule::Monotone;
+    if (name == "paper") return UpdateRule::Paper;
+    throw InvalidInput("the update rule must be monotone or paper, not '" + name + "'");
+}
+
+void validate_method_settings(const MethodSettings& settings) {
+    if (!std::isfinite(settings.lambda)) throw InvalidInput("lambda must be a finite number");
+    const ClusteringSettings& c = settings.clustering;
+    if (c.clusters == 0 || c.clusters > 255) throw InvalidInput("k (clusters) must be between 1 and 255");
+    if (!(c.min_separation_deg >= 0 && c.min_separation_deg <= 180))
+        throw InvalidInput("the minimum separation must be between 0 and 180 degrees");
+    icosphere_subdivisions_for(c.views);  // throws for a count that is no icosphere
+    icosphere_subdivisions_for(settings.nehab_views);
+}
+
+StaticMethodResult run_static_method(const AnimatedMesh& mesh, StaticMethod method,
+                                     const StaticMethodSettings& settings) {
+    validate_animated_mesh(mesh);
+    if (!info(method).single_buffer)
+        throw InvalidInput(std::string(method_name(method)) + " is not a single-buffer method");
+    if (mesh.keyframe_count() > 0 && settings.keyframe >= mesh.keyframe_count())
+        throw InvalidInput("keyframe " + std::to_string(settings.keyframe) + " does not exist (the mesh has " +
+                           std::to_string(mesh.keyframe_count()) + ")");
+    if (method != StaticMethod::Original && mesh.keyframe_count() == 0 && mesh.triangle_count() > 0)
+        throw InvalidInput(std::string(method_name(method)) + " needs positions, and the mesh has no keyframe");
+
+    StaticMethodResult result;
+    result.indices.resize(mesh.indices.size());
+    result.order.reserve(mesh.triangle_count());
+    for (const Primitive& primitive : mesh.primitives) {
+        const uint32_t* source = mesh.indices.data() + primitive.first_index;
+        const size_t triangles = primitive.index_count / 3;
+        std::vector<uint32_t> order(triangles);
+        if (method == StaticMethod::Original) {
+            result.hard_boundary_count +=
+                tipsify(order.data(), source, primitive.index_count, mesh.vertex_count, settings.cache_size)
+                    .hard_boundaries.size();
+        } else if (method == StaticMethod::Meshopt) {
+            order = meshopt_order(source, primitive.index_count, mesh.keyframe(settings.keyframe), mesh.vertex_count,
+                                  settings.cache_size);
+        } else if (method == StaticMethod::StaticNehab06) {
+            Nehab06Settings nehab;
+            nehab.clusters = std::min(settings.nehab_clusters, triangles);  // small primitives: fewer
+            nehab.views = settings.nehab_views;
+            nehab.resolution = settings.nehab_resolution;
+            nehab.cache_size = settings.cache_size;
+            nehab.threads = settings.threads;
+            // The clustering keyframe first: clusters come from the first listed keyframe.
+            std::vector<uint32_t> keyframes{uint32_t(settings.keyframe)};
+            if (settings.nehab_all_keyframes) {
+                const size_t count = mesh.keyframe_count(), stride = (count + 7) / 8;
+                for (size_t f = 0; f < count; f += stride)
+                    if (f != settings.keyframe) keyframes.push_back(uint32_t(f));
+            }
+            result.patch_count += order_static_nehab06(order.data(), source, primitive.index_count,
+                                                       mesh.keyframe_positions.data(), mesh.keyframe_count(),
+                                                       mesh.vertex_count, keyframes.data(), keyframes.size(), nehab)
+                                      .cluster_count;
+        } else {
+            const StaticOrderResult r = order_static_sander07(
+                order.data(), source, primitive.index_count, mesh.keyframe(settings.keyframe), mesh.vertex_count,
+                3 * sizeof(float), settings.lambda, settings.cache_size);
+            result.patch_count += r.patch_count;
+            result.hard_boundary_count += r.hard_boundary_count;
+        }
+        apply_triangle_order(result.indices.data() + primitive.first_index, source, order.data(), triangles);
+        const uint32_t first_triangle = uint32_t(primitive.first_index / 3);
+        for (uint32_t t : order) result.order.push_back(first_triangle + t);
+    }
+    return result;
+}
+
+VertexCacheStats analyze_mesh_vertex_cache(const AnimatedMesh& mesh, const std::vector<uint32_t>& indices,
+                                           unsigned cache_size) {
+    VertexCacheStats total;
+    size_t referenced = 0;
+    for (const Primitive& primitive : mesh.primitives) {
+        const VertexCacheStats s = analyze_vertex_cache(indices.data() + primitive.first_index,
+                                                        primitive.index_count, mesh.vertex_count, cache_size);
+        total.misses += s.misses;
+        total.triangles += s.triangles;
+        referenced += s.referenced_vertices;
+    }
+    // Vertices shared by two primitives count once per primitive, as each draw transforms them.
+    total.referenced_vertices = referenced;
+    total.acmr = total.triangles ? double(total.misses) / double(total.triangles) : 0.0;
+    total.atvr = referenced ? double(total.misses) / double(referenced) : 0.0;
+    return total;
+}
+
+AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double lambda, unsigned cache_size,
+                                    const ClusteringSettings& settings) {
+    validate_animated_mesh(mesh);
+    if (mesh.clips.empty()) throw InvalidInput("the mesh has no clip to cluster");
+    AnimatedMethodResult result;
+    const auto start = std::chrono::steady_clock::now();
+    result.patches = build_mesh_patches(mesh, lambda, cache_size);
+    result.seconds_patches = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    result.framing = frame_keyframes(mesh.keyframe_positions.data(), mesh.keyframe_count(), mesh.vertex_count,
+                                     mesh.indices.data(), mesh.indices.size());
+
+    auto clip_keyframes = [&](const Clip& c) {
+        std::vector<uint32_t> k;
+        for (size_t f = 0; f < c.keyframe_count; ++f) k.push_back(uint32_t(c.first_keyframe + f));
+        return k;
+    };
+    std::vector<std::vector<uint32_t>> sets;
+    if (joint) {
+        std::vector<uint32_t> all;
+        for (const Clip& c : mesh.clips)
+            for (uint32_t k : clip_keyframes(c)) all.push_back(k);
+        sets.push_back(all);
+    } else {
+        for (const Clip& c : mesh.clips) sets.push_back(clip_keyframes(c));
+    }
+    for (const auto& keyframes : sets) {
+        const Framing framing = frame_subset(result.framing, keyframes);
+        result.run_radius.push_back(framing.radius);
+        result.runs.push_back(cluster_nodes(mesh, result.patches, framing, keyframes, settings));
+    }
+    for (size_t c = 0; c < mesh.clips.size(); ++c) {
+        const size_t run = joint ? 0 : c;
+        result.buffers.table_base.push_back(uint32_t(joint ? 0 : c * settings.clusters));
+        result.buffers.tables.push_back(
+            build_selection_table(result.runs[run], mesh.clips[c].first_keyframe, mesh.clips[c].keyframe_count));
+    }
+    for (const ClusteringResult& r : result.runs)
+        for (const auto& order : r.triangle_orders) result.buffers.orders.push_back(order);
+    return result;
+}
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+Framing frame_all_keyframes(const AnimatedMesh& mesh) {
+    return frame_keyframes(mesh.keyframe_positions.data(), mesh.keyframe_count(), mesh.vertex_count,
+                           mesh.indices.data(), mesh.indices.size());
+}
+
+// One table per clip whose every cell says `buffer of keyframe f` (a single buffer: always 0).
+SelectionTable constant_table(size_t keyframes, bool one_per_keyframe) {
+    SelectionTable t;
+    t.keyframes = uint32_t(keyframes);
+    t.theta_steps = 2;
+    t.phi_steps = 1;
+    for (uint32_t f = 0; f < t.keyframes; ++f) t.cells.insert(t.cells.end(), 2, uint8_t(one_per_keyframe ? f : 0));
+    return t;
+}
+
+StaticMethodSettings static_settings(const MethodSettings& settings) {
+    StaticMethodSettings s;
+    s.lambda = settings.lambda;
+    s.cache_size = settings.cache_size;
+    s.keyframe = settings.keyframe;
+    s.nehab_clusters = settings.nehab_clusters;
+    s.nehab_views = settings.nehab_views;
+    s.nehab_resolution = settings.clustering.resolution;
+    s.nehab_all_keyframes = settings.nehab_all_keyframes;
+    s.threads = settings.clustering.threads;
+    return s;
+}
+
+// A single-buffer method: its order, and a table per clip that always names it.
+void run_single_buffer(MethodResult& result, const AnimatedMesh& mesh, const MethodSettings& settings) {
+    StaticMethodResult r = run_static_method(mesh, result.method, static_settings(settings));
+    result.buffers.orders.push_back(std::move(r.order));
+    result.framing = frame_all_keyframes(mesh);
+    for (const Clip& c : mesh.clips) {
+        result.buffers.tables.push_back(constant_table(c.keyframe_count, false));
+        result.buffers.table_base.push_back(0);
+    }
+    result.patch_count = r.patch_count;
+    result.hard_boundary_count = r.hard_boundary_count;
+}
+
+// Han & Sander 2017; the fallback is the buffer the most clustering nodes chose.
+void run_clustered(MethodResult& result, const AnimatedMesh& mesh, const MethodSettings& settings) {
+    const bool joint = result.method == Method::Joint;
+    AnimatedMethodResult r = run_han_sander(mesh, joint, settings.lambda, settings.cache_size, settings.clustering);
+    std::vector<size_t> chosen(r.buffers.orders.size(), 0);
+    for (size_t i = 0; i < r.runs.size(); ++i)
+        for (uint32_t c : r.runs[i].assignment) ++chosen[(joint ? 0 : i * settings.clustering.clusters) + c];
+    result.fallback = uint32_t(std::max_element(chosen.begin(), chosen.end()) - chosen.begin());
+    for (const ClusteringResult& run : r.runs) {
+        double seconds = run.seconds_rasterization;
+        for (const ClusteringIteration& x : run.iterations) seconds += x.seconds_raster + x.seconds_update;
+        result.run_seconds.push_back(seconds);
+    }
+    result.buffers = std::move(r.buffers);
+    result.framing = std::move(r.framing);
+    result.patch_count = r.patches.patch_count();
+    result.runs = std::move(r.runs);
+    result.run_radius = std::move(r.run_radius);
+    result.seconds_patches = r.seconds_patches;
+}
+
+// static-sander07 sorted at every keyframe: the paper's "Tipsify" column. A keyframe's table cell
+// names its own buffer, so the sidecar and glTF writers take it as they are (clips of up to 256
+// keyframes; the table cells are bytes).
+void run_tipsify_per_frame(MethodResult& result, const AnimatedMesh& mesh, const MethodSettings& settings) {
+    StaticMethodSettings s = static_settings(settings);
+    for (size_t f = 0; f < mesh.keyframe_count(); ++f) {
+        s.keyframe = f;
+        StaticMethodResult r = run_static_method(mesh, Method::StaticSander07, s);
+        result.patch_count = r.patch_count;
+        result.buffers.orders.push_back(std::move(r.order));
+        result.buffers.keyframe_buffer.push_back(uint32_t(f));
+    }
+    result.framing = frame_all_keyframes(mesh);
+    bool fits = true;
+    for (const Clip& c : mesh.clips) fits = fits && c.keyframe_count <= 256;
+    for (size_t c = 0; fits && c < mesh.clips.size(); ++c) {
+        result.buffers.tables.push_back(constant_table(mesh.clips[c].keyframe_count, true));
+        result.buffers.table_base.push_back(uint32_t(mesh.clips[c].first_keyframe));
+    }
+}
+
+// A bound, not a product: every evaluation node draws the patches sorted front-to-back for itself
+// (evaluation.cpp). Its ACMR is the mean over the orders of 12 icosahedron views at each clip's
+// first keyframe.
+void run_oracle(MethodResult& result, const AnimatedMesh& mesh, const MethodSettings& settings) {
+    auto patches = std::make_shared<MeshPatches>(build_mesh_patches(mesh, settings.lambda, settings.cache_size));
+    result.buffers.front_to_back = patches;
+    result.framing = frame_all_keyframes(mesh);
+    result.patch_count = patches->patch_count();
+    const std::vector<float> views = icosphere_directions(0);
+    std::vector<uint32_t> indices(mesh.indices.size());
+    size_t samples = 0;
+    for (const Clip& clip : mesh.clips) {
+        const std::vector<uint32_t> first = {uint32_t(clip.first_keyframe)};
+        const std::vector<float> centroids = patch_centroids(mesh, *patches, result.framing, first);
+        for (size_t v = 0; v < views.size() / 3; ++v) {
+            const float radius = 3 * result.framing.radius;
+            const float eye[3] = {radius * views[3 * v], radius * views[3 * v + 1], radius * views[3 * v + 2]};
+            const std::vector<uint32_t> order = patch_order_to_triangle_order(
+                *patches, front_to_back_patch_order(centroids.data(), patches->patch_count(), eye));
+            apply_triangle_order(indices.data(), mesh.indices.data(), order.data(), mesh.triangle_count());
+            const VertexCacheStats s = analyze_mesh_vertex_cache(mesh, indices, settings.cache_size);
+            result.acmr_mean += s.acmr;
+            result.atvr_mean += s.atvr;
+            ++samples;
+        }
+    }
+    result.acmr_mean /= double(std::max<size_t>(1, samples));
+    result.atvr_mean /= double(std::max<size_t>(1, samples));
+}
+
+}  // namespace
+
+MethodResult run_method(const AnimatedMesh& mesh, Method method, const MethodSettings& settings) {
+    validate_method_settings(settings);
+    validate_animated_mesh(mesh);
+    if (mesh.keyframe_count() > 0 && settings.keyframe >= mesh.keyframe_count())
+        throw InvalidInput("keyframe " + std::to_string(settings.keyframe) + " does not exist (the mesh has " +
+                           std::to_string(mesh.keyframe_count()) + ")");
+    const auto start = std::chrono::steady_clock::now();
+    MethodResult result;
+    result.method = method;
+    switch (method) {
+        case Method::Original:
+        case Method::StaticSander07:
+        case Method::StaticNehab06:
+        case Method::Meshopt: run_single_buffer(result, mesh, settings); break;
+        case Method::TipsifyPerFrame: run_tipsify_per_frame(result, mesh, settings); break;
+        case Method::Single:
+        case Method::Joint: run_clustered(result, mesh, settings); break;
+        case Method::Oracle:
+            run_oracle(result, mesh, settings);
+            result.seconds = seconds_since(start);
+            return result;
+    }
+    // The time covers the method, not its ACMR (the oracle's ACMR sampling is part of its run).
+    result.seconds = seconds_since(start);
+    std::vector<uint32_t> indices(mesh.indices.size());
+    const size_t count = result.buffers.orders.size();
+    for (const std::vector<uint32_t>& order : result.buffers.orders) {
+        apply_triangle_order(indices.data(), mesh.indices.data(), order.data(), mesh.triangle_count());
+        const VertexCacheStats s = analyze_mesh_vertex_cache(mesh, indices, settings.cache_size);
+        result.acmr_mean += s.acmr / double(count);
+        result.atvr_mean += s.atvr / double(count);
+    }
+    return result;
+}
+
+}  // namespace animorder

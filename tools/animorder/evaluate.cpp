@@ -1,0 +1,184 @@
+// `animorder evaluate`: run methods (every value of the swept settings) and score each over the
+// evaluation nodes of DESIGN.md; print a table shaped like the paper's Table 1, and write the
+// JSON report and a CSV.
+#include "commands.h"
+#include "input.h"
+#include "report.h"
+
+#include "animorder/atomic_write.h"
+
+#include <chrono>
+#include <cstdio>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+namespace animorder::tool {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+std::vector<std::string> split_list(const std::string& text) {
+    std::vector<std::string> items;
+    std::stringstream ss(text);
+    std::string item;
+    while (std::getline(ss, item, ','))
+        if (!item.empty()) items.push_back(item);
+    return items;
+}
+
+// One row of the table: a method with the settings it ran with.
+struct Row {
+    MethodResult result;
+    MethodSettings settings;
+};
+
+// Every combination of the swept settings, for the methods that use them.
+std::vector<std::pair<Method, MethodOptions>> plan_rows(const std::vector<Method>& methods, const MethodOptions& base,
+                                                        const std::vector<double>& lambdas, const std::vector<size_t>& ks,
+                                                        const std::vector<size_t>& views) {
+    std::vector<std::pair<Method, MethodOptions>> plan;
+    for (Method n : methods)
+        for (size_t li = 0; li < (method_uses_lambda(n) ? lambdas.size() : 1); ++li)
+            for (size_t ki = 0; ki < (method_uses_clusters(n) ? ks.size() : 1); ++ki)
+                for (size_t vi = 0; vi < (method_uses_clusters(n) ? views.size() : 1); ++vi) {
+                    MethodOptions m = base;
+                    m.settings.lambda = lambdas[li];
+                    m.settings.clustering.clusters = ks[ki];
+                    m.settings.clustering.views = views[vi];
+                    plan.emplace_back(n, m);
+                }
+    return plan;
+}
+
+}  // namespace
+
+int run_evaluate(const EvaluateOptions& options) {
+    using json = nlohmann::ordered_json;
+    const Clock::time_point start = Clock::now();
+    const MethodOptions& base = options.method_options;
+    const std::vector<std::string> names = split_list(options.methods);
+    if (names.empty()) throw std::runtime_error("--methods names no method");
+    std::vector<Method> methods;
+    for (const std::string& n : names) methods.push_back(parse_method(n));
+    const MethodSettings& b = base.settings;
+    const std::vector<double> lambdas = base.lambdas.empty() ? std::vector<double>{b.lambda} : base.lambdas;
+    const std::vector<size_t> ks = base.cluster_list.empty() ? std::vector<size_t>{b.clustering.clusters} : base.cluster_list;
+    const std::vector<size_t> views = base.view_list.empty() ? std::vector<size_t>{b.clustering.views} : base.view_list;
+    std::vector<std::pair<Method, MethodSettings>> plan;
+    for (const auto& [n, m] : plan_rows(methods, base, lambdas, ks, views)) {
+        plan.emplace_back(n, method_settings(m, options.common, n));
+        validate_method_settings(plan.back().second);
+    }
+    std::vector<std::string> outputs;
+    for (const std::string* p : {&options.report_path, &options.csv_path})
+        if (!p->empty()) outputs.push_back(*p);
+    check_output_paths(outputs, {options.common.input});
+
+    std::string input_name;
+    const AnimatedMesh mesh = load_drawable_input(options.common, input_name);
+    std::vector<Row> rows;
+    for (const auto& [n, m] : plan) {
+        std::string label = method_name(n);
+        if (method_uses_lambda(n) && lambdas.size() > 1) label += " lambda=" + format_number(m.lambda);
+        if (method_uses_clusters(n) && ks.size() > 1) label += " k=" + std::to_string(m.clustering.clusters);
+        if (method_uses_clusters(n) && views.size() > 1) label += " views=" + std::to_string(m.clustering.views);
+        note(options.common, "running " + label);
+        rows.push_back({run_method(mesh, n, m), m});
+    }
+    const double methods_s = seconds_since(start);
+
+    EvaluationSettings eval = options.evaluation;
+    eval.threads = b.clustering.threads;
+    eval.progress = progress_printer(options.common, "evaluating");
+    note(options.common, "evaluating " + std::to_string(rows.size()) + " methods at " +
+                             std::to_string(mesh.keyframe_count() * eval.views) + " nodes (" +
+                             std::to_string(mesh.keyframe_count()) + " keyframes x " + std::to_string(eval.views) +
+                             " views, " + std::to_string(eval.resolution) + "^2)");
+    std::vector<MethodBuffers> buffers;
+    for (const Row& r : rows) buffers.push_back(r.result.buffers);
+    const Clock::time_point eval_start = Clock::now();
+    const std::vector<OrderEvaluation> results = evaluate_methods(mesh, buffers, eval);
+    const double eval_s = seconds_since(eval_start);
+    const size_t nodes = mesh.keyframe_count() * eval.views;
+
+    json report = report_header(mesh, input_name);
+    report["settings"] = {{"methods", names},
+                          {"lambda", lambdas},
+                          {"clusters", ks},
+                          {"views", views},
+                          {"resolution", b.clustering.resolution},
+                          {"seed", b.clustering.seed},
+                          {"nehab_clusters", b.nehab_clusters},
+                          {"nehab_views", b.nehab_views},
+                          {"nehab_all_keyframes", b.nehab_all_keyframes},
+                          {"cache_size", options.common.cache_size},
+                          {"eval_views", eval.views},
+                          {"eval_resolution", eval.resolution},
+                          {"eval_seed", eval.seed},
+                          {"clips", options.common.clips}};
+    report["clips"] = json::array();
+    for (const Clip& c : mesh.clips) report["clips"].push_back({{"name", c.name}, {"keyframes", c.keyframe_count}});
+    report["methods"] = json::array();
+    std::string table = "| method | lambda | k | views | buffers | ACMR | ATVR | OVR mean | OVR pooled | time s |";
+    std::string rule = "|---|---|---|---|---|---|---|---|---|---|";
+    for (const Clip& c : mesh.clips) {
+        table += " " + c.name + " |";
+        rule += "---|";
+    }
+    table += "\n" + rule + "\n";
+    std::string csv = "method,lambda,clusters,views,buffers,acmr,atvr,ovr_mean,ovr_pooled,time_s\n";
+    for (size_t m = 0; m < rows.size(); ++m) {
+        const MethodResult& run = rows[m].result;
+        const MethodSettings& s = rows[m].settings;
+        const OrderEvaluation& r = results[m];
+        const char* name = method_name(run.method);
+        json entry = method_entry(mesh, run, s);
+        const bool per_node = !method_has_buffers(run.method);
+        entry["buffers"] = per_node ? nodes : run.buffers.orders.size();
+        entry["ovr_mean"] = r.overall.ovr_mean;
+        entry["ovr_pooled"] = r.overall.ovr_pooled;
+        entry["per_clip"] = json::array();
+        for (size_t c = 0; c < mesh.clips.size(); ++c)
+            entry["per_clip"].push_back({{"clip", mesh.clips[c].name},
+                                         {"ovr_mean", r.per_clip[c].ovr_mean},
+                                         {"ovr_pooled", r.per_clip[c].ovr_pooled},
+                                         {"nodes", r.per_clip[c].nodes},
+                                         {"time_s", run.method == Method::Single && c < run.run_seconds.size()
+                                                        ? json(run.run_seconds[c])
+                                                        : json(nullptr)}});
+        const std::string lambda = method_uses_lambda(run.method) ? format_number(s.lambda) : "";
+        const std::string k = method_uses_clusters(run.method) ? std::to_string(s.clustering.clusters) : "";
+        const std::string v = method_uses_clusters(run.method) ? std::to_string(s.clustering.views) : "";
+        const std::string count = per_node ? "per node" : std::to_string(run.buffers.orders.size());
+        char cells[256];
+        std::snprintf(cells, sizeof cells, "| %s | %s | %s | %s | %s | %.3f | %.3f | %.3f | %.3f | %.1f |", name,
+                      lambda.c_str(), k.c_str(), v.c_str(), count.c_str(), run.acmr_mean, run.atvr_mean,
+                      r.overall.ovr_mean, r.overall.ovr_pooled, run.seconds);
+        table += cells;
+        for (size_t c = 0; c < mesh.clips.size(); ++c) {
+            std::snprintf(cells, sizeof cells, " %.3f |", r.per_clip[c].ovr_mean);
+            table += cells;
+        }
+        table += "\n";
+        std::snprintf(cells, sizeof cells, "%s,%s,%s,%s,%zu,%.6f,%.6f,%.6f,%.6f,%.6f\n", name, lambda.c_str(),
+                      k.c_str(), v.c_str(), per_node ? nodes : run.buffers.orders.size(), run.acmr_mean, run.atvr_mean,
+                      r.overall.ovr_mean, r.overall.ovr_pooled, run.seconds);
+        csv += cells;
+        report["methods"].push_back(entry);
+    }
+    std::fputs(table.c_str(), stdout);
+    report["nodes"] = nodes;
+    report["timings_s"] = {{"methods", methods_s}, {"evaluation", eval_s}, {"total", seconds_since(start)}};
+    report["machine"] = {{"threads", b.clustering.threads ? b.clustering.threads : std::thread::hardware_concurrency()}};
+    OutputSet files;
+    if (!options.report_path.empty()) files.add(options.report_path, report_text(report));
+    if (!options.csv_path.empty()) files.add(options.csv_path, csv);
+    files.commit();
+    note(options.common, "evaluation took " + format_number(eval_s) + " s (" + format_number(seconds_since(start)) +
+                             " s in all)");
+    return 0;
+}
+
+}  // namespace animorder::tool

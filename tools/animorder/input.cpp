@@ -1,0 +1,94 @@
+#include "input.h"
+
+#include "animorder/procedural_character.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <stdexcept>
+
+namespace animorder::tool {
+
+void note(const CommonOptions& common, const std::string& text) {
+    if (!common.quiet) std::fprintf(stderr, "animorder: %s\n", text.c_str());
+}
+
+std::function<void(size_t, size_t)> progress_printer(const CommonOptions& common, const std::string& stage) {
+    if (common.quiet) return {};
+    using Clock = std::chrono::steady_clock;
+    const Clock::time_point start = Clock::now();
+    auto last = std::make_shared<double>(-1.0);
+    return [stage, start, last](size_t done, size_t total) {
+        const double now = std::chrono::duration<double>(Clock::now() - start).count();
+        if (done != total && now - *last < 0.5) return;  // at most two updates a second
+        *last = now;
+        std::fprintf(stderr, "\ranimorder: %s: %zu/%zu nodes, %.1f s", stage.c_str(), done, total, now);
+        if (done == total) std::fputc('\n', stderr);
+        std::fflush(stderr);
+    };
+}
+
+AnimatedMesh load_animated_input(const CommonOptions& common, std::string& input_name) {
+    std::vector<std::string> clip_files, clip_names;
+    for (const std::string& c : common.clips) (std::filesystem::exists(c) ? clip_files : clip_names).push_back(c);
+    AnimatedMesh mesh;
+    if (common.input.empty()) {
+        if (!clip_files.empty()) throw std::runtime_error("clip files need an input character file");
+        note(common, "no input file given: using the bundled procedural character");
+        input_name = kProceduralCharacterName;
+        mesh = make_procedural_character();
+    } else {
+        input_name = common.input;
+        LoadOptions options;
+        options.max_keyframe_bytes = common.max_memory;
+        mesh = load_character(common.input, clip_files, options);
+        note(common, "loaded " + common.input + ": " + std::to_string(mesh.triangle_count()) + " triangles, " +
+                         std::to_string(mesh.clips.size()) + " clips, " + std::to_string(mesh.keyframe_count()) +
+                         " keyframes");
+    }
+    if (!clip_names.empty()) mesh = select_clips(mesh, clip_names);
+    return mesh;
+}
+
+AnimatedMesh load_drawable_input(const CommonOptions& common, std::string& input_name) {
+    AnimatedMesh mesh = load_animated_input(common, input_name);
+    validate_animated_mesh(mesh);
+    // A mesh with no area at its first keyframe has nothing to draw, so nothing to reorder.
+    double area = 0;
+    const float* p = mesh.keyframe_count() ? mesh.keyframe(0) : nullptr;
+    for (size_t t = 0; p && t < mesh.indices.size() && area == 0; t += 3) {
+        const float *a = p + 3 * mesh.indices[t], *b = p + 3 * mesh.indices[t + 1], *c = p + 3 * mesh.indices[t + 2];
+        const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+        area += std::fabs(u[1] * v[2] - u[2] * v[1]) + std::fabs(u[2] * v[0] - u[0] * v[2]) + std::fabs(u[0] * v[1] - u[1] * v[0]);
+    }
+    if (area == 0) throw std::runtime_error(input_name + ": every triangle has zero area: nothing to reorder");
+    return mesh;
+}
+
+MethodSettings method_settings(const MethodOptions& options, const CommonOptions& common, Method method) {
+    MethodSettings settings = options.settings;
+    settings.cache_size = common.cache_size;
+    // Errors name the option the user typed; the library checks the same again in run_method.
+    if (options.distance != distance_name(DistanceVariant::Jcgt) && options.distance != distance_name(DistanceVariant::I3d))
+        throw std::runtime_error("--distance must be jcgt or i3d, not '" + options.distance + "'");
+    if (options.update != update_name(UpdateRule::Monotone) && options.update != update_name(UpdateRule::Paper))
+        throw std::runtime_error("--update must be monotone or paper, not '" + options.update + "'");
+    if (!(settings.clustering.min_separation_deg >= 0 && settings.clustering.min_separation_deg <= 180))
+        throw std::runtime_error("--min-separation must be between 0 and 180 degrees");
+    settings.clustering.distance = parse_distance(options.distance);
+    settings.clustering.update = parse_update(options.update);
+    const std::string name = method_name(method);
+    settings.clustering.log = [common, name](const std::string& line) { note(common, name + ": " + line); };
+    settings.clustering.progress = progress_printer(common, name + ": assigning nodes");
+    return settings;
+}
+
+std::string format_number(double value) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.4g", value);
+    return text;
+}
+
+}  // namespace animorder::tool

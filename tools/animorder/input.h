@@ -1,0 +1,37 @@
+// What every subcommand shares: notes and progress on stderr, the input character (a file or
+// the bundled one), and the method settings built from the options.
+#pragma once
+
+#include "commands.h"
+
+#include "animorder/animated_mesh.h"
+
+#include <cstddef>
+#include <functional>
+#include <string>
+
+namespace animorder::tool {
+
+// Progress and notes go to stderr ("animorder: TEXT"), unless --quiet, so stdout stays clean
+// for text or JSON a script may read.
+void note(const CommonOptions& common, const std::string& text);
+
+// A progress line on stderr that rewrites itself (at most two updates a second); none if --quiet.
+std::function<void(size_t, size_t)> progress_printer(const CommonOptions& common, const std::string& stage);
+
+// The input named on the command line (or the bundled character, saying so). --clip values that
+// exist on disk are clip files or folders (Mixamo style); the others name the clips to keep.
+AnimatedMesh load_animated_input(const CommonOptions& common, std::string& input_name);
+
+// load_animated_input's mesh, validated, and refused when it has nothing to draw (every
+// triangle of zero area at its first keyframe).
+AnimatedMesh load_drawable_input(const CommonOptions& common, std::string& input_name);
+
+// The library's settings for one method from the options (names of the k-means variants
+// parsed, --cache-size, log and progress lines on stderr labelled with the method's name).
+MethodSettings method_settings(const MethodOptions& options, const CommonOptions& common, Method method);
+
+// Numbers in labels and tables: the shortest form that reads back the same ("0.85", "3").
+std::string format_number(double value);
+
+}  // namespace animorder::tool

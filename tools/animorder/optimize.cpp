@@ -1,0 +1,138 @@
+// `animorder optimize`: run one method on the input and write what an application ships — the
+// glTF with the orders (glTF input), the sidecar and its description — and the JSON report. Every
+// output path is checked before any work; the outputs appear all together or not at all.
+#include "commands.h"
+#include "input.h"
+#include "report.h"
+
+#include "animorder/atomic_write.h"
+#include "animorder/gltf_writer.h"
+#include "animorder/sidecar.h"
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <stdexcept>
+
+namespace animorder::tool {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+// The files `-o OUT` names: OUT.glb / OUT.gltf (only for glTF input), OUT.animorder.bin and .json.
+struct OutputPaths {
+    std::string gltf, sidecar, sidecar_json;
+};
+
+OutputPaths output_paths(const OptimizeOptions& options) {
+    OutputPaths paths;
+    if (options.output.empty()) return paths;
+    std::string stem = options.output;
+    const std::string extension = std::filesystem::path(options.output).extension().string();
+    if (extension == ".glb" || extension == ".gltf") {
+        const std::string in_ext = std::filesystem::path(options.common.input).extension().string();
+        if (in_ext != ".glb" && in_ext != ".gltf")
+            throw std::runtime_error(options.output + ": glTF output needs a glTF input (the sidecar works for any input)");
+        paths.gltf = options.output;
+        stem = options.output.substr(0, options.output.size() - extension.size());
+    }
+    paths.sidecar = stem + ".animorder.bin";
+    paths.sidecar_json = stem + ".animorder.json";
+    return paths;
+}
+
+// Every file this run reads: the character and the clip files or folders named by --clip.
+std::vector<std::string> input_paths(const CommonOptions& common) {
+    std::vector<std::string> inputs;
+    if (!common.input.empty()) inputs.push_back(common.input);
+    for (const std::string& c : common.clips)
+        if (std::filesystem::exists(c)) inputs.push_back(c);
+    return inputs;
+}
+
+nlohmann::ordered_json settings_json(const OptimizeOptions& options, Method method, const MethodSettings& m) {
+    return {{"method", method_name(method)},
+            {"lambda", m.lambda},
+            {"cache_size", m.cache_size},
+            {"keyframe", m.keyframe},
+            {"clusters", m.clustering.clusters},
+            {"views", m.clustering.views},
+            {"resolution", m.clustering.resolution},
+            {"seed", m.clustering.seed},
+            {"min_separation_deg", m.clustering.min_separation_deg},
+            {"max_iterations", m.clustering.max_iterations},
+            {"distance", options.methods.distance},
+            {"update", options.methods.update},
+            {"nehab_clusters", m.nehab_clusters},
+            {"nehab_views", m.nehab_views},
+            {"nehab_all_keyframes", m.nehab_all_keyframes},
+            {"threads", m.clustering.threads}};
+}
+
+}  // namespace
+
+int run_optimize(const OptimizeOptions& options) {
+    const Clock::time_point start = Clock::now();
+    const Method method = options.joint ? Method::Joint : parse_method(options.method);
+    if (options.joint && options.method != method_name(Method::Single) && options.method != method_name(Method::Joint) &&
+        options.method != method_name(kDefaultMethod))
+        throw std::runtime_error("--joint applies to the single method, not " + options.method);
+    if (!method_has_buffers(method))
+        throw std::runtime_error(std::string(method_name(method)) +
+                                 " is a bound (a new order at every node), not an order to ship; use evaluate --methods " +
+                                 method_name(method));
+    const MethodSettings settings = method_settings(options.methods, options.common, method);
+    validate_method_settings(settings);
+
+    // Every output is checked now, not after minutes of work: folders exist, nothing is an input,
+    // no file is named twice.
+    const OutputPaths paths = output_paths(options);
+    std::vector<std::string> outputs;
+    for (const std::string* p : {&paths.gltf, &paths.sidecar, &paths.sidecar_json, &options.report_path})
+        if (!p->empty()) outputs.push_back(*p);
+    check_output_paths(outputs, input_paths(options.common));
+
+    std::string input_name;
+    const AnimatedMesh mesh = load_drawable_input(options.common, input_name);
+    const double load_s = seconds_since(start);
+    note(options.common, "loaded " + input_name + ": " + std::to_string(mesh.triangle_count()) + " triangles, " +
+                             std::to_string(mesh.vertex_count) + " vertices, " + std::to_string(mesh.keyframe_count()) +
+                             " keyframes");
+
+    const MethodResult run = run_method(mesh, method, settings);
+    const VertexCacheStats before = analyze_mesh_vertex_cache(mesh, mesh.indices, settings.cache_size);
+
+    OutputSet files;
+    nlohmann::ordered_json written = {{"gltf", nullptr}, {"sidecar", nullptr}, {"sidecar_json", nullptr}};
+    if (!paths.gltf.empty()) {
+        const bool binary = std::filesystem::path(paths.gltf).extension() == ".glb";
+        files.add(paths.gltf, gltf_with_orders(options.common.input, paths.gltf, mesh, run.buffers, run.fallback,
+                                               run.framing, method_name(method), binary));
+        written["gltf"] = paths.gltf;
+    }
+    if (!paths.sidecar.empty()) {
+        files.add(paths.sidecar, serialize_sidecar(mesh, run.buffers, run.framing));
+        files.add(paths.sidecar_json, sidecar_json(mesh, run.buffers, method_name(method), run.fallback,
+                                                   std::filesystem::path(paths.sidecar).filename().string()));
+        written["sidecar"] = paths.sidecar;
+        written["sidecar_json"] = paths.sidecar_json;
+    }
+
+    nlohmann::ordered_json report = report_header(mesh, input_name);
+    report["settings"] = settings_json(options, method, settings);
+    report["input_order"] = cache_stats_json(before);
+    report["methods"] = nlohmann::ordered_json::array({method_entry(mesh, run, settings)});
+    report["outputs"] = written;
+    report["timings_s"] = {{"load", load_s}, {"method", run.seconds}, {"total", seconds_since(start)}};
+    if (!options.report_path.empty()) files.add(options.report_path, report_text(report));
+    files.commit();
+    for (const std::string& path : outputs) note(options.common, "wrote " + path);
+
+    std::printf("%s on %s: %zu triangles, %zu buffers, ACMR %.4f -> %.4f, ATVR %.4f -> %.4f, %.3f s\n",
+                method_name(method), input_name.c_str(), mesh.triangle_count(), run.buffers.orders.size(), before.acmr,
+                run.acmr_mean, before.atvr, run.atvr_mean, run.seconds);
+    return 0;
+}
+
+}  // namespace animorder::tool

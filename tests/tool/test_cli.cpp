@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "support/files.h"
+#include "support/require.h"
 #include <nlohmann/json.hpp>
 
 #include <cstdio>
@@ -98,8 +99,8 @@ TEST_F(Cli, SingleWritesKBuffersPerClipAndReportsIterations) {
 }
 
 TEST_F(Cli, GltfInGltfOut) {
-    const std::string fox = std::string(ANIMORDER_SOURCE_DIR) + "/../shared/data/gltf-fox/Fox.glb";
-    if (!fs::exists(fox)) GTEST_SKIP() << "../shared/data is absent";
+    const std::string fox = test::shared_data_path("gltf-fox/Fox.glb").string();
+    ANIMORDER_REQUIRE_DATA(fox);
     const std::string fast = " -q -k 2 --views 12 --resolution 32 --max-iterations 2";
     ASSERT_EQ(run("optimize " + fox + " --method single" + fast + " -o " + path("fox.glb").string() + " --report " +
                   path("r.json").string()).exit_code, 0);

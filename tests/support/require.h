@@ -64,8 +64,10 @@ inline std::filesystem::path shared_data_path(const std::string& relative = "") 
 // requires `component`.
 #define ANIMORDER_REQUIRE_OR_SKIP(component, condition, reason)                                            \
     do {                                                                                                   \
+        /* read first, so a typo in ANIMORDER_REQUIRE fails even where everything is present */           \
+        const bool animorder_required_ = ::animorder::test::required(component);                          \
         if (!(condition)) {                                                                                \
-            if (::animorder::test::required(component))                                                    \
+            if (animorder_required_)                                                                       \
                 FAIL() << "required " << (component) << " (ANIMORDER_REQUIRE) is missing: " << reason;     \
             else                                                                                           \
                 GTEST_SKIP() << (component) << " missing: " << reason;                                     \

@@ -2,7 +2,7 @@
 // the real characters of ../shared/data): without one, the test is skipped with the reason, so
 // the skip shows in the CTest summary; and where the environment variable ANIMORDER_REQUIRE names
 // the component (a comma list of gl, validator, data; or all), the test fails with the reason
-// instead. .ci/run sets ANIMORDER_REQUIRE=all, so CI cannot pass by skipping.
+// instead. .ci/run sets ANIMORDER_REQUIRE=gl,validator,data, so CI cannot pass by skipping.
 //
 //   ANIMORDER_REQUIRE_OR_SKIP("data", fs::exists(path), path + " is absent");
 //

@@ -10,6 +10,7 @@
 #include "animorder/tipsify.h"
 #include "animorder/vertex_cache.h"
 #include "support/meshes.h"
+#include "support/require.h"
 
 #include <gtest/gtest.h>
 #include <meshoptimizer.h>
@@ -146,14 +147,16 @@ TEST(Tipsify, AcmrWithinTwoPercentOfMeshoptimizerOnTheCharacter) {
 }
 
 TEST(Tipsify, AcmrWithinTwoPercentOfMeshoptimizerOnRealCharacters) {
-    const std::string data = std::string(ANIMORDER_SOURCE_DIR) + "/../shared/data/";
     const char* files[] = {"mixamo-ganfaul/Ganfaul.gltf", "gltf-cesiumman/CesiumMan.glb", "glb-xbot/Xbot.glb"};
     for (const char* f : files) {
+        // Only an absent file may skip; a file that is there but does not load is a failure.
+        const std::filesystem::path path = animorder::test::shared_data_path(f);
+        ANIMORDER_REQUIRE_DATA(path);
         AnimatedMesh mesh;
         try {
-            mesh = load_gltf(data + f);
+            mesh = load_gltf(path.string());
         } catch (const LoadError& e) {
-            GTEST_SKIP() << "../shared/data is absent (" << e.what() << ")";
+            FAIL() << path.string() << " is there but does not load: " << e.what();
         }
         mesh.name = f;
         expect_within_two_percent_of_meshoptimizer(mesh);

@@ -4,6 +4,7 @@
 #include "animorder/animated_mesh.h"
 #include "animorder/load.h"
 #include "support/meshes.h"
+#include "support/require.h"
 
 #include <gtest/gtest.h>
 
@@ -32,7 +33,7 @@ double median_stretch(const AnimatedMesh& m, const Clip& c) {
 }  // namespace
 
 TEST(AssimpCharacters, EveryCharacterInSharedDataLoadsWithItsClips) {
-    if (!fs::exists(kData)) GTEST_SKIP() << "../shared/data is absent: real characters not checked";
+    ANIMORDER_REQUIRE_DATA(kData);
     struct Case {
         const char* file;
         const char* clips;  // folder of Mixamo-style clip files, or ""
@@ -71,7 +72,7 @@ TEST(AssimpCharacters, EveryCharacterInSharedDataLoadsWithItsClips) {
 
 TEST(Md2, EveryFrameIsAKeyframeAndFrontsFaceOut) {
     const std::string path = kData + "md2-sydney/sydney.md2";
-    if (!fs::exists(path)) GTEST_SKIP() << "../shared/data is absent";
+    ANIMORDER_REQUIRE_DATA(path);
     const AnimatedMesh m = load_character(path);
     // 198 frames in 16 groups at 10 frames per second, resampled at 30: 3·(n − 1) + 1 per group.
     size_t frames = 0;
@@ -101,7 +102,7 @@ TEST(Md2, EveryFrameIsAKeyframeAndFrontsFaceOut) {
 
 TEST(Iqm, SkeletalAnimationMovesAndFrontsFaceOut) {
     const std::string path = kData + "iqm-mrfixit/mrfixit.iqm";
-    if (!fs::exists(path)) GTEST_SKIP() << "../shared/data is absent";
+    ANIMORDER_REQUIRE_DATA(path);
     const AnimatedMesh m = load_character(path);
     ASSERT_EQ(m.clips.size(), 1u);
     EXPECT_EQ(m.joint_count, 75u);
@@ -126,7 +127,7 @@ TEST(Iqm, SkeletalAnimationMovesAndFrontsFaceOut) {
 }
 
 TEST(AssimpCharacters, ClipFilesOfAnotherSkeletonAreRefused) {
-    if (!fs::exists(kData)) GTEST_SKIP() << "../shared/data is absent";
+    ANIMORDER_REQUIRE_DATA(kData);
     try {
         load_character(kData + "pg-barbarian/model.fbx", {kData + "x-dwarf/dwarf.x"});
         FAIL() << "no error";

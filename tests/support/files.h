@@ -64,19 +64,38 @@ protected:
 };
 
 #ifdef ANIMORDER_SOURCE_DIR
-// Runs the Khronos glTF validator (installed by scripts/install-deps.sh into .tools/) on `file`:
-// true when it reports no error; `report` gets its output or why it could not run.
-inline bool validate_gltf(const std::filesystem::path& file, std::string& report) {
-    const std::filesystem::path tools = std::filesystem::path(ANIMORDER_SOURCE_DIR) / ".tools" / "node_modules";
-    const std::filesystem::path script =
-        std::filesystem::path(ANIMORDER_SOURCE_DIR) / "tools" / "validate" / "validate_gltf.js";
-    if (!std::filesystem::exists(tools / "gltf-validator")) {
-        report = "gltf-validator is not installed (run scripts/install-deps.sh)";
+inline std::filesystem::path validator_modules() {
+    return std::filesystem::path(ANIMORDER_SOURCE_DIR) / ".tools" / "node_modules";
+}
+
+// Whether the Khronos glTF validator (installed by scripts/install-deps.sh into .tools/) and node
+// are there; `why` says what is missing. Pair it with ANIMORDER_REQUIRE_OR_SKIP("validator", ...).
+inline bool validator_available(std::string& why) {
+    if (!std::filesystem::exists(validator_modules() / "gltf-validator")) {
+        why = "gltf-validator is not installed in " + validator_modules().string() + " (run scripts/install-deps.sh)";
         return false;
     }
-    const std::filesystem::path out = file.string() + ".report";
-    const std::string command = "NODE_PATH='" + tools.string() + "' node '" + script.string() + "' '" + file.string() +
-                                "' > '" + out.string() + "' 2>&1";
+    if (std::system("node --version >/dev/null 2>&1") != 0) {
+        why = "node is not on the PATH (the glTF validator runs on it)";
+        return false;
+    }
+    return true;
+}
+
+// Runs the validator on `file`: true when it reports no error; `report` gets its output. The
+// output is captured in `scratch` (the test's own folder), never next to `file`, which may be
+// read-only data.
+inline bool validate_gltf(const std::filesystem::path& file, std::string& report, const std::filesystem::path& scratch) {
+    const std::filesystem::path script =
+        std::filesystem::path(ANIMORDER_SOURCE_DIR) / "tools" / "validate" / "validate_gltf.js";
+    std::string why;
+    if (!validator_available(why)) {
+        report = why;
+        return false;
+    }
+    const std::filesystem::path out = scratch / (file.filename().string() + ".validator-report.json");
+    const std::string command = "NODE_PATH='" + validator_modules().string() + "' node '" + script.string() + "' '" +
+                                file.string() + "' > '" + out.string() + "' 2>&1";
     const int status = std::system(command.c_str());
     report = slurp(out);
     return status == 0;

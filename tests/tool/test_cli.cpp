@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "support/files.h"
+#include "support/require.h"
 #include <nlohmann/json.hpp>
 
 #include <cstdio>
@@ -98,8 +99,8 @@ TEST_F(Cli, SingleWritesKBuffersPerClipAndReportsIterations) {
 }
 
 TEST_F(Cli, GltfInGltfOut) {
-    const std::string fox = std::string(ANIMORDER_SOURCE_DIR) + "/../shared/data/gltf-fox/Fox.glb";
-    if (!fs::exists(fox)) GTEST_SKIP() << "../shared/data is absent";
+    const std::string fox = test::shared_data_path("gltf-fox/Fox.glb").string();
+    ANIMORDER_REQUIRE_DATA(fox);
     const std::string fast = " -q -k 2 --views 12 --resolution 32 --max-iterations 2";
     ASSERT_EQ(run("optimize " + fox + " --method single" + fast + " -o " + path("fox.glb").string() + " --report " +
                   path("r.json").string()).exit_code, 0);
@@ -229,12 +230,43 @@ TEST_F(Cli, Nehab06RunsInOptimizeAndEvaluateAndBeatsTheOriginalOrder) {
     EXPECT_LT(methods[1]["ovr_mean"].get<double>(), methods[0]["ovr_mean"].get<double>());
 }
 
+namespace {
+// Every entry of `folder`, hidden ones included, as "name name ..." (empty when there is none).
+std::string entries_of(const fs::path& folder) {
+    std::string names;
+    for (const auto& entry : fs::directory_iterator(folder)) names += entry.path().filename().string() + " ";
+    return names;
+}
+}  // namespace
+
+// A write that fails after its temporary file exists: the output folder is there, but the
+// temporary of the sidecar's .bin (the tool names it .NAME.tmpPID) is a link to /dev/full, so
+// writing it fails with "No space left on device". `exec` keeps the shell's PID ($$), so the link
+// carries the tool's PID. Afterwards the folder must be empty: no temporary (the link is it), no
+// output. Were the temporary named otherwise, the write would succeed and the link stay: a failure too.
 TEST_F(Cli, FailedWriteLeavesNoFileBehind) {
-    const test::Outcome o = run("optimize -q -o " + path("no/such/out").string());
+    ASSERT_TRUE(fs::exists("/dev/full"));
+    const fs::path out = path("out");
+    fs::create_directories(out);
+    const test::Outcome o = test::run_captured("ln -s /dev/full '" + (out / ".o.animorder.bin.tmp").string() + "'$$ && exec " +
+                                                   std::string(ANIMORDER_EXE) + " optimize -q -o '" + (out / "o").string() + "'",
+                                               dir_);
     EXPECT_NE(o.exit_code, 0);
-    size_t entries = 0;
-    for (const auto& entry : fs::directory_iterator(dir_)) entries += entry.path().filename().string()[0] == '.';
-    EXPECT_EQ(entries, 0u);  // no temporary file left
+    EXPECT_NE(o.err.find("o.animorder.bin: write failed"), std::string::npos) << o.err;
+    EXPECT_EQ(entries_of(out), "");
+}
+
+// The second of the outputs fails (o.animorder.json is a folder) after the first (the .bin) was
+// written: a failed run must not leave half of its outputs behind either. Today the .bin stays.
+// Disabled until the tool writes its outputs as one transaction: enabled by the lead's output transaction.
+TEST_F(Cli, FailedSecondWriteLeavesNoEarlierOutputBehind) {
+    const fs::path out = path("out");
+    fs::create_directories(out / "o.animorder.json");
+    const test::Outcome o = run("optimize -q -o '" + (out / "o").string() + "'");
+    EXPECT_NE(o.exit_code, 0);
+    EXPECT_NE(o.err.find("o.animorder.json"), std::string::npos) << o.err;
+    EXPECT_EQ(entries_of(out), "o.animorder.json ");  // only the folder that was in the way
+    EXPECT_TRUE(fs::is_directory(out / "o.animorder.json"));
 }
 
 TEST_F(Cli, NoSubcommandPrintsUsage) {

@@ -2,6 +2,8 @@
 // summary as JSON: {"errors", "warnings", "infos", "hints", "messages": [first errors]}.
 // Exit code 0 when the file has no errors, 1 when it has some, 2 when it cannot be validated.
 //   NODE_PATH=<folder with node_modules> node tools/validate/validate_gltf.js FILE
+// It writes no file: the caller captures the output (tests into their own scratch folder, never
+// beside FILE, which may be read-only data such as ../shared/data).
 const fs = require('fs');
 const path = require('path');
 const validator = require('gltf-validator');

@@ -1,0 +1,80 @@
+// Prerequisites of a test that a machine may lack (an OpenGL context, the Khronos glTF validator,
+// the real characters of ../shared/data): without one, the test is skipped with the reason, so
+// the skip shows in the CTest summary; and where the environment variable ANIMORDER_REQUIRE names
+// the component (a comma list of gl, validator, data; or all), the test fails with the reason
+// instead. .ci/run sets ANIMORDER_REQUIRE=gl,validator,data, so CI cannot pass by skipping.
+//
+//   ANIMORDER_REQUIRE_OR_SKIP("data", fs::exists(path), path + " is absent");
+//
+// Use it in a test body (it returns from the function: GTEST_SKIP and FAIL do).
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <sstream>
+#include <string>
+
+namespace animorder::test {
+
+// The components a test can require; anything else in ANIMORDER_REQUIRE is a typo, and fails.
+inline bool known_component(const std::string& name) {
+    return name == "gl" || name == "validator" || name == "data";
+}
+
+// Whether `requirement` (ANIMORDER_REQUIRE's value; null when unset) requires `component`.
+// Unknown names in the list are reported as failures of the calling test.
+inline bool requires_component(const char* requirement, const std::string& component) {
+    if (!known_component(component)) {
+        ADD_FAILURE() << "test code asks for an unknown prerequisite '" << component << "'";
+        return true;
+    }
+    if (!requirement) return false;
+    bool found = false;
+    std::stringstream list(requirement);
+    std::string item;
+    while (std::getline(list, item, ',')) {
+        const size_t first = item.find_first_not_of(" \t"), last = item.find_last_not_of(" \t");
+        item = first == std::string::npos ? "" : item.substr(first, last - first + 1);
+        if (item.empty()) continue;
+        if (item == "all" || item == component) found = true;
+        else if (!known_component(item))
+            ADD_FAILURE() << "ANIMORDER_REQUIRE names an unknown component '" << item << "' (known: gl, validator, data, all)";
+    }
+    return found;
+}
+
+inline bool required(const std::string& component) {
+    return requires_component(std::getenv("ANIMORDER_REQUIRE"), component);
+}
+
+// ../shared/data/RELATIVE, the real characters (read only: tests never write there).
+inline std::filesystem::path shared_data_path(const std::string& relative = "") {
+#ifdef ANIMORDER_SOURCE_DIR
+    return std::filesystem::path(ANIMORDER_SOURCE_DIR) / ".." / "shared" / "data" / relative;
+#else
+    return std::filesystem::path("..") / "shared" / "data" / relative;
+#endif
+}
+
+}  // namespace animorder::test
+
+// Skips the test with `reason` when `condition` is false, or fails it when ANIMORDER_REQUIRE
+// requires `component`.
+#define ANIMORDER_REQUIRE_OR_SKIP(component, condition, reason)                                            \
+    do {                                                                                                   \
+        /* read first, so a typo in ANIMORDER_REQUIRE fails even where everything is present */           \
+        const bool animorder_required_ = ::animorder::test::required(component);                          \
+        if (!(condition)) {                                                                                \
+            if (animorder_required_)                                                                       \
+                FAIL() << "required " << (component) << " (ANIMORDER_REQUIRE) is missing: " << reason;     \
+            else                                                                                           \
+                GTEST_SKIP() << (component) << " missing: " << reason;                                     \
+        }                                                                                                  \
+    } while (0)
+
+// Skips (or fails, when data is required) unless the file or folder DATA_PATH of ../shared/data exists.
+#define ANIMORDER_REQUIRE_DATA(data_path)                                                                   \
+    ANIMORDER_REQUIRE_OR_SKIP("data", std::filesystem::exists(data_path),                                   \
+                              std::filesystem::path(data_path).string() + " is absent (../shared/data)")

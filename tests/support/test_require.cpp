@@ -1,0 +1,55 @@
+// The prerequisite switch of support/require.h: which ANIMORDER_REQUIRE values require which
+// component, and that a required, missing prerequisite is a fatal failure carrying the reason.
+#include "support/require.h"
+
+#include <gtest/gtest-spi.h>
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <string>
+
+namespace test = animorder::test;
+
+TEST(Require, UnsetOrEmptyRequiresNothing) {
+    EXPECT_FALSE(test::requires_component(nullptr, "gl"));
+    EXPECT_FALSE(test::requires_component("", "data"));
+    EXPECT_FALSE(test::requires_component(",,", "validator"));
+}
+
+TEST(Require, CommaListNamesExactlyItsComponents) {
+    EXPECT_TRUE(test::requires_component("gl,validator,data", "gl"));
+    EXPECT_TRUE(test::requires_component("gl,validator,data", "validator"));
+    EXPECT_TRUE(test::requires_component("gl,validator,data", "data"));
+    EXPECT_TRUE(test::requires_component("gl", "gl"));
+    EXPECT_FALSE(test::requires_component("gl", "data"));
+    EXPECT_FALSE(test::requires_component("validator,data", "gl"));
+    EXPECT_TRUE(test::requires_component(" gl , data ", "data"));  // spaces around names are ignored
+}
+
+TEST(Require, AllRequiresEveryComponent) {
+    for (const char* c : {"gl", "validator", "data"}) EXPECT_TRUE(test::requires_component("all", c)) << c;
+    EXPECT_TRUE(test::requires_component("data,all", "gl"));
+}
+
+TEST(Require, UnknownNamesAreFailuresNotSilentlyIgnored) {
+    EXPECT_NONFATAL_FAILURE(test::requires_component("gl,opengl", "gl"), "unknown component 'opengl'");
+    EXPECT_NONFATAL_FAILURE(test::requires_component("gl", "gpu"), "unknown prerequisite 'gpu'");
+}
+
+namespace {
+void missing_gl() { ANIMORDER_REQUIRE_OR_SKIP("gl", 1 + 1 == 3, "no display for " << 42); }
+void present_gl() { ANIMORDER_REQUIRE_OR_SKIP("gl", 1 + 1 == 2, "never printed"); }
+}  // namespace
+
+TEST(Require, RequiredAndMissingFailsWithTheReason) {
+    const char* before = std::getenv("ANIMORDER_REQUIRE");
+    const std::string saved = before ? before : "";
+    ::setenv("ANIMORDER_REQUIRE", "validator,gl", 1);
+    EXPECT_FATAL_FAILURE(missing_gl(), "no display for 42");
+    ::setenv("ANIMORDER_REQUIRE", "all", 1);
+    EXPECT_FATAL_FAILURE(missing_gl(), "required gl (ANIMORDER_REQUIRE) is missing");
+    EXPECT_NO_FATAL_FAILURE(present_gl());  // present: neither a failure nor a skip
+    if (before) ::setenv("ANIMORDER_REQUIRE", saved.c_str(), 1);
+    else ::unsetenv("ANIMORDER_REQUIRE");
+    EXPECT_FALSE(::testing::Test::IsSkipped());
+}

@@ -18,8 +18,10 @@
 // with every size checked and validates it. A child that dies by a signal or exits non-zero (as
 // AddressSanitizer does) becomes one LoadError "FILE: assimp crashed reading it (signal 11:
 // SIGSEGV)"; its stderr is captured, never shown. Cost: one fork plus one copy of the mesh
-// through memory, a few milliseconds on the characters of ../shared/data (numbers in the
-// commit adding it).
+// through memory. `animorder inspect`, median of 5: x-dwarf 48 -> 70 ms, md5-bob 32 -> 40 ms,
+// pg-witch 123 -> 130 ms; pg-barbarian with its 10 clip files: user time unchanged (0.30 s),
+// system time 0.12 -> 0.27 s (page faults of the copy), peak memory 149 -> 239 MB (child
+// and parent each hold the mesh for a moment).
 #include "animorder/io.h"
 
 #include "checked_size.h"

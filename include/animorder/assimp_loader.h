@@ -13,7 +13,9 @@ namespace animorder {
 // own vertices (identical vertices joined), bones (8 strongest weights, normalised), node
 // animations sampled at sample_rate. clip_files: Mixamo-style animation-only files whose
 // channels drive the character's joints by node name; each adds its animations as clips (named
-// after the file), and a file none of whose joints the character has is an error.
+// after the file), and a file none of whose joints the character has is an error. Clip files whose
+// rest skeleton differs from the character's by more than 2% of its size are refused, naming the
+// joint. assimp runs in a child process, so a crash inside it is a LoadError, never a signal.
 AnimatedMesh load_assimp(const std::string& path, const std::vector<std::string>& clip_files = {},
                          const LoadOptions& options = {});
 

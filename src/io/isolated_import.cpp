@@ -1,0 +1,395 @@
+// A loader run in a forked child (isolated_import.h). The child's mesh comes back through a
+// memfd in a small native-endian format: magic, kind ('M' mesh or 'E' error message), fields,
+// end magic. The parent trusts none of it: every count is checked against the bytes left before
+// anything is allocated, the keyframes against the loading budget, and the mesh is validated.
+#include "isolated_import.h"
+
+#include "checked_size.h"
+
+#include "animorder/animated_mesh.h"
+#include "animorder/invalid_input.h"
+#include "animorder/load.h"
+
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <climits>
+#include <cstdint>
+#include <cstring>
+#include <csignal>
+#include <algorithm>
+#include <new>
+
+namespace animorder::io {
+namespace {
+
+constexpr char kMagic[8] = {'A', 'O', 'C', 'H', 'I', 'L', 'D', '1'};
+constexpr char kEnd[8] = {'A', 'O', 'C', 'H', 'I', 'L', 'D', '.'};
+constexpr int kCannotWriteBack = 97;  // the child's exit code when the memfd write fails
+
+struct Fd {
+    int fd = -1;
+    explicit Fd(int f) : fd(f) {}
+    Fd(const Fd&) = delete;
+    Fd& operator=(const Fd&) = delete;
+    ~Fd() {
+        if (fd >= 0) ::close(fd);
+    }
+};
+
+struct Mapping {
+    void* data = MAP_FAILED;
+    size_t size = 0;
+    Mapping(void* d, size_t s) : data(d), size(s) {}
+    Mapping(const Mapping&) = delete;
+    Mapping& operator=(const Mapping&) = delete;
+    ~Mapping() {
+        if (data != MAP_FAILED) ::munmap(data, size);
+    }
+};
+
+std::string errno_text() { return std::strerror(errno); }
+
+// One printable line of at most `limit` characters.
+std::string one_line(const std::string& text, size_t limit) {
+    std::string out;
+    for (char ch : text) {
+        if (out.size() >= limit) {
+            out += "...";
+            break;
+        }
+        const unsigned char u = static_cast<unsigned char>(ch);
+        out += (u < 0x20 || u == 0x7f) ? ' ' : ch;
+    }
+    while (!out.empty() && out.back() == ' ') out.pop_back();
+    return out;
+}
+
+std::string signal_name(int sig) {
+    switch (sig) {
+        case SIGSEGV: return "SIGSEGV";
+        case SIGBUS: return "SIGBUS";
+        case SIGABRT: return "SIGABRT";
+        case SIGFPE: return "SIGFPE";
+        case SIGILL: return "SIGILL";
+        case SIGKILL: return "SIGKILL";
+        case SIGTRAP: return "SIGTRAP";
+        case SIGTERM: return "SIGTERM";
+        case SIGSYS: return "SIGSYS";
+        default: return "signal";
+    }
+}
+
+// --- Child side ---------------------------------------------------------------------------------
+
+struct WriteFailed {};
+
+class Writer {
+public:
+    explicit Writer(int fd) : fd_(fd) {}
+    void bytes(const void* p, size_t n) {
+        constexpr size_t kChunk = size_t(1) << 16;
+        if (buf_.size() + n > kChunk) flush();
+        if (n >= kChunk)
+            write_all(static_cast<const char*>(p), n);
+        else
+            buf_.append(static_cast<const char*>(p), n);
+    }
+    void u64(uint64_t v) { bytes(&v, sizeof v); }
+    void i64(int64_t v) { bytes(&v, sizeof v); }
+    void f64(double v) { bytes(&v, sizeof v); }
+    void str(const std::string& s) {
+        u64(s.size());
+        bytes(s.data(), s.size());
+    }
+    template <class T>
+    void array(const std::vector<T>& v) {
+        u64(v.size());
+        bytes(v.data(), v.size() * sizeof(T));
+    }
+    void flush() {
+        write_all(buf_.data(), buf_.size());
+        buf_.clear();
+    }
+
+private:
+    void write_all(const char* p, size_t n) {
+        while (n > 0) {
+            const ssize_t w = ::write(fd_, p, n);
+            if (w < 0 && errno == EINTR) continue;
+            if (w <= 0) throw WriteFailed{};
+            p += w, n -= size_t(w);
+        }
+    }
+    int fd_;
+    std::string buf_;
+};
+
+void write_mesh(Writer& w, const AnimatedMesh& m) {
+    w.bytes(kMagic, sizeof kMagic);
+    w.bytes("M", 1);
+    w.str(m.name);
+    w.u64(m.vertex_count);
+    w.array(m.indices);
+    w.u64(m.primitives.size());
+    for (const Primitive& p : m.primitives) {
+        w.str(p.name);
+        w.u64(p.first_index);
+        w.u64(p.index_count);
+        w.i64(p.source_mesh);
+        w.i64(p.source_primitive);
+        w.u64(p.vertex_base);
+        w.u64(p.vertex_count);
+    }
+    w.u64(m.clips.size());
+    for (const Clip& c : m.clips) {
+        w.str(c.name);
+        w.f64(c.duration_s);
+        w.f64(c.sample_rate);
+        w.u64(c.first_keyframe);
+        w.u64(c.keyframe_count);
+    }
+    w.array(m.keyframe_positions);
+    w.u64(m.joint_count);
+    w.u64(m.morph_target_count);
+    w.bytes(kEnd, sizeof kEnd);
+    w.flush();
+}
+
+void write_error(Writer& w, const std::string& message) {
+    w.bytes(kMagic, sizeof kMagic);
+    w.bytes("E", 1);
+    w.str(message);
+    w.bytes(kEnd, sizeof kEnd);
+    w.flush();
+}
+
+[[noreturn]] void run_child(int data_fd, int log_fd, volatile uint64_t* reading_index, const std::string& path,
+                            const std::function<AnimatedMesh(const ReadingFile&)>& load) {
+    // Nothing the child (assimp, a sanitizer) prints reaches the user; the parent reads the log.
+    ::dup2(log_fd, STDOUT_FILENO);
+    ::dup2(log_fd, STDERR_FILENO);
+    int code = 0;
+    try {
+        Writer w(data_fd);
+        try {
+            const AnimatedMesh mesh = load([reading_index](size_t i) { *reading_index = i; });
+            write_mesh(w, mesh);
+        } catch (const WriteFailed&) {
+            throw;
+        } catch (const std::bad_alloc&) {
+            ::ftruncate(data_fd, 0), ::lseek(data_fd, 0, SEEK_SET);
+            write_error(w, path + ": out of memory while reading it");
+        } catch (const std::exception& e) {
+            ::ftruncate(data_fd, 0), ::lseek(data_fd, 0, SEEK_SET);
+            write_error(w, e.what());
+        }
+    } catch (...) {
+        code = kCannotWriteBack;
+    }
+    // _exit: no atexit handlers, static destructors or stdio flushes of the parent's state.
+    ::_exit(code);
+}
+
+// --- Parent side --------------------------------------------------------------------------------
+
+class Reader {
+public:
+    Reader(const char* data, size_t size, const std::string& file) : p_(data), left_(size), file_(file) {}
+    void bytes(void* out, size_t n) {
+        need(n);
+        if (n) std::memcpy(out, p_, n);
+        p_ += n, left_ -= n;
+    }
+    uint64_t u64() {
+        uint64_t v;
+        bytes(&v, sizeof v);
+        return v;
+    }
+    int64_t i64() {
+        int64_t v;
+        bytes(&v, sizeof v);
+        return v;
+    }
+    double f64() {
+        double v;
+        bytes(&v, sizeof v);
+        return v;
+    }
+    int small_int() {
+        const int64_t v = i64();
+        if (v < INT_MIN || v > INT_MAX) bad("an index out of range");
+        return int(v);
+    }
+    // A count of elements of `element` bytes each, which must all be in the bytes left.
+    size_t count(size_t element) { return count(element, u64()); }
+    size_t count(size_t element, uint64_t n) {
+        size_t total = 0;
+        if (n > SIZE_MAX || !checked_mul(size_t(n), element, total) || total > left_) bad("a count larger than its data");
+        return size_t(n);
+    }
+    std::string str() {
+        std::string s(count(1), '\0');
+        bytes(s.data(), s.size());
+        return s;
+    }
+    template <class T>
+    void array(std::vector<T>& v) {
+        array(v, u64());
+    }
+    // n elements whose count was already read.
+    template <class T>
+    void array(std::vector<T>& v, uint64_t n) {
+        size_t total = 0;
+        if (n > SIZE_MAX || !checked_mul(size_t(n), sizeof(T), total) || total > left_) bad("a count larger than its data");
+        v.resize(size_t(n));
+        bytes(v.data(), total);
+    }
+    void expect(const char (&tag)[8]) {
+        char got[8];
+        bytes(got, sizeof got);
+        if (std::memcmp(got, tag, sizeof got) != 0) bad("a damaged frame");
+    }
+    bool at_end() const { return left_ == 0; }
+    [[noreturn]] void bad(const std::string& what) const {
+        throw LoadError(file_ + ": the isolated reader passed back " + what);
+    }
+
+private:
+    void need(size_t n) const {
+        if (n > left_) bad("a truncated mesh");
+    }
+    const char* p_;
+    size_t left_;
+    const std::string& file_;
+};
+
+AnimatedMesh read_mesh(Reader& r, const std::string& path, const LoadOptions& options) {
+    AnimatedMesh m;
+    m.name = r.str();
+    m.vertex_count = r.u64();
+    r.array(m.indices);
+    // Each primitive takes at least 6 · 8 bytes, each clip 4 · 8: counts are bounded by the data.
+    m.primitives.resize(r.count(6 * 8));
+    for (Primitive& p : m.primitives) {
+        p.name = r.str();
+        p.first_index = r.u64();
+        p.index_count = r.u64();
+        p.source_mesh = r.small_int();
+        p.source_primitive = r.small_int();
+        p.vertex_base = r.u64();
+        p.vertex_count = r.u64();
+    }
+    m.clips.resize(r.count(4 * 8));
+    for (Clip& c : m.clips) {
+        c.name = r.str();
+        c.duration_s = r.f64();
+        c.sample_rate = r.f64();
+        c.first_keyframe = r.u64();
+        c.keyframe_count = r.u64();
+    }
+    // The budget before the largest allocation: keyframes × vertices × 3 floats.
+    const uint64_t floats = r.u64();
+    if (m.vertex_count == 0 || floats % 3 != 0 || floats / 3 % m.vertex_count != 0)
+        r.bad("keyframes that do not match the vertex count");
+    check_keyframe_budget(path, size_t(floats / 3 / m.vertex_count), m.vertex_count, options);
+    r.array(m.keyframe_positions, floats);
+    m.joint_count = r.u64();
+    m.morph_target_count = r.u64();
+    r.expect(kEnd);
+    if (!r.at_end()) r.bad("bytes after the mesh");
+    try {
+        validate_animated_mesh(m);
+    } catch (const InvalidInput& e) {
+        r.bad(std::string("an invalid mesh: ") + e.what());
+    }
+    return m;
+}
+
+// The last meaningful line the child wrote: a sanitizer's SUMMARY line when there is one, else
+// the last non-blank line.
+std::string last_words(int log_fd) {
+    struct stat st {};
+    if (::fstat(log_fd, &st) != 0 || st.st_size <= 0) return "";
+    const size_t size = size_t(st.st_size), tail = std::min<size_t>(size, 64 * 1024);
+    std::string text(tail, '\0');
+    const ssize_t got = ::pread(log_fd, text.data(), tail, off_t(size - tail));
+    if (got <= 0) return "";
+    text.resize(size_t(got));
+    std::string last, summary;
+    size_t begin = 0;
+    while (begin < text.size()) {
+        size_t end = text.find('\n', begin);
+        if (end == std::string::npos) end = text.size();
+        const std::string line = one_line(text.substr(begin, end - begin), 300);
+        if (line.find_first_not_of(' ') != std::string::npos) last = line;
+        if (line.find("SUMMARY:") != std::string::npos) summary = line;
+        begin = end + 1;
+    }
+    const std::string& chosen = summary.empty() ? last : summary;
+    const size_t first = chosen.find_first_not_of(' ');
+    return first == std::string::npos ? "" : chosen.substr(first);
+}
+
+}  // namespace
+
+AnimatedMesh load_isolated(const std::vector<std::string>& files, const LoadOptions& options,
+                           const std::function<AnimatedMesh(const ReadingFile& reading)>& load) {
+    if (files.empty()) throw LoadError("(no file): nothing to read");
+    const std::string& path = files[0];
+    const Fd data(::memfd_create("animorder-child-mesh", MFD_CLOEXEC));
+    const Fd log(::memfd_create("animorder-child-log", MFD_CLOEXEC));
+    if (data.fd < 0 || log.fd < 0) throw LoadError(path + ": cannot create the isolated reader's buffer: " + errno_text());
+    const Mapping shared(::mmap(nullptr, sizeof(uint64_t), PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0),
+                         sizeof(uint64_t));
+    if (shared.data == MAP_FAILED) throw LoadError(path + ": cannot map the isolated reader's page: " + errno_text());
+    volatile uint64_t* reading_index = static_cast<volatile uint64_t*>(shared.data);
+    *reading_index = 0;
+
+    const pid_t child = ::fork();
+    if (child < 0) throw LoadError(path + ": cannot start the isolated reader: " + errno_text());
+    if (child == 0) run_child(data.fd, log.fd, reading_index, path, load);
+
+    int status = 0;
+    pid_t waited;
+    do waited = ::waitpid(child, &status, 0);
+    while (waited < 0 && errno == EINTR);
+    if (waited < 0) throw LoadError(path + ": lost the isolated reader: " + errno_text());
+
+    const uint64_t index = *reading_index;
+    const std::string& blamed = index < files.size() ? files[size_t(index)] : path;
+    if (WIFSIGNALED(status) || (WIFEXITED(status) && WEXITSTATUS(status) != 0 && WEXITSTATUS(status) != kCannotWriteBack)) {
+        std::string why = WIFSIGNALED(status) ? "signal " + std::to_string(WTERMSIG(status)) + ": " + signal_name(WTERMSIG(status))
+                                              : "exit code " + std::to_string(WEXITSTATUS(status));
+        const std::string said = last_words(log.fd);
+        throw LoadError(blamed + ": assimp crashed reading it (" + why + ")" + (said.empty() ? "" : "; it said: " + said));
+    }
+    if (!WIFEXITED(status)) throw LoadError(path + ": the isolated reader stopped abnormally");
+    if (WEXITSTATUS(status) == kCannotWriteBack)
+        throw LoadError(path + ": the isolated reader could not pass the mesh back (out of memory?)");
+
+    struct stat st {};
+    if (::fstat(data.fd, &st) != 0 || st.st_size <= 0) throw LoadError(path + ": the isolated reader passed nothing back");
+    const size_t size = size_t(st.st_size);
+    const Mapping bytes(::mmap(nullptr, size, PROT_READ, MAP_PRIVATE, data.fd, 0), size);
+    if (bytes.data == MAP_FAILED) throw LoadError(path + ": cannot read the isolated reader's mesh: " + errno_text());
+    Reader r(static_cast<const char*>(bytes.data), size, path);
+    r.expect(kMagic);
+    char kind = 0;
+    r.bytes(&kind, 1);
+    if (kind == 'E') {
+        const std::string message = one_line(r.str(), 2000);
+        r.expect(kEnd);
+        // Errors start with a file name; a message that does not (garbled) gets the character's.
+        for (const std::string& f : files)
+            if (message.rfind(f + ":", 0) == 0) throw LoadError(message);
+        throw LoadError(path + ": " + message);
+    }
+    if (kind != 'M') r.bad("an unknown answer");
+    return read_mesh(r, path, options);
+}
+
+}  // namespace animorder::io

@@ -1,0 +1,33 @@
+// Running a loader in a child process, so that a crash inside a third-party parser (assimp) on a
+// hostile file becomes a LoadError instead of killing us. Private to src/io.
+#pragma once
+
+#include "animorder/animated_mesh.h"
+#include "animorder/load.h"
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace animorder::io {
+
+// Called by the child's loader with i before it starts reading files[i], so that a crash is
+// blamed on the right file.
+using ReadingFile = std::function<void(size_t)>;
+
+// Runs load(reading) in a forked child and returns the AnimatedMesh it produced. files[0] is
+// the character (the file errors are about when nothing better is known), the rest are the
+// clip files the loader reads. The child passes the mesh back through an in-memory file
+// (memfd); the parent reads it with every count and size checked against the bytes actually
+// there and options.max_keyframe_bytes (the child's bytes are treated as hostile), then
+// validates the mesh. Errors, all LoadError with one line starting with a file name:
+//  - the loader's own exception (its message, passed back and cleaned to one line);
+//  - the child killed by a signal: "FILE: assimp crashed reading it (signal 11: SIGSEGV)",
+//    followed by the last meaningful line the child wrote to stderr, if any;
+//  - the child exiting non-zero (AddressSanitizer does this after a report): "FILE: assimp
+//    crashed reading it (exit code N)" and the same stderr line.
+// The child's stdout and stderr are captured, never shown.
+AnimatedMesh load_isolated(const std::vector<std::string>& files, const LoadOptions& options,
+                           const std::function<AnimatedMesh(const ReadingFile& reading)>& load);
+
+}  // namespace animorder::io

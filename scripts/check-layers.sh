@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# The layering rules of README "Layout", checked on the source tree (CTest runs it):
+#  1. every public header include/animorder/X.h is defined by one source src/LAYER/X.cpp (except
+#     animorder.h, the manual, and invalid_input.h, which are declarations only);
+#  2. no source or public header includes a header of a higher layer, ground up:
+#     mesh (0) → algorithms (1) → assets (2) → pipeline (3) → io (4); the OpenGL reference
+#     (src/reference) sits beside the pipeline (3); tools may include anything;
+#  3. below io nothing includes a file-format, JSON or command-line library header.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+declare -A layer_of_dir=([mesh]=0 [algorithms]=1 [assets]=2 [pipeline]=3 [reference]=3 [io]=4)
+declare -A layer   # public header name → layer
+layer[animorder.h]=1
+layer[invalid_input.h]=0
+failures=0
+fail() { echo "check-layers: $*" >&2; failures=$((failures + 1)); }
+
+for header in include/animorder/*.h; do
+    name=$(basename "$header")
+    [ -n "${layer[$name]:-}" ] && continue
+    sources=(src/*/"${name%.h}.cpp")
+    if [ ! -f "${sources[0]}" ] || [ ${#sources[@]} -ne 1 ]; then
+        fail "$header: expected exactly one source src/<layer>/${name%.h}.cpp"
+        continue
+    fi
+    dir=$(basename "$(dirname "${sources[0]}")")
+    layer[$name]=${layer_of_dir[$dir]:?unknown layer folder $dir}
+done
+
+check_file() {  # file, its layer
+    local file="$1" own="$2" included
+    while read -r included; do
+        [ -z "$included" ] && continue
+        local l="${layer[$included]:-}"
+        if [ -z "$l" ]; then fail "$file includes animorder/$included, which is no public header"; continue; fi
+        [ "$l" -le "$own" ] || fail "$file (layer $own) includes animorder/$included (layer $l)"
+    done < <(sed -n 's|^#include "animorder/\([^"]*\)".*|\1|p' "$file")
+    if [ "$own" -lt 4 ] && grep -qE '^#include [<"](tiny_gltf|assimp/|CLI/|nlohmann/|stb_)' "$file"; then
+        fail "$file (layer $own) includes a file-format, JSON or CLI header"
+    fi
+}
+for dir in "${!layer_of_dir[@]}"; do
+    for file in src/"$dir"/*.cpp src/"$dir"/*.h; do
+        [ -f "$file" ] && check_file "$file" "${layer_of_dir[$dir]}"
+    done
+done
+for header in include/animorder/*.h; do check_file "$header" "${layer[$(basename "$header")]}"; done
+
+if [ "$failures" -gt 0 ]; then
+    echo "check-layers: $failures violation(s)" >&2
+    exit 1
+fi
+echo "check-layers: ${#layer[@]} public headers, every include goes down the layers"

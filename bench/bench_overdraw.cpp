@@ -46,8 +46,7 @@ struct Workload {
 
 Workload make_workload(const AnimatedMesh& mesh, size_t keyframe_step, unsigned subdivisions) {
     Workload w;
-    w.framing = frame_keyframes(mesh.keyframe_positions.data(), mesh.keyframe_count(), mesh.vertex_count,
-                                mesh.indices.data(), mesh.indices.size());
+    w.framing = frame_animated_mesh(mesh);
     const std::vector<float> dirs = icosphere_directions(subdivisions);
     for (uint32_t k = 0; k < mesh.keyframe_count(); k += uint32_t(keyframe_step))
         for (size_t v = 0; v < dirs.size() / 3; ++v) {

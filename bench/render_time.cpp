@@ -208,8 +208,7 @@ int run(const Options& options) {
     // The nodes: every keyframe_stride-th keyframe of each clip × random evaluation directions;
     // single's buffer picked as evaluation.cpp does (table_base[clip] + the table's cell).
     const std::vector<float> directions = random_sphere_directions(options.views, kEvaluationSeed);
-    const Framing all = frame_keyframes(mesh.keyframe_positions.data(), mesh.keyframe_count(), mesh.vertex_count,
-                                        mesh.indices.data(), mesh.indices.size());
+    const Framing all = frame_animated_mesh(mesh);
     std::vector<Node> nodes;
     std::vector<float> radius(mesh.clips.size());
     for (size_t c = 0; c < mesh.clips.size(); ++c) {

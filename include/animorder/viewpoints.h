@@ -1,6 +1,8 @@
 // animorder — viewpoints and framing (viewpoints.cpp; DESIGN.md "Framing", "Viewpoints").
 #pragma once
 
+#include "animorder/animated_mesh.h"
+
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -29,6 +31,9 @@ struct Framing {
 };
 Framing frame_keyframes(const float* keyframe_positions, size_t keyframe_count, size_t vertex_count,
                         const uint32_t* indices, size_t index_count);
+
+// frame_keyframes of every keyframe of an animated mesh, over its whole index buffer.
+Framing frame_animated_mesh(const AnimatedMesh& mesh);
 
 // The same framing with R taken over a subset of keyframes (one clip is one animation).
 Framing frame_subset(const Framing& framing, const std::vector<uint32_t>& keyframes);

@@ -9,6 +9,7 @@
 // the whole character at every keyframe; it never rotates.
 #include "animorder/viewpoints.h"
 
+#include "animorder/animated_mesh.h"
 #include "animorder/invalid_input.h"
 #include "animorder/triangle_order.h"
 
@@ -135,6 +136,11 @@ Framing frame_keyframes(const float* keyframe_positions, size_t keyframe_count, 
     }
     framing.radius = float(radius * (1.0 + 1e-6));
     return framing;
+}
+
+Framing frame_animated_mesh(const AnimatedMesh& mesh) {
+    return frame_keyframes(mesh.keyframe_positions.data(), mesh.keyframe_count(), mesh.vertex_count,
+                           mesh.indices.data(), mesh.indices.size());
 }
 
 Framing frame_subset(const Framing& framing, const std::vector<uint32_t>& keyframes) {

@@ -115,8 +115,7 @@ std::vector<OrderEvaluation> evaluate_methods(const AnimatedMesh& mesh, const st
             rank_of[m].push_back(std::move(rank));
         }
 
-    const Framing all = frame_keyframes(mesh.keyframe_positions.data(), mesh.keyframe_count(), mesh.vertex_count,
-                                        mesh.indices.data(), mesh.indices.size());
+    const Framing all = frame_animated_mesh(mesh);
     const std::vector<float> directions = random_sphere_directions(settings.views, settings.seed);
     size_t total_nodes = 0, done_before = 0;
     for (const Clip& c : mesh.clips) total_nodes += c.keyframe_count * settings.views;

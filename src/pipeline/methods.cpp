@@ -200,8 +200,7 @@ AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double
     const auto start = std::chrono::steady_clock::now();
     result.patches = build_mesh_patches(mesh, lambda, cache_size);
     result.seconds_patches = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    result.framing = frame_keyframes(mesh.keyframe_positions.data(), mesh.keyframe_count(), mesh.vertex_count,
-                                     mesh.indices.data(), mesh.indices.size());
+    result.framing = frame_animated_mesh(mesh);
 
     auto clip_keyframes = [&](const Clip& c) {
         std::vector<uint32_t> k;
@@ -239,11 +238,6 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-Framing frame_all_keyframes(const AnimatedMesh& mesh) {
-    return frame_keyframes(mesh.keyframe_positions.data(), mesh.keyframe_count(), mesh.vertex_count,
-                           mesh.indices.data(), mesh.indices.size());
-}
-
 // One table per clip whose every cell says `buffer of keyframe f` (a single buffer: always 0).
 SelectionTable constant_table(size_t keyframes, bool one_per_keyframe) {
     SelectionTable t;
@@ -271,7 +265,7 @@ StaticMethodSettings static_settings(const MethodSettings& settings) {
 void run_single_buffer(MethodResult& result, const AnimatedMesh& mesh, const MethodSettings& settings) {
     StaticMethodResult r = run_static_method(mesh, result.method, static_settings(settings));
     result.buffers.orders.push_back(std::move(r.order));
-    result.framing = frame_all_keyframes(mesh);
+    result.framing = frame_animated_mesh(mesh);
     for (const Clip& c : mesh.clips) {
         result.buffers.tables.push_back(constant_table(c.keyframe_count, false));
         result.buffers.table_base.push_back(0);
@@ -313,7 +307,7 @@ void run_tipsify_per_frame(MethodResult& result, const AnimatedMesh& mesh, const
         result.buffers.orders.push_back(std::move(r.order));
         result.buffers.keyframe_buffer.push_back(uint32_t(f));
     }
-    result.framing = frame_all_keyframes(mesh);
+    result.framing = frame_animated_mesh(mesh);
     bool fits = true;
     for (const Clip& c : mesh.clips) fits = fits && c.keyframe_count <= 256;
     for (size_t c = 0; fits && c < mesh.clips.size(); ++c) {
@@ -328,7 +322,7 @@ void run_tipsify_per_frame(MethodResult& result, const AnimatedMesh& mesh, const
 void run_oracle(MethodResult& result, const AnimatedMesh& mesh, const MethodSettings& settings) {
     auto patches = std::make_shared<MeshPatches>(build_mesh_patches(mesh, settings.lambda, settings.cache_size));
     result.buffers.front_to_back = patches;
-    result.framing = frame_all_keyframes(mesh);
+    result.framing = frame_animated_mesh(mesh);
     result.patch_count = patches->patch_count();
     const std::vector<float> views = icosphere_directions(0);
     std::vector<uint32_t> indices(mesh.indices.size());

@@ -42,7 +42,7 @@ ClusteringSettings small_settings() {
 }
 
 Framing framing_of(const AnimatedMesh& m) {
-    return frame_keyframes(m.keyframe_positions.data(), m.keyframe_count(), m.vertex_count, m.indices.data(), m.indices.size());
+    return frame_animated_mesh(m);
 }
 }  // namespace
 

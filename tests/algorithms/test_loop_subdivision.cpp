@@ -363,8 +363,7 @@ TEST(LoopSubdivision, BadInputThrows) {
 TEST(SubdivideAnimatedMesh, ProceduralCharacterCountsClipsAndFraming) {
     const AnimatedMesh character = make_procedural_character();
     ASSERT_EQ(character.triangle_count(), 10776u);
-    const Framing base = frame_keyframes(character.keyframe_positions.data(), character.keyframe_count(),
-                                         character.vertex_count, character.indices.data(), character.indices.size());
+    const Framing base = frame_animated_mesh(character);
     const size_t expected[] = {10776, 43104, 172416};
     for (unsigned levels = 1; levels <= 2; ++levels) {
         const AnimatedMesh s = subdivide_animated_mesh(character, levels);
@@ -385,8 +384,7 @@ TEST(SubdivideAnimatedMesh, ProceduralCharacterCountsClipsAndFraming) {
         }
         // The overdraw engine frames it: finite centres, radii a little inside the original's
         // (Loop's limit surface lies inside the control mesh's hull).
-        const Framing f = frame_keyframes(s.keyframe_positions.data(), s.keyframe_count(), s.vertex_count,
-                                          s.indices.data(), s.indices.size());
+        const Framing f = frame_animated_mesh(s);
         ASSERT_EQ(f.radii.size(), base.radii.size());
         for (size_t k = 0; k < f.radii.size(); ++k) {
             ASSERT_TRUE(std::isfinite(f.radii[k]) && std::isfinite(f.centres[3 * k])) << k;

@@ -18,8 +18,7 @@ struct ScoreRun {
 };
 
 ScoreRun score_all(const AnimatedMesh& mesh, const std::vector<uint32_t>& ranks, size_t orders, unsigned threads) {
-    const Framing framing = frame_keyframes(mesh.keyframe_positions.data(), mesh.keyframe_count(), mesh.vertex_count,
-                                            mesh.indices.data(), mesh.indices.size());
+    const Framing framing = frame_animated_mesh(mesh);
     const std::vector<float> dirs = icosphere_directions(1);
     std::vector<OverdrawNode> nodes;
     for (uint32_t k = 0; k < mesh.keyframe_count(); k += 7)

@@ -206,8 +206,7 @@ uint64_t brute_force_passed(const NodeRasterizer& r, const std::vector<uint32_t>
 
 TEST(Rasterizer, ScoringManyOrdersEqualsDrawingEachOrderWithAZBuffer) {
     const AnimatedMesh mesh = make_procedural_character();
-    const Framing framing = frame_keyframes(mesh.keyframe_positions.data(), mesh.keyframe_count(), mesh.vertex_count,
-                                            mesh.indices.data(), mesh.indices.size());
+    const Framing framing = frame_animated_mesh(mesh);
     const size_t n = mesh.triangle_count();
     std::vector<std::vector<uint32_t>> orders(4, std::vector<uint32_t>(n));
     std::mt19937 rng(1);

@@ -118,8 +118,7 @@ TEST_F(GltfWriter, RefusesAMeshItWasNotReadFrom) {
     std::vector<uint32_t> order(character.triangle_count());
     for (size_t i = 0; i < order.size(); ++i) order[i] = uint32_t(i);
     buffers.orders.push_back(order);
-    const Framing framing = frame_keyframes(character.keyframe_positions.data(), character.keyframe_count(),
-                                            character.vertex_count, character.indices.data(), character.indices.size());
+    const Framing framing = frame_animated_mesh(character);
     EXPECT_THROW(gltf_with_orders(input, (dir_ / "x.glb").string(), character, buffers, 0, framing, "original", true),
                  LoadError);
 }

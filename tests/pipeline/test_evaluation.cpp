@@ -64,8 +64,7 @@ std::vector<uint32_t> iota_order(size_t n) {
 // The engine directly: mean and pooled OVR of one order over one clip's evaluation nodes.
 OverdrawSummary direct(const AnimatedMesh& mesh, size_t clip, const std::vector<uint32_t>& order,
                        const EvaluationSettings& settings) {
-    const Framing all = frame_keyframes(mesh.keyframe_positions.data(), mesh.keyframe_count(), mesh.vertex_count,
-                                        mesh.indices.data(), mesh.indices.size());
+    const Framing all = frame_animated_mesh(mesh);
     std::vector<uint32_t> keyframes;
     for (size_t f = 0; f < mesh.clips[clip].keyframe_count; ++f) keyframes.push_back(uint32_t(mesh.clips[clip].first_keyframe + f));
     const Framing framing = frame_subset(all, keyframes);

@@ -55,8 +55,7 @@ struct Totals {
 
 void compare_mesh(GlOverdrawReference& gl, const AnimatedMesh& mesh, size_t keyframe, unsigned resolution, Totals& totals) {
     SCOPED_TRACE(mesh.name + " keyframe " + std::to_string(keyframe));
-    const Framing framing = frame_keyframes(mesh.keyframe_positions.data(), mesh.keyframe_count(), mesh.vertex_count,
-                                            mesh.indices.data(), mesh.indices.size());
+    const Framing framing = frame_animated_mesh(mesh);
     const size_t n = mesh.triangle_count();
     std::vector<uint32_t> tipsified(n), random(n);
     tipsify(tipsified.data(), mesh.indices.data(), mesh.indices.size(), mesh.vertex_count);

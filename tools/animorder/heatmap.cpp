@@ -36,8 +36,7 @@ int run_heatmap(const HeatmapOptions& options) {
     settings.cache_size = options.common.cache_size;
     const StaticMethodResult result = run_static_method(mesh, method, settings);
 
-    const Framing framing = frame_keyframes(mesh.keyframe_positions.data(), mesh.keyframe_count(), mesh.vertex_count,
-                                            mesh.indices.data(), mesh.indices.size());
+    const Framing framing = frame_animated_mesh(mesh);
     const float direction[3] = {float(options.view[0] / length), float(options.view[1] / length),
                                 float(options.view[2] / length)};
     std::vector<float> clip(mesh.vertex_count * 4);

@@ -14,8 +14,7 @@ namespace {
 
 // The view radius R of every clip (DESIGN.md framing): the largest per-keyframe bounding radius.
 std::vector<float> clip_radii(const AnimatedMesh& mesh) {
-    const Framing all = frame_keyframes(mesh.keyframe_positions.data(), mesh.keyframe_count(), mesh.vertex_count,
-                                        mesh.indices.data(), mesh.indices.size());
+    const Framing all = frame_animated_mesh(mesh);
     std::vector<float> radii;
     for (const Clip& c : mesh.clips) {
         float r = 0;

@@ -9,7 +9,9 @@
 #   scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]      e.g. scripts/fuzz.sh 60 fuzz_runtime
 #
 # Environment: FUZZ_JOBS (build parallelism, default 2), FUZZ_DATA (characters folder, default
-# ../shared/data next to the repository), FUZZ_KEEP=1 keeps the temporary folder (corpora grown).
+# ../shared/data next to the repository), FUZZ_SHARED_MAX_KB (largest characters file used as a
+# seed, default 100: a sanitized load of a 300 KB character takes ~0.3 s, which would leave only a
+# few hundred executions a minute), FUZZ_KEEP=1 keeps the temporary folder (corpora grown).
 set -euo pipefail
 
 seconds="${1:-30}"
@@ -43,8 +45,11 @@ shared_seeds() {
     *) return 0 ;;
   esac
   # shellcheck disable=SC2086
-  find "$data" -type f \( $pattern \) -size -400k -print
+  find "$data" -type f \( $pattern \) -size -"${FUZZ_SHARED_MAX_KB:-100}"k -print
 }
+
+# Stack traces for UBSan reports too; ASan's defaults already print them.
+export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1}"
 
 status=0
 for target in "${targets[@]}"; do
@@ -59,7 +64,7 @@ for target in "${targets[@]}"; do
   if ! "$build/fuzz/$target" "$corpus" -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=10 \
        -artifact_prefix="$artifacts" -print_final_stats=1 >"$log" 2>&1; then
     status=1
-    grep -E "ERROR|SUMMARY|#[0-9]+ +0x" "$log" | head -20 >&2 || true
+    grep -E "ERROR|runtime error|SUMMARY|^ +#[0-9]+ +0x" "$log" | head -12 >&2 || true
     for crash in "$artifacts"*; do
       [ -e "$crash" ] || continue
       kept="${TMPDIR:-/tmp}/animorder-$name-$(basename "$crash")"

@@ -36,7 +36,7 @@ const Fixture& fixture() {
 // A 4-byte aligned copy, as an application would load it.
 std::vector<uint32_t> aligned(const std::string& bytes) {
     std::vector<uint32_t> words((bytes.size() + 3) / 4);
-    std::memcpy(words.data(), bytes.data(), bytes.size());
+    if (!bytes.empty()) std::memcpy(words.data(), bytes.data(), bytes.size());
     return words;
 }
 }  // namespace

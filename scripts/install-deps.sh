@@ -14,6 +14,7 @@ packages=(
   libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri  # OpenGL reference (llvmpipe)
   libtinygltf-dev                          # glTF 2.0 in and out
   libassimp-dev                            # FBX, Collada, .X, .b3d, MD5, ...
+  clang libclang-rt-14-dev                 # scripts/fuzz.sh: clang 14 and its libFuzzer/ASan runtimes
 )
 
 # Node.js runs the Khronos glTF Validator in the tests; any node >= 12 will do (the machine's own

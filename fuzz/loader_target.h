@@ -5,8 +5,12 @@
 // a huge animation is refused by the loader's own check, not by the fuzzer's memory limit.
 #pragma once
 
-#include "animorder/animorder.h"
-#include "animorder/io.h"
+#include "animorder/animated_mesh.h"
+#include "animorder/gltf_loader.h"
+#include "animorder/invalid_input.h"
+#include "animorder/iqm_loader.h"
+#include "animorder/load.h"
+#include "animorder/md2_loader.h"
 
 #include <unistd.h>
 

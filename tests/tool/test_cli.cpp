@@ -6,6 +6,7 @@
 #include "support/require.h"
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -13,6 +14,7 @@
 #include <sstream>
 #include <string>
 #include <sys/wait.h>
+#include <vector>
 
 namespace fs = std::filesystem;
 namespace test = animorder::test;
@@ -232,9 +234,17 @@ TEST_F(Cli, Nehab06RunsInOptimizeAndEvaluateAndBeatsTheOriginalOrder) {
 
 namespace {
 // Every entry of `folder`, hidden ones included, as "name name ..." (empty when there is none).
+// The names in a folder, sorted, each followed by a space; the captured stdout.txt/stderr.txt of
+// the runs are left out.
 std::string entries_of(const fs::path& folder) {
+    std::vector<std::string> sorted;
+    for (const auto& entry : fs::directory_iterator(folder)) {
+        const std::string name = entry.path().filename().string();
+        if (name != "stdout.txt" && name != "stderr.txt") sorted.push_back(name);
+    }
+    std::sort(sorted.begin(), sorted.end());
     std::string names;
-    for (const auto& entry : fs::directory_iterator(folder)) names += entry.path().filename().string() + " ";
+    for (const std::string& name : sorted) names += name + " ";
     return names;
 }
 }  // namespace
@@ -273,4 +283,66 @@ TEST_F(Cli, NoSubcommandPrintsUsage) {
     const test::Outcome o = run("");
     EXPECT_NE(o.exit_code, 0);
     EXPECT_NE((o.out + o.err).find("inspect"), std::string::npos);
+}
+
+// Nothing the user owns is lost: no output may be an input (however it is spelled: a link, a
+// relative path) or another output of the run, and the check comes before any work. Each of these
+// overwrote a file before outputs were checked as one set (`-r input.glb` replaced a character
+// with a 1 KB report, exit 0).
+class CliOutputs : public Cli {
+protected:
+    // A small glTF input of our own: the bundled character's walk clip, unsubdivided.
+    void SetUp() override {
+        Cli::SetUp();
+        ASSERT_EQ(run("subdivide -q --levels 0 --clip walk -o " + path("in.glb").string()).exit_code, 0);
+        original_ = test::slurp(path("in.glb"));
+        ASSERT_GT(original_.size(), 1000u);
+    }
+    void expect_refused(const std::string& args, const std::string& what) {
+        const bool optimize = args.rfind("optimize", 0) == 0;
+        const test::Outcome o = run(args + " -q" + (optimize ? " --method original" : ""));
+        EXPECT_EQ(o.exit_code, 1) << args;
+        EXPECT_EQ(test::line_count(o.err), 1u) << args << " → " << o.err;
+        EXPECT_NE(o.err.find(what), std::string::npos) << args << " → " << o.err;
+        EXPECT_EQ(test::slurp(path("in.glb")), original_) << args << ": the input changed";
+    }
+    std::string original_;
+};
+
+TEST_F(CliOutputs, ReportOnTheInputIsRefused) {
+    expect_refused("optimize " + path("in.glb").string() + " -r " + path("in.glb").string(), "in.glb");
+    fs::create_symlink(path("in.glb"), path("link.json"));
+    expect_refused("optimize " + path("in.glb").string() + " -r " + path("link.json").string(), "link.json");
+    expect_refused("optimize " + path("in.glb").string() + " -r " + (dir_ / "." / "in.glb").string(), "in.glb");
+    expect_refused("evaluate " + path("in.glb").string() + " --csv " + path("in.glb").string(), "in.glb");
+    expect_refused("heatmap " + path("in.glb").string() + " -o " + path("in.glb").string(), "in.glb");
+}
+
+TEST_F(CliOutputs, TwoOutputsOnOneFileAreRefusedBeforeAnyWrite) {
+    expect_refused("optimize " + path("in.glb").string() + " -o " + path("out.glb").string() + " -r " +
+                       path("out.glb").string(),
+                   "named twice");
+    expect_refused("optimize " + path("in.glb").string() + " -o " + path("out").string() + " -r " +
+                       path("out.animorder.json").string(),
+                   "named twice");
+    EXPECT_EQ(entries_of(dir_), "in.glb ") << "nothing written";
+}
+
+TEST_F(CliOutputs, AllOutputsAppearTogether) {
+    const test::Outcome o = run("optimize -q --method original " + path("in.glb").string() + " -o " +
+                                path("out.glb").string() + " -r " + path("r.json").string());
+    ASSERT_EQ(o.exit_code, 0) << o.err;
+    EXPECT_EQ(entries_of(dir_), "in.glb out.animorder.bin out.animorder.json out.glb r.json ");
+}
+
+// Option errors from the parser read like every other error: one line, exit code 1.
+TEST_F(Cli, OptionRangeErrorsAreOneLineWithExitCodeOne) {
+    for (const char* args : {"optimize -k 0", "optimize -k 1000", "optimize --lambda -1", "optimize --lambda inf",
+                             "optimize --resolution 0", "evaluate --eval-views 0", "inspect --no-such-option",
+                             "optimize --max-memory 12"}) {
+        const test::Outcome o = run(args);
+        EXPECT_EQ(o.exit_code, 1) << args;
+        EXPECT_EQ(test::line_count(o.err), 1u) << args << " → " << o.err;
+        EXPECT_EQ(o.err.rfind("animorder: error: ", 0), 0u) << args << " → " << o.err;
+    }
 }

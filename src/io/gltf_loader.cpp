@@ -11,6 +11,7 @@
 #include "animorder/io.h"
 
 #include "animorder/animorder.h"
+#include "checked_size.h"
 #include "transform.h"
 
 #include <tiny_gltf.h>
@@ -18,6 +19,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <map>
 
@@ -30,70 +32,100 @@ using io::identity;
 using io::mul;
 using io::trs;
 
+// A number from a file for an error message: an integer when it is one, without converting a
+// value out of range.
+std::string number_text(double v) {
+    if (v > -1e15 && v < 1e15 && v == std::floor(v)) return std::to_string(int64_t(v));
+    return std::to_string(v);
+}
+
 class Reader {
 public:
-    Reader(const tinygltf::Model& model, const std::string& file) : model_(model), file_(file) {}
+    // max_bytes: the most bytes one accessor's values (as doubles) may take, the loading budget.
+    Reader(const tinygltf::Model& model, const std::string& file, size_t max_bytes)
+        : model_(model), file_(file), max_bytes_(max_bytes) {}
 
     [[noreturn]] void fail(const std::string& what) const { throw LoadError(file_ + ": " + what); }
 
     // count × components values of an accessor as doubles (normalised integers mapped to [0, 1]
-    // or [−1, 1] as the spec says), sparse substitution applied, every byte range checked.
+    // or [−1, 1] as the spec says), sparse substitution applied, every byte range checked before
+    // anything is allocated or read.
     std::vector<double> read(int index, int expected_components = 0) const {
         if (index < 0 || size_t(index) >= model_.accessors.size()) fail("accessor " + std::to_string(index) + " does not exist");
         const tinygltf::Accessor& a = model_.accessors[size_t(index)];
+        const std::string name = "accessor " + std::to_string(index);
         const int components = tinygltf::GetNumComponentsInType(uint32_t(a.type));
         const int size = tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType));
-        if (components <= 0 || size <= 0) fail("accessor " + std::to_string(index) + " has an unknown type");
+        if (components <= 0 || size <= 0) fail(name + " has an unknown type");
         if (expected_components && components != expected_components)
-            fail("accessor " + std::to_string(index) + " has " + std::to_string(components) + " components, expected " +
-                 std::to_string(expected_components));
-        std::vector<double> out(a.count * size_t(components), 0.0);
-        if (a.bufferView >= 0) {
-            const unsigned char* base = view_bytes(a.bufferView, a.byteOffset, a.count, size_t(components * size),
-                                                   stride_of(a, components * size), index);
-            const size_t stride = stride_of(a, components * size);
+            fail(name + " has " + std::to_string(components) + " components, expected " + std::to_string(expected_components));
+        const size_t element = size_t(components) * size_t(size);
+        // The count is the file's: checked against the buffer view (and the budget) first.
+        size_t stride = element;
+        const unsigned char* base = nullptr;
+        if (a.bufferView >= 0) base = view_bytes(a.bufferView, a.byteOffset, a.count, element, true, index, stride);
+        size_t values = 0;
+        if (!io::checked_mul(a.count, size_t(components), values) || values > max_bytes_ / sizeof(double))
+            fail(name + " has " + std::to_string(a.count) + " elements, more than the loading budget of " +
+                 std::to_string(max_bytes_) + " bytes");
+        std::vector<double> out(values, 0.0);
+        if (base)
             for (size_t i = 0; i < a.count; ++i)
                 for (int c = 0; c < components; ++c)
                     out[i * size_t(components) + size_t(c)] = convert(base + i * stride + size_t(c * size), a.componentType, a.normalized);
-        }
         if (a.sparse.isSparse) {
+            if (a.sparse.count < 0 || size_t(a.sparse.count) > a.count)
+                fail("sparse " + name + " substitutes " + std::to_string(a.sparse.count) + " of " + std::to_string(a.count) + " elements");
+            const int index_type = a.sparse.indices.componentType;
+            if (index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+                index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+                fail("sparse " + name + " has indices that are not unsigned integers");
             const size_t n = size_t(a.sparse.count);
-            const int index_size = tinygltf::GetComponentSizeInBytes(uint32_t(a.sparse.indices.componentType));
-            const unsigned char* idx = view_bytes(a.sparse.indices.bufferView, size_t(a.sparse.indices.byteOffset), n,
-                                                  size_t(index_size), size_t(index_size), index);
-            const unsigned char* val = view_bytes(a.sparse.values.bufferView, size_t(a.sparse.values.byteOffset), n,
-                                                  size_t(components * size), size_t(components * size), index);
+            const size_t index_size = size_t(tinygltf::GetComponentSizeInBytes(uint32_t(index_type)));
+            size_t unused = 0;
+            const unsigned char* idx = view_bytes(a.sparse.indices.bufferView, offset_of(a.sparse.indices.byteOffset, index), n,
+                                                  index_size, false, index, unused);
+            const unsigned char* val = view_bytes(a.sparse.values.bufferView, offset_of(a.sparse.values.byteOffset, index), n,
+                                                  element, false, index, unused);
             for (size_t i = 0; i < n; ++i) {
-                const size_t target = size_t(convert(idx + i * size_t(index_size), a.sparse.indices.componentType, false));
-                if (target >= a.count) fail("sparse accessor " + std::to_string(index) + " names element " + std::to_string(target));
+                const size_t target = size_t(convert(idx + i * index_size, index_type, false));
+                if (target >= a.count) fail("sparse " + name + " names element " + std::to_string(target));
                 for (int c = 0; c < components; ++c)
                     out[target * size_t(components) + size_t(c)] =
                         convert(val + (i * size_t(components) + size_t(c)) * size_t(size), a.componentType, a.normalized);
             }
         }
         for (double v : out)
-            if (!std::isfinite(v)) fail("accessor " + std::to_string(index) + " holds a NaN or infinite value");
+            if (!std::isfinite(v)) fail(name + " holds a NaN or infinite value");
         return out;
     }
 
 private:
-    size_t stride_of(const tinygltf::Accessor& a, int element) const {
-        const tinygltf::BufferView& v = model_.bufferViews[size_t(a.bufferView)];
-        return v.byteStride ? v.byteStride : size_t(element);
+    size_t offset_of(int byte_offset, int accessor) const {
+        if (byte_offset < 0) fail("accessor " + std::to_string(accessor) + " has a negative byte offset");
+        return size_t(byte_offset);
     }
 
-    const unsigned char* view_bytes(int view_index, size_t offset, size_t count, size_t element, size_t stride,
-                                    int accessor) const {
+    // The first byte of `count` elements of `element` bytes at `offset` in buffer view
+    // `view_index`, every index and range checked with overflow-checked arithmetic. `stride` is
+    // the view's byteStride when `strided` (and the view has one), else `element`.
+    const unsigned char* view_bytes(int view_index, size_t offset, size_t count, size_t element, bool strided,
+                                    int accessor, size_t& stride) const {
         if (view_index < 0 || size_t(view_index) >= model_.bufferViews.size())
             fail("accessor " + std::to_string(accessor) + " names a missing buffer view");
         const tinygltf::BufferView& view = model_.bufferViews[size_t(view_index)];
         if (view.buffer < 0 || size_t(view.buffer) >= model_.buffers.size())
             fail("buffer view " + std::to_string(view_index) + " names a missing buffer");
         const std::vector<unsigned char>& data = model_.buffers[size_t(view.buffer)].data;
-        if (view.byteOffset + view.byteLength > data.size())
+        size_t view_end = 0;
+        if (!io::checked_add(view.byteOffset, view.byteLength, view_end) || view_end > data.size())
             fail("buffer view " + std::to_string(view_index) + " runs past the end of its buffer (truncated file?)");
-        if (count > 0 && offset + stride * (count - 1) + element > view.byteLength)
-            fail("accessor " + std::to_string(accessor) + " runs past the end of its buffer view");
+        stride = strided && view.byteStride ? view.byteStride : element;
+        size_t end = offset, last = 0;  // offset + stride · (count − 1) + element
+        if (count > 0 && (!io::checked_mul(stride, count - 1, last) || !io::checked_add(end, last, end) ||
+                          !io::checked_add(end, element, end)))
+            end = SIZE_MAX;
+        if (end > view.byteLength) fail("accessor " + std::to_string(accessor) + " runs past the end of its buffer view");
         return data.data() + view.byteOffset + offset;
     }
 
@@ -111,6 +143,7 @@ private:
 
     const tinygltf::Model& model_;
     std::string file_;
+    size_t max_bytes_;
 };
 
 struct PrimitiveData {
@@ -135,8 +168,8 @@ std::vector<uint32_t> triangle_list(const std::vector<double>& raw, int mode, si
                                     const std::string& where) {
     std::vector<uint32_t> idx(raw.size());
     for (size_t i = 0; i < raw.size(); ++i) {
-        if (raw[i] >= double(vertex_count))
-            reader.fail(where + ": index " + std::to_string(i) + " is " + std::to_string(uint64_t(raw[i])) + ", but there are " +
+        if (!(raw[i] >= 0 && raw[i] < double(vertex_count)))
+            reader.fail(where + ": index " + std::to_string(i) + " is " + number_text(raw[i]) + ", but there are " +
                         std::to_string(vertex_count) + " vertices");
         idx[i] = uint32_t(raw[i]);
     }
@@ -245,7 +278,7 @@ AnimatedMesh load_gltf(const std::string& path, const LoadOptions& options) {
         std::replace(error.begin(), error.end(), '\n', ' ');
         throw LoadError(path + ": not a readable glTF 2.0 file: " + error);
     }
-    const Reader reader(model, path);
+    const Reader reader(model, path, options.max_keyframe_bytes);
 
     // Parents and the nodes of the scene, depth first (parents before children).
     std::vector<int> parent(model.nodes.size(), -1);
@@ -336,9 +369,9 @@ AnimatedMesh load_gltf(const std::string& path, const LoadOptions& options) {
                         }
                         for (size_t i = 0; i < 4; ++i) {
                             const double joint = jv[4 * v + i];
-                            if (joint >= double(joint_count) && wv[4 * v + i] > 0)
+                            if (joint < 0 || (joint >= double(joint_count) && wv[4 * v + i] > 0))
                                 reader.fail(where + ": vertex " + std::to_string(v) + " names joint " +
-                                            std::to_string(uint64_t(joint)) + ", the skin has " + std::to_string(joint_count));
+                                            number_text(joint) + ", the skin has " + std::to_string(joint_count));
                             joints[v * (d.influences + 4) + d.influences + i] = uint16_t(std::min(joint, 65535.0));
                             weights[v * (d.influences + 4) + d.influences + i] = float(wv[4 * v + i]);
                         }
@@ -435,6 +468,7 @@ AnimatedMesh load_gltf(const std::string& path, const LoadOptions& options) {
     };
 
     if (model.animations.empty()) {
+        io::check_keyframe_budget(path, 1, mesh.vertex_count, options);
         add_keyframe(rest);
         mesh.clips.push_back({"static", 0.0, options.sample_rate, 0, 1});
     }
@@ -469,8 +503,8 @@ AnimatedMesh load_gltf(const std::string& path, const LoadOptions& options) {
         clip.duration_s = t1 - t0;
         clip.sample_rate = options.sample_rate;
         clip.first_keyframe = mesh.keyframe_count();
-        clip.keyframe_count = size_t(std::llround(clip.duration_s * options.sample_rate)) + 1;
-        if (clip.keyframe_count > 100000) reader.fail("clip '" + name + "' is absurdly long");
+        clip.keyframe_count = io::clip_keyframes(path, name, clip.duration_s, options.sample_rate);
+        io::check_keyframe_budget(path, clip.first_keyframe + clip.keyframe_count, mesh.vertex_count, options);
         for (size_t f = 0; f < clip.keyframe_count; ++f) {
             const double t = std::min(t0 + double(f) / options.sample_rate, t1);
             std::vector<NodePose> pose = rest;

@@ -74,6 +74,20 @@ protected:
         std::ofstream(p, std::ios::binary) << content;
         return p.string();
     }
+    // Loading `content` fails with a one-line LoadError that starts with the file name and holds `message`.
+    void expect_load_error(const std::string& name, const std::string& content, const std::string& message,
+                           const LoadOptions& options = {}) {
+        const std::string path = write(name, content);
+        try {
+            load_gltf(path, options);
+            ADD_FAILURE() << name << ": no error";
+        } catch (const LoadError& e) {
+            const std::string what = e.what();
+            EXPECT_EQ(what.rfind(path, 0), 0u) << what;
+            EXPECT_NE(what.find(message), std::string::npos) << name << ": " << what;
+            EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+        }
+    }
     fs::path dir_;
 };
 
@@ -243,6 +257,108 @@ TEST_F(GltfLoader, BrokenFilesGiveOneLineErrorsNamingTheFile) {
     } catch (const LoadError& e) {
         EXPECT_NE(std::string(e.what()).find("cannot open"), std::string::npos);
     }
+}
+
+// Regressions from hostile files: sizes, counts and offsets that wrapped or were used before they
+// were checked (heap overflows, a SEGV, out-of-bounds reads, 32 GB allocations).
+TEST_F(GltfLoader, HostileAccessorsGiveOneLineErrors) {
+    {
+        Gltf g = skinned_bar();  // count × 3 components wraps to 2
+        g.doc["accessors"][0]["count"] = 6148914691236517206ull;
+        expect_load_error("wrap.gltf", g.text(), "runs past the end of its buffer view");
+    }
+    {
+        Gltf g = skinned_bar();
+        g.doc["accessors"][0]["bufferView"] = 99;
+        expect_load_error("view.gltf", g.text(), "names a missing buffer view");
+    }
+    {
+        Gltf g = skinned_bar();  // offset + stride · (count − 1) + element wraps to a small number
+        g.doc["accessors"][0]["byteOffset"] = 18446744073709551600ull;
+        expect_load_error("offset.gltf", g.text(), "runs past the end of its buffer view");
+    }
+    {
+        Gltf g = skinned_bar();
+        g.doc["bufferViews"][0]["byteOffset"] = 18446744073709551600ull;
+        expect_load_error("view-offset.gltf", g.text(), "runs past the end of its buffer");
+    }
+    {
+        Gltf g = skinned_bar();  // 32 GB of doubles if allocated before the range check
+        g.doc["accessors"][0]["count"] = 1000000000;
+        expect_load_error("count.gltf", g.text(), "runs past the end of its buffer view");
+    }
+    {
+        Gltf g = skinned_bar();
+        g.doc["accessors"][0]["sparse"] = {{"count", -1},
+                                           {"indices", {{"bufferView", 1}, {"componentType", 5123}}},
+                                           {"values", {{"bufferView", 0}}}};
+        expect_load_error("sparse-count.gltf", g.text(), "substitutes -1 of 4 elements");
+    }
+    {
+        Gltf g = skinned_bar();
+        g.doc["accessors"][0]["sparse"] = {{"count", 1},
+                                           {"indices", {{"bufferView", 0}, {"componentType", 5126}}},
+                                           {"values", {{"bufferView", 0}}}};
+        expect_load_error("sparse-type.gltf", g.text(), "not unsigned integers");
+    }
+    {
+        Gltf g = skinned_bar();  // no buffer view: a billion zeros, 24 GB of doubles
+        g.doc["accessors"].push_back({{"componentType", 5126}, {"count", 1000000000}, {"type", "VEC3"}});
+        g.doc["meshes"][0]["primitives"][0]["targets"] = json::array({json{{"POSITION", g.doc["accessors"].size() - 1}}});
+        expect_load_error("zeros.gltf", g.text(), "more than the loading budget");
+    }
+    {
+        Gltf g = skinned_bar();
+        const std::vector<int8_t> bad = {0, 1, 2, 0, 2, -1};
+        g.doc["meshes"][0]["primitives"][0]["indices"] = g.add(bad.data(), bad.size(), bad.size(), "SCALAR", 5120);
+        expect_load_error("negative-index.gltf", g.text(), "is -1, but there are 4 vertices");
+    }
+    {
+        Gltf g = skinned_bar();
+        const std::vector<int8_t> joints = {0, 0, 0, 0, 0, 0, 0, 0, -1, 0, 0, 0, 1, 0, 0, 0};
+        g.doc["meshes"][0]["primitives"][0]["attributes"]["JOINTS_0"] = g.add(joints.data(), joints.size(), 4, "VEC4", 5120);
+        expect_load_error("negative-joint.gltf", g.text(), "names joint -1");
+    }
+    {
+        Gltf g = skinned_bar();
+        g.doc["nodes"][2]["skin"] = 5;
+        expect_load_error("skin.gltf", g.text(), "names a missing skin");
+    }
+    {
+        Gltf g = skinned_bar();
+        g.doc["skins"][0]["joints"] = {0, 7};
+        expect_load_error("joint-node.gltf", g.text(), "missing joint node");
+    }
+    {
+        Gltf g = skinned_bar();
+        g.doc["animations"][0]["channels"][0]["sampler"] = 3;
+        expect_load_error("sampler.gltf", g.text(), "names a missing sampler");
+    }
+    {
+        Gltf g = skinned_bar();
+        g.doc["nodes"][1]["children"] = {0};  // a cycle: root → child → root
+        expect_load_error("cycle.gltf", g.text(), "repeated node");
+    }
+}
+
+// The long clip of the finding (its last key at 3,333 s passes the 100,000-keyframe cap) is
+// refused by the loading budget before any keyframe is sampled; one more second is too long.
+TEST_F(GltfLoader, LoadingBudgetIsCheckedBeforeSampling) {
+    auto clip_until = [](double last) {
+        Gltf g = skinned_bar();
+        const std::vector<float> times = {0, float(last)};
+        g.doc["animations"][0]["samplers"][0]["input"] = g.floats(times, "SCALAR", 1);
+        return g.text();
+    };
+    LoadOptions small;
+    small.max_keyframe_bytes = 1 << 20;  // 99,991 keyframes × 4 vertices × 12 bytes = 4.8 MB
+    expect_load_error("long.gltf", clip_until(3333), "loading budget", small);
+    expect_load_error("longer.gltf", clip_until(3334), "absurdly long");
+    // The bar's 1 s clip: 31 keyframes × 4 vertices × 12 bytes = 1,488 bytes, exactly.
+    small.max_keyframe_bytes = 1488;
+    EXPECT_EQ(load_gltf(write("fits.gltf", clip_until(1)), small).keyframe_count(), 31u);
+    small.max_keyframe_bytes = 1487;
+    expect_load_error("tight.gltf", clip_until(1), "loading budget", small);
 }
 
 namespace {

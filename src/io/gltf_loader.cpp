@@ -41,7 +41,9 @@ std::string number_text(double v) {
 
 class Reader {
 public:
-    // max_bytes: the most bytes one accessor's values (as doubles) may take, the loading budget.
+    // max_bytes: the loading budget, also the most bytes that the values of all accessors read
+    // (as doubles) may take together: a small file that names one large accessor many times (as
+    // morph targets, samplers) must not multiply it past the budget.
     Reader(const tinygltf::Model& model, const std::string& file, size_t max_bytes)
         : model_(model), file_(file), max_bytes_(max_bytes) {}
 
@@ -68,6 +70,10 @@ public:
         if (!io::checked_mul(a.count, size_t(components), values) || values > max_bytes_ / sizeof(double))
             fail(name + " has " + std::to_string(a.count) + " elements, more than the loading budget of " +
                  std::to_string(max_bytes_) + " bytes");
+        if (values > (max_bytes_ - read_bytes_) / sizeof(double))
+            fail("the accessors read need more than the loading budget of " + std::to_string(max_bytes_) +
+                 " bytes (is one accessor named many times?); raise it with --max-memory");
+        read_bytes_ += values * sizeof(double);
         std::vector<double> out(values, 0.0);
         if (base)
             for (size_t i = 0; i < a.count; ++i)
@@ -144,6 +150,7 @@ private:
     const tinygltf::Model& model_;
     std::string file_;
     size_t max_bytes_;
+    mutable size_t read_bytes_ = 0;  // bytes of all accessors read so far (≤ max_bytes_)
 };
 
 struct PrimitiveData {

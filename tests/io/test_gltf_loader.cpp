@@ -361,6 +361,19 @@ TEST_F(GltfLoader, LoadingBudgetIsCheckedBeforeSampling) {
     expect_load_error("tight.gltf", clip_until(1), "loading budget", small);
 }
 
+// Accessors named many times are read each time: their values together count against the budget.
+TEST_F(GltfLoader, AccessorsNamedManyTimesCountAgainstTheBudget) {
+    Gltf g = skinned_bar();
+    // 1,000 morph targets that are all the positions: 1,000 × 4 × 3 doubles = 96,000 bytes.
+    g.doc["meshes"][0]["primitives"][0]["targets"] = json::array();
+    for (int t = 0; t < 1000; ++t) g.doc["meshes"][0]["primitives"][0]["targets"].push_back({{"POSITION", 0}});
+    LoadOptions small;
+    small.max_keyframe_bytes = 64000;
+    expect_load_error("targets.gltf", g.text(), "is one accessor named many times?", small);
+    small.max_keyframe_bytes = 200000;
+    EXPECT_EQ(load_gltf(write("fits.gltf", g.text()), small).morph_target_count, 1000u);
+}
+
 namespace {
 std::string shared_data(const std::string& relative) {
     return (fs::path(ANIMORDER_SOURCE_DIR) / ".." / "shared" / "data" / relative).string();

@@ -202,6 +202,30 @@ TEST_F(IqmLoader, HostileFilesGiveOneLineErrors) {
     expect_error("rate.iqm", tiny_iqm(), "sample rate", zero_rate);
 }
 
+// Every byte of the tiny file set in turn to 0x00, 0x7F, 0x80 and 0xFF (counts, offsets, indices,
+// floats become huge, negative, NaN): each copy loads or fails with a LoadError, nothing else
+// (under scripts/test-sanitized.sh: no memory error, no undefined behaviour).
+TEST_F(IqmLoader, EveryByteMutatedLoadsOrFailsCleanly) {
+    const Image tiny = tiny_iqm();
+    size_t loaded = 0, refused = 0;
+    for (size_t at = 0; at < tiny.bytes.size(); ++at)
+        for (unsigned char value : {0x00, 0x7F, 0x80, 0xFF}) {
+            Image m = tiny;
+            m.bytes[at] = value;
+            const std::string file = write("mutated.iqm", m);
+            try {
+                const AnimatedMesh mesh = load_iqm(file);
+                EXPECT_NO_THROW(validate_animated_mesh(mesh)) << "byte " << at << " = " << int(value);
+                ++loaded;
+            } catch (const LoadError& e) {
+                EXPECT_EQ(std::string(e.what()).rfind(file, 0), 0u) << e.what();
+                ++refused;
+            }
+        }
+    EXPECT_GT(loaded, 0u);
+    EXPECT_GT(refused, 0u);
+}
+
 TEST_F(IqmLoader, LoadingBudgetIsCheckedBeforeSampling) {
     Image m = tiny_iqm();  // 1000 frames per second slowed to 10^-3: 1000 s, 30001 keyframes
     m.put<float>(kAnims + 12, 1e-3f);

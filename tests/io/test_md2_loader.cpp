@@ -152,6 +152,30 @@ TEST_F(Md2Loader, HostileHeadersGiveOneLineErrors) {
     expect_error("rate.md2", tiny_md2(), "sample rate", zero_rate);
 }
 
+// Every byte of the tiny file set in turn to 0x00, 0x7F, 0x80 and 0xFF (counts, offsets, indices,
+// floats become huge, negative, NaN): each copy loads or fails with a LoadError, nothing else
+// (under scripts/test-sanitized.sh: no memory error, no undefined behaviour).
+TEST_F(Md2Loader, EveryByteMutatedLoadsOrFailsCleanly) {
+    const Image tiny = tiny_md2();
+    size_t loaded = 0, refused = 0;
+    for (size_t at = 0; at < tiny.bytes.size(); ++at)
+        for (unsigned char value : {0x00, 0x7F, 0x80, 0xFF}) {
+            Image m = tiny;
+            m.bytes[at] = value;
+            const std::string file = write("mutated.md2", m);
+            try {
+                const AnimatedMesh mesh = load_md2(file);
+                EXPECT_NO_THROW(validate_animated_mesh(mesh)) << "byte " << at << " = " << int(value);
+                ++loaded;
+            } catch (const LoadError& e) {
+                EXPECT_EQ(std::string(e.what()).rfind(file, 0), 0u) << e.what();
+                ++refused;
+            }
+        }
+    EXPECT_GT(loaded, 0u);
+    EXPECT_GT(refused, 0u);
+}
+
 TEST_F(Md2Loader, LoadingBudgetIsCheckedBeforeSampling) {
     LoadOptions small;
     small.max_keyframe_bytes = 4 * 3 * 12 - 1;  // one byte less than the four keyframes of three vertices

@@ -341,6 +341,46 @@ TEST_F(GltfLoader, HostileAccessorsGiveOneLineErrors) {
     }
 }
 
+// Every size, count, offset and index of the accessors, buffer views and sparse substitutions
+// set in turn to values a hostile file would use (negative, zero, just past a limit, near 2^31,
+// 2^32, 2^63, 2^64): each file loads or fails with a LoadError, nothing else (under
+// scripts/test-sanitized.sh: no memory error, no undefined behaviour).
+TEST_F(GltfLoader, HostileNumbersLoadOrFailCleanly) {
+    Gltf bar = skinned_bar();
+    bar.doc["accessors"][0]["sparse"] = {{"count", 1},
+                                         {"indices", {{"bufferView", 1}, {"componentType", 5123}}},
+                                         {"values", {{"bufferView", 0}}}};
+    const json values = json::array({-1, 0, 1, 3, 4, 255, 2147483647LL, 4294967296LL, 9223372036854775807LL,
+                                     18446744073709551615ULL});
+    const std::vector<std::pair<std::string, std::vector<std::string>>> fields = {
+        {"accessors", {"/bufferView", "/byteOffset", "/count", "/componentType", "/sparse/count",
+                       "/sparse/indices/bufferView", "/sparse/indices/byteOffset", "/sparse/values/bufferView",
+                       "/sparse/values/byteOffset"}},
+        {"bufferViews", {"/buffer", "/byteOffset", "/byteLength", "/byteStride"}}};
+    size_t loaded = 0, refused = 0;
+    for (const auto& [array, keys] : fields)
+        for (size_t i = 0; i < bar.doc[array].size(); ++i)
+            for (const std::string& key : keys) {
+                const json::json_pointer at("/" + array + "/" + std::to_string(i) + key);
+                if (!bar.doc.contains(at)) continue;
+                for (const json& value : values) {
+                    Gltf g = bar;
+                    g.doc[at] = value;
+                    const std::string path = write("hostile.gltf", g.text());
+                    try {
+                        load_gltf(path);
+                        ++loaded;
+                    } catch (const LoadError& e) {
+                        EXPECT_EQ(std::string(e.what()).rfind(path, 0), 0u) << e.what();
+                        EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+                        ++refused;
+                    }
+                }
+            }
+    EXPECT_GT(loaded, 0u);
+    EXPECT_GT(refused, 100u);
+}
+
 // The long clip of the finding (its last key at 3,333 s passes the 100,000-keyframe cap) is
 // refused by the loading budget before any keyframe is sampled; one more second is too long.
 TEST_F(GltfLoader, LoadingBudgetIsCheckedBeforeSampling) {

@@ -4,6 +4,7 @@
 
 #include "animorder/load.h"
 
+#include <cmath>
 #include <cstddef>
 #include <string>
 
@@ -32,6 +33,21 @@ inline void check_keyframe_budget(const std::string& path, size_t keyframes, siz
         throw LoadError(path + ": the animation needs " + std::to_string(keyframes) + " keyframes x " +
                         std::to_string(vertices) + " vertices x 12 bytes, more than the loading budget of " +
                         std::to_string(options.max_keyframe_bytes) + " bytes (raise it with --max-memory)");
+}
+
+// The most keyframes one clip may have (about 55 minutes at 30 per second).
+constexpr size_t kMaxClipKeyframes = 100000;
+
+// Keyframes of a clip of duration_s sampled at sample_rate, both ends included
+// (round(duration · rate) + 1), or throws LoadError("<path>: clip '<name>' is absurdly long")
+// past kMaxClipKeyframes; a NaN, infinite or negative duration is an error too (never converted).
+inline size_t clip_keyframes(const std::string& path, const std::string& name, double duration_s, double sample_rate) {
+    const double intervals = duration_s * sample_rate;
+    if (!(intervals >= 0)) throw LoadError(path + ": clip '" + name + "' has an invalid duration");
+    if (intervals > double(kMaxClipKeyframes)) throw LoadError(path + ": clip '" + name + "' is absurdly long");
+    const size_t count = size_t(std::llround(intervals)) + 1;
+    if (count > kMaxClipKeyframes) throw LoadError(path + ": clip '" + name + "' is absurdly long");
+    return count;
 }
 
 }  // namespace animorder::io

@@ -15,6 +15,7 @@
 #include "animorder/load.h"
 #include "animorder/skinning.h"
 
+#include "checked_size.h"
 #include "transform.h"
 
 #include <tiny_gltf.h>
@@ -22,6 +23,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <map>
 
@@ -34,70 +36,106 @@ using io::identity;
 using io::mul;
 using io::trs;
 
+// A number from a file for an error message: an integer when it is one, without converting a
+// value out of range.
+std::string number_text(double v) {
+    if (v > -1e15 && v < 1e15 && v == std::floor(v)) return std::to_string(int64_t(v));
+    return std::to_string(v);
+}
+
 class Reader {
 public:
-    Reader(const tinygltf::Model& model, const std::string& file) : model_(model), file_(file) {}
+    // max_bytes: the loading budget, also the most bytes that the values of all accessors read
+    // (as doubles) may take together: a small file that names one large accessor many times (as
+    // morph targets, samplers) must not multiply it past the budget.
+    Reader(const tinygltf::Model& model, const std::string& file, size_t max_bytes)
+        : model_(model), file_(file), max_bytes_(max_bytes) {}
 
     [[noreturn]] void fail(const std::string& what) const { throw LoadError(file_ + ": " + what); }
 
     // count × components values of an accessor as doubles (normalised integers mapped to [0, 1]
-    // or [−1, 1] as the spec says), sparse substitution applied, every byte range checked.
+    // or [−1, 1] as the spec says), sparse substitution applied, every byte range checked before
+    // anything is allocated or read.
     std::vector<double> read(int index, int expected_components = 0) const {
         if (index < 0 || size_t(index) >= model_.accessors.size()) fail("accessor " + std::to_string(index) + " does not exist");
         const tinygltf::Accessor& a = model_.accessors[size_t(index)];
+        const std::string name = "accessor " + std::to_string(index);
         const int components = tinygltf::GetNumComponentsInType(uint32_t(a.type));
         const int size = tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType));
-        if (components <= 0 || size <= 0) fail("accessor " + std::to_string(index) + " has an unknown type");
+        if (components <= 0 || size <= 0) fail(name + " has an unknown type");
         if (expected_components && components != expected_components)
-            fail("accessor " + std::to_string(index) + " has " + std::to_string(components) + " components, expected " +
-                 std::to_string(expected_components));
-        std::vector<double> out(a.count * size_t(components), 0.0);
-        if (a.bufferView >= 0) {
-            const unsigned char* base = view_bytes(a.bufferView, a.byteOffset, a.count, size_t(components * size),
-                                                   stride_of(a, components * size), index);
-            const size_t stride = stride_of(a, components * size);
+            fail(name + " has " + std::to_string(components) + " components, expected " + std::to_string(expected_components));
+        const size_t element = size_t(components) * size_t(size);
+        // The count is the file's: checked against the buffer view (and the budget) first.
+        size_t stride = element;
+        const unsigned char* base = nullptr;
+        if (a.bufferView >= 0) base = view_bytes(a.bufferView, a.byteOffset, a.count, element, true, index, stride);
+        size_t values = 0;
+        if (!io::checked_mul(a.count, size_t(components), values) || values > max_bytes_ / sizeof(double))
+            fail(name + " has " + std::to_string(a.count) + " elements, more than the loading budget of " +
+                 std::to_string(max_bytes_) + " bytes");
+        if (values > (max_bytes_ - read_bytes_) / sizeof(double))
+            fail("the accessors read need more than the loading budget of " + std::to_string(max_bytes_) +
+                 " bytes (is one accessor named many times?); raise it with --max-memory");
+        read_bytes_ += values * sizeof(double);
+        std::vector<double> out(values, 0.0);
+        if (base)
             for (size_t i = 0; i < a.count; ++i)
                 for (int c = 0; c < components; ++c)
                     out[i * size_t(components) + size_t(c)] = convert(base + i * stride + size_t(c * size), a.componentType, a.normalized);
-        }
         if (a.sparse.isSparse) {
+            if (a.sparse.count < 0 || size_t(a.sparse.count) > a.count)
+                fail("sparse " + name + " substitutes " + std::to_string(a.sparse.count) + " of " + std::to_string(a.count) + " elements");
+            const int index_type = a.sparse.indices.componentType;
+            if (index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+                index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+                fail("sparse " + name + " has indices that are not unsigned integers");
             const size_t n = size_t(a.sparse.count);
-            const int index_size = tinygltf::GetComponentSizeInBytes(uint32_t(a.sparse.indices.componentType));
-            const unsigned char* idx = view_bytes(a.sparse.indices.bufferView, size_t(a.sparse.indices.byteOffset), n,
-                                                  size_t(index_size), size_t(index_size), index);
-            const unsigned char* val = view_bytes(a.sparse.values.bufferView, size_t(a.sparse.values.byteOffset), n,
-                                                  size_t(components * size), size_t(components * size), index);
+            const size_t index_size = size_t(tinygltf::GetComponentSizeInBytes(uint32_t(index_type)));
+            size_t unused = 0;
+            const unsigned char* idx = view_bytes(a.sparse.indices.bufferView, offset_of(a.sparse.indices.byteOffset, index), n,
+                                                  index_size, false, index, unused);
+            const unsigned char* val = view_bytes(a.sparse.values.bufferView, offset_of(a.sparse.values.byteOffset, index), n,
+                                                  element, false, index, unused);
             for (size_t i = 0; i < n; ++i) {
-                const size_t target = size_t(convert(idx + i * size_t(index_size), a.sparse.indices.componentType, false));
-                if (target >= a.count) fail("sparse accessor " + std::to_string(index) + " names element " + std::to_string(target));
+                const size_t target = size_t(convert(idx + i * index_size, index_type, false));
+                if (target >= a.count) fail("sparse " + name + " names element " + std::to_string(target));
                 for (int c = 0; c < components; ++c)
                     out[target * size_t(components) + size_t(c)] =
                         convert(val + (i * size_t(components) + size_t(c)) * size_t(size), a.componentType, a.normalized);
             }
         }
         for (double v : out)
-            if (!std::isfinite(v)) fail("accessor " + std::to_string(index) + " holds a NaN or infinite value");
+            if (!std::isfinite(v)) fail(name + " holds a NaN or infinite value");
         return out;
     }
 
 private:
-    size_t stride_of(const tinygltf::Accessor& a, int element) const {
-        const tinygltf::BufferView& v = model_.bufferViews[size_t(a.bufferView)];
-        return v.byteStride ? v.byteStride : size_t(element);
+    size_t offset_of(int byte_offset, int accessor) const {
+        if (byte_offset < 0) fail("accessor " + std::to_string(accessor) + " has a negative byte offset");
+        return size_t(byte_offset);
     }
 
-    const unsigned char* view_bytes(int view_index, size_t offset, size_t count, size_t element, size_t stride,
-                                    int accessor) const {
+    // The first byte of `count` elements of `element` bytes at `offset` in buffer view
+    // `view_index`, every index and range checked with overflow-checked arithmetic. `stride` is
+    // the view's byteStride when `strided` (and the view has one), else `element`.
+    const unsigned char* view_bytes(int view_index, size_t offset, size_t count, size_t element, bool strided,
+                                    int accessor, size_t& stride) const {
         if (view_index < 0 || size_t(view_index) >= model_.bufferViews.size())
             fail("accessor " + std::to_string(accessor) + " names a missing buffer view");
         const tinygltf::BufferView& view = model_.bufferViews[size_t(view_index)];
         if (view.buffer < 0 || size_t(view.buffer) >= model_.buffers.size())
             fail("buffer view " + std::to_string(view_index) + " names a missing buffer");
         const std::vector<unsigned char>& data = model_.buffers[size_t(view.buffer)].data;
-        if (view.byteOffset + view.byteLength > data.size())
+        size_t view_end = 0;
+        if (!io::checked_add(view.byteOffset, view.byteLength, view_end) || view_end > data.size())
             fail("buffer view " + std::to_string(view_index) + " runs past the end of its buffer (truncated file?)");
-        if (count > 0 && offset + stride * (count - 1) + element > view.byteLength)
-            fail("accessor " + std::to_string(accessor) + " runs past the end of its buffer view");
+        stride = strided && view.byteStride ? view.byteStride : element;
+        size_t end = offset, last = 0;  // offset + stride · (count − 1) + element
+        if (count > 0 && (!io::checked_mul(stride, count - 1, last) || !io::checked_add(end, last, end) ||
+                          !io::checked_add(end, element, end)))
+            end = SIZE_MAX;
+        if (end > view.byteLength) fail("accessor " + std::to_string(accessor) + " runs past the end of its buffer view");
         return data.data() + view.byteOffset + offset;
     }
 
@@ -115,6 +153,8 @@ private:
 
     const tinygltf::Model& model_;
     std::string file_;
+    size_t max_bytes_;
+    mutable size_t read_bytes_ = 0;  // bytes of all accessors read so far (≤ max_bytes_)
 };
 
 struct PrimitiveData {
@@ -139,8 +179,8 @@ std::vector<uint32_t> triangle_list(const std::vector<double>& raw, int mode, si
                                     const std::string& where) {
     std::vector<uint32_t> idx(raw.size());
     for (size_t i = 0; i < raw.size(); ++i) {
-        if (raw[i] >= double(vertex_count))
-            reader.fail(where + ": index " + std::to_string(i) + " is " + std::to_string(uint64_t(raw[i])) + ", but there are " +
+        if (!(raw[i] >= 0 && raw[i] < double(vertex_count)))
+            reader.fail(where + ": index " + std::to_string(i) + " is " + number_text(raw[i]) + ", but there are " +
                         std::to_string(vertex_count) + " vertices");
         idx[i] = uint32_t(raw[i]);
     }
@@ -218,6 +258,7 @@ std::vector<double> sample(const std::vector<double>& times, const std::vector<d
     return out;
 }
 
+// One animation channel: a node's translation, rotation, scale or morph weights over time.
 struct Channel {
     size_t node;
     std::string path;
@@ -225,10 +266,35 @@ struct Channel {
     std::string interpolation;
 };
 
-}  // namespace
+// A clip and its channels, read before any clip is sampled, so that the keyframes of every clip
+// are counted (and checked against the loading budget) first.
+struct ClipChannels {
+    Clip clip;
+    double t0 = 0, t1 = 0;  // first and last key time
+    std::vector<Channel> channels;
+};
 
-AnimatedMesh load_gltf(const std::string& path, const LoadOptions& options) {
-    if (!(options.sample_rate > 0 && options.sample_rate <= 1000)) throw LoadError(path + ": sample rate must be in (0, 1000]");
+// What the steps after parsing the file share; each parse_* step fills its part.
+struct Scene {
+    const tinygltf::Model& model;
+    const Reader& reader;
+    std::vector<int> parent;           // per node: its parent, −1 for a root
+    std::vector<size_t> order;         // nodes of the scene, depth first (parents before children)
+    std::vector<PrimitiveData> prims;  // triangle primitives of the mesh nodes, in scene order
+    std::vector<NodePose> rest;        // per node: its pose without animation
+    std::vector<Mat> inverse_bind;     // per skin, concatenated
+    std::vector<size_t> skin_first;    // per skin: the index of its first inverse bind matrix
+};
+
+// Components of a channel's value: 4 for a rotation, the node's morph target count for weights,
+// 3 for translation and scale.
+size_t channel_components(const Scene& s, size_t node, const std::string& path) {
+    return path == "rotation" ? 4 : path == "weights" ? s.rest[node].weights.size() : 3;
+}
+
+// The file through tinygltf (binary when it starts with "glTF", else JSON), textures passed
+// through undecoded.
+tinygltf::Model parse_file(const std::string& path) {
     tinygltf::Model model;
     tinygltf::TinyGLTF loader;
     loader.SetImageLoader([](tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int,
@@ -249,122 +315,144 @@ AnimatedMesh load_gltf(const std::string& path, const LoadOptions& options) {
         std::replace(error.begin(), error.end(), '\n', ' ');
         throw LoadError(path + ": not a readable glTF 2.0 file: " + error);
     }
-    const Reader reader(model, path);
+    return model;
+}
 
-    // Parents and the nodes of the scene, depth first (parents before children).
-    std::vector<int> parent(model.nodes.size(), -1);
+// Every node's parent (a node is the child of one node at most, so the nodes form a forest) and
+// the nodes of the default scene (or, without scenes, of every root), depth first.
+void parse_node_hierarchy(Scene& s) {
+    const tinygltf::Model& model = s.model;
+    s.parent.assign(model.nodes.size(), -1);
     for (size_t n = 0; n < model.nodes.size(); ++n)
         for (int c : model.nodes[n].children) {
-            if (c < 0 || size_t(c) >= model.nodes.size() || parent[size_t(c)] >= 0) reader.fail("node hierarchy is not a tree");
-            parent[size_t(c)] = int(n);
+            if (c < 0 || size_t(c) >= model.nodes.size() || s.parent[size_t(c)] >= 0) s.reader.fail("node hierarchy is not a tree");
+            s.parent[size_t(c)] = int(n);
         }
-    std::vector<size_t> order;
     std::vector<int> roots;
     const int scene = model.defaultScene >= 0 ? model.defaultScene : 0;
     if (size_t(scene) < model.scenes.size()) roots = model.scenes[size_t(scene)].nodes;
     else
         for (size_t n = 0; n < model.nodes.size(); ++n)
-            if (parent[n] < 0) roots.push_back(int(n));
+            if (s.parent[n] < 0) roots.push_back(int(n));
     std::vector<int> stack(roots.rbegin(), roots.rend());
-    std::vector<uint8_t> seen(model.nodes.size(), 0);
+    std::vector<uint8_t> seen(model.nodes.size(), 0);  // a cycle or a repeated root shows as a node seen twice
     while (!stack.empty()) {
         const int n = stack.back();
         stack.pop_back();
-        if (n < 0 || size_t(n) >= model.nodes.size() || seen[size_t(n)]) reader.fail("scene names a bad or repeated node");
+        if (n < 0 || size_t(n) >= model.nodes.size() || seen[size_t(n)]) s.reader.fail("scene names a bad or repeated node");
         seen[size_t(n)] = 1;
-        order.push_back(size_t(n));
+        s.order.push_back(size_t(n));
         const auto& children = model.nodes[size_t(n)].children;
         for (auto it = children.rbegin(); it != children.rend(); ++it) stack.push_back(*it);
     }
+}
 
-    // Primitives of the mesh nodes, in scene order.
-    AnimatedMesh mesh;
-    mesh.name = path;
-    std::vector<PrimitiveData> prims;
-    size_t joint_total = 0;
-    for (size_t n : order) {
-        const tinygltf::Node& node = model.nodes[n];
-        if (node.mesh < 0) continue;
-        if (size_t(node.mesh) >= model.meshes.size()) reader.fail("node " + std::to_string(n) + " names a missing mesh");
-        const tinygltf::Mesh& m = model.meshes[size_t(node.mesh)];
-        for (size_t p = 0; p < m.primitives.size(); ++p) {
-            const tinygltf::Primitive& prim = m.primitives[p];
-            const std::string where = "mesh '" + m.name + "' primitive " + std::to_string(p);
-            if (prim.mode == TINYGLTF_MODE_POINTS || prim.mode == TINYGLTF_MODE_LINE || prim.mode == TINYGLTF_MODE_LINE_LOOP ||
-                prim.mode == TINYGLTF_MODE_LINE_STRIP)
-                reader.fail(where + ": points and lines cannot be reordered for overdraw");
-            const auto position = prim.attributes.find("POSITION");
-            if (position == prim.attributes.end()) reader.fail(where + " has no POSITION");
-            PrimitiveData d;
-            d.node = n;
-            d.positions = reader.read(position->second, 3);
-            d.vertex_count = d.positions.size() / 3;
-            d.vertex_base = mesh.vertex_count;
-            std::vector<double> raw;
-            if (prim.indices >= 0) raw = reader.read(prim.indices, 1);
-            else for (size_t i = 0; i < d.vertex_count; ++i) raw.push_back(double(i));  // non-indexed
-            const std::vector<uint32_t> local = triangle_list(raw, prim.mode, d.vertex_count, reader, where);
-            Primitive out;
-            out.name = m.name.empty() ? "primitive" + std::to_string(prims.size()) : m.name + "/" + std::to_string(p);
-            out.first_index = mesh.indices.size();
-            out.index_count = local.size();
-            out.source_mesh = node.mesh;
-            out.source_primitive = int(p);
-            out.vertex_base = d.vertex_base;
-            out.vertex_count = d.vertex_count;
-            for (uint32_t i : local) mesh.indices.push_back(uint32_t(d.vertex_base + i));
-            mesh.primitives.push_back(out);
-            for (const auto& target : prim.targets) {
-                const auto t = target.find("POSITION");
-                d.targets.push_back(t == target.end() ? std::vector<double>(d.positions.size(), 0.0) : reader.read(t->second, 3));
-                if (d.targets.back().size() != d.positions.size()) reader.fail(where + ": a morph target has the wrong size");
-            }
-            mesh.morph_target_count = std::max(mesh.morph_target_count, d.targets.size());
-            if (node.skin >= 0) {
-                if (size_t(node.skin) >= model.skins.size()) reader.fail(where + ": the node names a missing skin");
-                const size_t joint_count = model.skins[size_t(node.skin)].joints.size();
-                joint_total = std::max(joint_total, joint_count);
-                for (int set = 0;; ++set) {
-                    const auto j = prim.attributes.find("JOINTS_" + std::to_string(set));
-                    const auto w = prim.attributes.find("WEIGHTS_" + std::to_string(set));
-                    if (j == prim.attributes.end() || w == prim.attributes.end()) break;
-                    const std::vector<double> jv = reader.read(j->second, 4), wv = reader.read(w->second, 4);
-                    if (jv.size() != 4 * d.vertex_count || wv.size() != 4 * d.vertex_count)
-                        reader.fail(where + ": joints or weights do not match the vertex count");
-                    std::vector<uint16_t> joints(d.joints.size() + jv.size());
-                    std::vector<float> weights(d.weights.size() + wv.size());
-                    for (size_t v = 0; v < d.vertex_count; ++v) {  // interleave sets: influences per vertex grow by 4
-                        for (size_t i = 0; i < d.influences; ++i) {
-                            joints[v * (d.influences + 4) + i] = d.joints[v * d.influences + i];
-                            weights[v * (d.influences + 4) + i] = d.weights[v * d.influences + i];
-                        }
-                        for (size_t i = 0; i < 4; ++i) {
-                            const double joint = jv[4 * v + i];
-                            if (joint >= double(joint_count) && wv[4 * v + i] > 0)
-                                reader.fail(where + ": vertex " + std::to_string(v) + " names joint " +
-                                            std::to_string(uint64_t(joint)) + ", the skin has " + std::to_string(joint_count));
-                            joints[v * (d.influences + 4) + d.influences + i] = uint16_t(std::min(joint, 65535.0));
-                            weights[v * (d.influences + 4) + d.influences + i] = float(wv[4 * v + i]);
-                        }
-                    }
-                    d.joints = std::move(joints);
-                    d.weights = std::move(weights);
-                    d.influences += 4;
-                }
-                if (d.influences == 0) reader.fail(where + ": skinned without JOINTS_0/WEIGHTS_0");
-            }
-            mesh.vertex_count += d.vertex_count;
-            prims.push_back(std::move(d));
-        }
+// POSITION of each morph target of a primitive (zero deltas for a target without one).
+void parse_morph_targets(const Scene& s, const tinygltf::Primitive& prim, const std::string& where, PrimitiveData& d) {
+    for (const auto& target : prim.targets) {
+        const auto t = target.find("POSITION");
+        d.targets.push_back(t == target.end() ? std::vector<double>(d.positions.size(), 0.0) : s.reader.read(t->second, 3));
+        if (d.targets.back().size() != d.positions.size()) s.reader.fail(where + ": a morph target has the wrong size");
     }
-    if (prims.empty()) reader.fail("no triangle mesh in the scene");
-    mesh.joint_count = joint_total;
+}
 
-    // Rest pose of every node.
-    std::vector<NodePose> rest(model.nodes.size());
-    for (size_t n = 0; n < model.nodes.size(); ++n) {
-        const tinygltf::Node& node = model.nodes[n];
-        NodePose& p = rest[n];
+// JOINTS_n / WEIGHTS_n sets of a skinned primitive, interleaved per vertex (4 influences per
+// set); every joint with weight is checked against the skin's joint_count.
+void parse_skin_weights(const Scene& s, const tinygltf::Primitive& prim, size_t joint_count, const std::string& where,
+                        PrimitiveData& d) {
+    for (int set = 0;; ++set) {
+        const auto j = prim.attributes.find("JOINTS_" + std::to_string(set));
+        const auto w = prim.attributes.find("WEIGHTS_" + std::to_string(set));
+        if (j == prim.attributes.end() || w == prim.attributes.end()) break;
+        const std::vector<double> jv = s.reader.read(j->second, 4), wv = s.reader.read(w->second, 4);
+        if (jv.size() != 4 * d.vertex_count || wv.size() != 4 * d.vertex_count)
+            s.reader.fail(where + ": joints or weights do not match the vertex count");
+        std::vector<uint16_t> joints(d.joints.size() + jv.size());
+        std::vector<float> weights(d.weights.size() + wv.size());
+        for (size_t v = 0; v < d.vertex_count; ++v) {  // interleave sets: influences per vertex grow by 4
+            for (size_t i = 0; i < d.influences; ++i) {
+                joints[v * (d.influences + 4) + i] = d.joints[v * d.influences + i];
+                weights[v * (d.influences + 4) + i] = d.weights[v * d.influences + i];
+            }
+            for (size_t i = 0; i < 4; ++i) {
+                const double joint = jv[4 * v + i];
+                if (joint < 0 || (joint >= double(joint_count) && wv[4 * v + i] > 0))
+                    s.reader.fail(where + ": vertex " + std::to_string(v) + " names joint " + number_text(joint) +
+                                  ", the skin has " + std::to_string(joint_count));
+                joints[v * (d.influences + 4) + d.influences + i] = uint16_t(std::min(joint, 65535.0));
+                weights[v * (d.influences + 4) + d.influences + i] = float(wv[4 * v + i]);
+            }
+        }
+        d.joints = std::move(joints);
+        d.weights = std::move(weights);
+        d.influences += 4;
+    }
+    if (d.influences == 0) s.reader.fail(where + ": skinned without JOINTS_0/WEIGHTS_0");
+}
+
+// Primitive p of node n's mesh: its vertices (appended to the mesh's), its triangles (appended to
+// the mesh's index buffer), morph targets and skin weights.
+PrimitiveData parse_primitive(const Scene& s, size_t n, size_t p, AnimatedMesh& mesh) {
+    const tinygltf::Node& node = s.model.nodes[n];
+    const tinygltf::Mesh& m = s.model.meshes[size_t(node.mesh)];
+    const tinygltf::Primitive& prim = m.primitives[p];
+    const std::string where = "mesh '" + m.name + "' primitive " + std::to_string(p);
+    if (prim.mode == TINYGLTF_MODE_POINTS || prim.mode == TINYGLTF_MODE_LINE || prim.mode == TINYGLTF_MODE_LINE_LOOP ||
+        prim.mode == TINYGLTF_MODE_LINE_STRIP)
+        s.reader.fail(where + ": points and lines cannot be reordered for overdraw");
+    const auto position = prim.attributes.find("POSITION");
+    if (position == prim.attributes.end()) s.reader.fail(where + " has no POSITION");
+    PrimitiveData d;
+    d.node = n;
+    d.positions = s.reader.read(position->second, 3);
+    d.vertex_count = d.positions.size() / 3;
+    d.vertex_base = mesh.vertex_count;
+    std::vector<double> raw;
+    if (prim.indices >= 0) raw = s.reader.read(prim.indices, 1);
+    else for (size_t i = 0; i < d.vertex_count; ++i) raw.push_back(double(i));  // non-indexed
+    const std::vector<uint32_t> local = triangle_list(raw, prim.mode, d.vertex_count, s.reader, where);
+    Primitive out;
+    out.name = m.name.empty() ? "primitive" + std::to_string(s.prims.size()) : m.name + "/" + std::to_string(p);
+    out.first_index = mesh.indices.size();
+    out.index_count = local.size();
+    out.source_mesh = node.mesh;
+    out.source_primitive = int(p);
+    out.vertex_base = d.vertex_base;
+    out.vertex_count = d.vertex_count;
+    for (uint32_t i : local) mesh.indices.push_back(uint32_t(d.vertex_base + i));
+    mesh.primitives.push_back(out);
+    parse_morph_targets(s, prim, where, d);
+    mesh.morph_target_count = std::max(mesh.morph_target_count, d.targets.size());
+    if (node.skin >= 0) {
+        if (size_t(node.skin) >= s.model.skins.size()) s.reader.fail(where + ": the node names a missing skin");
+        const size_t joint_count = s.model.skins[size_t(node.skin)].joints.size();
+        mesh.joint_count = std::max(mesh.joint_count, joint_count);
+        parse_skin_weights(s, prim, joint_count, where, d);
+    }
+    mesh.vertex_count += d.vertex_count;
+    return d;
+}
+
+// Every primitive of the mesh nodes, in scene order (node, then primitive): at least one.
+void parse_primitives(Scene& s, AnimatedMesh& mesh) {
+    mesh.joint_count = 0;
+    for (size_t n : s.order) {
+        const tinygltf::Node& node = s.model.nodes[n];
+        if (node.mesh < 0) continue;
+        if (size_t(node.mesh) >= s.model.meshes.size()) s.reader.fail("node " + std::to_string(n) + " names a missing mesh");
+        for (size_t p = 0; p < s.model.meshes[size_t(node.mesh)].primitives.size(); ++p)
+            s.prims.push_back(parse_primitive(s, n, p, mesh));
+    }
+    if (s.prims.empty()) s.reader.fail("no triangle mesh in the scene");
+}
+
+// Every node's pose without animation: matrix or T, R, S, and morph weights (the node's, else
+// its mesh's defaults).
+void parse_rest_pose(Scene& s) {
+    s.rest.resize(s.model.nodes.size());
+    for (size_t n = 0; n < s.model.nodes.size(); ++n) {
+        const tinygltf::Node& node = s.model.nodes[n];
+        NodePose& p = s.rest[n];
         if (node.matrix.size() == 16) {
             p.has_matrix = true;
             std::copy(node.matrix.begin(), node.matrix.end(), p.matrix.begin());
@@ -372,127 +460,174 @@ AnimatedMesh load_gltf(const std::string& path, const LoadOptions& options) {
         if (node.translation.size() == 3) std::copy(node.translation.begin(), node.translation.end(), p.t.begin());
         if (node.rotation.size() == 4) std::copy(node.rotation.begin(), node.rotation.end(), p.r.begin());
         if (node.scale.size() == 3) std::copy(node.scale.begin(), node.scale.end(), p.s.begin());
-        if (node.mesh >= 0 && size_t(node.mesh) < model.meshes.size()) p.weights = model.meshes[size_t(node.mesh)].weights;
+        if (node.mesh >= 0 && size_t(node.mesh) < s.model.meshes.size()) p.weights = s.model.meshes[size_t(node.mesh)].weights;
         if (!node.weights.empty()) p.weights = node.weights;
     }
-    std::vector<Mat> inverse_bind;  // per skin, concatenated
-    std::vector<size_t> skin_first;
-    for (const tinygltf::Skin& skin : model.skins) {
-        skin_first.push_back(inverse_bind.size());
+}
+
+// Every skin's inverse bind matrices (identity without them), its joints checked to be nodes.
+void parse_skins(Scene& s) {
+    for (const tinygltf::Skin& skin : s.model.skins) {
+        s.skin_first.push_back(s.inverse_bind.size());
         std::vector<double> m;
-        if (skin.inverseBindMatrices >= 0) m = reader.read(skin.inverseBindMatrices, 16);
+        if (skin.inverseBindMatrices >= 0) m = s.reader.read(skin.inverseBindMatrices, 16);
         for (size_t j = 0; j < skin.joints.size(); ++j) {
-            if (skin.joints[j] < 0 || size_t(skin.joints[j]) >= model.nodes.size()) reader.fail("a skin names a missing joint node");
+            if (skin.joints[j] < 0 || size_t(skin.joints[j]) >= s.model.nodes.size()) s.reader.fail("a skin names a missing joint node");
             Mat ibm = identity();
             if (!m.empty()) {
-                if (m.size() < 16 * (j + 1)) reader.fail("a skin has fewer inverse bind matrices than joints");
+                if (m.size() < 16 * (j + 1)) s.reader.fail("a skin has fewer inverse bind matrices than joints");
                 std::copy(m.begin() + ptrdiff_t(16 * j), m.begin() + ptrdiff_t(16 * j + 16), ibm.begin());
             }
-            inverse_bind.push_back(ibm);
+            s.inverse_bind.push_back(ibm);
         }
     }
+}
 
-    auto evaluate = [&](std::vector<NodePose> pose, float* out) {
-        std::vector<Mat> global(model.nodes.size(), identity());
-        for (size_t n : order) {
-            const NodePose& p = pose[n];
-            const Mat local = p.has_matrix ? p.matrix : trs(p.t, p.r, p.s);
-            global[n] = parent[n] >= 0 ? mul(global[size_t(parent[n])], local) : local;
+// One channel of a clip: its sampler's key times (sorted) and values (as many as the keys and
+// the path need).
+Channel parse_channel(const Scene& s, const tinygltf::Animation& anim, const tinygltf::AnimationChannel& ch,
+                      const std::string& name) {
+    if (ch.sampler < 0 || size_t(ch.sampler) >= anim.samplers.size()) s.reader.fail("clip '" + name + "' names a missing sampler");
+    const tinygltf::AnimationSampler& sampler = anim.samplers[size_t(ch.sampler)];
+    Channel c;
+    c.node = size_t(ch.target_node);
+    c.path = ch.target_path;
+    c.interpolation = sampler.interpolation;
+    c.times = s.reader.read(sampler.input, 1);
+    c.values = s.reader.read(sampler.output);
+    if (c.times.empty()) s.reader.fail("clip '" + name + "' has a channel without keys");
+    if (!std::is_sorted(c.times.begin(), c.times.end())) s.reader.fail("clip '" + name + "' has key times out of order");
+    const size_t components = channel_components(s, c.node, c.path);
+    const size_t per_key = (c.interpolation == "CUBICSPLINE" ? 3 : 1) * components;
+    if (components == 0 || c.values.size() != per_key * c.times.size())
+        s.reader.fail("clip '" + name + "' channel for node " + std::to_string(c.node) + " (" + c.path +
+                      ") has the wrong number of values");
+    return c;
+}
+
+// Every animation as a clip of channels, from its first to its last key time, with its keyframe
+// count at the sample rate (no more than kMaxClipKeyframes); channels of missing nodes are skipped.
+std::vector<ClipChannels> parse_animations(const Scene& s, const std::string& path, const LoadOptions& options) {
+    std::vector<ClipChannels> clips;
+    for (size_t a = 0; a < s.model.animations.size(); ++a) {
+        const tinygltf::Animation& anim = s.model.animations[a];
+        ClipChannels c;
+        c.clip.name = anim.name.empty() ? "animation" + std::to_string(a) : anim.name;
+        for (const tinygltf::AnimationChannel& ch : anim.channels)
+            if (ch.target_node >= 0 && size_t(ch.target_node) < s.model.nodes.size())
+                c.channels.push_back(parse_channel(s, anim, ch, c.clip.name));
+        if (c.channels.empty()) s.reader.fail("clip '" + c.clip.name + "' animates nothing");
+        c.t0 = INFINITY, c.t1 = -INFINITY;
+        for (const Channel& ch : c.channels) c.t0 = std::min(c.t0, ch.times.front()), c.t1 = std::max(c.t1, ch.times.back());
+        c.clip.duration_s = c.t1 - c.t0;
+        c.clip.sample_rate = options.sample_rate;
+        c.clip.keyframe_count = io::clip_keyframes(path, c.clip.name, c.clip.duration_s, options.sample_rate);
+        clips.push_back(std::move(c));
+    }
+    return clips;
+}
+
+// Positions of every vertex in `pose` into out (vertex_count × 3 floats): node transforms down
+// the hierarchy, then per primitive morph targets, then its skin (joint matrix = joint's global
+// transform · inverse bind matrix) or, unskinned, its node's global transform.
+void evaluate_pose(const Scene& s, const std::vector<NodePose>& pose, float* out) {
+    std::vector<Mat> global(s.model.nodes.size(), identity());
+    for (size_t n : s.order) {
+        const NodePose& p = pose[n];
+        const Mat local = p.has_matrix ? p.matrix : trs(p.t, p.r, p.s);
+        global[n] = s.parent[n] >= 0 ? mul(global[size_t(s.parent[n])], local) : local;
+    }
+    for (const PrimitiveData& d : s.prims) {
+        const tinygltf::Node& node = s.model.nodes[d.node];
+        std::vector<float> morphed(d.positions.size());
+        const std::vector<double>& w = pose[d.node].weights;
+        for (size_t i = 0; i < d.positions.size(); ++i) {
+            double v = d.positions[i];
+            for (size_t t = 0; t < d.targets.size() && t < w.size(); ++t) v += w[t] * d.targets[t][i];
+            morphed[i] = float(v);
         }
-        for (const PrimitiveData& d : prims) {
-            const tinygltf::Node& node = model.nodes[d.node];
-            std::vector<float> morphed(d.positions.size());
-            const std::vector<double>& w = pose[d.node].weights;
-            for (size_t i = 0; i < d.positions.size(); ++i) {
-                double v = d.positions[i];
-                for (size_t t = 0; t < d.targets.size() && t < w.size(); ++t) v += w[t] * d.targets[t][i];
-                morphed[i] = float(v);
+        float* dst = out + 3 * d.vertex_base;
+        if (node.skin >= 0) {
+            const tinygltf::Skin& skin = s.model.skins[size_t(node.skin)];
+            std::vector<Mat4> joints(skin.joints.size());
+            for (size_t j = 0; j < skin.joints.size(); ++j) {
+                const Mat m = mul(global[size_t(skin.joints[j])], s.inverse_bind[s.skin_first[size_t(node.skin)] + j]);
+                for (int k = 0; k < 16; ++k) joints[j][size_t(k)] = float(m[size_t(k)]);
             }
-            float* dst = out + 3 * d.vertex_base;
-            if (node.skin >= 0) {
-                const tinygltf::Skin& skin = model.skins[size_t(node.skin)];
-                std::vector<Mat4> joints(skin.joints.size());
-                for (size_t j = 0; j < skin.joints.size(); ++j) {
-                    const Mat m = mul(global[size_t(skin.joints[j])], inverse_bind[skin_first[size_t(node.skin)] + j]);
-                    for (int k = 0; k < 16; ++k) joints[j][size_t(k)] = float(m[size_t(k)]);
-                }
-                try {
-                    skin_positions(dst, morphed.data(), d.vertex_count, d.joints.data(), d.weights.data(), d.influences,
-                                   joints.data(), joints.size());
-                } catch (const InvalidInput& e) {
-                    reader.fail(e.what());
-                }
-            } else {
-                const Mat& m = global[d.node];
-                for (size_t v = 0; v < d.vertex_count; ++v) {
-                    const double x = morphed[3 * v], y = morphed[3 * v + 1], z = morphed[3 * v + 2];
-                    for (int r = 0; r < 3; ++r) dst[3 * v + size_t(r)] = float(m[size_t(r)] * x + m[size_t(4 + r)] * y + m[size_t(8 + r)] * z + m[size_t(12 + r)]);
-                }
+            try {
+                skin_positions(dst, morphed.data(), d.vertex_count, d.joints.data(), d.weights.data(), d.influences,
+                               joints.data(), joints.size());
+            } catch (const InvalidInput& e) {
+                s.reader.fail(e.what());
+            }
+        } else {
+            const Mat& m = global[d.node];
+            for (size_t v = 0; v < d.vertex_count; ++v) {
+                const double x = morphed[3 * v], y = morphed[3 * v + 1], z = morphed[3 * v + 2];
+                for (int r = 0; r < 3; ++r) dst[3 * v + size_t(r)] = float(m[size_t(r)] * x + m[size_t(4 + r)] * y + m[size_t(8 + r)] * z + m[size_t(12 + r)]);
             }
         }
-    };
+    }
+}
 
-    auto add_keyframe = [&](const std::vector<NodePose>& pose) {
-        const size_t first = mesh.keyframe_positions.size();
-        mesh.keyframe_positions.resize(first + mesh.vertex_count * 3);
-        evaluate(pose, mesh.keyframe_positions.data() + first);
-    };
+// One more keyframe of the mesh: the vertices in `pose`.
+void add_keyframe(const Scene& s, const std::vector<NodePose>& pose, AnimatedMesh& mesh) {
+    const size_t first = mesh.keyframe_positions.size();
+    mesh.keyframe_positions.resize(first + mesh.vertex_count * 3);
+    evaluate_pose(s, pose, mesh.keyframe_positions.data() + first);
+}
 
-    if (model.animations.empty()) {
-        add_keyframe(rest);
+// The rest pose with every channel of a clip sampled at time t (an animated T, R or S replaces a
+// node's matrix).
+std::vector<NodePose> pose_at(const Scene& s, const std::vector<Channel>& channels, double t) {
+    std::vector<NodePose> pose = s.rest;
+    for (const Channel& c : channels) {
+        const bool rotation = c.path == "rotation";
+        const std::vector<double> v = sample(c.times, c.values, channel_components(s, c.node, c.path), c.interpolation, rotation, t);
+        NodePose& p = pose[c.node];
+        if (c.path == "translation") std::copy(v.begin(), v.end(), p.t.begin());
+        else if (rotation) std::copy(v.begin(), v.end(), p.r.begin());
+        else if (c.path == "scale") std::copy(v.begin(), v.end(), p.s.begin());
+        else if (c.path == "weights") p.weights = v;
+        p.has_matrix = p.has_matrix && c.path == "weights";  // an animated TRS replaces a matrix
+    }
+    return pose;
+}
+
+// A clip's keyframes, every 1 / sample_rate seconds from its first key time, the last one at its
+// last key time, appended to the mesh.
+void sample_keyframes(const Scene& s, ClipChannels& c, const LoadOptions& options, AnimatedMesh& mesh) {
+    c.clip.first_keyframe = mesh.keyframe_count();
+    for (size_t f = 0; f < c.clip.keyframe_count; ++f)
+        add_keyframe(s, pose_at(s, c.channels, std::min(c.t0 + double(f) / options.sample_rate, c.t1)), mesh);
+    mesh.clips.push_back(c.clip);
+}
+
+}  // namespace
+
+// The steps, in order: the file, the node hierarchy, primitives (with morph targets and skin
+// weights), rest pose, skins, animations into clips; then, within the loading budget, keyframes.
+AnimatedMesh load_gltf(const std::string& path, const LoadOptions& options) {
+    if (!(options.sample_rate > 0 && options.sample_rate <= 1000)) throw LoadError(path + ": sample rate must be in (0, 1000]");
+    const tinygltf::Model model = parse_file(path);
+    const Reader reader(model, path, options.max_keyframe_bytes);
+    Scene scene{model, reader, {}, {}, {}, {}, {}, {}};
+    AnimatedMesh mesh;
+    mesh.name = path;
+    parse_node_hierarchy(scene);
+    parse_primitives(scene, mesh);
+    parse_rest_pose(scene);
+    parse_skins(scene);
+    std::vector<ClipChannels> clips = parse_animations(scene, path, options);
+
+    size_t keyframes = clips.empty() ? 1 : 0;  // without animation: one static keyframe
+    for (const ClipChannels& c : clips) keyframes += c.clip.keyframe_count;
+    io::check_keyframe_budget(path, keyframes, mesh.vertex_count, options);
+    if (clips.empty()) {
+        add_keyframe(scene, scene.rest, mesh);
         mesh.clips.push_back({"static", 0.0, options.sample_rate, 0, 1});
     }
-    for (size_t a = 0; a < model.animations.size(); ++a) {
-        const tinygltf::Animation& anim = model.animations[a];
-        const std::string name = anim.name.empty() ? "animation" + std::to_string(a) : anim.name;
-        std::vector<Channel> channels;
-        for (const tinygltf::AnimationChannel& ch : anim.channels) {
-            if (ch.target_node < 0 || size_t(ch.target_node) >= model.nodes.size()) continue;
-            if (ch.sampler < 0 || size_t(ch.sampler) >= anim.samplers.size()) reader.fail("clip '" + name + "' names a missing sampler");
-            const tinygltf::AnimationSampler& s = anim.samplers[size_t(ch.sampler)];
-            Channel c;
-            c.node = size_t(ch.target_node);
-            c.path = ch.target_path;
-            c.interpolation = s.interpolation;
-            c.times = reader.read(s.input, 1);
-            c.values = reader.read(s.output);
-            if (c.times.empty()) reader.fail("clip '" + name + "' has a channel without keys");
-            if (!std::is_sorted(c.times.begin(), c.times.end())) reader.fail("clip '" + name + "' has key times out of order");
-            const size_t components = c.path == "rotation" ? 4 : c.path == "weights" ? rest[c.node].weights.size() : 3;
-            const size_t per_key = (c.interpolation == "CUBICSPLINE" ? 3 : 1) * components;
-            if (components == 0 || c.values.size() != per_key * c.times.size())
-                reader.fail("clip '" + name + "' channel for node " + std::to_string(c.node) + " (" + c.path +
-                            ") has the wrong number of values");
-            channels.push_back(std::move(c));
-        }
-        if (channels.empty()) reader.fail("clip '" + name + "' animates nothing");
-        double t0 = INFINITY, t1 = -INFINITY;
-        for (const Channel& c : channels) t0 = std::min(t0, c.times.front()), t1 = std::max(t1, c.times.back());
-        Clip clip;
-        clip.name = name;
-        clip.duration_s = t1 - t0;
-        clip.sample_rate = options.sample_rate;
-        clip.first_keyframe = mesh.keyframe_count();
-        clip.keyframe_count = size_t(std::llround(clip.duration_s * options.sample_rate)) + 1;
-        if (clip.keyframe_count > 100000) reader.fail("clip '" + name + "' is absurdly long");
-        for (size_t f = 0; f < clip.keyframe_count; ++f) {
-            const double t = std::min(t0 + double(f) / options.sample_rate, t1);
-            std::vector<NodePose> pose = rest;
-            for (const Channel& c : channels) {
-                const bool rotation = c.path == "rotation";
-                const size_t components = rotation ? 4 : c.path == "weights" ? rest[c.node].weights.size() : 3;
-                const std::vector<double> v = sample(c.times, c.values, components, c.interpolation, rotation, t);
-                NodePose& p = pose[c.node];
-                if (c.path == "translation") std::copy(v.begin(), v.end(), p.t.begin());
-                else if (rotation) std::copy(v.begin(), v.end(), p.r.begin());
-                else if (c.path == "scale") std::copy(v.begin(), v.end(), p.s.begin());
-                else if (c.path == "weights") p.weights = v;
-                p.has_matrix = p.has_matrix && c.path == "weights";  // an animated TRS replaces a matrix
-            }
-            add_keyframe(pose);
-        }
-        mesh.clips.push_back(clip);
-    }
+    for (ClipChannels& c : clips) sample_keyframes(scene, c, options, mesh);
     try {
         validate_animated_mesh(mesh);
     } catch (const InvalidInput& e) {

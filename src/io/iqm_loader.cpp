@@ -17,6 +17,7 @@
 #include "animorder/load.h"
 #include "animorder/skinning.h"
 
+#include "checked_size.h"
 #include "transform.h"
 
 #include <cmath>
@@ -62,6 +63,7 @@ Mat pose_matrix(const double t[3], const double q_in[4], const double s[3]) {
 }  // namespace
 
 AnimatedMesh load_iqm(const std::string& path, const LoadOptions& options) {
+    if (!(options.sample_rate > 0 && options.sample_rate <= 1000)) throw LoadError(path + ": sample rate must be in (0, 1000]");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw LoadError(path + ": cannot open file");
     const Bytes b(path, std::vector<unsigned char>((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()));
@@ -80,7 +82,7 @@ AnimatedMesh load_iqm(const std::string& path, const LoadOptions& options) {
     b.need(ofs_joints, num_joints, 48, "joints");
     b.need(ofs_poses, num_poses, 88, "poses");
     b.need(ofs_anims, num_anims, 20, "animations");
-    b.need(ofs_frames, num_frames * num_channels, 2, "frames");
+    b.need(ofs_frames, io::mul_or_throw(path + ": frames", num_frames, num_channels), 2, "frames");
     if (num_vertexes == 0 || num_triangles == 0) throw b.fail("no triangle mesh in the file");
 
     std::vector<float> positions;
@@ -91,10 +93,12 @@ AnimatedMesh load_iqm(const std::string& path, const LoadOptions& options) {
         const uint32_t type = b.u32(at), format = b.u32(at + 8), size = b.u32(at + 12), offset = b.u32(at + 16);
         if (type == 0) {  // POSITION
             if (format != 7 || size != 3) throw b.fail("positions must be 3 floats");
+            if (!positions.empty()) throw b.fail("two POSITION vertex arrays");
             b.need(offset, num_vertexes * 3, 4, "positions");
             for (size_t i = 0; i < num_vertexes * 3; ++i) positions.push_back(b.f32(offset + 4 * i));
         } else if (type == 4 || type == 5) {  // BLENDINDEXES, BLENDWEIGHTS
             if (format != 1 || size != 4) throw b.fail("blend indices and weights must be 4 unsigned bytes");
+            if (type == 4 ? !joints.empty() : !weights.empty()) throw b.fail("two blend index or weight vertex arrays");
             b.need(offset, num_vertexes * 4, 1, "blend data");
             for (size_t i = 0; i < num_vertexes * 4; ++i)
                 if (type == 4) joints.push_back(b.u8(offset + i));
@@ -128,7 +132,7 @@ AnimatedMesh load_iqm(const std::string& path, const LoadOptions& options) {
     for (size_t j = 0; j < num_joints; ++j) {
         const size_t at = ofs_joints + 48 * j;
         parent[j] = int32_t(b.u32(at + 4));
-        if (parent[j] >= int(j)) throw b.fail("joint " + std::to_string(j) + " has a parent that does not come before it");
+        if (parent[j] >= 0 && size_t(parent[j]) >= j) throw b.fail("joint " + std::to_string(j) + " has a parent that does not come before it");
         double t[3], q[4], s[3];
         for (int c = 0; c < 3; ++c) t[c] = b.f32(at + 8 + 4 * size_t(c));
         for (int c = 0; c < 4; ++c) q[c] = b.f32(at + 20 + 4 * size_t(c));
@@ -173,28 +177,45 @@ AnimatedMesh load_iqm(const std::string& path, const LoadOptions& options) {
         return out;
     };
 
+    // Every animation's frames and keyframe count first: the total is checked against the loading
+    // budget before any frame is skinned or any clip sampled.
+    struct Animation {
+        uint32_t first, count;
+        double rate;
+    };
+    std::vector<Animation> anims;
+    size_t total_keyframes = 0;
     for (size_t a = 0; a < num_anims; ++a) {
         const size_t at = ofs_anims + 20 * a;
         const uint32_t first = b.u32(at + 4), count = b.u32(at + 8);
         const double rate = b.f32(at + 12) > 0 ? b.f32(at + 12) : 24.0;
         if (count == 0 || size_t(first) + count > num_frames) throw b.fail("animation " + std::to_string(a) + " names missing frames");
-        std::vector<std::vector<float>> frames;
-        for (uint32_t f = 0; f < count; ++f) frames.push_back(frame_positions(long(first + f)));
+        if (!std::isfinite(rate)) throw b.fail("animation " + std::to_string(a) + " has an infinite frame rate");
+        io::check_keyframe_budget(path, count, num_vertexes, options);  // its frames, skinned before resampling
         Clip clip;
         clip.name = b.text(ofs_text, num_text, b.u32(at));
         if (clip.name.empty()) clip.name = "animation" + std::to_string(a);
         clip.duration_s = double(count - 1) / rate;
         clip.sample_rate = options.sample_rate;
-        clip.first_keyframe = mesh.keyframe_count();
-        clip.keyframe_count = size_t(std::llround(clip.duration_s * options.sample_rate)) + 1;
-        for (size_t k = 0; k < clip.keyframe_count; ++k) {
+        clip.first_keyframe = total_keyframes;
+        clip.keyframe_count = io::clip_keyframes(path, clip.name, clip.duration_s, options.sample_rate);
+        total_keyframes += clip.keyframe_count;
+        mesh.clips.push_back(clip);
+        anims.push_back({first, count, rate});
+    }
+    io::check_keyframe_budget(path, total_keyframes, num_vertexes, options);
+
+    for (size_t a = 0; a < anims.size(); ++a) {
+        const auto [first, count, rate] = anims[a];
+        std::vector<std::vector<float>> frames;
+        for (uint32_t f = 0; f < count; ++f) frames.push_back(frame_positions(long(first + f)));
+        for (size_t k = 0; k < mesh.clips[a].keyframe_count; ++k) {
             const double at_frame = std::min(double(k) / options.sample_rate * rate, double(count - 1));
             const size_t f0 = size_t(at_frame), f1 = std::min<size_t>(f0 + 1, count - 1);
             const float u = float(at_frame - double(f0));
             for (size_t i = 0; i < positions.size(); ++i)
                 mesh.keyframe_positions.push_back(frames[f0][i] + u * (frames[f1][i] - frames[f0][i]));
         }
-        mesh.clips.push_back(clip);
     }
     if (mesh.clips.empty()) {
         mesh.keyframe_positions = frame_positions(-1);

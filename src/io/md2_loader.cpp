@@ -15,11 +15,15 @@
 #include "animorder/invalid_input.h"
 #include "animorder/load.h"
 
+#include "checked_size.h"
+
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <utility>
 
 namespace animorder {
 namespace {
@@ -35,6 +39,7 @@ int32_t i32(const std::vector<unsigned char>& d, size_t at) {
 }  // namespace
 
 AnimatedMesh load_md2(const std::string& path, const LoadOptions& options) {
+    if (!(options.sample_rate > 0 && options.sample_rate <= 1000)) throw LoadError(path + ": sample rate must be in (0, 1000]");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw LoadError(path + ": cannot open file");
     const std::vector<unsigned char> d((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -43,18 +48,25 @@ AnimatedMesh load_md2(const std::string& path, const LoadOptions& options) {
     if (std::memcmp(d.data(), "IDP2", 4) != 0 || i32(d, 4) != 8) throw fail("not an MD2 version 8 file");
     const int32_t frame_size = i32(d, 16), vertices = i32(d, 24), triangles = i32(d, 32), frames = i32(d, 40);
     const int32_t ofs_tris = i32(d, 52), ofs_frames = i32(d, 56);
-    if (vertices <= 0 || triangles <= 0 || frames <= 0 || frame_size < 40 + 4 * vertices)
+    // Every count and offset is hostile: compared in 64 bits (40 + 4 · vertices overflows an int)
+    // and every byte range checked against the file before anything is allocated or read.
+    if (vertices <= 0 || triangles <= 0 || frames <= 0 || int64_t(frame_size) < 40 + 4 * int64_t(vertices))
         throw fail("header counts are invalid");
-    if (ofs_tris < 0 || size_t(ofs_tris) + size_t(triangles) * 12 > d.size() || ofs_frames < 0 ||
-        size_t(ofs_frames) + size_t(frames) * size_t(frame_size) > d.size())
+    size_t tris_end = 0, frames_end = 0;
+    if (ofs_tris < 0 || ofs_frames < 0 || !io::checked_add(size_t(ofs_tris), size_t(triangles) * 12, tris_end) ||
+        tris_end > d.size() ||
+        !io::checked_add(size_t(ofs_frames), io::mul_or_throw(path + ": frames", size_t(frames), size_t(frame_size)), frames_end) ||
+        frames_end > d.size())
         throw fail("file is truncated (triangles or frames past its end)");
+    // The file's own frames, then the resampled clips, must fit the loading budget.
+    io::check_keyframe_budget(path, size_t(frames), size_t(vertices), options);
 
     AnimatedMesh mesh;
     mesh.name = path;
     mesh.vertex_count = size_t(vertices);
     for (int32_t t = 0; t < triangles; ++t) {
         uint16_t v[3];
-        std::memcpy(v, d.data() + ofs_tris + 12 * t, 6);
+        std::memcpy(v, d.data() + size_t(ofs_tris) + 12 * size_t(t), 6);
         for (uint16_t x : v)
             if (x >= vertices)
                 throw fail("triangle " + std::to_string(t) + " names vertex " + std::to_string(x) + ", there are " +
@@ -75,15 +87,22 @@ AnimatedMesh load_md2(const std::string& path, const LoadOptions& options) {
         float scale[3], translate[3];
         std::memcpy(scale, p, 12);
         std::memcpy(translate, p + 12, 12);
+        for (int c = 0; c < 3; ++c)
+            if (!std::isfinite(scale[c]) || !std::isfinite(translate[c]))
+                throw fail("frame " + std::to_string(f) + " has a NaN or infinite scale or translation");
         std::string name(reinterpret_cast<const char*>(p + 24), strnlen(reinterpret_cast<const char*>(p + 24), 16));
         while (!name.empty() && std::isdigit(static_cast<unsigned char>(name.back()))) name.pop_back();
         group[size_t(f)] = name.empty() ? "frames" : name;
         for (int32_t v = 0; v < vertices; ++v)
             for (int c = 0; c < 3; ++c)
-                frame_positions[size_t(f)][size_t(v) * 3 + size_t(c)] = float(p[40 + 4 * v + c]) * scale[c] + translate[c];
+                frame_positions[size_t(f)][size_t(v) * 3 + size_t(c)] = float(p[40 + 4 * size_t(v) + size_t(c)]) * scale[c] + translate[c];
     }
 
-    // One clip per run of frames with the same group name, resampled from 10 frames per second.
+    // One clip per run of frames with the same group name, resampled from 10 frames per second;
+    // every clip's keyframe count is known (and the total checked against the budget) before any
+    // is sampled.
+    std::vector<std::pair<int32_t, int32_t>> runs;  // [begin, end) frames of each clip
+    size_t total_keyframes = 0;
     for (int32_t begin = 0; begin < frames;) {
         int32_t end = begin + 1;
         while (end < frames && group[size_t(end)] == group[size_t(begin)]) ++end;
@@ -91,17 +110,24 @@ AnimatedMesh load_md2(const std::string& path, const LoadOptions& options) {
         clip.name = group[size_t(begin)];
         clip.duration_s = double(end - begin - 1) / kMd2FramesPerSecond;
         clip.sample_rate = options.sample_rate;
-        clip.first_keyframe = mesh.keyframe_count();
-        clip.keyframe_count = size_t(std::llround(clip.duration_s * options.sample_rate)) + 1;
-        for (size_t k = 0; k < clip.keyframe_count; ++k) {
+        clip.keyframe_count = io::clip_keyframes(path, clip.name, clip.duration_s, options.sample_rate);
+        clip.first_keyframe = total_keyframes;
+        total_keyframes += clip.keyframe_count;
+        mesh.clips.push_back(clip);
+        runs.emplace_back(begin, end);
+        begin = end;
+    }
+    io::check_keyframe_budget(path, total_keyframes, size_t(vertices), options);
+    mesh.keyframe_positions.reserve(total_keyframes * size_t(vertices) * 3);
+    for (size_t c = 0; c < mesh.clips.size(); ++c) {
+        const auto [begin, end] = runs[c];
+        for (size_t k = 0; k < mesh.clips[c].keyframe_count; ++k) {
             const double at = std::min(double(k) / options.sample_rate * kMd2FramesPerSecond, double(end - begin - 1));
             const size_t a = size_t(begin) + size_t(at), b = std::min(a + 1, size_t(end - 1));
             const float u = float(at - std::floor(at));
             for (size_t i = 0; i < size_t(vertices) * 3; ++i)
                 mesh.keyframe_positions.push_back(frame_positions[a][i] + u * (frame_positions[b][i] - frame_positions[a][i]));
         }
-        mesh.clips.push_back(clip);
-        begin = end;
     }
     try {
         validate_animated_mesh(mesh);

@@ -6,6 +6,8 @@
 #include "animorder/load.h"
 #include "support/meshes.h"
 
+#include "support/require.h"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -73,6 +75,20 @@ protected:
         const fs::path p = dir_ / name;
         std::ofstream(p, std::ios::binary) << content;
         return p.string();
+    }
+    // Loading `content` fails with a one-line LoadError that starts with the file name and holds `message`.
+    void expect_load_error(const std::string& name, const std::string& content, const std::string& message,
+                           const LoadOptions& options = {}) {
+        const std::string path = write(name, content);
+        try {
+            load_gltf(path, options);
+            ADD_FAILURE() << name << ": no error";
+        } catch (const LoadError& e) {
+            const std::string what = e.what();
+            EXPECT_EQ(what.rfind(path, 0), 0u) << what;
+            EXPECT_NE(what.find(message), std::string::npos) << name << ": " << what;
+            EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+        }
     }
     fs::path dir_;
 };
@@ -245,6 +261,161 @@ TEST_F(GltfLoader, BrokenFilesGiveOneLineErrorsNamingTheFile) {
     }
 }
 
+// Regressions from hostile files: sizes, counts and offsets that wrapped or were used before they
+// were checked (heap overflows, a SEGV, out-of-bounds reads, 32 GB allocations).
+TEST_F(GltfLoader, HostileAccessorsGiveOneLineErrors) {
+    {
+        Gltf g = skinned_bar();  // count × 3 components wraps to 2
+        g.doc["accessors"][0]["count"] = 6148914691236517206ull;
+        expect_load_error("wrap.gltf", g.text(), "runs past the end of its buffer view");
+    }
+    {
+        Gltf g = skinned_bar();
+        g.doc["accessors"][0]["bufferView"] = 99;
+        expect_load_error("view.gltf", g.text(), "names a missing buffer view");
+    }
+    {
+        Gltf g = skinned_bar();  // offset + stride · (count − 1) + element wraps to a small number
+        g.doc["accessors"][0]["byteOffset"] = 18446744073709551600ull;
+        expect_load_error("offset.gltf", g.text(), "runs past the end of its buffer view");
+    }
+    {
+        Gltf g = skinned_bar();
+        g.doc["bufferViews"][0]["byteOffset"] = 18446744073709551600ull;
+        expect_load_error("view-offset.gltf", g.text(), "runs past the end of its buffer");
+    }
+    {
+        Gltf g = skinned_bar();  // 32 GB of doubles if allocated before the range check
+        g.doc["accessors"][0]["count"] = 1000000000;
+        expect_load_error("count.gltf", g.text(), "runs past the end of its buffer view");
+    }
+    {
+        Gltf g = skinned_bar();
+        g.doc["accessors"][0]["sparse"] = {{"count", -1},
+                                           {"indices", {{"bufferView", 1}, {"componentType", 5123}}},
+                                           {"values", {{"bufferView", 0}}}};
+        expect_load_error("sparse-count.gltf", g.text(), "substitutes -1 of 4 elements");
+    }
+    {
+        Gltf g = skinned_bar();
+        g.doc["accessors"][0]["sparse"] = {{"count", 1},
+                                           {"indices", {{"bufferView", 0}, {"componentType", 5126}}},
+                                           {"values", {{"bufferView", 0}}}};
+        expect_load_error("sparse-type.gltf", g.text(), "not unsigned integers");
+    }
+    {
+        Gltf g = skinned_bar();  // no buffer view: a billion zeros, 24 GB of doubles
+        g.doc["accessors"].push_back({{"componentType", 5126}, {"count", 1000000000}, {"type", "VEC3"}});
+        g.doc["meshes"][0]["primitives"][0]["targets"] = json::array({json{{"POSITION", g.doc["accessors"].size() - 1}}});
+        expect_load_error("zeros.gltf", g.text(), "more than the loading budget");
+    }
+    {
+        Gltf g = skinned_bar();
+        const std::vector<int8_t> bad = {0, 1, 2, 0, 2, -1};
+        g.doc["meshes"][0]["primitives"][0]["indices"] = g.add(bad.data(), bad.size(), bad.size(), "SCALAR", 5120);
+        expect_load_error("negative-index.gltf", g.text(), "is -1, but there are 4 vertices");
+    }
+    {
+        Gltf g = skinned_bar();
+        const std::vector<int8_t> joints = {0, 0, 0, 0, 0, 0, 0, 0, -1, 0, 0, 0, 1, 0, 0, 0};
+        g.doc["meshes"][0]["primitives"][0]["attributes"]["JOINTS_0"] = g.add(joints.data(), joints.size(), 4, "VEC4", 5120);
+        expect_load_error("negative-joint.gltf", g.text(), "names joint -1");
+    }
+    {
+        Gltf g = skinned_bar();
+        g.doc["nodes"][2]["skin"] = 5;
+        expect_load_error("skin.gltf", g.text(), "names a missing skin");
+    }
+    {
+        Gltf g = skinned_bar();
+        g.doc["skins"][0]["joints"] = {0, 7};
+        expect_load_error("joint-node.gltf", g.text(), "missing joint node");
+    }
+    {
+        Gltf g = skinned_bar();
+        g.doc["animations"][0]["channels"][0]["sampler"] = 3;
+        expect_load_error("sampler.gltf", g.text(), "names a missing sampler");
+    }
+    {
+        Gltf g = skinned_bar();
+        g.doc["nodes"][1]["children"] = {0};  // a cycle: root → child → root
+        expect_load_error("cycle.gltf", g.text(), "repeated node");
+    }
+}
+
+// Every size, count, offset and index of the accessors, buffer views and sparse substitutions
+// set in turn to values a hostile file would use (negative, zero, just past a limit, near 2^31,
+// 2^32, 2^63, 2^64): each file loads or fails with a LoadError, nothing else (under
+// scripts/test-sanitized.sh: no memory error, no undefined behaviour).
+TEST_F(GltfLoader, HostileNumbersLoadOrFailCleanly) {
+    Gltf bar = skinned_bar();
+    bar.doc["accessors"][0]["sparse"] = {{"count", 1},
+                                         {"indices", {{"bufferView", 1}, {"componentType", 5123}}},
+                                         {"values", {{"bufferView", 0}}}};
+    const json values = json::array({-1, 0, 1, 3, 4, 255, 2147483647LL, 4294967296LL, 9223372036854775807LL,
+                                     18446744073709551615ULL});
+    const std::vector<std::pair<std::string, std::vector<std::string>>> fields = {
+        {"accessors", {"/bufferView", "/byteOffset", "/count", "/componentType", "/sparse/count",
+                       "/sparse/indices/bufferView", "/sparse/indices/byteOffset", "/sparse/values/bufferView",
+                       "/sparse/values/byteOffset"}},
+        {"bufferViews", {"/buffer", "/byteOffset", "/byteLength", "/byteStride"}}};
+    size_t loaded = 0, refused = 0;
+    for (const auto& [array, keys] : fields)
+        for (size_t i = 0; i < bar.doc[array].size(); ++i)
+            for (const std::string& key : keys) {
+                const json::json_pointer at("/" + array + "/" + std::to_string(i) + key);
+                if (!bar.doc.contains(at)) continue;
+                for (const json& value : values) {
+                    Gltf g = bar;
+                    g.doc[at] = value;
+                    const std::string path = write("hostile.gltf", g.text());
+                    try {
+                        load_gltf(path);
+                        ++loaded;
+                    } catch (const LoadError& e) {
+                        EXPECT_EQ(std::string(e.what()).rfind(path, 0), 0u) << e.what();
+                        EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+                        ++refused;
+                    }
+                }
+            }
+    EXPECT_GT(loaded, 0u);
+    EXPECT_GT(refused, 100u);
+}
+
+// The long clip of the finding (its last key at 3,333 s passes the 100,000-keyframe cap) is
+// refused by the loading budget before any keyframe is sampled; one more second is too long.
+TEST_F(GltfLoader, LoadingBudgetIsCheckedBeforeSampling) {
+    auto clip_until = [](double last) {
+        Gltf g = skinned_bar();
+        const std::vector<float> times = {0, float(last)};
+        g.doc["animations"][0]["samplers"][0]["input"] = g.floats(times, "SCALAR", 1);
+        return g.text();
+    };
+    LoadOptions small;
+    small.max_keyframe_bytes = 1 << 20;  // 99,991 keyframes × 4 vertices × 12 bytes = 4.8 MB
+    expect_load_error("long.gltf", clip_until(3333), "loading budget", small);
+    expect_load_error("longer.gltf", clip_until(3334), "absurdly long");
+    // The bar's 1 s clip: 31 keyframes × 4 vertices × 12 bytes = 1,488 bytes, exactly.
+    small.max_keyframe_bytes = 1488;
+    EXPECT_EQ(load_gltf(write("fits.gltf", clip_until(1)), small).keyframe_count(), 31u);
+    small.max_keyframe_bytes = 1487;
+    expect_load_error("tight.gltf", clip_until(1), "loading budget", small);
+}
+
+// Accessors named many times are read each time: their values together count against the budget.
+TEST_F(GltfLoader, AccessorsNamedManyTimesCountAgainstTheBudget) {
+    Gltf g = skinned_bar();
+    // 1,000 morph targets that are all the positions: 1,000 × 4 × 3 doubles = 96,000 bytes.
+    g.doc["meshes"][0]["primitives"][0]["targets"] = json::array();
+    for (int t = 0; t < 1000; ++t) g.doc["meshes"][0]["primitives"][0]["targets"].push_back({{"POSITION", 0}});
+    LoadOptions small;
+    small.max_keyframe_bytes = 64000;
+    expect_load_error("targets.gltf", g.text(), "is one accessor named many times?", small);
+    small.max_keyframe_bytes = 200000;
+    EXPECT_EQ(load_gltf(write("fits.gltf", g.text()), small).morph_target_count, 1000u);
+}
+
 namespace {
 std::string shared_data(const std::string& relative) {
     return (fs::path(ANIMORDER_SOURCE_DIR) / ".." / "shared" / "data" / relative).string();
@@ -257,7 +428,7 @@ TEST(GltfCharacters, EveryGltfInSharedDataLoads) {
                            "glb-robot-expressive/RobotExpressive.glb", "gltf-morph-stress-test/MorphStressTest.gltf",
                            "gltf-animated-morph-sphere/AnimatedMorphSphere.gltf", "glb-horse-morph/Horse.glb",
                            "glb-flamingo-morph/Flamingo.glb"};
-    if (!fs::exists(shared_data(""))) GTEST_SKIP() << "../shared/data is absent: real characters not checked";
+    ANIMORDER_REQUIRE_DATA(shared_data(""));
     for (const char* f : files) {
         SCOPED_TRACE(f);
         AnimatedMesh m;
@@ -272,7 +443,7 @@ TEST(GltfCharacters, EveryGltfInSharedDataLoads) {
 
 TEST(GltfCharacters, GanfaulSkinsWithoutStretching) {
     const std::string path = shared_data("mixamo-ganfaul/Ganfaul.gltf");
-    if (!fs::exists(path)) GTEST_SKIP() << path << " is absent";
+    ANIMORDER_REQUIRE_DATA(path);
     const AnimatedMesh m = load_gltf(path);
     EXPECT_NEAR(double(m.triangle_count()), 13802.0, 5.0);
     EXPECT_EQ(m.clips.size(), 12u);

@@ -1,0 +1,201 @@
+// The MD2 loader: a tiny model built here whose keyframes are worked out by hand, hostile headers
+// (overflowing counts, offsets past the end, indices out of range) as one-line errors, the loading
+// budget, and the MD2 characters of ../shared/data.
+#include "animorder/animated_mesh.h"
+#include "animorder/load.h"
+#include "animorder/md2_loader.h"
+#include "support/files.h"
+
+#include "support/require.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <vector>
+
+using namespace animorder;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A little-endian byte image that grows as values are written at given offsets.
+struct Image {
+    std::vector<unsigned char> bytes;
+    template <typename T>
+    void put(size_t at, T value) {
+        if (bytes.size() < at + sizeof(T)) bytes.resize(at + sizeof(T), 0);
+        std::memcpy(bytes.data() + at, &value, sizeof(T));
+    }
+    void put_text(size_t at, const char* text, size_t room) {
+        if (bytes.size() < at + room) bytes.resize(at + room, 0);
+        std::memcpy(bytes.data() + at, text, std::min(std::strlen(text), room));
+    }
+};
+
+// Header fields (id Software's md2.h) by byte offset.
+enum : size_t { kFrameSize = 16, kVertices = 24, kTexCoords = 28, kTriangles = 32, kFrames = 40, kOfsTris = 52, kOfsFrames = 56, kOfsEnd = 64 };
+
+// Three vertices, one triangle (0, 1, 2), two frames "wave1" and "wave2": frame f has scale
+// (1, 1, 1), translate (0, 0, 10·f) and vertex bytes v0 = (0, 0, 0), v1 = (4, 0, 0), v2 = (0, 8 + 2·f, 0).
+Image tiny_md2() {
+    Image m;
+    m.put_text(0, "IDP2", 4);
+    m.put<int32_t>(4, 8);
+    const int32_t vertices = 3, frame_size = 40 + 4 * vertices;
+    m.put<int32_t>(kFrameSize, frame_size);
+    m.put<int32_t>(kVertices, vertices);
+    m.put<int32_t>(kTexCoords, 0);
+    m.put<int32_t>(kTriangles, 1);
+    m.put<int32_t>(kFrames, 2);
+    m.put<int32_t>(kOfsTris, 68);
+    m.put<int32_t>(kOfsFrames, 68 + 12);
+    const uint16_t tri[6] = {0, 1, 2, 0, 0, 0};
+    for (size_t i = 0; i < 6; ++i) m.put<uint16_t>(68 + 2 * i, tri[i]);
+    for (int f = 0; f < 2; ++f) {
+        const size_t at = 80 + size_t(f) * size_t(frame_size);
+        for (int c = 0; c < 3; ++c) m.put<float>(at + 4 * size_t(c), 1.0f);
+        m.put<float>(at + 12, 0.0f);
+        m.put<float>(at + 16, 0.0f);
+        m.put<float>(at + 20, 10.0f * float(f));
+        m.put_text(at + 24, f == 0 ? "wave1" : "wave2", 16);
+        const unsigned char v[3][3] = {{0, 0, 0}, {4, 0, 0}, {0, static_cast<unsigned char>(8 + 2 * f), 0}};
+        for (size_t i = 0; i < 3; ++i)
+            for (size_t c = 0; c < 3; ++c) m.put<unsigned char>(at + 40 + 4 * i + c, v[i][c]);
+    }
+    m.bytes.resize(80 + 2 * size_t(frame_size));  // the last normal index byte
+    m.put<int32_t>(kOfsEnd, int32_t(m.bytes.size()));
+    return m;
+}
+
+class Md2Loader : public test::ScratchFolderTest {
+protected:
+    Md2Loader() : ScratchFolderTest("animorder-md2") {}
+    std::string write(const std::string& name, const Image& image) {
+        const fs::path p = path(name);
+        std::ofstream(p, std::ios::binary).write(reinterpret_cast<const char*>(image.bytes.data()), std::streamsize(image.bytes.size()));
+        return p.string();
+    }
+    // Loading `image` fails with a one-line LoadError that starts with the file name and holds `message`.
+    void expect_error(const std::string& name, const Image& image, const std::string& message, const LoadOptions& options = {}) {
+        const std::string file = write(name, image);
+        try {
+            load_md2(file, options);
+            ADD_FAILURE() << name << ": no error";
+        } catch (const LoadError& e) {
+            const std::string what = e.what();
+            EXPECT_EQ(what.rfind(file, 0), 0u) << what;
+            EXPECT_NE(what.find(message), std::string::npos) << name << ": " << what;
+            EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+        }
+    }
+};
+
+}  // namespace
+
+TEST_F(Md2Loader, TinyModelResamplesAsWorkedOutByHand) {
+    const AnimatedMesh m = load_md2(write("tiny.md2", tiny_md2()));
+    ASSERT_EQ(m.clips.size(), 1u);
+    EXPECT_EQ(m.clips[0].name, "wave");
+    EXPECT_EQ(m.clips[0].keyframe_count, 4u);  // 0.1 s (two frames at 10/s) at 30/s, both ends
+    EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 2, 1}));  // clockwise → counter-clockwise
+    // Keyframe k is 1/3·k of the way from frame 0 to frame 1: v2 = (0, 8 + 2k/3, 10k/3).
+    for (size_t k = 0; k < 4; ++k) {
+        const float* p = m.keyframe(k);
+        EXPECT_NEAR(p[3], 4.0, 1e-5);
+        EXPECT_NEAR(p[5], 10.0 * double(k) / 3, 1e-5);
+        EXPECT_NEAR(p[7], 8 + 2.0 * double(k) / 3, 1e-5) << k;
+    }
+}
+
+TEST_F(Md2Loader, HostileHeadersGiveOneLineErrors) {
+    {
+        Image m = tiny_md2();  // 40 + 4 · vertices overflows a 32-bit int
+        m.put<int32_t>(kVertices, 0x40000000);
+        expect_error("overflow.md2", m, "header counts are invalid");
+    }
+    {
+        Image m = tiny_md2();
+        m.put<int32_t>(kVertices, 0x7FFFFFFF);
+        m.put<int32_t>(kFrameSize, 0x7FFFFFFF);
+        expect_error("huge.md2", m, "header counts are invalid");
+    }
+    {
+        Image m = tiny_md2();
+        m.put<int32_t>(kFrames, 0x7FFFFFFF);
+        expect_error("frames.md2", m, "truncated");
+    }
+    {
+        Image m = tiny_md2();
+        m.put<int32_t>(kOfsFrames, 0x7FFFFFF0);
+        expect_error("offset.md2", m, "truncated");
+    }
+    {
+        Image m = tiny_md2();
+        m.put<int32_t>(kOfsTris, -12);
+        expect_error("negative.md2", m, "truncated");
+    }
+    {
+        Image m = tiny_md2();
+        m.put<uint16_t>(68 + 2, 3);
+        expect_error("index.md2", m, "names vertex 3, there are 3");
+    }
+    {
+        Image m = tiny_md2();
+        m.put<float>(80, NAN);
+        expect_error("nan.md2", m, "NaN");
+    }
+    Image m = tiny_md2();
+    m.bytes.resize(40);
+    expect_error("short.md2", m, "no MD2 header");
+    LoadOptions zero_rate;
+    zero_rate.sample_rate = 0;
+    expect_error("rate.md2", tiny_md2(), "sample rate", zero_rate);
+}
+
+// Every byte of the tiny file set in turn to 0x00, 0x7F, 0x80 and 0xFF (counts, offsets, indices,
+// floats become huge, negative, NaN): each copy loads or fails with a LoadError, nothing else
+// (under scripts/test-sanitized.sh: no memory error, no undefined behaviour).
+TEST_F(Md2Loader, EveryByteMutatedLoadsOrFailsCleanly) {
+    const Image tiny = tiny_md2();
+    size_t loaded = 0, refused = 0;
+    for (size_t at = 0; at < tiny.bytes.size(); ++at)
+        for (unsigned char value : {0x00, 0x7F, 0x80, 0xFF}) {
+            Image m = tiny;
+            m.bytes[at] = value;
+            const std::string file = write("mutated.md2", m);
+            try {
+                const AnimatedMesh mesh = load_md2(file);
+                EXPECT_NO_THROW(validate_animated_mesh(mesh)) << "byte " << at << " = " << int(value);
+                ++loaded;
+            } catch (const LoadError& e) {
+                EXPECT_EQ(std::string(e.what()).rfind(file, 0), 0u) << e.what();
+                ++refused;
+            }
+        }
+    EXPECT_GT(loaded, 0u);
+    EXPECT_GT(refused, 0u);
+}
+
+TEST_F(Md2Loader, LoadingBudgetIsCheckedBeforeSampling) {
+    LoadOptions small;
+    small.max_keyframe_bytes = 4 * 3 * 12 - 1;  // one byte less than the four keyframes of three vertices
+    expect_error("budget.md2", tiny_md2(), "loading budget", small);
+    small.max_keyframe_bytes = 4 * 3 * 12;
+    EXPECT_EQ(load_md2(write("fits.md2", tiny_md2()), small).keyframe_count(), 4u);
+}
+
+TEST(Md2Characters, EveryMd2InSharedDataLoads) {
+    const fs::path data = fs::path(ANIMORDER_SOURCE_DIR) / ".." / "shared" / "data";
+    ANIMORDER_REQUIRE_DATA(data);
+    for (const char* f : {"md2-dolphin/dolphin.md2", "md2-faerie/faerie.md2", "md2-sydney/sydney.md2"}) {
+        SCOPED_TRACE(f);
+        AnimatedMesh m;
+        ASSERT_NO_THROW(m = load_md2((data / f).string()));
+        EXPECT_GT(m.triangle_count(), 100u);
+        EXPECT_GE(m.clips.size(), 1u);
+        EXPECT_NO_THROW(validate_animated_mesh(m));
+    }
+}

@@ -263,19 +263,19 @@ MethodRun run_method(const AnimatedMesh& mesh, const std::string& name, const Me
         for (size_t i = 0; i < r.runs.size(); ++i) {
             rasterization += r.runs[i].seconds_rasterization;
             double run_seconds = r.runs[i].seconds_rasterization;
-            for (const ClusteringIteration& x : r.runs[i].iterations) run_seconds += x.seconds_raster + x.seconds_update;
+            for (const ClusteringIteration& x : r.runs[i].iterations) run_seconds += x.seconds_assignment + x.seconds_update;
             run.clip_seconds.push_back(run_seconds);
             nlohmann::ordered_json iterations = nlohmann::ordered_json::array();
             for (size_t it = 0; it < r.runs[i].iterations.size(); ++it) {
                 const ClusteringIteration& x = r.runs[i].iterations[it];
-                raster += x.seconds_raster;
+                raster += x.seconds_assignment;
                 update += x.seconds_update;
                 iterations.push_back({{"iteration", it + 1},
                                       {"mean_ovr", x.mean_ovr},
                                       {"reassigned", x.reassigned},
                                       {"reseeded", x.reseeded},
                                       {"improved_buffers", x.accepted},
-                                      {"seconds_assignment", x.seconds_raster},
+                                      {"seconds_assignment", x.seconds_assignment},
                                       {"seconds_update", x.seconds_update}});
             }
             runs.push_back({{"clips", name == "joint" ? nlohmann::ordered_json("all") : nlohmann::ordered_json(mesh.clips[i].name)},

@@ -15,13 +15,13 @@
 // Every step is deterministic: nodes are scored into their own slots, sums run in node order,
 // sorts break ties by patch id, and the random viewpoints come from a seeded std::mt19937_64.
 #include "animorder/clustering.h"
+#include "stopwatch.h"
 
 #include <algorithm>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
-#include <chrono>
 #include <cmath>
 #include <numeric>
 #include <random>
@@ -29,9 +29,6 @@
 
 namespace animorder {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 void say(const ClusteringSettings& settings, const std::string& line) {
     if (settings.log) settings.log(line);

@@ -24,6 +24,7 @@
 // drawn first can pass.
 #include "animorder/animorder.h"
 #include "animorder/overdraw.h"
+#include "fragment_encoding.h"
 
 #include <algorithm>
 #include <cmath>
@@ -43,9 +44,6 @@ struct Fragment {
     uint32_t triangle;
     float depth;
 };
-
-constexpr uint32_t kTieBit = 0x80000000u;
-constexpr uint32_t kTriangleMask = 0x7fffffffu;
 
 struct NodeRasterizer::State {
     unsigned resolution = 0;

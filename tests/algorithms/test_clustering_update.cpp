@@ -3,10 +3,13 @@
 // These are independent references: every expected order below follows from the numbers in the
 // comments, not from the library.
 #include "animorder/animorder.h"
+#include "animorder/animated_mesh.h"
 #include "animorder/clustering.h"
+#include "animorder/overdraw.h"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -114,6 +117,106 @@ TEST(ClusteringUpdate, NoNodesKeepsPatchIdOrder) {
 
 TEST(ClusteringUpdate, RejectsAKeyframeRowOutOfRange) {
     EXPECT_THROW(order_of({0, 2}, {0, 0, 3, 0, 0, 3}, DistanceVariant::Jcgt), InvalidInput);
+}
+
+// ---------------------------------------------------------------------------------------------
+// End to end through cluster_nodes with k = 1: the single cluster holds every node, so after one
+// update its order must be the integrated-distance order worked out here.
+//
+// Two keyframes, two patches (both in primitive 0), positions before framing:
+//   patch 0, A: one small triangle. Keyframe 0: (−1,−1,1) (0,2,1) (1,−1,1), clockwise seen from
+//       +z, so it faces −z; centroid (0,0,1). Keyframe 1: the same turned 180° about the y axis,
+//       (1,−1,−1) (0,2,−1) (−1,−1,−1), facing +z; centroid (0,0,−1).
+//   patch 1, B: a big triangle (−3,−3,0) (3,−3,0) (0,6,0), counter-clockwise from +z (faces +z),
+//       centroid (0,0,0), and a zero-area triangle (0,0,−1) (0,0,1) (0,0,1) that only pins the
+//       bounding box (no area: no weight in the centroid, never rasterised). Both keyframes.
+// Framing: the box is x ∈ [−3,3], y ∈ [−3,6], z ∈ [−1,1] at both keyframes, centre (0,1.5,0);
+// R = |(−3,−3,0) − (0,1.5,0)| = √29.25 ≈ 5.408, eyes at 3R ≈ 16.225 along the 12 icosahedron
+// directions (permutations of (0, ±1, ±φ)/√(1+φ²)). Framed centroids:
+//   A: (0,−1.5,1) at keyframe 0, (0,−1.5,−1) at keyframe 1, averaged (0,−1.5,0);
+//   B: (0,−1.5,0) at both, averaged (0,−1.5,0).
+// Bootstrap: the averaged centroids coincide, so from any seed viewpoint the keys tie and the
+// order is by id, A then B: [0, 1].
+// Update, JCGT: with f(c) = Σ over the 12 eyes of |eye − c|, d(B) = 2 f((0,−1.5,0)) and
+// d(A) = f((0,−1.5,1)) + f((0,−1.5,−1)); f is strictly convex, so d(A) > d(B) (numerically
+// d(A) ≈ 391.00, d(B) ≈ 390.51): B then A, [1, 0].
+// Update, I3D: B faces the 4 eyes with z > 0 at each keyframe, mean ≈ 16.285; A faces the 8 eyes
+// with z ≤ 0 at keyframe 0 and the 8 with z ≥ 0 at keyframe 1, mean ≈ 16.631: again [1, 0].
+// And the new order really is better, so k-means keeps it: at keyframe 0 A and B never face the
+// same eye (no eye has 0 < z < 1; the 4 eyes with z = 0 see B exactly edge-on), so nothing
+// overlaps; at keyframe 1 the 4 eyes with z > 0 see B in front of A, and drawing A first lets
+// A's fragments pass under B: B first has strictly less overdraw.
+AnimatedMesh two_patch_mesh() {
+    AnimatedMesh m;
+    m.name = "two patches";
+    m.vertex_count = 9;
+    m.indices = {0, 1, 2, 3, 4, 5, 6, 7, 8};  // A; B's big triangle; B's zero-area triangle
+    Primitive p;
+    p.name = "all";
+    p.index_count = 9;
+    p.vertex_count = 9;
+    m.primitives = {p};
+    Clip c;
+    c.name = "flip";
+    c.keyframe_count = 2;
+    m.clips = {c};
+    const std::vector<float> b = {-3, -3, 0, 3, -3, 0, 0, 6, 0, 0, 0, -1, 0, 0, 1, 0, 0, 1};
+    const std::vector<float> a0 = {-1, -1, 1, 0, 2, 1, 1, -1, 1}, a1 = {1, -1, -1, 0, 2, -1, -1, -1, -1};
+    for (const std::vector<float>* a : {&a0, &a1}) {
+        m.keyframe_positions.insert(m.keyframe_positions.end(), a->begin(), a->end());
+        m.keyframe_positions.insert(m.keyframe_positions.end(), b.begin(), b.end());
+    }
+    return m;
+}
+
+MeshPatches two_patches() {
+    MeshPatches p;
+    p.cache_order = {0, 1, 2};
+    p.patch_starts = {0, 1, 3};  // A = triangle 0; B = triangles 1, 2
+    p.patch_primitive = {0, 0};
+    return p;
+}
+
+ClusteringResult cluster_two_patches(DistanceVariant distance, UpdateRule update, size_t max_iterations) {
+    const AnimatedMesh mesh = two_patch_mesh();
+    const Framing framing = frame_keyframes(mesh.keyframe_positions.data(), 2, mesh.vertex_count, mesh.indices.data(),
+                                            mesh.indices.size());
+    // The framing worked out above.
+    EXPECT_EQ(framing.centres, (std::vector<float>{0, 1.5f, 0, 0, 1.5f, 0}));
+    EXPECT_NEAR(framing.radius, std::sqrt(29.25), 1e-4);  // (frame_keyframes adds a 1e-6 margin)
+    ClusteringSettings s;
+    s.clusters = 1;
+    s.views = 12;
+    s.resolution = 64;
+    s.distance = distance;
+    s.update = update;
+    s.max_iterations = max_iterations;
+    return cluster_nodes(mesh, two_patches(), framing, {0, 1}, s);
+}
+
+TEST(ClusteringUpdateEndToEnd, BootstrapTiesGiveIdOrder) {
+    // One iteration: the assignment only, so the bootstrap order comes back.
+    const ClusteringResult r = cluster_two_patches(DistanceVariant::Jcgt, UpdateRule::Monotone, 1);
+    EXPECT_EQ(r.patch_orders, (std::vector<std::vector<uint32_t>>{{0, 1}}));
+}
+
+TEST(ClusteringUpdateEndToEnd, JcgtSingleClusterTakesTheIntegratedOrder) {
+    for (UpdateRule rule : {UpdateRule::Monotone, UpdateRule::Paper}) {
+        const ClusteringResult r = cluster_two_patches(DistanceVariant::Jcgt, rule, 30);
+        EXPECT_EQ(r.patch_orders, (std::vector<std::vector<uint32_t>>{{1, 0}}));
+        EXPECT_EQ(r.triangle_orders, (std::vector<std::vector<uint32_t>>{{1, 2, 0}}));
+        EXPECT_EQ(r.assignment, std::vector<uint32_t>(24, 0));
+        EXPECT_TRUE(r.converged);
+        EXPECT_EQ(r.best_iteration, 1u);
+        ASSERT_EQ(r.iterations.size(), 2u);
+        EXPECT_LT(r.iterations[1].mean_ovr, r.iterations[0].mean_ovr);
+    }
+}
+
+TEST(ClusteringUpdateEndToEnd, I3dSingleClusterTakesTheIntegratedOrder) {
+    const ClusteringResult r = cluster_two_patches(DistanceVariant::I3d, UpdateRule::Monotone, 30);
+    EXPECT_EQ(r.patch_orders, (std::vector<std::vector<uint32_t>>{{1, 0}}));
+    EXPECT_TRUE(r.converged);
 }
 
 }  // namespace

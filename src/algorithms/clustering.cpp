@@ -14,6 +14,11 @@
 //
 // Every step is deterministic: nodes are scored into their own slots, sums run in node order,
 // sorts break ties by patch id, and the random viewpoints come from a seeded std::mt19937_64.
+//
+// Reading order, by the lines of the paper's Algorithm 1: bootstrap_orders (lines 9–14),
+// assign_nodes (15–17), stop_after_assignment (18–19), update_orders and its pure core
+// integrated_distance_order (20–24); not in the paper: reseed_empty_clusters and
+// keep_improved_orders (UpdateRule::Monotone). cluster_nodes, at the end, runs the loop.
 #include "animorder/clustering.h"
 #include "stopwatch.h"
 
@@ -158,8 +163,8 @@ struct Nodes {
     std::vector<NodeFragments> kept;     // every node's fragments, or empty when over budget
 };
 
-// Measured overdraw at every node: fragments visible (the front-most ones) and fragments passing
-// the depth test with each of the k buffers, passed[n · k + c].
+// Measured overdraw at every node: visible[n], the pixels covered (what drawing front-to-back
+// would pass), and passed[n · k + c], the fragments passing the depth test with buffer c.
 struct NodeScores {
     std::vector<uint64_t> visible, passed;
 };

@@ -48,12 +48,12 @@ struct ClusteringSettings {
 };
 
 struct ClusteringIteration {
-    double mean_ovr = 0;        // mean node OVR with every node drawn by its assigned buffer
-    size_t reassigned = 0;      // nodes whose cluster changed in this assignment step
-    size_t reseeded = 0;        // clusters that were empty and got re-seeded
-    size_t accepted = 0;        // Monotone rule: clusters whose new order was kept
-    double seconds_raster = 0;  // assignment step (scoring k orders at every node)
-    double seconds_update = 0;  // integrated-distance update
+    double mean_ovr = 0;            // mean node OVR with every node drawn by its assigned buffer
+    size_t reassigned = 0;          // nodes whose cluster changed in this assignment step
+    size_t reseeded = 0;            // clusters that were empty and got re-seeded
+    size_t accepted = 0;            // Monotone rule: clusters whose new order was kept
+    double seconds_assignment = 0;  // assignment step (scoring k orders at every node)
+    double seconds_update = 0;      // integrated-distance update
 };
 
 struct ClusteringResult {
@@ -73,5 +73,24 @@ struct ClusteringResult {
 // Han & Sander 2017, Algorithm 1, over the nodes keyframes × icosphere viewpoints.
 ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patches, const Framing& framing,
                                const std::vector<uint32_t>& keyframes, const ClusteringSettings& settings);
+
+// The update step alone (Algorithm 1 lines 21–24) for one cluster: its patches sorted by the
+// integrated distance over its nodes, ascending, ties by patch id. cluster_nodes calls it for
+// every non-empty cluster.
+//   centroids: keyframe_count × patch_count × xyz (patch_centroids' layout, framed);
+//   node_keyframes[n]: the centroids row (0 ≤ row < keyframe_count) of the cluster's node n;
+//   node_eyes: node_count × xyz, node n's eye in the same framed space;
+//   Jcgt: d(p) = Σ_n |eye_n − centroid(p, row_n)| (node_visible is ignored);
+//   I3d:  the sum only over nodes with node_visible[n · patch_count + p] ≠ 0 (cluster_nodes sets
+//         it when some triangle of p faces eye_n), divided by their number; a patch no node sees
+//         goes last. node_visible == nullptr: every node sees every patch;
+//   patch_primitive (may be nullptr: one primitive): patches of a lower primitive come first, so
+//         primitives keep file order.
+// Throws InvalidInput for a node row >= keyframe_count.
+std::vector<uint32_t> integrated_distance_order(const float* centroids, size_t keyframe_count, size_t patch_count,
+                                                const uint32_t* node_keyframes, const float* node_eyes,
+                                                size_t node_count, DistanceVariant variant,
+                                                const uint8_t* node_visible = nullptr,
+                                                const uint32_t* patch_primitive = nullptr);
 
 }  // namespace animorder

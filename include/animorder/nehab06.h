@@ -63,7 +63,7 @@ struct OverdrawGraphSettings {
 // the thread count (integer sums). cluster_count <= kMaxNehabClusters.
 std::vector<Arc> build_overdraw_graph(const uint32_t* indices, size_t index_count, const float* keyframe_positions,
                                       size_t keyframe_count, size_t vertex_count, const uint32_t* keyframes,
-                                      size_t keyframes_count, const uint32_t* cluster_of, size_t cluster_count,
+                                      size_t keyframe_list_count, const uint32_t* cluster_of, size_t cluster_count,
                                       const uint32_t* draw_order, const OverdrawGraphSettings& settings);
 
 // The graph keeps a dense triangular matrix of pair sums per worker: 4096 clusters take 64 MiB.
@@ -118,7 +118,7 @@ struct Nehab06Result {
 // kMaxNehabClusters clusters.
 Nehab06Result order_static_nehab06(uint32_t* order, const uint32_t* indices, size_t index_count,
                                    const float* keyframe_positions, size_t keyframe_count, size_t vertex_count,
-                                   const uint32_t* keyframes, size_t keyframes_count,
+                                   const uint32_t* keyframes, size_t keyframe_list_count,
                                    const Nehab06Settings& settings);
 
 }  // namespace animorder

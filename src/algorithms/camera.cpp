@@ -9,6 +9,8 @@
 
 #include "animorder/invalid_input.h"
 
+#include "mat4.h"
+
 #include <cmath>
 
 namespace animorder {
@@ -23,17 +25,6 @@ double dot3(V3 a, V3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 V3 unit(V3 a) {
     const double n = std::sqrt(dot3(a, a));
     return {a.x / n, a.y / n, a.z / n};
-}
-
-Mat4d multiply(const Mat4d& a, const Mat4d& b) {
-    Mat4d r{};
-    for (int col = 0; col < 4; ++col)
-        for (int row = 0; row < 4; ++row) {
-            double s = 0;
-            for (int k = 0; k < 4; ++k) s += a[k * 4 + row] * b[col * 4 + k];
-            r[col * 4 + row] = s;
-        }
-    return r;
 }
 
 }  // namespace
@@ -56,7 +47,7 @@ Mat4d node_view_projection(const float view_direction[3], float radius) {
     const double n = radius, fr = 5.0 * radius;
     const Mat4d projection = {cot_half_fov, 0, 0, 0, 0, cot_half_fov, 0, 0,
                               0, 0, (fr + n) / (n - fr), -1, 0, 0, 2.0 * fr * n / (n - fr), 0};
-    return multiply(projection, view);
+    return multiply_mat4(projection, view);
 }
 
 void transform_to_clip(float* clip_xyzw, const float* positions, size_t vertex_count, const float centre[3],

@@ -14,7 +14,13 @@
 //
 // Every step is deterministic: nodes are scored into their own slots, sums run in node order,
 // sorts break ties by patch id, and the random viewpoints come from a seeded std::mt19937_64.
+//
+// Reading order, by the lines of the paper's Algorithm 1: bootstrap_orders (lines 9–14),
+// assign_nodes (15–17), stop_after_assignment (18–19), update_orders and its pure core
+// integrated_distance_order (20–24); not in the paper: reseed_empty_clusters and
+// keep_improved_orders (UpdateRule::Monotone). cluster_nodes, at the end, runs the loop.
 #include "animorder/clustering.h"
+#include "stopwatch.h"
 
 #include "animorder/animated_mesh.h"
 #include "animorder/invalid_input.h"
@@ -28,7 +34,6 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
-#include <chrono>
 #include <cmath>
 #include <numeric>
 #include <random>
@@ -37,20 +42,17 @@
 namespace animorder {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-
 void say(const ClusteringSettings& settings, const std::string& line) {
     if (settings.log) settings.log(line);
 }
 
 // Sorts patches by ascending key within each primitive (primitives keep file order), ties by id.
-std::vector<uint32_t> sort_patches(const MeshPatches& patches, const std::vector<double>& key) {
-    std::vector<uint32_t> order(patches.patch_count());
+// primitive == nullptr: all patches in one primitive.
+std::vector<uint32_t> sort_patches(const uint32_t* primitive, const std::vector<double>& key) {
+    std::vector<uint32_t> order(key.size());
     std::iota(order.begin(), order.end(), 0u);
     std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
-        if (patches.patch_primitive[a] != patches.patch_primitive[b])
-            return patches.patch_primitive[a] < patches.patch_primitive[b];
+        if (primitive && primitive[a] != primitive[b]) return primitive[a] < primitive[b];
         if (key[a] != key[b]) return key[a] < key[b];
         return a < b;
     });
@@ -67,7 +69,7 @@ std::vector<uint32_t> front_to_back(const MeshPatches& patches, const std::vecto
                                     const float eye[3]) {
     std::vector<double> key(patches.patch_count());
     for (size_t p = 0; p < key.size(); ++p) key[p] = distance(eye, &average_centroids[3 * p]);
-    return sort_patches(patches, key);
+    return sort_patches(patches.patch_primitive.data(), key);
 }
 
 std::vector<float> average_over_keyframes(const std::vector<float>& centroids, size_t keyframes, size_t patch_count) {
@@ -144,223 +146,355 @@ std::vector<uint8_t> patch_visibility(const AnimatedMesh& mesh, const MeshPatche
     return visible;
 }
 
-}  // namespace
+// ---------------------------------------------------------------------------------------------
+// The steps of Algorithm 1 (JCGT 2017 §3.2; "line" below means a line of its pseudocode), each
+// a short function over the shared state below; cluster_nodes at the end strings them together.
 
-ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patches, const Framing& framing,
-                               const std::vector<uint32_t>& keyframes, const ClusteringSettings& settings) {
-    validate_animated_mesh(mesh);
+// What every step reads and never changes: the nodes N from the keyframes F and viewpoints V
+// (lines 3–5), their cameras, the patches P (line 6) and their framed centroids (lines 7–8).
+struct Nodes {
+    Nodes(const AnimatedMesh& m, const MeshPatches& p, const Framing& f) : mesh(m), patches(p), framing(f) {}
+    const AnimatedMesh& mesh;
+    const MeshPatches& patches;
+    const Framing& framing;
+    size_t k = 0;                        // clusters
+    size_t keyframes = 0;                // listed keyframes (rows of centroids)
+    size_t views = 0;                    // node n = (keyframes[n / views], directions[n % views])
+    size_t count = 0;                    // keyframes × views
+    std::vector<OverdrawNode> cameras;   // per node
+    std::vector<float> eyes;             // per view: 3R · direction, in the framed space
+    std::vector<float> centroids;        // per listed keyframe, per patch (patch_centroids)
+    std::vector<float> average;          // per patch: its centroid averaged over the keyframes
+    std::vector<uint8_t> patch_visible;  // I3D only: [n · patch_count + p], some triangle faces n
+    ScoreSettings score;
+    std::vector<NodeFragments> kept;     // every node's fragments, or empty when over budget
+};
+
+// Measured overdraw at every node: visible[n], the pixels covered (what drawing front-to-back
+// would pass), and passed[n · k + c], the fragments passing the depth test with buffer c.
+struct NodeScores {
+    std::vector<uint64_t> visible, passed;
+};
+
+// The best state met so far (its orders produced its assignment): what cluster_nodes returns.
+struct BestState {
+    double mean_ovr = INFINITY;
+    std::vector<std::vector<uint32_t>> patch_orders;
+    std::vector<uint32_t> assignment;
+};
+
+std::vector<std::vector<uint32_t>> triangle_orders_of(const MeshPatches& patches,
+                                                      const std::vector<std::vector<uint32_t>>& patch_orders) {
+    std::vector<std::vector<uint32_t>> out;
+    for (const auto& o : patch_orders) out.push_back(patch_order_to_triangle_order(patches, o));
+    return out;
+}
+
+// Every node scored with every one of the face orders: a replay of the kept fragments, or a new
+// rasterisation when they did not fit.
+void score_orders(const Nodes& nodes, const std::vector<std::vector<uint32_t>>& triangle_orders, NodeScores& out) {
+    std::vector<const uint32_t*> pointers;
+    for (const auto& o : triangle_orders) pointers.push_back(o.data());
+    const AnimatedMesh& mesh = nodes.mesh;
+    const std::vector<uint32_t> ranks = make_rank_table(pointers, mesh.triangle_count());
+    if (nodes.kept.empty())
+        score_nodes(out.visible.data(), out.passed.data(), mesh.keyframe_positions.data(), mesh.vertex_count,
+                    nodes.framing, mesh.indices.data(), mesh.indices.size(), nodes.cameras.data(), nodes.count,
+                    ranks.data(), pointers.size(), nodes.score);
+    else
+        score_kept_nodes(out.visible.data(), out.passed.data(), nodes.kept, ranks.data(), pointers.size(), nodes.score);
+}
+
+// Bootstrapping (lines 9–14): k viewpoints at least min_separation apart (line 10), and for each
+// the patches front-to-back by their centroids averaged over all keyframes (lines 11–14).
+std::vector<std::vector<uint32_t>> bootstrap_orders(const Nodes& nodes, const ClusteringSettings& settings) {
+    const std::vector<float> seeds = bootstrap_directions(settings);
+    const float distance_to_eye = 3.0f * nodes.framing.radius;
+    std::vector<std::vector<uint32_t>> orders(nodes.k);
+    for (size_t c = 0; c < nodes.k; ++c) {
+        const float eye[3] = {distance_to_eye * seeds[3 * c], distance_to_eye * seeds[3 * c + 1],
+                              distance_to_eye * seeds[3 * c + 2]};
+        orders[c] = front_to_back(nodes.patches, nodes.average, eye);
+    }
+    return orders;
+}
+
+// Node assignment (lines 15–17): every node to the buffer with the fewest fragments passing the
+// depth test there, ties to the lowest cluster id. Fills the assignment, each node's OVR with its
+// buffer (0 for a node that sees nothing), and the iteration's reassigned count and mean OVR.
+void assign_nodes(const Nodes& nodes, const std::vector<std::vector<uint32_t>>& patch_orders, NodeScores& scores,
+                  std::vector<uint32_t>& assignment, std::vector<double>& node_ovr, ClusteringIteration& log) {
+    score_orders(nodes, triangle_orders_of(nodes.patches, patch_orders), scores);
+    const size_t k = nodes.k;
+    node_ovr.assign(nodes.count, 0.0);
+    double ovr_sum = 0;
+    size_t counted = 0;
+    for (size_t n = 0; n < nodes.count; ++n) {
+        const uint64_t* passed = &scores.passed[n * k];
+        uint32_t best = 0;
+        for (uint32_t c = 1; c < k; ++c)
+            if (passed[c] < passed[best]) best = c;
+        log.reassigned += assignment[n] != best;
+        assignment[n] = best;
+        if (scores.visible[n] > 0) {
+            node_ovr[n] = double(passed[best]) / double(scores.visible[n]);
+            ovr_sum += node_ovr[n];
+            ++counted;
+        }
+    }
+    log.mean_ovr = counted ? ovr_sum / double(counted) : 0.0;
+}
+
+// Index buffer computation (lines 20–24): each non-empty cluster's patches by the integrated
+// distance d(p) over its nodes (integrated_distance_order). Empty clusters keep their order here
+// (reseed_empty_clusters replaces it). Returns the number of nodes of each cluster.
+std::vector<size_t> update_orders(const Nodes& nodes, DistanceVariant variant, const std::vector<uint32_t>& assignment,
+                                  std::vector<std::vector<uint32_t>>& patch_orders) {
+    const size_t patch_count = nodes.patches.patch_count();
+    const bool i3d = variant == DistanceVariant::I3d;
+    // Each cluster's nodes, in node order (so the sums run in the same order for any k).
+    std::vector<std::vector<uint32_t>> rows(nodes.k);
+    std::vector<std::vector<float>> eyes(nodes.k);
+    std::vector<std::vector<uint8_t>> visible(nodes.k);
+    for (size_t n = 0; n < nodes.count; ++n) {
+        const uint32_t c = assignment[n];
+        rows[c].push_back(uint32_t(n / nodes.views));
+        const float* eye = &nodes.eyes[3 * (n % nodes.views)];
+        eyes[c].insert(eyes[c].end(), eye, eye + 3);
+        if (i3d) {
+            const uint8_t* row = &nodes.patch_visible[n * patch_count];
+            visible[c].insert(visible[c].end(), row, row + patch_count);
+        }
+    }
+    std::vector<size_t> members(nodes.k);
+    for (size_t c = 0; c < nodes.k; ++c) {
+        members[c] = rows[c].size();
+        if (members[c] == 0) continue;
+        patch_orders[c] = integrated_distance_order(
+            nodes.centroids.data(), nodes.keyframes, patch_count,
+            rows[c].data(), eyes[c].data(), rows[c].size(), variant, i3d ? visible[c].data() : nullptr,
+            nodes.patches.patch_primitive.data());
+    }
+    return members;
+}
+
+// Not in the paper (DESIGN.md step 6: never drop a cluster silently): an empty cluster takes the
+// front-to-back order, by averaged centroids, from the viewpoint of the worst-served node (highest
+// OVR) not used for another cluster in this iteration. Marks the clusters re-seeded.
+size_t reseed_empty_clusters(const Nodes& nodes, const std::vector<size_t>& members, const std::vector<double>& node_ovr,
+                             const ClusteringSettings& settings, std::vector<std::vector<uint32_t>>& patch_orders,
+                             std::vector<uint8_t>& reseeded) {
+    std::vector<uint8_t> used_as_seed(nodes.count, 0);
+    reseeded.assign(nodes.k, 0);
+    size_t count = 0;
+    for (size_t c = 0; c < nodes.k; ++c) {
+        if (members[c] != 0) continue;
+        size_t worst = 0;
+        double worst_ovr = -1;
+        for (size_t n = 0; n < nodes.count; ++n)
+            if (!used_as_seed[n] && node_ovr[n] > worst_ovr) worst_ovr = node_ovr[n], worst = n;
+        used_as_seed[worst] = 1;
+        patch_orders[c] = front_to_back(nodes.patches, nodes.average, &nodes.eyes[3 * (worst % nodes.views)]);
+        reseeded[c] = 1;
+        ++count;
+        say(settings, "cluster " + std::to_string(c) + " was empty: re-seeded from the viewpoint of node " +
+                          std::to_string(worst) + " (OVR " + std::to_string(worst_ovr) + ")");
+    }
+    return count;
+}
+
+// UpdateRule::Monotone, not in the paper: a cluster keeps its new order only if its own nodes'
+// summed OVR falls (re-seeded clusters always take theirs). With the assignment step (each node
+// to its best buffer) the mean node OVR can then only fall, so k-means settles instead of
+// cycling. `scores` are the previous orders' (from the assignment step). Returns the number of
+// clusters whose new order was kept.
+size_t keep_improved_orders(const Nodes& nodes, const std::vector<uint32_t>& assignment, const NodeScores& scores,
+                            const std::vector<std::vector<uint32_t>>& previous, const std::vector<uint8_t>& reseeded,
+                            unsigned threads, std::vector<std::vector<uint32_t>>& patch_orders) {
+    const size_t k = nodes.k;
+    const std::vector<std::vector<uint32_t>> candidate = triangle_orders_of(nodes.patches, patch_orders);
+    NodeScores after_scores{std::vector<uint64_t>(nodes.count), std::vector<uint64_t>(nodes.count * k)};
+    if (nodes.kept.empty()) {
+        score_orders(nodes, candidate, after_scores);
+    } else {
+        // Each node only needs its own cluster's candidate: one order per node, not k.
+        std::vector<std::vector<uint32_t>> single_ranks;
+        for (const auto& o : candidate) single_ranks.push_back(make_rank_table({o.data()}, nodes.mesh.triangle_count()));
+        tbb::task_arena arena(threads ? int(threads) : tbb::this_task_arena::max_concurrency());
+        arena.execute([&] {
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, nodes.count, 64), [&](const tbb::blocked_range<size_t>& r) {
+                for (size_t n = r.begin(); n != r.end(); ++n) {
+                    const uint32_t c = assignment[n];
+                    score_fragments(&after_scores.passed[n * k + c], nodes.kept[n], single_ranks[c].data(), 1);
+                }
+            });
+        });
+    }
+    std::vector<double> before(k, 0.0), after(k, 0.0);
+    for (size_t n = 0; n < nodes.count; ++n) {
+        if (scores.visible[n] == 0) continue;
+        const uint32_t c = assignment[n];
+        before[c] += double(scores.passed[n * k + c]) / double(scores.visible[n]);
+        after[c] += double(after_scores.passed[n * k + c]) / double(scores.visible[n]);
+    }
+    size_t accepted = 0;
+    for (size_t c = 0; c < k; ++c) {
+        if (reseeded[c]) continue;
+        if (after[c] < before[c]) ++accepted;
+        else patch_orders[c] = previous[c];  // no better: keep the old buffer
+    }
+    return accepted;
+}
+
+// The stopping rule after an assignment (lines 18–19, "if no cluster assignment has changed"),
+// with two guards the paper does not need: patience (no new best mean OVR for that many
+// iterations: k-means is cycling) and the iteration cap. Empty: go on.
+std::string stop_after_assignment(size_t iteration, const ClusteringIteration& log, size_t best_iteration,
+                                  const ClusteringSettings& settings) {
+    const bool settled = iteration > 0 && log.reassigned == 0;
+    const bool stalled = iteration >= best_iteration + settings.patience;
+    if (settled) return "converged";
+    if (stalled) return "stalled";
+    if (iteration + 1 >= settings.max_iterations) return "iteration cap";
+    return {};
+}
+
+// The best state's buffers and assignment into the result.
+void finish(ClusteringResult& result, const MeshPatches& patches, const BestState& best) {
+    result.patch_orders = best.patch_orders;
+    result.assignment = best.assignment;
+    result.triangle_orders = triangle_orders_of(patches, result.patch_orders);
+}
+
+void validate_settings(const std::vector<uint32_t>& keyframes, const ClusteringSettings& settings) {
     if (settings.clusters == 0 || settings.clusters > 255)
         throw InvalidInput("the number of clusters must be between 1 and 255, not " + std::to_string(settings.clusters));
     if (keyframes.empty()) throw InvalidInput("clustering needs at least one keyframe");
     if (settings.max_iterations == 0) throw InvalidInput("clustering needs at least one iteration");
     if (!(settings.min_separation_deg >= 0) || settings.min_separation_deg > 180)
         throw InvalidInput("minimum separation must be between 0 and 180 degrees");
-    const size_t k = settings.clusters;
-    const size_t patch_count = patches.patch_count();
+}
 
+}  // namespace
+
+std::vector<uint32_t> integrated_distance_order(const float* centroids, size_t keyframe_count, size_t patch_count,
+                                                const uint32_t* node_keyframes, const float* node_eyes,
+                                                size_t node_count, DistanceVariant variant,
+                                                const uint8_t* node_visible, const uint32_t* patch_primitive) {
+    const bool i3d = variant == DistanceVariant::I3d;
+    std::vector<double> d(patch_count, 0.0), seen(patch_count, 0.0);
+    for (size_t n = 0; n < node_count; ++n) {
+        if (node_keyframes[n] >= keyframe_count)
+            throw InvalidInput("integrated distance: node " + std::to_string(n) + " names keyframe row " +
+                               std::to_string(node_keyframes[n]) + ", but there are " + std::to_string(keyframe_count));
+        const float* eye = &node_eyes[3 * n];
+        const float* cent = &centroids[size_t(node_keyframes[n]) * patch_count * 3];
+        const uint8_t* vis = i3d && node_visible ? &node_visible[n * patch_count] : nullptr;
+        for (size_t p = 0; p < patch_count; ++p) {
+            if (vis && !vis[p]) continue;  // I3D: wholly back-facing at this node
+            d[p] += distance(eye, cent + 3 * p);
+            seen[p] += 1.0;
+        }
+    }
+    if (i3d)
+        for (size_t p = 0; p < patch_count; ++p)
+            // A patch no node of the cluster sees goes last (it is never visible there).
+            d[p] = seen[p] > 0 ? d[p] / seen[p] : INFINITY;
+    return sort_patches(patch_primitive, d);
+}
+
+ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patches, const Framing& framing,
+                               const std::vector<uint32_t>& keyframes, const ClusteringSettings& settings) {
+    validate_animated_mesh(mesh);
+    validate_settings(keyframes, settings);
+
+    // Preprocessing (lines 2–8): nodes = keyframes × icosphere viewpoints, each keyframe framed
+    // on its own centre, eyes at 3R.
     ClusteringResult result;
     result.keyframes = keyframes;
     result.directions = icosphere_directions(icosphere_subdivisions_for(settings.views));
-    const size_t views = settings.views, node_count = keyframes.size() * views;
-    std::vector<float> eyes(result.directions.size());
-    for (size_t j = 0; j < eyes.size(); ++j) eyes[j] = 3.0f * framing.radius * result.directions[j];
-
-    std::vector<OverdrawNode> nodes(node_count);
+    Nodes nodes(mesh, patches, framing);
+    nodes.k = settings.clusters;
+    nodes.keyframes = keyframes.size();
+    nodes.views = settings.views;
+    nodes.count = nodes.keyframes * nodes.views;
+    nodes.eyes.resize(result.directions.size());
+    for (size_t j = 0; j < nodes.eyes.size(); ++j) nodes.eyes[j] = 3.0f * framing.radius * result.directions[j];
+    nodes.cameras.resize(nodes.count);
     for (size_t i = 0; i < keyframes.size(); ++i)
-        for (size_t v = 0; v < views; ++v) {
-            nodes[i * views + v].keyframe = keyframes[i];
-            std::copy(&result.directions[3 * v], &result.directions[3 * v] + 3, nodes[i * views + v].direction);
+        for (size_t v = 0; v < nodes.views; ++v) {
+            nodes.cameras[i * nodes.views + v].keyframe = keyframes[i];
+            std::copy(&result.directions[3 * v], &result.directions[3 * v] + 3, nodes.cameras[i * nodes.views + v].direction);
         }
-
-    const std::vector<float> centroids = patch_centroids(mesh, patches, framing, keyframes);
-    const std::vector<float> average = average_over_keyframes(centroids, keyframes.size(), patch_count);
-    std::vector<uint8_t> patch_visible;
+    nodes.centroids = patch_centroids(mesh, patches, framing, keyframes);
+    nodes.average = average_over_keyframes(nodes.centroids, keyframes.size(), patches.patch_count());
     if (settings.distance == DistanceVariant::I3d)
-        patch_visible = patch_visibility(mesh, patches, framing, keyframes, eyes);
+        nodes.patch_visible = patch_visibility(mesh, patches, framing, keyframes, nodes.eyes);
+    nodes.score.resolution = settings.resolution;
+    nodes.score.threads = settings.threads;
+    nodes.score.progress = settings.progress;
 
-    // Bootstrap.
-    const std::vector<float> seeds = bootstrap_directions(settings);
-    result.patch_orders.resize(k);
-    for (size_t c = 0; c < k; ++c) {
-        const float eye[3] = {3.0f * framing.radius * seeds[3 * c], 3.0f * framing.radius * seeds[3 * c + 1],
-                              3.0f * framing.radius * seeds[3 * c + 2]};
-        result.patch_orders[c] = front_to_back(patches, average, eye);
-    }
-
-    ScoreSettings score;
-    score.resolution = settings.resolution;
-    score.threads = settings.threads;
-    score.progress = settings.progress;
-    std::vector<uint64_t> visible(node_count), passed(node_count * k);
-    result.assignment.assign(node_count, UINT32_MAX);
+    result.patch_orders = bootstrap_orders(nodes, settings);
 
     // Rasterise every node once; later iterations only replay the kept fragments in new orders.
     const Clock::time_point raster_start = Clock::now();
-    const std::vector<NodeFragments> kept =
-        rasterize_nodes(mesh.keyframe_positions.data(), mesh.vertex_count, framing, mesh.indices.data(),
-                        mesh.indices.size(), nodes.data(), node_count, score, settings.max_cache_bytes);
+    nodes.kept = rasterize_nodes(mesh.keyframe_positions.data(), mesh.vertex_count, framing, mesh.indices.data(),
+                                 mesh.indices.size(), nodes.cameras.data(), nodes.count, nodes.score,
+                                 settings.max_cache_bytes);
     result.seconds_rasterization = seconds_since(raster_start);
-    if (kept.empty())
+    if (nodes.kept.empty())
         say(settings, "node fragments exceed the cache budget: rasterising again every iteration");
 
-    double best_ovr = INFINITY;
-    std::vector<std::vector<uint32_t>> best_orders;
-    std::vector<uint32_t> best_assignment;
+    NodeScores scores{std::vector<uint64_t>(nodes.count), std::vector<uint64_t>(nodes.count * nodes.k)};
+    std::vector<double> node_ovr;
+    result.assignment.assign(nodes.count, UINT32_MAX);
+    BestState best;
     for (size_t iteration = 0;; ++iteration) {
         ClusteringIteration log;
-        // Step 1: node assignment by measured overdraw.
-        const Clock::time_point raster_start = Clock::now();
-        result.triangle_orders.clear();
-        std::vector<const uint32_t*> pointers;
-        for (size_t c = 0; c < k; ++c) result.triangle_orders.push_back(patch_order_to_triangle_order(patches, result.patch_orders[c]));
-        for (const auto& o : result.triangle_orders) pointers.push_back(o.data());
-        const std::vector<uint32_t> ranks = make_rank_table(pointers, mesh.triangle_count());
-        if (kept.empty())
-            score_nodes(visible.data(), passed.data(), mesh.keyframe_positions.data(), mesh.vertex_count, framing,
-                        mesh.indices.data(), mesh.indices.size(), nodes.data(), node_count, ranks.data(), k, score);
-        else
-            score_kept_nodes(visible.data(), passed.data(), kept, ranks.data(), k, score);
-        std::vector<double> node_ovr(node_count, 0.0);
-        double ovr_sum = 0;
-        size_t counted = 0;
-        for (size_t n = 0; n < node_count; ++n) {
-            uint32_t best = 0;
-            for (uint32_t c = 1; c < k; ++c)
-                if (passed[n * k + c] < passed[n * k + best]) best = c;
-            log.reassigned += result.assignment[n] != best;
-            result.assignment[n] = best;
-            if (visible[n] > 0) {
-                node_ovr[n] = double(passed[n * k + best]) / double(visible[n]);
-                ovr_sum += node_ovr[n];
-                ++counted;
-            }
-        }
-        log.mean_ovr = counted ? ovr_sum / double(counted) : 0.0;
-        log.seconds_raster = seconds_since(raster_start);
+        const Clock::time_point assignment_start = Clock::now();
+        assign_nodes(nodes, result.patch_orders, scores, result.assignment, node_ovr, log);
+        log.seconds_assignment = seconds_since(assignment_start);
 
         // Keep the best state (its orders produced this assignment), so cycling never loses it.
-        if (log.mean_ovr < best_ovr) {
-            best_ovr = log.mean_ovr;
-            best_orders = result.patch_orders;
-            best_assignment = result.assignment;
+        if (log.mean_ovr < best.mean_ovr) {
+            best = {log.mean_ovr, result.patch_orders, result.assignment};
             result.best_iteration = iteration;
         }
-        const bool settled = iteration > 0 && log.reassigned == 0;
-        const bool stalled = iteration >= result.best_iteration + settings.patience;
-        if (settled || stalled || iteration + 1 >= settings.max_iterations) {
-            result.converged = settled;
-            result.stop_reason = settled ? "converged" : stalled ? "stalled" : "iteration cap";
+        const std::string stop = stop_after_assignment(iteration, log, result.best_iteration, settings);
+        if (!stop.empty()) {
+            result.converged = stop == "converged";
+            result.stop_reason = stop;
             result.iterations.push_back(log);
             say(settings, "iteration " + std::to_string(iteration + 1) + ": mean OVR " + std::to_string(log.mean_ovr) +
                               ", " + std::to_string(log.reassigned) + " nodes reassigned — " + result.stop_reason +
                               "; keeping iteration " + std::to_string(result.best_iteration + 1) + " (mean OVR " +
-                              std::to_string(best_ovr) + ")");
-            result.patch_orders = best_orders;
-            result.assignment = best_assignment;
-            result.triangle_orders.clear();
-            for (const auto& o : result.patch_orders) result.triangle_orders.push_back(patch_order_to_triangle_order(patches, o));
+                              std::to_string(best.mean_ovr) + ")");
+            finish(result, patches, best);
             break;
         }
 
-        // Step 2: each cluster's patches by integrated distance d(p) over its nodes.
         const Clock::time_point update_start = Clock::now();
-        std::vector<std::vector<double>> d(k, std::vector<double>(patch_count, 0.0));
-        std::vector<std::vector<double>> seen(k, std::vector<double>(patch_count, 0.0));
-        std::vector<size_t> members(k, 0);
-        for (size_t n = 0; n < node_count; ++n) {
-            const uint32_t c = result.assignment[n];
-            ++members[c];
-            const size_t i = n / views, v = n % views;
-            const float* eye = &eyes[3 * v];
-            const float* cent = &centroids[i * patch_count * 3];
-            const uint8_t* vis = patch_visible.empty() ? nullptr : &patch_visible[n * patch_count];
-            for (size_t p = 0; p < patch_count; ++p) {
-                if (vis && !vis[p]) continue;  // I3D: wholly back-facing at this node
-                d[c][p] += distance(eye, cent + 3 * p);
-                seen[c][p] += 1.0;
-            }
-        }
-        std::vector<uint8_t> used_as_seed(node_count, 0);
-        std::vector<uint8_t> reseeded(k, 0);
         const std::vector<std::vector<uint32_t>> previous_orders = result.patch_orders;
-        for (size_t c = 0; c < k; ++c) {
-            if (members[c] == 0) {
-                // Re-seed from the worst-served node not used yet.
-                size_t worst = 0;
-                double worst_ovr = -1;
-                for (size_t n = 0; n < node_count; ++n)
-                    if (!used_as_seed[n] && node_ovr[n] > worst_ovr) worst_ovr = node_ovr[n], worst = n;
-                used_as_seed[worst] = 1;
-                result.patch_orders[c] = front_to_back(patches, average, &eyes[3 * (worst % views)]);
-                reseeded[c] = 1;
-                ++log.reseeded;
-                say(settings, "cluster " + std::to_string(c) + " was empty: re-seeded from the viewpoint of node " +
-                                  std::to_string(worst) + " (OVR " + std::to_string(worst_ovr) + ")");
-                continue;
-            }
-            if (settings.distance == DistanceVariant::I3d)
-                for (size_t p = 0; p < patch_count; ++p)
-                    // A patch no node of the cluster sees goes last (it is never visible there).
-                    d[c][p] = seen[c][p] > 0 ? d[c][p] / seen[c][p] : INFINITY;
-            result.patch_orders[c] = sort_patches(patches, d[c]);
-        }
-        if (settings.update == UpdateRule::Monotone) {
-            // Keep a cluster's new order only if its own nodes' mean OVR does not rise: with the
-            // assignment step (each node to its best buffer) the mean node OVR can then only fall,
-            // so k-means settles instead of cycling. Scored from the kept fragments.
-            std::vector<const uint32_t*> pointers;
-            std::vector<std::vector<uint32_t>> candidate;
-            for (size_t c = 0; c < k; ++c) candidate.push_back(patch_order_to_triangle_order(patches, result.patch_orders[c]));
-            for (const auto& o : candidate) pointers.push_back(o.data());
-            std::vector<uint64_t> candidate_visible(node_count), candidate_passed(node_count * k);
-            if (kept.empty()) {
-                const std::vector<uint32_t> candidate_ranks = make_rank_table(pointers, mesh.triangle_count());
-                score_nodes(candidate_visible.data(), candidate_passed.data(), mesh.keyframe_positions.data(),
-                            mesh.vertex_count, framing, mesh.indices.data(), mesh.indices.size(), nodes.data(), node_count,
-                            candidate_ranks.data(), k, score);
-            } else {
-                // Each node only needs its own cluster's candidate: one order per node, not k.
-                std::vector<std::vector<uint32_t>> single_ranks;
-                for (const uint32_t* o : pointers) single_ranks.push_back(make_rank_table({o}, mesh.triangle_count()));
-                const int threads = settings.threads ? int(settings.threads) : tbb::this_task_arena::max_concurrency();
-                tbb::task_arena arena(threads);
-                arena.execute([&] {
-                    tbb::parallel_for(tbb::blocked_range<size_t>(0, node_count, 64), [&](const tbb::blocked_range<size_t>& r) {
-                        for (size_t n = r.begin(); n != r.end(); ++n) {
-                            const uint32_t c = result.assignment[n];
-                            score_fragments(&candidate_passed[n * k + c], kept[n], single_ranks[c].data(), 1);
-                        }
-                    });
-                });
-            }
-            std::vector<double> before(k, 0.0), after(k, 0.0);
-            for (size_t n = 0; n < node_count; ++n) {
-                if (visible[n] == 0) continue;
-                const uint32_t c = result.assignment[n];
-                before[c] += double(passed[n * k + c]) / double(visible[n]);
-                after[c] += double(candidate_passed[n * k + c]) / double(visible[n]);
-            }
-            for (size_t c = 0; c < k; ++c) {
-                if (reseeded[c]) continue;
-                if (after[c] < before[c]) ++log.accepted;
-                else result.patch_orders[c] = previous_orders[c];  // no better: keep the old buffer
-            }
-        }
+        const std::vector<size_t> members = update_orders(nodes, settings.distance, result.assignment, result.patch_orders);
+        std::vector<uint8_t> reseeded;
+        log.reseeded = reseed_empty_clusters(nodes, members, node_ovr, settings, result.patch_orders, reseeded);
+        if (settings.update == UpdateRule::Monotone)
+            log.accepted = keep_improved_orders(nodes, result.assignment, scores, previous_orders, reseeded,
+                                                settings.threads, result.patch_orders);
         log.seconds_update = seconds_since(update_start);
         result.iterations.push_back(log);
         say(settings, "iteration " + std::to_string(iteration + 1) + ": mean OVR " + std::to_string(log.mean_ovr) + ", " +
                           std::to_string(log.reassigned) + " nodes reassigned" +
                           (settings.update == UpdateRule::Monotone
-                               ? ", " + std::to_string(log.accepted) + " of " + std::to_string(k) + " buffers improved"
+                               ? ", " + std::to_string(log.accepted) + " of " + std::to_string(nodes.k) +
+                                     " buffers improved"
                                : std::string()));
         if (settings.update == UpdateRule::Monotone && log.accepted == 0 && log.reseeded == 0) {
-            // Same buffers, so the next assignment would be this one: k-means has settled.
+            // Same buffers, so the next assignment would be this one: k-means has settled (the
+            // Monotone rule's form of lines 18–19).
             result.converged = true;
             result.stop_reason = "converged";
-            result.patch_orders = best_orders;
-            result.assignment = best_assignment;
-            result.triangle_orders.clear();
-            for (const auto& o : result.patch_orders) result.triangle_orders.push_back(patch_order_to_triangle_order(patches, o));
+            finish(result, patches, best);
             break;
         }
     }

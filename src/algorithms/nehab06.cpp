@@ -39,13 +39,15 @@
 #include "animorder/vertex_cache.h"
 #include "animorder/viewpoints.h"
 
+#include "fragment_encoding.h"
+#include "stopwatch.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <deque>
@@ -57,11 +59,6 @@
 namespace animorder {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
-
-constexpr uint32_t kTieBit = 0x80000000u;  // NodeFragments: depth equal to the previous fragment's
-constexpr uint32_t kTriangleMask = 0x7fffffffu;
 constexpr size_t kMaxKeptBytes = size_t(1) << 30;  // keep node fragments across candidates below 1 GiB
 
 size_t pair_index(size_t a, size_t b, size_t n) {  // a < b < n, row-major upper triangle
@@ -164,12 +161,12 @@ Nodes make_nodes(const uint32_t* indices, size_t index_count, const float* keyfr
     return nodes;
 }
 
-std::vector<uint32_t> checked_keyframes(const uint32_t* keyframes, size_t keyframes_count, size_t keyframe_count,
+std::vector<uint32_t> checked_keyframes(const uint32_t* keyframes, size_t keyframe_list_count, size_t keyframe_count,
                                         const float* keyframe_positions, size_t vertex_count, const uint32_t* indices,
                                         size_t index_count) {
     if (!keyframe_positions || keyframe_count == 0) throw InvalidInput("static-nehab06 needs keyframe positions");
-    if (keyframes_count && !keyframes) throw InvalidInput("static-nehab06: the keyframe list is missing");
-    std::vector<uint32_t> list(keyframes, keyframes + keyframes_count);
+    if (keyframe_list_count && !keyframes) throw InvalidInput("static-nehab06: the keyframe list is missing");
+    std::vector<uint32_t> list(keyframes, keyframes + keyframe_list_count);
     if (list.empty()) list.push_back(0);
     for (uint32_t k : list) {
         if (k >= keyframe_count)
@@ -430,7 +427,7 @@ FeedbackArcs count_feedback_arcs(const uint32_t* node_order, size_t node_count, 
 
 std::vector<Arc> build_overdraw_graph(const uint32_t* indices, size_t index_count, const float* keyframe_positions,
                                       size_t keyframe_count, size_t vertex_count, const uint32_t* keyframes,
-                                      size_t keyframes_count, const uint32_t* cluster_of, size_t cluster_count,
+                                      size_t keyframe_list_count, const uint32_t* cluster_of, size_t cluster_count,
                                       const uint32_t* draw_order, const OverdrawGraphSettings& settings) {
     validate_indices(indices, index_count, vertex_count);
     check_graph_settings(settings.views, settings.resolution, cluster_count);
@@ -441,7 +438,7 @@ std::vector<Arc> build_overdraw_graph(const uint32_t* indices, size_t index_coun
         if (cluster_of[t] >= cluster_count)
             throw InvalidInput("overdraw graph: triangle " + std::to_string(t) + " is in cluster " +
                                std::to_string(cluster_of[t]) + ", but there are " + std::to_string(cluster_count));
-    const std::vector<uint32_t> list = checked_keyframes(keyframes, keyframes_count, keyframe_count, keyframe_positions,
+    const std::vector<uint32_t> list = checked_keyframes(keyframes, keyframe_list_count, keyframe_count, keyframe_positions,
                                                          vertex_count, indices, index_count);
     std::vector<uint32_t> rank(triangles);
     for (size_t i = 0; i < triangles; ++i) rank[draw_order[i]] = uint32_t(i);
@@ -453,9 +450,121 @@ std::vector<Arc> build_overdraw_graph(const uint32_t* indices, size_t index_coun
     return arcs_from_sums(source.pair_sums(cluster_of, rank.data(), cluster_count, raster), cluster_count);
 }
 
+namespace {
+
+// One candidate order for a given number of clusters (§3–§5), and what the search compares.
+struct Candidate {
+    std::vector<uint32_t> order;  // face permutation
+    double acmr = 0;              // of its clusters Tipsified
+    size_t clusters = 0, arcs = 0;
+    FeedbackArcs feedback;
+};
+
+// Builds candidates for any cluster count from the same mesh, nodes and clusterer; the time of
+// each stage adds to the result's timings.
+struct CandidateBuilder {
+    const uint32_t* indices;
+    size_t index_count;
+    size_t vertex_count;
+    unsigned cache_size;
+    const NodeSource& source;
+    PlanarClusterer& clusterer;
+    Nehab06Result& result;
+
+    Candidate build(size_t wanted) const {
+        const size_t triangles = index_count / 3;
+        Candidate c;
+        c.clusters = std::min(wanted, triangles);
+
+        // §3: planar clusters, each Tipsified on its own; the ACMR of the clusters in id order
+        // (the cluster order changes it little).
+        Clock::time_point t0 = Clock::now();
+        const std::vector<uint32_t> cluster_of = clusterer.cluster(c.clusters);
+        std::vector<uint32_t> grouped(triangles);
+        const std::vector<uint32_t> starts =
+            tipsify_clusters(grouped.data(), indices, index_count, vertex_count, cluster_of.data(), c.clusters, cache_size);
+        {
+            std::vector<uint32_t> buffer(index_count);
+            apply_triangle_order(buffer.data(), indices, grouped.data(), triangles);
+            c.acmr = analyze_vertex_cache(buffer.data(), index_count, vertex_count, cache_size).acmr;
+        }
+        result.seconds_clustering += seconds_since(t0);
+
+        // §4: the partial-order graph from the pair sums over every node.
+        t0 = Clock::now();
+        std::vector<uint32_t> rank(triangles);
+        for (size_t i = 0; i < triangles; ++i) rank[grouped[i]] = uint32_t(i);
+        std::vector<Arc> arcs;
+        if (c.clusters > 1)
+            arcs = arcs_from_sums(source.pair_sums(cluster_of.data(), rank.data(), c.clusters, result.seconds_rasterization),
+                                  c.clusters);
+        result.seconds_graph += seconds_since(t0);
+
+        // §5: the cluster order (feedback arc set), then each cluster's triangles in Tipsify order.
+        t0 = Clock::now();
+        const std::vector<uint32_t> cluster_order = order_feedback_arc_set(c.clusters, arcs.data(), arcs.size());
+        c.arcs = arcs.size();
+        c.feedback = count_feedback_arcs(cluster_order.data(), c.clusters, arcs.data(), arcs.size());
+        c.order.reserve(triangles);
+        for (uint32_t cluster : cluster_order)
+            c.order.insert(c.order.end(), grouped.begin() + starts[cluster], grouped.begin() + starts[cluster + 1]);
+        result.seconds_ordering += seconds_since(t0);
+        return c;
+    }
+};
+
+double tipsify_acmr(const uint32_t* indices, size_t index_count, size_t vertex_count, unsigned cache_size) {
+    std::vector<uint32_t> buffer(index_count);
+    tipsify_index_buffer(buffer.data(), indices, index_count, vertex_count, cache_size);
+    return analyze_vertex_cache(buffer.data(), index_count, vertex_count, cache_size).acmr;
+}
+
+// The automatic cluster count, §6 ("an appropriate number of clusters can be found by trying the
+// method on successive powers of two, until the average overdraw stops improving consistently";
+// the rules are Nehab06Settings::clusters'): 2, 4, 8, ... clusters, each scored by its mean OVR
+// over the nodes. Every eligible count goes into result.candidates; returns the chosen one.
+Candidate search_cluster_count(const CandidateBuilder& builder, const PlanarClusterer& clusterer,
+                               const NodeSource& source, Nehab06Result& result) {
+    constexpr double kGain = 0.005;       // a doubling "improves" when it lowers the best by 0.5%
+    constexpr double kAcmrBudget = 1.25;  // a count costing more than 1.25 × Tipsify's ACMR is out
+    constexpr size_t kLargest = 1024;
+    const size_t triangles = builder.index_count / 3;
+    const size_t components = clusterer.component_count();
+    Clock::time_point t0 = Clock::now();
+    const double budget = kAcmrBudget * tipsify_acmr(builder.indices, builder.index_count, builder.vertex_count,
+                                                     builder.cache_size);
+    result.seconds_selection += seconds_since(t0);
+
+    std::vector<Candidate> tried;
+    double best = std::numeric_limits<double>::infinity();
+    int stalled = 0;
+    for (size_t k = 2;; k *= 2) {
+        Candidate c = builder.build(k);
+        if (c.acmr > budget && !tried.empty()) break;  // over the ACMR budget: not eligible, stop
+        t0 = Clock::now();
+        const double ovr = source.mean_ovr(c.order.data(), triangles);
+        result.seconds_selection += seconds_since(t0);
+        result.candidates.push_back({c.clusters, ovr, c.acmr});
+        tried.push_back(std::move(c));
+        // The stopping rule: two doublings in a row without a gain of kGain on the best. Below the
+        // component count clusters are unions of whole components: the mean OVR can sit on a
+        // plateau there and fall once components split, so no stall counts.
+        if (ovr < best * (1 - kGain) || k < components) stalled = 0;
+        else ++stalled;
+        best = std::min(best, ovr);
+        if (stalled >= 2 || k >= kLargest || k >= triangles) break;
+    }
+    // The smallest count within kGain of the best mean OVR.
+    size_t pick = 0;
+    while (result.candidates[pick].mean_ovr > best * (1 + kGain)) ++pick;
+    return std::move(tried[pick]);
+}
+
+}  // namespace
+
 Nehab06Result order_static_nehab06(uint32_t* order, const uint32_t* indices, size_t index_count,
                                    const float* keyframe_positions, size_t keyframe_count, size_t vertex_count,
-                                   const uint32_t* keyframes, size_t keyframes_count,
+                                   const uint32_t* keyframes, size_t keyframe_list_count,
                                    const Nehab06Settings& settings) {
     validate_indices(indices, index_count, vertex_count);
     check_graph_settings(settings.views, settings.resolution, settings.clusters);
@@ -463,11 +572,13 @@ Nehab06Result order_static_nehab06(uint32_t* order, const uint32_t* indices, siz
     Nehab06Result result;
     const size_t triangles = index_count / 3;
     if (triangles == 0) return result;
-    const std::vector<uint32_t> list = checked_keyframes(keyframes, keyframes_count, keyframe_count, keyframe_positions,
+    const std::vector<uint32_t> list = checked_keyframes(keyframes, keyframe_list_count, keyframe_count, keyframe_positions,
                                                          vertex_count, indices, index_count);
     const float* cluster_positions = keyframe_positions + size_t(list[0]) * vertex_count * 3;
     const bool automatic = settings.clusters == 0;
 
+    // The measuring nodes (§4's viewpoints, at every listed keyframe); their fragments are kept
+    // when several candidates will replay them.
     Clock::time_point start = Clock::now();
     const NodeSource source(indices, index_count, keyframe_positions, vertex_count,
                             make_nodes(indices, index_count, keyframe_positions, keyframe_count, vertex_count, list,
@@ -480,87 +591,11 @@ Nehab06Result order_static_nehab06(uint32_t* order, const uint32_t* indices, siz
     PlanarClusterer clusterer(indices, index_count, cluster_positions, vertex_count);
     result.seconds_clustering += seconds_since(start);
 
-    // One candidate: clusters, Tipsify inside, graph, order; writes the face order.
-    struct Candidate {
-        std::vector<uint32_t> order;
-        double acmr = 0;
-        size_t clusters = 0, arcs = 0;
-        FeedbackArcs feedback;
-    };
-    auto run = [&](size_t wanted) {
-        Candidate c;
-        c.clusters = std::min(wanted, triangles);
-        Clock::time_point t0 = Clock::now();
-        const std::vector<uint32_t> cluster_of = clusterer.cluster(c.clusters);
-        std::vector<uint32_t> grouped(triangles);
-        const std::vector<uint32_t> starts = tipsify_clusters(grouped.data(), indices, index_count, vertex_count,
-                                                              cluster_of.data(), c.clusters, settings.cache_size);
-        {
-            std::vector<uint32_t> buffer(index_count);
-            apply_triangle_order(buffer.data(), indices, grouped.data(), triangles);
-            c.acmr = analyze_vertex_cache(buffer.data(), index_count, vertex_count, settings.cache_size).acmr;
-        }
-        result.seconds_clustering += seconds_since(t0);
+    const CandidateBuilder builder{indices, index_count, vertex_count, settings.cache_size, source, clusterer, result};
+    const Candidate chosen =
+        automatic ? search_cluster_count(builder, clusterer, source, result) : builder.build(settings.clusters);
 
-        t0 = Clock::now();
-        std::vector<uint32_t> rank(triangles);
-        for (size_t i = 0; i < triangles; ++i) rank[grouped[i]] = uint32_t(i);
-        std::vector<Arc> arcs;
-        if (c.clusters > 1)
-            arcs = arcs_from_sums(source.pair_sums(cluster_of.data(), rank.data(), c.clusters, result.seconds_rasterization),
-                                  c.clusters);
-        result.seconds_graph += seconds_since(t0);
-
-        t0 = Clock::now();
-        const std::vector<uint32_t> cluster_order = order_feedback_arc_set(c.clusters, arcs.data(), arcs.size());
-        c.arcs = arcs.size();
-        c.feedback = count_feedback_arcs(cluster_order.data(), c.clusters, arcs.data(), arcs.size());
-        c.order.reserve(triangles);
-        for (uint32_t cluster : cluster_order)
-            c.order.insert(c.order.end(), grouped.begin() + starts[cluster], grouped.begin() + starts[cluster + 1]);
-        result.seconds_ordering += seconds_since(t0);
-        return c;
-    };
-
-    Candidate chosen;
-    if (!automatic) {
-        chosen = run(settings.clusters);
-    } else {
-        // §6: powers of two until the mean OVR stops improving (see Nehab06Settings::clusters).
-        constexpr double kGain = 0.005;
-        constexpr double kAcmrBudget = 1.25;
-        const size_t components = clusterer.component_count();
-        constexpr size_t kLargest = 1024;
-        Clock::time_point t0 = Clock::now();
-        double tipsify_acmr = 0;
-        {
-            std::vector<uint32_t> buffer(index_count);
-            tipsify_index_buffer(buffer.data(), indices, index_count, vertex_count, settings.cache_size);
-            tipsify_acmr = analyze_vertex_cache(buffer.data(), index_count, vertex_count, settings.cache_size).acmr;
-        }
-        result.seconds_selection += seconds_since(t0);
-        std::vector<Candidate> tried;
-        double best = std::numeric_limits<double>::infinity();
-        int stalled = 0;
-        for (size_t k = 2;; k *= 2) {
-            Candidate c = run(k);
-            if (c.acmr > tipsify_acmr * kAcmrBudget && !tried.empty()) break;
-            t0 = Clock::now();
-            const double ovr = source.mean_ovr(c.order.data(), triangles);
-            result.seconds_selection += seconds_since(t0);
-            result.candidates.push_back({c.clusters, ovr, c.acmr});
-            tried.push_back(std::move(c));
-            // Below the component count clusters are unions of whole components: the mean OVR
-            // can sit on a plateau there and fall once components split, so no stall counts.
-            if (ovr < best * (1 - kGain) || k < components) stalled = 0;
-            else ++stalled;
-            best = std::min(best, ovr);
-            if (stalled >= 2 || k >= kLargest || k >= triangles) break;
-        }
-        size_t pick = 0;
-        while (result.candidates[pick].mean_ovr > best * (1 + kGain)) ++pick;
-        chosen = std::move(tried[pick]);
-    }
+    // The final order: the chosen candidate's faces.
     std::copy(chosen.order.begin(), chosen.order.end(), order);
     result.cluster_count = chosen.clusters;
     result.arc_count = chosen.arcs;

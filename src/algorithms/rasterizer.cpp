@@ -27,6 +27,8 @@
 #include "animorder/invalid_input.h"
 #include "animorder/triangle_order.h"
 
+#include "fragment_encoding.h"
+
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -45,9 +47,6 @@ struct Fragment {
     uint32_t triangle;
     float depth;
 };
-
-constexpr uint32_t kTieBit = 0x80000000u;
-constexpr uint32_t kTriangleMask = 0x7fffffffu;
 
 struct NodeRasterizer::State {
     unsigned resolution = 0;

@@ -11,6 +11,8 @@
 
 #include "animorder/animated_mesh.h"
 #include "animorder/skinning.h"
+
+#include "../algorithms/mat4.h"
 #include "lathe.h"
 
 #include <algorithm>
@@ -69,18 +71,8 @@ struct Builder {
     }
 };
 
-// Column-major 4×4 helpers (glTF layout).
+// Column-major 4×4 helpers (glTF layout); the product is multiply_mat4 (src/algorithms/mat4.h).
 Mat4 identity() { return {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}; }
-Mat4 multiply(const Mat4& a, const Mat4& b) {
-    Mat4 r{};
-    for (int c = 0; c < 4; ++c)
-        for (int row = 0; row < 4; ++row) {
-            float s = 0;
-            for (int k = 0; k < 4; ++k) s += a[k * 4 + row] * b[c * 4 + k];
-            r[c * 4 + row] = s;
-        }
-    return r;
-}
 Mat4 translation(Vec3 t) {
     Mat4 m = identity();
     m[12] = float(t.x), m[13] = float(t.y), m[14] = float(t.z);
@@ -93,7 +85,7 @@ Mat4 rotation(Vec3 angles) {
     const Mat4 rx = {1, 0, 0, 0, 0, float(cx), float(sx), 0, 0, float(-sx), float(cx), 0, 0, 0, 0, 1};
     const Mat4 ry = {float(cy), 0, float(-sy), 0, 0, 1, 0, 0, float(sy), 0, float(cy), 0, 0, 0, 0, 1};
     const Mat4 rz = {float(cz), float(sz), 0, 0, float(-sz), float(cz), 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-    return multiply(rz, multiply(ry, rx));
+    return multiply_mat4(rz, multiply_mat4(ry, rx));
 }
 
 struct Pose {
@@ -143,9 +135,9 @@ std::array<Mat4, kJointCount> skinning_matrices(const Pose& pose) {
     for (int j = 0; j < kJointCount; ++j) {
         const Bone& bone = kSkeleton[j];
         const Vec3 offset = bone.parent < 0 ? bone.position + pose.root_offset : bone.position - kSkeleton[bone.parent].position;
-        const Mat4 local = multiply(translation(offset), rotation(pose.rotation[j]));
-        world[j] = bone.parent < 0 ? local : multiply(world[bone.parent], local);  // parents come first
-        skin[j] = multiply(world[j], translation(bone.position * -1.0));           // · inverse bind
+        const Mat4 local = multiply_mat4(translation(offset), rotation(pose.rotation[j]));
+        world[j] = bone.parent < 0 ? local : multiply_mat4(world[bone.parent], local);  // parents come first
+        skin[j] = multiply_mat4(world[j], translation(bone.position * -1.0));      // · inverse bind
     }
     return skin;
 }

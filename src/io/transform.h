@@ -2,6 +2,8 @@
 // to src/io.
 #pragma once
 
+#include "../algorithms/mat4.h"
+
 #include <array>
 #include <cmath>
 
@@ -11,16 +13,7 @@ using Mat = std::array<double, 16>;  // column-major
 using Quat = std::array<double, 4>;  // x, y, z, w
 
 inline Mat identity() { return {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}; }
-inline Mat mul(const Mat& a, const Mat& b) {
-    Mat r{};
-    for (int c = 0; c < 4; ++c)
-        for (int row = 0; row < 4; ++row) {
-            double s = 0;
-            for (int k = 0; k < 4; ++k) s += a[k * 4 + row] * b[c * 4 + k];
-            r[c * 4 + row] = s;
-        }
-    return r;
-}
+inline Mat mul(const Mat& a, const Mat& b) { return multiply_mat4(a, b); }
 inline Mat trs(const std::array<double, 3>& t, const Quat& q, const std::array<double, 3>& s) {
     const double x = q[0], y = q[1], z = q[2], w = q[3];
     Mat m = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w), 2 * (x * z - y * w), 0,

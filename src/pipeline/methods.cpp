@@ -284,7 +284,7 @@ void run_clustered(MethodResult& result, const AnimatedMesh& mesh, const MethodS
     result.fallback = uint32_t(std::max_element(chosen.begin(), chosen.end()) - chosen.begin());
     for (const ClusteringResult& run : r.runs) {
         double seconds = run.seconds_rasterization;
-        for (const ClusteringIteration& x : run.iterations) seconds += x.seconds_raster + x.seconds_update;
+        for (const ClusteringIteration& x : run.iterations) seconds += x.seconds_assignment + x.seconds_update;
         result.run_seconds.push_back(seconds);
     }
     result.buffers = std::move(r.buffers);

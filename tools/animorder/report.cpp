@@ -31,14 +31,14 @@ nlohmann::ordered_json clustering_details(const AnimatedMesh& mesh, const Method
         json iterations = json::array();
         for (size_t it = 0; it < r.runs[i].iterations.size(); ++it) {
             const ClusteringIteration& x = r.runs[i].iterations[it];
-            assignment += x.seconds_raster;
+            assignment += x.seconds_assignment;
             update += x.seconds_update;
             iterations.push_back({{"iteration", it + 1},
                                   {"mean_ovr", x.mean_ovr},
                                   {"reassigned", x.reassigned},
                                   {"reseeded", x.reseeded},
                                   {"improved_buffers", x.accepted},
-                                  {"seconds_assignment", x.seconds_raster},
+                                  {"seconds_assignment", x.seconds_assignment},
                                   {"seconds_update", x.seconds_update}});
         }
         runs.push_back({{"clips", r.method == Method::Joint ? json("all") : json(mesh.clips[i].name)},

@@ -10,6 +10,7 @@
 #include "animorder/animated_mesh.h"
 #include "animorder/gltf_loader.h"
 #include "support/files.h"
+#include "support/meshes.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -75,10 +76,7 @@ protected:
 };
 
 void expect_vertex(const AnimatedMesh& m, size_t keyframe, size_t vertex, double x, double y, double z) {
-    const float* p = m.keyframe(keyframe) + 3 * vertex;
-    EXPECT_NEAR(p[0], x, 1e-5) << "keyframe " << keyframe << " vertex " << vertex;
-    EXPECT_NEAR(p[1], y, 1e-5) << "keyframe " << keyframe << " vertex " << vertex;
-    EXPECT_NEAR(p[2], z, 1e-5) << "keyframe " << keyframe << " vertex " << vertex;
+    test::expect_position(m, keyframe, vertex, x, y, z, 1e-5);
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include "animorder/animated_mesh.h"
 #include "animorder/iqm_loader.h"
 #include "animorder/load.h"
+#include "support/binary_loader.h"
 #include "support/files.h"
 
 #include "support/require.h"
@@ -21,16 +22,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A little-endian byte image that grows as values are written at given offsets.
-struct Image {
-    std::vector<unsigned char> bytes;
-    template <typename T>
-    void put(size_t at, T value) {
-        if (bytes.size() < at + sizeof(T)) bytes.resize(at + sizeof(T), 0);
-        std::memcpy(bytes.data() + at, &value, sizeof(T));
-    }
-};
-
 // Header fields (Lee Salzman's iqm.h) by byte offset.
 enum : size_t {
     kNumText = 28, kOfsText = 32, kNumArrays = 44, kNumVertexes = 48, kOfsArrays = 52, kNumTriangles = 56,
@@ -46,8 +37,8 @@ enum : size_t {
 // Three vertices (0,0,0), (1,0,0), (0,1,0), one triangle, one joint at the origin that carries
 // every vertex, and one animation "slide" of two frames at 10 frames per second in which the
 // joint's x translation (the only channel: offset 0, scale 1) goes from 0 to 3.
-Image tiny_iqm() {
-    Image m;
+test::ByteImage tiny_iqm() {
+    test::ByteImage m;
     const char magic[16] = "INTERQUAKEMODEL";
     for (size_t i = 0; i < 16; ++i) m.put<char>(i, magic[i]);
     m.put<uint32_t>(16, 2);
@@ -96,27 +87,9 @@ Image tiny_iqm() {
     return m;
 }
 
-class IqmLoader : public test::ScratchFolderTest {
+class IqmLoader : public test::BinaryLoaderTest {
 protected:
-    IqmLoader() : ScratchFolderTest("animorder-iqm") {}
-    std::string write(const std::string& name, const Image& image) {
-        const fs::path p = path(name);
-        std::ofstream(p, std::ios::binary).write(reinterpret_cast<const char*>(image.bytes.data()), std::streamsize(image.bytes.size()));
-        return p.string();
-    }
-    // Loading `image` fails with a one-line LoadError that starts with the file name and holds `message`.
-    void expect_error(const std::string& name, const Image& image, const std::string& message, const LoadOptions& options = {}) {
-        const std::string file = write(name, image);
-        try {
-            load_iqm(file, options);
-            ADD_FAILURE() << name << ": no error";
-        } catch (const LoadError& e) {
-            const std::string what = e.what();
-            EXPECT_EQ(what.rfind(file, 0), 0u) << what;
-            EXPECT_NE(what.find(message), std::string::npos) << name << ": " << what;
-            EXPECT_EQ(what.find('\n'), std::string::npos) << what;
-        }
-    }
+    IqmLoader() : BinaryLoaderTest("animorder-iqm", [](const std::string& f, const LoadOptions& o) { return load_iqm(f, o); }) {}
 };
 
 }  // namespace
@@ -137,67 +110,35 @@ TEST_F(IqmLoader, TinyModelSlidesAsWorkedOutByHand) {
 
 TEST_F(IqmLoader, HostileFilesGiveOneLineErrors) {
     {
-        Image m = tiny_iqm();  // two billion frames of no channels: no data to check, 77 GB to sample
+        test::ByteImage m = tiny_iqm();  // two billion frames of no channels: no data to check, 77 GB to sample
         m.put<uint32_t>(kPoses + 4, 0);  // nothing animated: no frame data is ever read
         m.put<uint32_t>(kNumChannels, 0);
         m.put<uint32_t>(kNumFrames, 0x7FFFFFFF);
         m.put<uint32_t>(kAnims + 8, 0x7FFFFFFF);
         expect_error("frames.iqm", m, "loading budget");
     }
+    expect_field_error(tiny_iqm(), "slow.iqm", kAnims + 12, float(1e-30f), "absurdly long"); // 10^30 s at 30 keyframes per second
+    expect_field_error(tiny_iqm(), "fast.iqm", kAnims + 12, float(INFINITY), "frame rate");
     {
-        Image m = tiny_iqm();  // 10^30 s at 30 keyframes per second
-        m.put<float>(kAnims + 12, 1e-30f);
-        expect_error("slow.iqm", m, "absurdly long");
-    }
-    {
-        Image m = tiny_iqm();
-        m.put<float>(kAnims + 12, INFINITY);
-        expect_error("fast.iqm", m, "frame rate");
-    }
-    {
-        Image m = tiny_iqm();
+        test::ByteImage m = tiny_iqm();
         m.put<uint32_t>(kNumFrames, 0xFFFFFFFF);
         m.put<uint32_t>(kNumChannels, 0xFFFFFFFF);
         expect_error("channels.iqm", m, "frames past its end");
     }
+    expect_field_error(tiny_iqm(), "offset.iqm", kOfsTriangles, uint32_t(0xFFFFFFF0), "triangles past its end");
+    expect_field_error(tiny_iqm(), "positions.iqm", kArrays + 16, uint32_t(0xFFFFFFF0), "positions past its end"); // positions far past the end
     {
-        Image m = tiny_iqm();
-        m.put<uint32_t>(kOfsTriangles, 0xFFFFFFF0);
-        expect_error("offset.iqm", m, "triangles past its end");
-    }
-    {
-        Image m = tiny_iqm();
-        m.put<uint32_t>(kArrays + 16, 0xFFFFFFF0);  // positions far past the end
-        expect_error("positions.iqm", m, "positions past its end");
-    }
-    {
-        Image m = tiny_iqm();
+        test::ByteImage m = tiny_iqm();
         m.put<uint32_t>(kArrays + 20, 0);  // the blend indices array is a second POSITION array
         m.put<uint32_t>(kArrays + 28, 7);
         m.put<uint32_t>(kArrays + 32, 3);
         expect_error("twice.iqm", m, "two POSITION");
     }
-    {
-        Image m = tiny_iqm();
-        m.put<uint32_t>(kTriangles + 4, 3);
-        expect_error("index.iqm", m, "names a vertex past 3");
-    }
-    {
-        Image m = tiny_iqm();
-        m.put<uint32_t>(kBlendIndices, 1);
-        expect_error("joint.iqm", m, "names joint 1");
-    }
-    {
-        Image m = tiny_iqm();
-        m.put<int32_t>(kJoints + 4, 0);  // its own parent
-        expect_error("parent.iqm", m, "parent");
-    }
-    {
-        Image m = tiny_iqm();
-        m.put<uint32_t>(kAnims + 4, 1);  // frames 1 and 2 of two
-        expect_error("missing.iqm", m, "names missing frames");
-    }
-    Image m = tiny_iqm();
+    expect_field_error(tiny_iqm(), "index.iqm", kTriangles + 4, uint32_t(3), "names a vertex past 3");
+    expect_field_error(tiny_iqm(), "joint.iqm", kBlendIndices, uint32_t(1), "names joint 1");
+    expect_field_error(tiny_iqm(), "parent.iqm", kJoints + 4, int32_t(0), "parent"); // its own parent
+    expect_field_error(tiny_iqm(), "missing.iqm", kAnims + 4, uint32_t(1), "names missing frames"); // frames 1 and 2 of two
+    test::ByteImage m = tiny_iqm();
     m.bytes.resize(100);
     expect_error("short.iqm", m, "no IQM header");
     LoadOptions zero_rate;
@@ -209,28 +150,11 @@ TEST_F(IqmLoader, HostileFilesGiveOneLineErrors) {
 // floats become huge, negative, NaN): each copy loads or fails with a LoadError, nothing else
 // (under scripts/test-sanitized.sh: no memory error, no undefined behaviour).
 TEST_F(IqmLoader, EveryByteMutatedLoadsOrFailsCleanly) {
-    const Image tiny = tiny_iqm();
-    size_t loaded = 0, refused = 0;
-    for (size_t at = 0; at < tiny.bytes.size(); ++at)
-        for (unsigned char value : {0x00, 0x7F, 0x80, 0xFF}) {
-            Image m = tiny;
-            m.bytes[at] = value;
-            const std::string file = write("mutated.iqm", m);
-            try {
-                const AnimatedMesh mesh = load_iqm(file);
-                EXPECT_NO_THROW(validate_animated_mesh(mesh)) << "byte " << at << " = " << int(value);
-                ++loaded;
-            } catch (const LoadError& e) {
-                EXPECT_EQ(std::string(e.what()).rfind(file, 0), 0u) << e.what();
-                ++refused;
-            }
-        }
-    EXPECT_GT(loaded, 0u);
-    EXPECT_GT(refused, 0u);
+    expect_every_byte_mutation_loads_or_fails(tiny_iqm(), "mutated.iqm");
 }
 
 TEST_F(IqmLoader, LoadingBudgetIsCheckedBeforeSampling) {
-    Image m = tiny_iqm();  // 1000 frames per second slowed to 10^-3: 1000 s, 30001 keyframes
+    test::ByteImage m = tiny_iqm();  // 1000 frames per second slowed to 10^-3: 1000 s, 30001 keyframes
     m.put<float>(kAnims + 12, 1e-3f);
     LoadOptions small;
     small.max_keyframe_bytes = 30001 * 3 * 12 - 1;

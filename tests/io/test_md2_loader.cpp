@@ -4,6 +4,7 @@
 #include "animorder/animated_mesh.h"
 #include "animorder/load.h"
 #include "animorder/md2_loader.h"
+#include "support/binary_loader.h"
 #include "support/files.h"
 
 #include "support/require.h"
@@ -21,27 +22,13 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A little-endian byte image that grows as values are written at given offsets.
-struct Image {
-    std::vector<unsigned char> bytes;
-    template <typename T>
-    void put(size_t at, T value) {
-        if (bytes.size() < at + sizeof(T)) bytes.resize(at + sizeof(T), 0);
-        std::memcpy(bytes.data() + at, &value, sizeof(T));
-    }
-    void put_text(size_t at, const char* text, size_t room) {
-        if (bytes.size() < at + room) bytes.resize(at + room, 0);
-        std::memcpy(bytes.data() + at, text, std::min(std::strlen(text), room));
-    }
-};
-
 // Header fields (id Software's md2.h) by byte offset.
 enum : size_t { kFrameSize = 16, kVertices = 24, kTexCoords = 28, kTriangles = 32, kFrames = 40, kOfsTris = 52, kOfsFrames = 56, kOfsEnd = 64 };
 
 // Three vertices, one triangle (0, 1, 2), two frames "wave1" and "wave2": frame f has scale
 // (1, 1, 1), translate (0, 0, 10·f) and vertex bytes v0 = (0, 0, 0), v1 = (4, 0, 0), v2 = (0, 8 + 2·f, 0).
-Image tiny_md2() {
-    Image m;
+test::ByteImage tiny_md2() {
+    test::ByteImage m;
     m.put_text(0, "IDP2", 4);
     m.put<int32_t>(4, 8);
     const int32_t vertices = 3, frame_size = 40 + 4 * vertices;
@@ -70,27 +57,9 @@ Image tiny_md2() {
     return m;
 }
 
-class Md2Loader : public test::ScratchFolderTest {
+class Md2Loader : public test::BinaryLoaderTest {
 protected:
-    Md2Loader() : ScratchFolderTest("animorder-md2") {}
-    std::string write(const std::string& name, const Image& image) {
-        const fs::path p = path(name);
-        std::ofstream(p, std::ios::binary).write(reinterpret_cast<const char*>(image.bytes.data()), std::streamsize(image.bytes.size()));
-        return p.string();
-    }
-    // Loading `image` fails with a one-line LoadError that starts with the file name and holds `message`.
-    void expect_error(const std::string& name, const Image& image, const std::string& message, const LoadOptions& options = {}) {
-        const std::string file = write(name, image);
-        try {
-            load_md2(file, options);
-            ADD_FAILURE() << name << ": no error";
-        } catch (const LoadError& e) {
-            const std::string what = e.what();
-            EXPECT_EQ(what.rfind(file, 0), 0u) << what;
-            EXPECT_NE(what.find(message), std::string::npos) << name << ": " << what;
-            EXPECT_EQ(what.find('\n'), std::string::npos) << what;
-        }
-    }
+    Md2Loader() : BinaryLoaderTest("animorder-md2", [](const std::string& f, const LoadOptions& o) { return load_md2(f, o); }) {}
 };
 
 }  // namespace
@@ -111,43 +80,19 @@ TEST_F(Md2Loader, TinyModelResamplesAsWorkedOutByHand) {
 }
 
 TEST_F(Md2Loader, HostileHeadersGiveOneLineErrors) {
+    expect_field_error(tiny_md2(), "overflow.md2", kVertices, int32_t(0x40000000), "header counts are invalid"); // 40 + 4 · vertices overflows a 32-bit int
     {
-        Image m = tiny_md2();  // 40 + 4 · vertices overflows a 32-bit int
-        m.put<int32_t>(kVertices, 0x40000000);
-        expect_error("overflow.md2", m, "header counts are invalid");
-    }
-    {
-        Image m = tiny_md2();
+        test::ByteImage m = tiny_md2();
         m.put<int32_t>(kVertices, 0x7FFFFFFF);
         m.put<int32_t>(kFrameSize, 0x7FFFFFFF);
         expect_error("huge.md2", m, "header counts are invalid");
     }
-    {
-        Image m = tiny_md2();
-        m.put<int32_t>(kFrames, 0x7FFFFFFF);
-        expect_error("frames.md2", m, "truncated");
-    }
-    {
-        Image m = tiny_md2();
-        m.put<int32_t>(kOfsFrames, 0x7FFFFFF0);
-        expect_error("offset.md2", m, "truncated");
-    }
-    {
-        Image m = tiny_md2();
-        m.put<int32_t>(kOfsTris, -12);
-        expect_error("negative.md2", m, "truncated");
-    }
-    {
-        Image m = tiny_md2();
-        m.put<uint16_t>(68 + 2, 3);
-        expect_error("index.md2", m, "names vertex 3, there are 3");
-    }
-    {
-        Image m = tiny_md2();
-        m.put<float>(80, NAN);
-        expect_error("nan.md2", m, "NaN");
-    }
-    Image m = tiny_md2();
+    expect_field_error(tiny_md2(), "frames.md2", kFrames, int32_t(0x7FFFFFFF), "truncated");
+    expect_field_error(tiny_md2(), "offset.md2", kOfsFrames, int32_t(0x7FFFFFF0), "truncated");
+    expect_field_error(tiny_md2(), "negative.md2", kOfsTris, int32_t(-12), "truncated");
+    expect_field_error(tiny_md2(), "index.md2", 68 + 2, uint16_t(3), "names vertex 3, there are 3");
+    expect_field_error(tiny_md2(), "nan.md2", 80, float(NAN), "NaN");
+    test::ByteImage m = tiny_md2();
     m.bytes.resize(40);
     expect_error("short.md2", m, "no MD2 header");
     LoadOptions zero_rate;
@@ -159,24 +104,7 @@ TEST_F(Md2Loader, HostileHeadersGiveOneLineErrors) {
 // floats become huge, negative, NaN): each copy loads or fails with a LoadError, nothing else
 // (under scripts/test-sanitized.sh: no memory error, no undefined behaviour).
 TEST_F(Md2Loader, EveryByteMutatedLoadsOrFailsCleanly) {
-    const Image tiny = tiny_md2();
-    size_t loaded = 0, refused = 0;
-    for (size_t at = 0; at < tiny.bytes.size(); ++at)
-        for (unsigned char value : {0x00, 0x7F, 0x80, 0xFF}) {
-            Image m = tiny;
-            m.bytes[at] = value;
-            const std::string file = write("mutated.md2", m);
-            try {
-                const AnimatedMesh mesh = load_md2(file);
-                EXPECT_NO_THROW(validate_animated_mesh(mesh)) << "byte " << at << " = " << int(value);
-                ++loaded;
-            } catch (const LoadError& e) {
-                EXPECT_EQ(std::string(e.what()).rfind(file, 0), 0u) << e.what();
-                ++refused;
-            }
-        }
-    EXPECT_GT(loaded, 0u);
-    EXPECT_GT(refused, 0u);
+    expect_every_byte_mutation_loads_or_fails(tiny_md2(), "mutated.md2");
 }
 
 TEST_F(Md2Loader, LoadingBudgetIsCheckedBeforeSampling) {

@@ -105,22 +105,22 @@ TEST(Runtime, RefusesCorruptOrTruncatedBytes) {
 
 // --- Hostile bytes: a tiny sidecar built by hand, and headers whose sizes wrap. ---------------
 namespace {
-void put_u32(std::string& out, uint32_t v) {
-    for (int b = 0; b < 4; ++b) out.push_back(char((v >> (8 * b)) & 0xff));
+// Little-endian fields written independently of the tool's writer (src/io/sidecar.cpp): a value's
+// bytes are its host bytes, and these tests run on little-endian hosts only.
+static_assert(sizeof(uint32_t) == 4 && sizeof(float) == 4, "32-bit fields");
+template <typename T>
+void set_field(std::string& bytes, size_t at, T value) {
+    std::memcpy(&bytes[at], &value, sizeof value);
 }
-void put_f32(std::string& out, float f) {
-    uint32_t u;
-    std::memcpy(&u, &f, 4);
-    put_u32(out, u);
+template <typename T>
+void append_field(std::string& bytes, T value) {
+    bytes.resize(bytes.size() + sizeof value);
+    set_field(bytes, bytes.size() - sizeof value, value);
 }
-void set_u32(std::string& bytes, size_t at, uint32_t v) {
-    for (int b = 0; b < 4; ++b) bytes[at + b] = char((v >> (8 * b)) & 0xff);
-}
-void set_f32(std::string& bytes, size_t at, float f) {
-    uint32_t u;
-    std::memcpy(&u, &f, 4);
-    set_u32(bytes, at, u);
-}
+void put_u32(std::string& out, uint32_t v) { append_field(out, v); }
+void put_f32(std::string& out, float f) { append_field(out, f); }
+void set_u32(std::string& bytes, size_t at, uint32_t v) { set_field(bytes, at, v); }
+void set_f32(std::string& bytes, size_t at, float f) { set_field(bytes, at, f); }
 std::string header(uint32_t buffers, uint32_t indices, uint32_t clips) {
     std::string out = "AOR1";
     put_u32(out, 1);

@@ -4,6 +4,8 @@
 #include "animorder/animated_mesh.h"
 #include "animorder/triangle_order.h"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <array>
@@ -81,6 +83,15 @@ inline double median(std::vector<double> values) {
     if (values.empty()) return 0.0;
     std::nth_element(values.begin(), values.begin() + ptrdiff_t(values.size() / 2), values.end());
     return values[values.size() / 2];
+}
+
+// Vertex v of keyframe `keyframe` is at (x, y, z) within `tolerance` on each axis.
+inline void expect_position(const AnimatedMesh& m, size_t keyframe, size_t v, double x, double y, double z,
+                            double tolerance = 1e-4) {
+    const float* p = m.keyframe(keyframe) + 3 * v;
+    EXPECT_NEAR(p[0], x, tolerance) << "keyframe " << keyframe << " vertex " << v;
+    EXPECT_NEAR(p[1], y, tolerance) << "keyframe " << keyframe << " vertex " << v;
+    EXPECT_NEAR(p[2], z, tolerance) << "keyframe " << keyframe << " vertex " << v;
 }
 
 }  // namespace animorder::test

@@ -36,7 +36,6 @@
 
 #include "animorder/animated_mesh.h"
 #include "animorder/camera.h"
-#include "animorder/clustering.h"
 #include "animorder/evaluation.h"
 #include "animorder/invalid_input.h"
 #include "animorder/load.h"
@@ -45,7 +44,6 @@
 #include "animorder/procedural_character.h"
 #include "animorder/selection_table.h"
 #include "animorder/triangle_order.h"
-#include "animorder/vertex_cache.h"
 #include "animorder/viewpoints.h"
 
 #include <algorithm>
@@ -183,7 +181,7 @@ int run(const Options& options) {
     std::string input_name;
     if (options.input.empty()) {
         mesh = make_procedural_character();
-        input_name = "procedural-character (bundled)";
+        input_name = kProceduralCharacterName;
         log("no input given: using the bundled procedural character");
     } else {
         mesh = load_character(options.input);
@@ -193,14 +191,13 @@ int run(const Options& options) {
     validate_animated_mesh(mesh);
 
     // The two methods, built with the library's defaults (λ, cache, k, 162 views at 256²).
-    StaticMethodSettings static_settings;
-    static_settings.lambda = options.lambda;
-    const std::vector<uint32_t> original = run_static_method(mesh, StaticMethod::Original, static_settings).order;
-    ClusteringSettings clustering;
-    clustering.clusters = options.clusters;
-    log("clustering (single, k = " + std::to_string(options.clusters) + ", " + std::to_string(clustering.views) +
-        " views at " + std::to_string(clustering.resolution) + "²) ...");
-    const AnimatedMethodResult single = run_han_sander(mesh, false, options.lambda, kDefaultCacheSize, clustering);
+    MethodSettings settings;
+    settings.lambda = options.lambda;
+    settings.clustering.clusters = options.clusters;
+    const std::vector<uint32_t> original = run_method(mesh, Method::Original, settings).buffers.orders[0];
+    log("clustering (single, k = " + std::to_string(options.clusters) + ", " + std::to_string(settings.clustering.views) +
+        " views at " + std::to_string(settings.clustering.resolution) + "²) ...");
+    const MethodResult single = run_method(mesh, Method::Single, settings);
     const MethodBuffers& buffers = single.buffers;
     const double seconds_methods = std::chrono::duration<double>(Clock::now() - start).count();
     log("methods ready in " + std::to_string(seconds_methods) + " s");
@@ -335,7 +332,7 @@ int run(const Options& options) {
                         "  \"shader_iterations\": %d,\n  \"repeats\": %d,\n  \"lambda\": %.17g,\n  \"clusters\": %zu,\n"
                         "  \"clustering_views\": %zu,\n  \"clustering_resolution\": %u,\n  \"methods\": [\n",
                      nodes.size(), options.views, options.keyframe_stride, options.resolution, options.iterations,
-                     options.repeats, options.lambda, options.clusters, clustering.views, clustering.resolution);
+                     options.repeats, options.lambda, options.clusters, settings.clustering.views, settings.clustering.resolution);
         for (int m = 0; m < 2; ++m)
             std::fprintf(f, "    {\"name\": \"%s\", \"buffers\": %zu, \"ovr\": %.17g, \"ovr_pooled\": %.17g, \"seconds\": %.17g, "
                             "\"gl_time_elapsed_s\": %.17g}%s\n",

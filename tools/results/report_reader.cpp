@@ -41,7 +41,7 @@ public:
     const json& member(const json& object, const std::string& key, const std::string& where) const {
         if (!object.is_object()) fail(where, "expected an object, got " + kind(object));
         const auto it = object.find(key);
-        if (it == object.end()) fail(where.empty() ? key : where + "." + key, "missing");
+        if (it == object.end()) fail(at(where, key), "missing");
         return *it;
     }
     const json* optional(const json& object, const std::string& key) const {

@@ -144,63 +144,39 @@ Section sweep_section(const Inputs& in, Charts& charts, const SweepSection& spec
 }  // namespace
 
 Section views_section(const Inputs& in, Charts& charts) {
-    return sweep_section(
-        in, charts,
-        {"views",
-         "Clustering viewpoints (Fig. 3)",
-         "sweep-views.json",
-         "",
-         "clustering viewpoints",
-         kViews,
-         "clustering viewpoints (icosphere vertices, log scale)",
-         true,
-         true,
-         0.05,
-         {"fig3-views-ovr.svg", "OVR against clustering viewpoints", "Overdraw against clustering viewpoints (Fig. 3)"},
-         {"fig3-views-time.svg", "Preprocessing time against clustering viewpoints",
-          "Preprocessing time against clustering viewpoints (Fig. 3)", "preprocessing s", &Method::time_s, false},
-         "The paper (Fig. 3, all 12 animations of its four models) finds 162 viewpoints sufficient: more improve OVR by "
-         "less than 0.01.\n"});
+    const Plot ovr{"fig3-views-ovr.svg", "OVR against clustering viewpoints",
+                   "Overdraw against clustering viewpoints (Fig. 3)"};
+    const Plot time{"fig3-views-time.svg", "Preprocessing time against clustering viewpoints",
+                    "Preprocessing time against clustering viewpoints (Fig. 3)", "preprocessing s", &Method::time_s};
+    return sweep_section(in, charts,
+                         {"views", "Clustering viewpoints (Fig. 3)", "sweep-views.json", "", "clustering viewpoints",
+                          kViews, "clustering viewpoints (icosphere vertices, log scale)", true, true, 0.05, ovr, time,
+                          "The paper (Fig. 3, all 12 animations of its four models) finds 162 viewpoints sufficient: "
+                          "more improve OVR by less than 0.01.\n"});
 }
 
 Section lambda_section(const Inputs& in, Charts& charts) {
+    const Plot ovr{"fig6-lambda-ovr.svg", "OVR against lambda", "Overdraw against λ (Fig. 6)"};
+    const Plot acmr{"fig6-lambda-acmr.svg", "ACMR against lambda", "Vertex cache: ACMR against λ (Fig. 6)", "ACMR",
+                    &Method::acmr, true};
     return sweep_section(
         in, charts,
-        {"lambda",
-         "Patch threshold lambda (Fig. 6)",
-         "sweep-lambda.json",
-         " Methods without λ are drawn as dashed reference lines.",
-         "λ",
-         kLambda,
-         "λ (patch ACMR threshold)",
-         false,
-         false,
-         0,
-         {"fig6-lambda-ovr.svg", "OVR against lambda", "Overdraw against λ (Fig. 6)"},
-         {"fig6-lambda-acmr.svg", "ACMR against lambda", "Vertex cache: ACMR against λ (Fig. 6)", "ACMR",
-          &Method::acmr, true},
+        {"lambda", "Patch threshold lambda (Fig. 6)", "sweep-lambda.json",
+         " Methods without λ are drawn as dashed reference lines.", "λ", kLambda, "λ (patch ACMR threshold)", false,
+         false, 0, ovr, acmr,
          "The paper (Fig. 6, six Ganfaul animations, λ 0.7 to 3) draws OVR on an axis from 1.08 to 1.16; the text "
          "extraction keeps no per-point values. It recommends λ in 0.75–0.95 and uses 0.85 (ACMR under 0.9) and 3 "
          "(overdraw only).\n"});
 }
 
 Section clusters_section(const Inputs& in, Charts& charts) {
-    return sweep_section(
-        in, charts,
-        {"clusters",
-         "Number of clusters k (Fig. 7)",
-         "sweep-k.json",
-         "",
-         "clusters",
-         kClusters,
-         "clusters k (index buffers per clip)",
-         false,
-         true,
-         0.05,
-         {"fig7-k-ovr.svg", "OVR against the number of clusters", "Overdraw against the number of clusters (Fig. 7)"},
-         {},
-         "The paper (Fig. 7, six Ganfaul animations, k = 1, 2, 3, 5, 7, 10; OVR axis 1 to 1.48) finds modest gains "
-         "beyond five clusters and uses k = 5.\n"});
+    const Plot ovr{"fig7-k-ovr.svg", "OVR against the number of clusters",
+                   "Overdraw against the number of clusters (Fig. 7)"};
+    return sweep_section(in, charts,
+                         {"clusters", "Number of clusters k (Fig. 7)", "sweep-k.json", "", "clusters", kClusters,
+                          "clusters k (index buffers per clip)", false, true, 0.05, ovr, Plot{},
+                          "The paper (Fig. 7, six Ganfaul animations, k = 1, 2, 3, 5, 7, 10; OVR axis 1 to 1.48) "
+                          "finds modest gains beyond five clusters and uses k = 5.\n"});
 }
 
 }  // namespace animorder::results

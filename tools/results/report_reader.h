@@ -1,0 +1,86 @@
+// make_results' typed view of RESULTS_DIR (report_reader.cpp): the `animorder evaluate --report`
+// files (Report), bench/render_time's --json file (RenderTime), the benchmarks' *.txt output and
+// the lead's notes-<section>.md, every field read and checked before anything is written. A
+// malformed file throws std::runtime_error naming the file and the key ("sweep-k.json:
+// methods[2].acmr: expected a number, got string"). Optional numbers left out or null read as NaN
+// (counts as -1), so the sections write "—" for them.
+#pragma once
+
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace animorder::results {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// One clip's numbers of a method (methods[i].per_clip[c]).
+struct ClipResult {
+    std::string clip;
+    double ovr_mean = kNaN, ovr_pooled = kNaN, time_s = kNaN;
+    long long nodes = -1;
+};
+
+// One row of a report's methods: a method at one setting (λ, k, views).
+struct Method {
+    std::string name;
+    double lambda = kNaN;  // NaN: the method does not use it (null)
+    long long clusters = -1, views = -1;
+    long long buffers = 0;
+    double acmr = kNaN, atvr = kNaN, ovr_mean = kNaN, ovr_pooled = kNaN, time_s = kNaN;
+    std::vector<ClipResult> per_clip;
+    std::map<std::string, size_t> iterations;  // k-means iterations per run ("all" for joint)
+};
+
+struct Clip {
+    std::string name;
+    long long keyframes = 0;
+};
+
+// An `animorder evaluate --report` file.
+struct Report {
+    std::string file, input;
+    long long triangles = -1, vertices = -1, nodes = -1, threads = -1;
+    long long eval_views = -1, eval_resolution = -1, eval_seed = -1, resolution = -1, seed = -1, cache_size = -1;
+    std::vector<double> lambdas;
+    std::vector<long long> clusters, views;
+    std::vector<Clip> clips;
+    std::vector<Method> methods;
+    double t_methods = kNaN, t_evaluation = kNaN, t_total = kNaN;
+};
+
+// A `bench/render_time --json` file.
+struct RenderTime {
+    struct Row {
+        std::string name;
+        double ovr = kNaN, seconds = kNaN;
+        long long buffers = -1;
+    };
+    std::string input, renderer;
+    long long nodes = -1, resolution = -1, shader_iterations = -1, triangles = -1, views = -1, keyframe_stride = -1,
+              repeats = -1;
+    std::vector<Row> methods;
+    double time_ratio = kNaN, ovr_ratio = kNaN, correlation = kNaN, unshaded_seconds = kNaN;
+};
+
+// The ids a notes-<id>.md may name, one per section of RESULTS.md.
+extern const std::vector<std::string> kSectionIds;
+
+// Everything in RESULTS_DIR that make_results reads.
+struct Inputs {
+    std::map<std::string, Report> reports;  // by file name (relative to RESULTS_DIR)
+    std::vector<std::string> characters;    // "characters/x.json", sorted
+    std::unique_ptr<RenderTime> render_time;
+    std::map<std::string, std::string> texts;  // *.txt by name, sorted
+    std::map<std::string, std::string> notes;  // section id -> notes-<id>.md
+    const Report* get(const std::string& name) const;
+};
+
+// Reads and checks every known file of `dir` (every one optional); throws std::runtime_error on
+// the first malformed one. A notes file naming no section is ignored with a line on stderr.
+Inputs load_inputs(const std::filesystem::path& dir);
+
+}  // namespace animorder::results

@@ -21,9 +21,11 @@
 
 #include <nettle/sha2.h>
 #include <nlohmann/json.hpp>
+#include <signal.h>
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -413,11 +415,34 @@ void drop_timings(json& value) {
     }
 }
 
+// What a run killed part-way leaves of an item (atomic_write.cpp's temporaries ".NAME.tmpPID" and
+// backups ".NAME.oldPID") is removed before the item is redone, when that process is gone.
+void remove_stale_temporaries(const std::vector<std::string>& outputs) {
+    std::error_code error;
+    for (const std::string& out : outputs) {
+        const fs::path target(out);
+        const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
+        const std::string prefix = "." + target.filename().string() + ".";
+        for (auto it = fs::directory_iterator(folder, error); !error && it != fs::directory_iterator(); it.increment(error)) {
+            const std::string name = it->path().filename().string();
+            if (name.size() <= prefix.size() + 3 || name.compare(0, prefix.size(), prefix) != 0) continue;
+            const std::string kind = name.substr(prefix.size(), 3), pid = name.substr(prefix.size() + 3);
+            if ((kind != "tmp" && kind != "old") || pid.empty() || pid.size() > 9 ||
+                !std::all_of(pid.begin(), pid.end(), [](char c) { return std::isdigit(uint8_t(c)); }))
+                continue;
+            if (::kill(pid_t(std::stol(pid)), 0) == 0 || errno != ESRCH) continue;  // still running (or not ours to judge)
+            std::error_code ignored;
+            fs::remove(it->path(), ignored);
+        }
+    }
+}
+
 json number_or_null(double v, bool have) { return have ? json(v) : json(nullptr); }
 
 // Runs one item into one OutputSet (the report, with its stamp, last): all files or none.
 void run_item(const PlannedItem& p, const std::string& stamp, const BatchOptions& batch) {
     const Clock::time_point start = Clock::now();
+    remove_stale_temporaries(p.plan.outputs);
     OutputSet files;
     OptimizeProduct product = produce_optimize(p.options, p.plan, files);
     const AnimatedMesh& mesh = product.mesh;

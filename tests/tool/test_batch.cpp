@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "support/files.h"
+#include "support/require.h"
 
 #include <nlohmann/json.hpp>
 
@@ -294,4 +295,38 @@ TEST_F(Batch, EveryOutputIsCheckedBeforeAnyWork) {
     const test::Outcome shard = run("batch -q --shard 3/3 " + manifest());
     EXPECT_EQ(shard.exit_code, 1);
     EXPECT_EQ(test::line_count(shard.err), 1u) << shard.err;
+}
+
+TEST_F(Batch, AChangedInputFileRerunsItsItemAndAGltfItemWritesTheGltf) {
+    // A .gltf's external buffer is one of the item's inputs: changing it re-runs that item only.
+    const fs::path source = test::shared_data_path("gltf-animated-morph-sphere");
+    ANIMORDER_REQUIRE_DATA(source / "AnimatedMorphSphere.gltf");
+    fs::create_directories(path("sphere"));
+    for (const char* name : {"AnimatedMorphSphere.gltf", "AnimatedMorphSphere.bin"}) {
+        fs::copy_file(source / name, path("sphere") / name);
+        fs::permissions(path("sphere") / name, fs::perms::owner_write, fs::perm_options::add);
+    }
+    write("m.json", R"({"items": [
+      {"name": "sphere", "input": "sphere/AnimatedMorphSphere.gltf", "method": "static-sander07", "output": "out/sphere.gltf"},
+      {"name": "bundled", "method": "original", "output": "out/bundled"}
+    ]})");
+    const test::Outcome first = run("batch -q" + kEval + " " + manifest());
+    ASSERT_EQ(first.exit_code, 0) << first.err;
+    EXPECT_TRUE(fs::exists(path("out/sphere.gltf")));
+    EXPECT_TRUE(fs::exists(path("out/sphere.animorder.bin")));
+    const nlohmann::json report = nlohmann::json::parse(test::slurp(path("out/sphere.animorder.report.json")));
+    EXPECT_EQ(report["outputs"]["gltf"], path("out/sphere.gltf").string());
+    EXPECT_NE(run("batch -q" + kEval + " " + manifest()).out.find("0 done, 2 up to date"), std::string::npos);
+
+    // One bit of the first normal's lowest mantissa byte (bufferView 0: NORMAL floats): same size,
+    // still a valid file.
+    {
+        std::fstream bin(path("sphere/AnimatedMorphSphere.bin"), std::ios::binary | std::ios::in | std::ios::out);
+        char byte = 0;
+        bin.read(&byte, 1);
+        bin.seekp(0);
+        bin.put(char(byte ^ 1));
+    }
+    const test::Outcome changed = run("batch -q" + kEval + " " + manifest());
+    EXPECT_NE(changed.out.find("2 items: 1 done, 1 up to date"), std::string::npos) << changed.out << changed.err;
 }

@@ -8,6 +8,7 @@ packages=(
   libtbb-dev                               # parallel node scoring
   libcli11-dev nlohmann-json3-dev          # the tool: options, JSON report
   libstb-dev                               # PNG heatmaps
+  nettle-dev                               # batch: SHA-256 stamps of items' inputs and options
   libgtest-dev libgmock-dev                # tests
   libbenchmark-dev                         # benchmarks
   libmeshoptimizer-dev                     # the meshopt baseline; an independent reference in tests

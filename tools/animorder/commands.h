@@ -9,6 +9,7 @@
 #include "animorder/methods.h"
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -77,5 +78,27 @@ int run_optimize(const OptimizeOptions& options);
 int run_evaluate(const EvaluateOptions& options);
 int run_heatmap(const HeatmapOptions& options);
 int run_subdivide(const SubdivideOptions& options);
+
+}  // namespace animorder::tool
+
+namespace animorder::tool {
+
+// `animorder batch MANIFEST` (batch.cpp): optimize every item of a manifest, skipping items whose
+// outputs are up to date, one shard of the items when asked, and the summary merged from the
+// items' reports. parse_item turns an item's optimize arguments into options (main.cpp's parser).
+struct BatchOptions {
+    std::string manifest;
+    bool quiet = false;
+    std::string shard;           // "I/N", "env/N" (JOB_COMPLETION_INDEX or SLURM_ARRAY_TASK_ID), empty: all
+    bool merge = false;          // only build the summary from the items' reports
+    std::string summary;         // SUMMARY → SUMMARY.json and SUMMARY.md (default: beside the manifest)
+    size_t eval_views = 10;      // OVR before/after per item: random views per keyframe (0: no OVR)
+    unsigned eval_resolution = 256;
+    bool no_timings = false;     // wall times left out: identical work gives byte-identical files
+    bool force = false;          // redo items even when up to date
+    unsigned threads = 0;
+};
+using ItemParser = std::function<OptimizeOptions(const std::vector<std::string>& args)>;
+int run_batch(const BatchOptions& options, const ItemParser& parse_item);
 
 }  // namespace animorder::tool

@@ -7,7 +7,9 @@
 #include <cstdio>
 #include <exception>
 #include <limits>
+#include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -91,6 +93,32 @@ std::string method_list(bool shippable_only) {
     return list;
 }
 
+void add_optimize_options(CLI::App& command, animorder::tool::OptimizeOptions& optimize) {
+    add_common(command, optimize.common);
+    command.add_option("-m,--method", optimize.method, "One of: " + method_list(true))
+        ->capture_default_str();
+    command.add_flag("--joint", optimize.joint, "One set of buffers for all clips (same as --method joint)");
+    add_method_options(command, optimize.methods);
+    command.add_option("-o,--output", optimize.output,
+                       "Write OUT.animorder.bin (buffers + lookup tables) and OUT.animorder.json; "
+                       "OUT.glb or OUT.gltf (glTF input) also writes the glTF with the orders");
+    command.add_option("-r,--report", optimize.report_path, "Write the JSON report to this file");
+}
+
+// A batch item's optimize arguments → options, by the optimize subcommand's own parser.
+animorder::tool::OptimizeOptions parse_batch_item(const std::vector<std::string>& args) {
+    CLI::App item{"batch item"};
+    animorder::tool::OptimizeOptions options;
+    add_optimize_options(item, options);
+    std::vector<std::string> reversed(args.rbegin(), args.rend());  // CLI11 takes them last first
+    try {
+        item.parse(reversed);
+    } catch (const CLI::ParseError& e) {
+        throw std::runtime_error(e.what());
+    }
+    return options;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -107,15 +135,7 @@ int main(int argc, char** argv) {
 
     OptimizeOptions optimize;
     CLI::App* optimize_cmd = app.add_subcommand("optimize", "Reorder triangles with a method; write buffers, table, report");
-    add_common(*optimize_cmd, optimize.common);
-    optimize_cmd->add_option("-m,--method", optimize.method, "One of: " + method_list(true))
-        ->capture_default_str();
-    optimize_cmd->add_flag("--joint", optimize.joint, "One set of buffers for all clips (same as --method joint)");
-    add_method_options(*optimize_cmd, optimize.methods);
-    optimize_cmd->add_option("-o,--output", optimize.output,
-                             "Write OUT.animorder.bin (buffers + lookup tables) and OUT.animorder.json; "
-                             "OUT.glb or OUT.gltf (glTF input) also writes the glTF with the orders");
-    optimize_cmd->add_option("-r,--report", optimize.report_path, "Write the JSON report to this file");
+    add_optimize_options(*optimize_cmd, optimize);
 
     EvaluateOptions evaluate;
     CLI::App* evaluate_cmd =
@@ -164,6 +184,31 @@ int main(int argc, char** argv) {
                      "(vertices x keyframes x 12 bytes): keep fewer clips with --clip NAME")
         ->required();
 
+    BatchOptions batch;
+    CLI::App* batch_cmd = app.add_subcommand(
+        "batch", "Optimize every item of a manifest (JSON or CSV); up-to-date items skipped; shards; summary");
+    batch_cmd->add_option("manifest", batch.manifest, "Manifest: JSON {\"items\": [...]} or CSV with a header line")
+        ->required();
+    batch_cmd->add_flag("-q,--quiet", batch.quiet, "No progress or notes on stderr");
+    batch_cmd->add_option("--shard", batch.shard,
+                          "I/N: only items i with i % N == I (0-based); env/N: I from JOB_COMPLETION_INDEX or "
+                          "SLURM_ARRAY_TASK_ID");
+    batch_cmd->add_flag("--merge", batch.merge, "Run nothing: build the summary from the items' reports (after the shards)");
+    batch_cmd->add_option("--summary", batch.summary,
+                          "Write SUMMARY.json and SUMMARY.md (default: the manifest's name + .summary)");
+    batch_cmd->add_option("--eval-views", batch.eval_views, "OVR before/after: random views per keyframe (0: no OVR)")
+        ->capture_default_str()
+        ->check(CLI::Range(size_t(0), size_t(100000)));
+    batch_cmd->add_option("--eval-resolution", batch.eval_resolution, "OVR before/after: viewport in pixels")
+        ->capture_default_str()
+        ->check(CLI::Range(8u, 8192u));
+    batch_cmd->add_flag("--no-timings", batch.no_timings,
+                        "Leave wall times out of reports and summary (identical work: byte-identical files)");
+    batch_cmd->add_flag("--force", batch.force, "Redo items whose outputs are up to date");
+    batch_cmd->add_option("--threads", batch.threads, "Worker threads per item (0: all cores)")
+        ->capture_default_str()
+        ->check(CLI::Range(0u, 1024u));
+
     if (argc == 1) {  // no arguments: the basics, and where to look next (gltfpack style)
         std::fputs(app.help().c_str(), stderr);
         return 2;
@@ -184,6 +229,7 @@ int main(int argc, char** argv) {
         if (*evaluate_cmd) return run_evaluate(evaluate);
         if (*heatmap_cmd) return run_heatmap(heatmap);
         if (*subdivide_cmd) return run_subdivide(subdivide);
+        if (*batch_cmd) return run_batch(batch, parse_batch_item);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "animorder: error: %s\n", e.what());
         return 1;

@@ -1,6 +1,8 @@
 // `animorder optimize`: run one method on the input and write what an application ships — the
 // glTF with the orders (glTF input), the sidecar and its description — and the JSON report. Every
 // output path is checked before any work; the outputs appear all together or not at all.
+#include "optimize.h"
+
 #include "commands.h"
 #include "input.h"
 #include "report.h"
@@ -21,13 +23,8 @@ using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 // The files `-o OUT` names: OUT.glb / OUT.gltf (only for glTF input), OUT.animorder.bin and .json.
-struct OutputPaths {
-    std::string gltf, sidecar, sidecar_json;
-};
-
-OutputPaths output_paths(const OptimizeOptions& options) {
-    OutputPaths paths;
-    if (options.output.empty()) return paths;
+void output_paths(const OptimizeOptions& options, OptimizePlan& paths) {
+    if (options.output.empty()) return;
     std::string stem = options.output;
     const std::string extension = std::filesystem::path(options.output).extension().string();
     if (extension == ".glb" || extension == ".gltf") {
@@ -39,7 +36,6 @@ OutputPaths output_paths(const OptimizeOptions& options) {
     }
     paths.sidecar = stem + ".animorder.bin";
     paths.sidecar_json = stem + ".animorder.json";
-    return paths;
 }
 
 // Every file this run reads: the character and the clip files or folders named by --clip.
@@ -51,8 +47,12 @@ std::vector<std::string> input_paths(const CommonOptions& common) {
     return inputs;
 }
 
-nlohmann::ordered_json settings_json(const OptimizeOptions& options, Method method, const MethodSettings& m) {
-    return {{"method", method_name(method)},
+}  // namespace
+
+nlohmann::ordered_json optimize_settings_json(const OptimizeOptions& options, const OptimizePlan& plan,
+                                              bool with_threads) {
+    const MethodSettings& m = plan.settings;
+    nlohmann::ordered_json settings = {{"method", method_name(plan.method)},
             {"lambda", m.lambda},
             {"cache_size", m.cache_size},
             {"keyframe", m.keyframe},
@@ -66,14 +66,13 @@ nlohmann::ordered_json settings_json(const OptimizeOptions& options, Method meth
             {"update", options.methods.update},
             {"nehab_clusters", m.nehab_clusters},
             {"nehab_views", m.nehab_views},
-            {"nehab_all_keyframes", m.nehab_all_keyframes},
-            {"threads", m.clustering.threads}};
+            {"nehab_all_keyframes", m.nehab_all_keyframes}};
+    if (with_threads) settings["threads"] = m.clustering.threads;
+    return settings;
 }
 
-}  // namespace
-
-int run_optimize(const OptimizeOptions& options) {
-    const Clock::time_point start = Clock::now();
+OptimizePlan plan_optimize(const OptimizeOptions& options) {
+    OptimizePlan plan;
     const Method method = options.joint ? Method::Joint : parse_method(options.method);
     if (options.joint && options.method != method_name(Method::Single) && options.method != method_name(Method::Joint) &&
         options.method != method_name(kDefaultMethod))
@@ -82,28 +81,36 @@ int run_optimize(const OptimizeOptions& options) {
         throw std::runtime_error(std::string(method_name(method)) +
                                  " is a bound (a new order at every node), not an order to ship; use evaluate --methods " +
                                  method_name(method));
-    const MethodSettings settings = method_settings(options.methods, options.common, method);
-    validate_method_settings(settings);
+    plan.method = method;
+    plan.settings = method_settings(options.methods, options.common, method);
+    validate_method_settings(plan.settings);
+    output_paths(options, plan);
+    const std::string* named[] = {&plan.gltf, &plan.sidecar, &plan.sidecar_json, &options.report_path};
+    for (const std::string* p : named)
+        if (!p->empty()) plan.outputs.push_back(*p);
+    plan.inputs = input_paths(options.common);
+    return plan;
+}
 
-    // Every output is checked now, not after minutes of work: folders exist, nothing is an input,
-    // no file is named twice.
-    const OutputPaths paths = output_paths(options);
-    std::vector<std::string> outputs;
-    for (const std::string* p : {&paths.gltf, &paths.sidecar, &paths.sidecar_json, &options.report_path})
-        if (!p->empty()) outputs.push_back(*p);
-    check_output_paths(outputs, input_paths(options.common));
-
+OptimizeProduct produce_optimize(const OptimizeOptions& options, const OptimizePlan& plan, OutputSet& files) {
+    const Clock::time_point start = Clock::now();
+    const Method method = plan.method;
+    const MethodSettings& settings = plan.settings;
+    const OptimizePlan& paths = plan;
     std::string input_name;
-    const AnimatedMesh mesh = load_drawable_input(options.common, input_name);
+    OptimizeProduct product;
+    product.mesh = load_drawable_input(options.common, input_name);
+    const AnimatedMesh& mesh = product.mesh;
     const double load_s = seconds_since(start);
     note(options.common, "loaded " + input_name + ": " + std::to_string(mesh.triangle_count()) + " triangles, " +
                              std::to_string(mesh.vertex_count) + " vertices, " + std::to_string(mesh.keyframe_count()) +
                              " keyframes");
 
-    const MethodResult run = run_method(mesh, method, settings);
-    const VertexCacheStats before = analyze_mesh_vertex_cache(mesh, mesh.indices, settings.cache_size);
+    product.run = run_method(mesh, method, settings);
+    const MethodResult& run = product.run;
+    product.before = analyze_mesh_vertex_cache(mesh, mesh.indices, settings.cache_size);
+    const VertexCacheStats& before = product.before;
 
-    OutputSet files;
     nlohmann::ordered_json written = {{"gltf", nullptr}, {"sidecar", nullptr}, {"sidecar_json", nullptr}};
     if (!paths.gltf.empty()) {
         const bool binary = std::filesystem::path(paths.gltf).extension() == ".glb";
@@ -119,18 +126,34 @@ int run_optimize(const OptimizeOptions& options) {
         written["sidecar_json"] = paths.sidecar_json;
     }
 
-    nlohmann::ordered_json report = report_header(mesh, input_name);
-    report["settings"] = settings_json(options, method, settings);
+    nlohmann::ordered_json& report = product.report;
+    report = report_header(mesh, input_name);
+    report["settings"] = optimize_settings_json(options, plan);
     report["input_order"] = cache_stats_json(before);
     report["methods"] = nlohmann::ordered_json::array({method_entry(mesh, run, settings)});
     report["outputs"] = written;
     report["timings_s"] = {{"load", load_s}, {"method", run.seconds}, {"total", seconds_since(start)}};
-    if (!options.report_path.empty()) files.add(options.report_path, report_text(report));
+    return product;
+}
+
+int run_optimize(const OptimizeOptions& options) {
+    const OptimizePlan plan = plan_optimize(options);
+    // Every output is checked now, not after minutes of work: folders exist, nothing is an input,
+    // no file is named twice.
+    check_output_paths(plan.outputs, plan.inputs);
+
+    OutputSet files;
+    const OptimizeProduct product = produce_optimize(options, plan, files);
+    if (!options.report_path.empty()) files.add(options.report_path, report_text(product.report));
     files.commit();
-    for (const std::string& path : outputs) note(options.common, "wrote " + path);
+    for (const std::string& path : plan.outputs) note(options.common, "wrote " + path);
+
+    const MethodResult& run = product.run;
+    const VertexCacheStats& before = product.before;
+    const std::string input_name = product.report["input"].get<std::string>();
 
     std::printf("%s on %s: %zu triangles, %zu buffers, ACMR %.4f -> %.4f, ATVR %.4f -> %.4f, %.3f s\n",
-                method_name(method), input_name.c_str(), mesh.triangle_count(), run.buffers.orders.size(), before.acmr,
+                method_name(plan.method), input_name.c_str(), product.mesh.triangle_count(), run.buffers.orders.size(), before.acmr,
                 run.acmr_mean, before.atvr, run.atvr_mean, run.seconds);
     return 0;
 }

@@ -1,0 +1,332 @@
+// `animorder batch` end to end: shards run in parallel give the same files and summary as one
+// run, a killed run resumes without redoing finished items, a broken item fails alone, a changed
+// option re-runs only the item it belongs to, and every output is checked before any work. The
+// references are independent of batch: `animorder optimize` run alone with the same options,
+// `inspect` for the input order's ACMR, `evaluate` for the optimised order's OVR.
+#include <gtest/gtest.h>
+
+#include "support/files.h"
+#include "support/require.h"
+
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
+#include <sys/wait.h>
+#include <thread>
+#include <unistd.h>
+#include <vector>
+
+namespace fs = std::filesystem;
+namespace test = animorder::test;
+
+namespace {
+
+// Small settings so every item takes a fraction of a second on the bundled character.
+const std::string kFast = "-k 2 --views 12 --resolution 32 --max-iterations 2";
+const std::string kEval = " --eval-views 1 --eval-resolution 32";
+
+class Batch : public test::ScratchFolderTest {
+protected:
+    Batch() : ScratchFolderTest("animorder-batch") {}
+    void SetUp() override {
+        ScratchFolderTest::SetUp();
+        fs::create_directories(path("out"));
+    }
+    test::Outcome run(const std::string& args) { return test::run_captured(std::string(ANIMORDER_EXE) + " " + args, dir_); }
+    std::string manifest() const { return path("m.json").string(); }
+    void write(const std::string& name, const std::string& text) { std::ofstream(path(name), std::ios::binary) << text; }
+
+    // Every regular file under out/ (name → bytes), temporaries included.
+    std::map<std::string, std::string> outputs() const {
+        std::map<std::string, std::string> files;
+        for (const auto& e : fs::directory_iterator(path("out"))) files[e.path().filename().string()] = test::slurp(e.path());
+        return files;
+    }
+};
+
+// Five items over the bundled character: single per clip, joint, two static methods.
+const char* kFiveItems = R"({"items": [
+  {"name": "walk-single", "clips": ["walk"], "options": "-k 2 --views 12 --resolution 32 --max-iterations 2", "output": "out/walk"},
+  {"name": "sander", "method": "static-sander07", "options": {"lambda": 3}, "output": "out/sander"},
+  {"name": "joint", "method": "joint", "options": ["-k", "2", "--views", "12", "--resolution", "32", "--max-iterations", "2"], "output": "out/joint"},
+  {"name": "wave-seed2", "clips": "wave", "options": "-k 2 --views 12 --resolution 32 --max-iterations 2 --seed 2", "output": "out/wave"},
+  {"name": "original", "method": "original", "output": "out/original"}
+]})";
+
+}  // namespace
+
+TEST_F(Batch, ThreeParallelShardsGiveTheFilesAndSummaryOfOneRun) {
+    write("m.json", kFiveItems);
+    const test::Outcome one = run("batch -q --no-timings" + kEval + " " + manifest());
+    ASSERT_EQ(one.exit_code, 0) << one.err;
+    const std::map<std::string, std::string> single_run = outputs();
+    const std::string summary_json = test::slurp(path("m.summary.json")), summary_md = test::slurp(path("m.summary.md"));
+    ASSERT_EQ(single_run.size(), 5u * 3u);  // sidecar, its description and the item report each
+    for (const auto& [name, bytes] : single_run) EXPECT_NE(name[0], '.') << name << ": a temporary was left";
+
+    // Each item's files are exactly what `animorder optimize` writes alone with the same options.
+    ASSERT_EQ(run("optimize -q --clip walk " + kFast + " -o " + path("alone").string()).exit_code, 0);
+    EXPECT_EQ(test::slurp(path("alone.animorder.bin")), single_run.at("walk.animorder.bin"));
+    ASSERT_EQ(run("optimize -q --method joint " + kFast + " -o " + path("alone-joint").string()).exit_code, 0);
+    EXPECT_EQ(test::slurp(path("alone-joint.animorder.bin")), single_run.at("joint.animorder.bin"));
+
+    // The summary's numbers: the input order's ACMR from inspect, the triangles, the clips, the
+    // buffers of single (k per clip) and joint (k), the index bytes those buffers add.
+    const nlohmann::json inspect = nlohmann::json::parse(run("inspect --json -q").out);
+    const nlohmann::json s = nlohmann::json::parse(summary_json);
+    ASSERT_EQ(s["items"].size(), 5u);
+    EXPECT_EQ(s["ok"], 5);
+    const size_t triangles = inspect["triangles"].get<size_t>();
+    for (const auto& row : s["items"]) {
+        EXPECT_EQ(row["status"], "ok") << row.dump();
+        EXPECT_EQ(row["triangles"], triangles);
+        EXPECT_DOUBLE_EQ(row["acmr_before"].get<double>(), inspect["input_order"]["acmr"].get<double>());
+        EXPECT_TRUE(row["time_s"].is_null());  // --no-timings
+        EXPECT_EQ(row["index_bytes_added"].get<size_t>(), (row["buffers"].get<size_t>() - 1) * triangles * 12);
+    }
+    EXPECT_EQ(s["items"][0]["clips"], 1);
+    EXPECT_EQ(s["items"][0]["buffers"], 2);
+    EXPECT_EQ(s["items"][2]["clips"], 2);
+    EXPECT_EQ(s["items"][2]["buffers"], 2);
+    EXPECT_EQ(s["items"][4]["buffers"], 1);
+    EXPECT_NE(summary_md.find("| wave-seed2 | single | " + std::to_string(triangles) + " | 1 |"), std::string::npos)
+        << summary_md;
+
+    // Again as three shards at once, then the merge: the same bytes.
+    for (const auto& e : fs::directory_iterator(path("out"))) fs::remove(e.path());
+    fs::remove(path("m.summary.json"));
+    fs::remove(path("m.summary.md"));
+    std::string parallel;
+    for (int i = 0; i < 3; ++i)
+        parallel += std::string(ANIMORDER_EXE) + " batch -q --no-timings" + kEval + " --shard " + std::to_string(i) +
+                    "/3 " + manifest() + " > " + path("shard" + std::to_string(i) + ".txt").string() + " 2>&1 & ";
+    const int status = std::system(("cd " + dir_.string() + " && " + parallel + "wait").c_str());
+    ASSERT_EQ(WEXITSTATUS(status), 0);
+    EXPECT_NE(test::slurp(path("shard0.txt")).find("shard 0/3: 2 items: 2 done"), std::string::npos)
+        << test::slurp(path("shard0.txt"));
+    EXPECT_NE(test::slurp(path("shard2.txt")).find("shard 2/3: 1 items: 1 done"), std::string::npos)
+        << test::slurp(path("shard2.txt"));
+    EXPECT_FALSE(fs::exists(path("m.summary.json")));  // a shard leaves the summary to the merge
+    const test::Outcome merge = run("batch -q --merge --no-timings" + kEval + " " + manifest());
+    ASSERT_EQ(merge.exit_code, 0) << merge.err;
+    EXPECT_EQ(outputs(), single_run);
+    EXPECT_EQ(test::slurp(path("m.summary.json")), summary_json);
+    EXPECT_EQ(test::slurp(path("m.summary.md")), summary_md);
+
+    // The shard index from a farm's environment.
+    const test::Outcome k8s = test::run_captured("env JOB_COMPLETION_INDEX=1 " + std::string(ANIMORDER_EXE) +
+                                  " batch -q --no-timings" + kEval + " --shard env/3 " + manifest(), dir_);
+    EXPECT_EQ(k8s.exit_code, 0) << k8s.err;
+    EXPECT_NE(k8s.out.find("shard 1/3: 2 items: 0 done, 2 up to date"), std::string::npos) << k8s.out;
+    const test::Outcome slurm = test::run_captured("env -u JOB_COMPLETION_INDEX SLURM_ARRAY_TASK_ID=2 " +
+                                                   std::string(ANIMORDER_EXE) + " batch -q --no-timings" + kEval +
+                                                   " --shard env/3 " + manifest(), dir_);
+    EXPECT_NE(slurm.out.find("shard 2/3: 1 items"), std::string::npos) << slurm.out;
+}
+
+TEST_F(Batch, CsvManifestIsTheJsonManifest) {
+    write("m.json", R"({"items": [{"clips": ["walk", "wave"], "options": "-k 2 --views 12 --resolution 32 --max-iterations 2", "output": "out/a"}]})");
+    write("m.csv", "input,clips,method,options,output\n,walk;wave,single,\"-k 2 --views 12 --resolution 32 --max-iterations 2\",out/b\n");
+    ASSERT_EQ(run("batch -q --eval-views 0 " + manifest()).exit_code, 0);
+    const test::Outcome csv = run("batch -q --eval-views 0 " + path("m.csv").string());
+    ASSERT_EQ(csv.exit_code, 0) << csv.err;
+    EXPECT_EQ(test::slurp(path("out/a.animorder.bin")), test::slurp(path("out/b.animorder.bin")));
+    const nlohmann::json s = nlohmann::json::parse(test::slurp(path("m.summary.json")));
+    EXPECT_TRUE(s["items"][0]["ovr_after"].is_null());  // --eval-views 0
+}
+
+TEST_F(Batch, KilledRunResumesWithoutRedoingFinishedItems) {
+    // Items slow enough (about a second each) that the kill lands while one is being made.
+    std::string items;
+    for (int i = 0; i < 4; ++i)
+        items += std::string(i ? "," : "") + R"({"options": "-k 3 --views 42 --resolution 48 --max-iterations 2 --seed )" +
+                 std::to_string(i + 1) + R"(", "output": "out/item)" + std::to_string(i) + "\"}";
+    write("m.json", "{\"items\": [" + items + "]}");
+    const pid_t child = fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+        const std::string log = path("first.txt").string();
+        if (!std::freopen(log.c_str(), "w", stdout) || dup2(fileno(stdout), 2) < 0) _exit(126);
+        execl(ANIMORDER_EXE, ANIMORDER_EXE, "batch", "-q", "--eval-views", "1", "--eval-resolution", "32",
+              manifest().c_str(), static_cast<char*>(nullptr));
+        _exit(127);
+    }
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    while (!fs::exists(path("out/item0.animorder.report.json")) && std::chrono::steady_clock::now() < deadline)
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    kill(child, SIGKILL);
+    int status = 0;
+    waitpid(child, &status, 0);
+    ASSERT_TRUE(WIFSIGNALED(status)) << "the batch ended before the kill: " << test::slurp(path("first.txt"));
+
+    // No item half written: each has all its files (report last) or none of them.
+    size_t finished = 0;
+    std::map<std::string, std::string> reports;
+    for (int i = 0; i < 4; ++i) {
+        const std::string stem = path("out/item" + std::to_string(i)).string();
+        const bool report = fs::exists(stem + ".animorder.report.json");
+        if (report) {
+            EXPECT_TRUE(fs::exists(stem + ".animorder.bin") && fs::exists(stem + ".animorder.json")) << stem;
+            reports[stem] = test::slurp(stem + ".animorder.report.json");
+            ++finished;
+        }
+    }
+    ASSERT_GE(finished, 1u);
+    ASSERT_LT(finished, 4u) << "the kill came after the last item: nothing left to resume";
+
+    const test::Outcome again = run("batch -q --eval-views 1 --eval-resolution 32 " + manifest());
+    ASSERT_EQ(again.exit_code, 0) << again.err;
+    EXPECT_NE(again.out.find(std::to_string(4 - finished) + " done, " + std::to_string(finished) + " up to date"),
+              std::string::npos)
+        << again.out;
+    for (const auto& [stem, bytes] : reports)  // wall times included: a redone item would differ
+        EXPECT_EQ(test::slurp(stem + ".animorder.report.json"), bytes) << stem;
+    for (const auto& [name, bytes] : outputs()) EXPECT_NE(name[0], '.') << name << ": the killed run's temporary remains";
+    const nlohmann::json s = nlohmann::json::parse(test::slurp(path("m.summary.json")));
+    EXPECT_EQ(s["ok"], 4);
+}
+
+TEST_F(Batch, ABrokenItemFailsAloneAndTheExitCodeSaysSo) {
+    write("broken.gltf", "{\"asset\": {\"version\": \"2.0\"}, \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 7}}]}]}");
+    write("m.json", R"({"items": [
+      {"name": "good", "method": "static-sander07", "output": "out/good"},
+      {"name": "broken", "input": "broken.gltf", "method": "static-sander07", "output": "out/broken"},
+      {"name": "absent", "input": "nowhere.glb", "method": "static-sander07", "output": "out/absent"},
+      {"name": "good2", "method": "original", "output": "out/good2"}
+    ]})");
+    const test::Outcome o = run("batch -q" + kEval + " " + manifest());
+    EXPECT_EQ(o.exit_code, 3) << o.err;
+    EXPECT_EQ(test::line_count(o.err), 2u) << o.err;  // one line per failed item
+    EXPECT_NE(o.err.find("broken.gltf"), std::string::npos) << o.err;
+    EXPECT_NE(o.err.find("nowhere.glb"), std::string::npos) << o.err;
+    EXPECT_TRUE(fs::exists(path("out/good.animorder.bin")));
+    EXPECT_TRUE(fs::exists(path("out/good2.animorder.bin")));
+    EXPECT_FALSE(fs::exists(path("out/broken.animorder.bin")));
+    const nlohmann::json s = nlohmann::json::parse(test::slurp(path("m.summary.json")));
+    EXPECT_EQ(s["ok"], 2);
+    EXPECT_EQ(s["failed"], 2);
+    EXPECT_EQ(s["items"][0]["status"], "ok");
+    EXPECT_EQ(s["items"][1]["status"], "failed");
+    EXPECT_NE(s["items"][1]["error"].get<std::string>().find("broken.gltf"), std::string::npos);
+    EXPECT_TRUE(s["items"][1]["triangles"].is_null());
+    EXPECT_EQ(s["items"][3]["status"], "ok");
+    const std::string md = test::slurp(path("m.summary.md"));
+    EXPECT_NE(md.find("| broken |"), std::string::npos);
+    EXPECT_NE(md.find("failed: "), std::string::npos);
+
+    // Once the file is repaired (here: removed from the manifest's list by fixing it to the
+    // bundled character), only that item runs.
+    write("m.json", R"({"items": [
+      {"name": "good", "method": "static-sander07", "output": "out/good"},
+      {"name": "broken", "method": "static-sander07", "output": "out/broken"},
+      {"name": "good2", "method": "original", "output": "out/good2"}
+    ]})");
+    const test::Outcome fixed = run("batch -q" + kEval + " " + manifest());
+    EXPECT_EQ(fixed.exit_code, 0) << fixed.err;
+    EXPECT_NE(fixed.out.find("1 done, 2 up to date, 0 failed"), std::string::npos) << fixed.out;
+    EXPECT_FALSE(fs::exists(path("out/broken.animorder.error.json")));
+}
+
+TEST_F(Batch, AChangedOptionRerunsOnlyTheItemsItAffects) {
+    auto manifest_with = [&](const std::string& k_of_b) {
+        write("m.json", R"({"items": [
+          {"name": "a", "clips": ["walk"], "options": "-k 2 --views 12 --resolution 32 --max-iterations 2", "output": "out/a"},
+          {"name": "b", "clips": ["wave"], "options": "-k )" + k_of_b + R"( --views 12 --resolution 32 --max-iterations 2", "output": "out/b"},
+          {"name": "c", "method": "static-sander07", "output": "out/c"}
+        ]})");
+    };
+    manifest_with("2");
+    ASSERT_EQ(run("batch -q" + kEval + " " + manifest()).exit_code, 0);
+    const std::map<std::string, std::string> first = outputs();
+
+    // Nothing changed, or only the thread count (which changes no output): nothing re-runs.
+    const test::Outcome same = run("batch -q --threads 1" + kEval + " " + manifest());
+    EXPECT_NE(same.out.find("0 done, 3 up to date"), std::string::npos) << same.out;
+    EXPECT_EQ(outputs(), first);
+
+    manifest_with("3");
+    const test::Outcome changed = run("batch -q" + kEval + " " + manifest());
+    ASSERT_EQ(changed.exit_code, 0) << changed.err;
+    EXPECT_NE(changed.out.find("1 done, 2 up to date"), std::string::npos) << changed.out;
+    const std::map<std::string, std::string> second = outputs();
+    for (const char* name : {"a.animorder.bin", "a.animorder.report.json", "c.animorder.bin", "c.animorder.report.json"})
+        EXPECT_EQ(second.at(name), first.at(name)) << name;
+    EXPECT_NE(second.at("b.animorder.bin"), first.at("b.animorder.bin"));
+    EXPECT_EQ(nlohmann::json::parse(second.at("b.animorder.report.json"))["settings"]["clusters"], 3);
+
+    // A batch-wide option the outputs depend on (the evaluation) re-runs every item; --force too.
+    const test::Outcome eval = run("batch -q --eval-views 2 --eval-resolution 32 " + manifest());
+    EXPECT_NE(eval.out.find("3 done, 0 up to date"), std::string::npos) << eval.out;
+    const test::Outcome forced = run("batch -q --force --eval-views 2 --eval-resolution 32 " + manifest());
+    EXPECT_NE(forced.out.find("3 done, 0 up to date"), std::string::npos) << forced.out;
+}
+
+TEST_F(Batch, EveryOutputIsCheckedBeforeAnyWork) {
+    write("m.json", R"({"items": [
+      {"method": "original", "output": "out/first"},
+      {"method": "original", "output": "missing-folder/second"}
+    ]})");
+    const test::Outcome o = run("batch -q " + manifest());
+    EXPECT_EQ(o.exit_code, 1);
+    EXPECT_EQ(test::line_count(o.err), 1u) << o.err;
+    EXPECT_NE(o.err.find("missing-folder"), std::string::npos) << o.err;
+    EXPECT_TRUE(outputs().empty());  // the first item did not run either
+
+    write("prev.animorder.bin", "an input that an output would replace");
+    for (const char* bad : {
+             R"({"items": [{"input": "prev.animorder.bin", "output": "out/x"}, {"method": "original", "output": "prev"}]})",
+             R"({"items": [{"method": "original", "output": "out/x"}, {"method": "original", "output": "out/x"}]})",
+             R"({"items": [{"method": "original", "output": "out/x", "colour": "red"}]})",
+             R"({"items": [{"method": "nonsense", "output": "out/x"}]})",
+             R"({"items": [{"method": "original", "options": "-o elsewhere", "output": "out/x"}]})",
+             R"({"items": [{"method": "original"}]})", "not json"}) {
+        write("m.json", bad);  // NOLINT
+        const test::Outcome e = run("batch -q " + manifest());
+        EXPECT_EQ(e.exit_code, 1) << bad;
+        EXPECT_EQ(test::line_count(e.err), 1u) << bad << "\n" << e.err;
+        EXPECT_TRUE(outputs().empty()) << bad;
+    }
+    const test::Outcome shard = run("batch -q --shard 3/3 " + manifest());
+    EXPECT_EQ(shard.exit_code, 1);
+    EXPECT_EQ(test::line_count(shard.err), 1u) << shard.err;
+}
+
+TEST_F(Batch, AChangedInputFileRerunsItsItemAndAGltfItemWritesTheGltf) {
+    // A .gltf's external buffer is one of the item's inputs: changing it re-runs that item only.
+    const fs::path source = test::shared_data_path("gltf-animated-morph-sphere");
+    ANIMORDER_REQUIRE_DATA(source / "AnimatedMorphSphere.gltf");
+    fs::create_directories(path("sphere"));
+    for (const char* name : {"AnimatedMorphSphere.gltf", "AnimatedMorphSphere.bin"}) {
+        fs::copy_file(source / name, path("sphere") / name);
+        fs::permissions(path("sphere") / name, fs::perms::owner_write, fs::perm_options::add);
+    }
+    write("m.json", R"({"items": [
+      {"name": "sphere", "input": "sphere/AnimatedMorphSphere.gltf", "method": "static-sander07", "output": "out/sphere.gltf"},
+      {"name": "bundled", "method": "original", "output": "out/bundled"}
+    ]})");
+    const test::Outcome first = run("batch -q" + kEval + " " + manifest());
+    ASSERT_EQ(first.exit_code, 0) << first.err;
+    EXPECT_TRUE(fs::exists(path("out/sphere.gltf")));
+    EXPECT_TRUE(fs::exists(path("out/sphere.animorder.bin")));
+    const nlohmann::json report = nlohmann::json::parse(test::slurp(path("out/sphere.animorder.report.json")));
+    EXPECT_EQ(report["outputs"]["gltf"], path("out/sphere.gltf").string());
+    EXPECT_NE(run("batch -q" + kEval + " " + manifest()).out.find("0 done, 2 up to date"), std::string::npos);
+
+    // One bit of the first normal's lowest mantissa byte (bufferView 0: NORMAL floats): same size,
+    // still a valid file.
+    {
+        std::fstream bin(path("sphere/AnimatedMorphSphere.bin"), std::ios::binary | std::ios::in | std::ios::out);
+        char byte = 0;
+        bin.read(&byte, 1);
+        bin.seekp(0);
+        bin.put(char(byte ^ 1));
+    }
+    const test::Outcome changed = run("batch -q" + kEval + " " + manifest());
+    EXPECT_NE(changed.out.find("2 items: 1 done, 1 up to date"), std::string::npos) << changed.out << changed.err;
+}

@@ -1,0 +1,669 @@
+// `animorder batch MANIFEST`: a library of characters through optimize, as a farm runs it.
+//
+// Each item of the manifest is one optimize run (the same library call as `animorder optimize`,
+// optimize.h) whose files — glTF, sidecar, sidecar description and the item report
+// OUT.animorder.report.json — appear together or not at all (OutputSet). The item report holds
+// the item's stamp: a SHA-256 (nettle) of the tool version, the item's resolved options and the
+// bytes of every file it reads. An item whose report carries the stamp it would have now, with
+// every output present, is up to date and skipped; so a run killed at any moment and started
+// again redoes only the items it had not finished, and a changed option or input re-runs only the
+// items it affects. A failing item leaves OUT.animorder.error.json (its stamp and the error) and
+// the batch goes on. `--shard I/N` runs items i with i % N == I; the summary (SUMMARY.json and
+// SUMMARY.md) is always merged from the items' files in manifest order, so it is the same
+// whichever process ran which item.
+#include "commands.h"
+#include "input.h"
+#include "optimize.h"
+#include "report.h"
+
+#include "animorder/atomic_write.h"
+#include "animorder/evaluation.h"
+
+#include <nettle/sha2.h>
+#include <nlohmann/json.hpp>
+#include <signal.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <numeric>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace animorder::tool {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::ordered_json;
+using Clock = std::chrono::steady_clock;
+
+// Exit codes beyond 0 (all done) and 1 (an error before any work).
+constexpr int kExitItemsFailed = 3;      // at least one item failed (each has its error line)
+constexpr int kExitItemsMissing = 4;     // merge: some items have no up-to-date result yet
+
+// ---------------------------------------------------------------------------------------------
+// The manifest
+
+struct ManifestItem {
+    std::string name;                // for the summary: "name", else the output
+    std::string input;               // resolved against the manifest's folder; empty: the bundled character
+    std::vector<std::string> clips;  // names, or clip files/folders (resolved when they exist)
+    std::string method;              // empty: optimize's default
+    std::vector<std::string> options;
+    std::string output;              // resolved against the manifest's folder
+};
+
+// Items' relative paths are relative to the manifest's folder, so a manifest moves with its data.
+std::string resolve(const fs::path& base, const std::string& path) {
+    if (path.empty() || fs::path(path).is_absolute() || base.empty()) return path;
+    return (base / path).string();
+}
+
+std::vector<std::string> split_words(const std::string& text) {
+    std::vector<std::string> words;
+    std::istringstream in(text);
+    for (std::string w; in >> w;) words.push_back(w);
+    return words;
+}
+
+std::string read_text(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw std::runtime_error(path + ": cannot read the manifest");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+// "options" as a string of optimize arguments, a list of them, or an object {"lambda": 3, "joint": true}.
+std::vector<std::string> options_from_json(const json& value, const std::string& where) {
+    std::vector<std::string> out;
+    if (value.is_null()) return out;
+    if (value.is_string()) return split_words(value.get<std::string>());
+    if (value.is_array()) {
+        for (const json& v : value) {
+            if (!v.is_string()) throw std::runtime_error(where + ": \"options\" list entries must be strings");
+            out.push_back(v.get<std::string>());
+        }
+        return out;
+    }
+    if (value.is_object()) {
+        for (auto it = value.begin(); it != value.end(); ++it) {
+            const std::string flag = (it.key().size() == 1 ? "-" : "--") + it.key();
+            if (it.value().is_boolean()) {
+                if (it.value().get<bool>()) out.push_back(flag);
+            } else if (it.value().is_string()) {
+                out.insert(out.end(), {flag, it.value().get<std::string>()});
+            } else if (it.value().is_number()) {
+                out.insert(out.end(), {flag, it.value().dump()});
+            } else {
+                throw std::runtime_error(where + ": option \"" + it.key() + "\" must be a string, number or boolean");
+            }
+        }
+        return out;
+    }
+    throw std::runtime_error(where + ": \"options\" must be a string, a list or an object");
+}
+
+std::vector<ManifestItem> parse_json_manifest(const std::string& text, const std::string& path) {
+    json doc;
+    try {
+        doc = json::parse(text);
+    } catch (const json::exception& e) {
+        throw std::runtime_error(path + ": not valid JSON: " + e.what());
+    }
+    const json* list = &doc;
+    if (doc.is_object()) {
+        if (!doc.contains("items")) throw std::runtime_error(path + ": a JSON manifest needs an \"items\" list");
+        list = &doc["items"];
+    }
+    if (!list->is_array()) throw std::runtime_error(path + ": \"items\" must be a list");
+    std::vector<ManifestItem> items;
+    for (size_t i = 0; i < list->size(); ++i) {
+        const json& e = (*list)[i];
+        const std::string where = path + ": item " + std::to_string(i + 1);
+        if (!e.is_object()) throw std::runtime_error(where + ": must be an object");
+        for (auto it = e.begin(); it != e.end(); ++it)
+            if (it.key() != "name" && it.key() != "input" && it.key() != "clips" && it.key() != "method" &&
+                it.key() != "options" && it.key() != "output")
+                throw std::runtime_error(where + ": unknown key \"" + it.key() +
+                                         "\" (known: name, input, clips, method, options, output)");
+        auto text_of = [&](const char* key) -> std::string {
+            if (!e.contains(key) || e[key].is_null()) return "";
+            if (!e[key].is_string()) throw std::runtime_error(where + ": \"" + key + "\" must be a string");
+            return e[key].get<std::string>();
+        };
+        ManifestItem item;
+        item.name = text_of("name");
+        item.input = text_of("input");
+        item.method = text_of("method");
+        item.output = text_of("output");
+        if (e.contains("clips")) {
+            const json& c = e["clips"];
+            if (c.is_string()) item.clips = {c.get<std::string>()};
+            else if (c.is_array())
+                for (const json& v : c) {
+                    if (!v.is_string()) throw std::runtime_error(where + ": \"clips\" entries must be strings");
+                    item.clips.push_back(v.get<std::string>());
+                }
+            else if (!c.is_null()) throw std::runtime_error(where + ": \"clips\" must be a string or a list");
+        }
+        item.options = options_from_json(e.contains("options") ? e["options"] : json(), where);
+        items.push_back(item);
+    }
+    return items;
+}
+
+// One CSV record (RFC 4180 quoting); `pos` moves past it and its line end.
+std::vector<std::string> csv_record(const std::string& text, size_t& pos, const std::string& where) {
+    std::vector<std::string> fields(1);
+    bool quoted = false;
+    for (; pos < text.size(); ++pos) {
+        const char c = text[pos];
+        if (quoted) {
+            if (c == '"' && pos + 1 < text.size() && text[pos + 1] == '"') fields.back() += '"', ++pos;
+            else if (c == '"') quoted = false;
+            else fields.back() += c;
+        } else if (c == '"') {
+            quoted = true;
+        } else if (c == ',') {
+            fields.emplace_back();
+        } else if (c == '\n' || c == '\r') {
+            if (c == '\r' && pos + 1 < text.size() && text[pos + 1] == '\n') ++pos;
+            ++pos;
+            return fields;
+        } else {
+            fields.back() += c;
+        }
+    }
+    if (quoted) throw std::runtime_error(where + ": a quoted field is not closed");
+    return fields;
+}
+
+std::vector<ManifestItem> parse_csv_manifest(const std::string& text, const std::string& path) {
+    size_t pos = 0;
+    std::vector<std::string> header = csv_record(text, pos, path + ": line 1");
+    for (std::string& h : header) {
+        h.erase(0, h.find_first_not_of(" \t"));
+        h.erase(h.find_last_not_of(" \t") + 1);
+        if (h != "name" && h != "input" && h != "clips" && h != "method" && h != "options" && h != "output")
+            throw std::runtime_error(path + ": line 1: unknown column \"" + h +
+                                     "\" (known: name, input, clips, method, options, output)");
+    }
+    std::vector<ManifestItem> items;
+    for (size_t line = 2; pos < text.size(); ++line) {
+        const std::string where = path + ": line " + std::to_string(line);
+        const std::vector<std::string> fields = csv_record(text, pos, where);
+        if (fields.size() == 1 && split_words(fields[0]).empty()) continue;  // blank line
+        if (fields.size() != header.size())
+            throw std::runtime_error(where + ": " + std::to_string(fields.size()) + " fields, the header has " +
+                                     std::to_string(header.size()));
+        ManifestItem item;
+        for (size_t f = 0; f < header.size(); ++f) {
+            const std::string& v = fields[f];
+            if (header[f] == "name") item.name = v;
+            else if (header[f] == "input") item.input = v;
+            else if (header[f] == "method") item.method = v;
+            else if (header[f] == "output") item.output = v;
+            else if (header[f] == "options") item.options = split_words(v);
+            else if (header[f] == "clips") {
+                std::stringstream list(v);
+                for (std::string c; std::getline(list, c, ';');)
+                    if (!split_words(c).empty()) item.clips.push_back(c);
+            }
+        }
+        items.push_back(item);
+    }
+    return items;
+}
+
+std::vector<ManifestItem> read_manifest(const std::string& path) {
+    const std::string text = read_text(path);
+    const std::string ext = fs::path(path).extension().string();
+    std::vector<ManifestItem> items;
+    if (ext == ".csv") items = parse_csv_manifest(text, path);
+    else {
+        const size_t first = text.find_first_not_of(" \t\r\n");
+        if (ext != ".json" && (first == std::string::npos || (text[first] != '{' && text[first] != '[')))
+            throw std::runtime_error(path + ": a manifest is .json or .csv");
+        items = parse_json_manifest(text, path);
+    }
+    const fs::path base = fs::path(path).parent_path();
+    for (size_t i = 0; i < items.size(); ++i) {
+        ManifestItem& item = items[i];
+        if (item.output.empty())
+            throw std::runtime_error(path + ": item " + std::to_string(i + 1) + " has no \"output\"");
+        if (item.name.empty()) item.name = item.output;
+        item.input = resolve(base, item.input);
+        item.output = resolve(base, item.output);
+        for (std::string& c : item.clips)  // a clip file or folder beside the manifest, else a clip name
+            if (!base.empty() && !fs::path(c).is_absolute() && fs::exists(base / c)) c = (base / c).string();
+    }
+    return items;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Items as optimize runs, and their stamps
+
+struct PlannedItem {
+    ManifestItem item;
+    OptimizeOptions options;
+    OptimizePlan plan;
+    std::string report, error;  // OUT.animorder.report.json, OUT.animorder.error.json
+};
+
+std::string stem_of(const std::string& output) {
+    const std::string ext = fs::path(output).extension().string();
+    return ext == ".glb" || ext == ".gltf" ? output.substr(0, output.size() - ext.size()) : output;
+}
+
+PlannedItem plan_item(const ManifestItem& item, size_t index, const BatchOptions& batch, const ItemParser& parse) {
+    PlannedItem p;
+    p.item = item;
+    std::vector<std::string> args;
+    if (!item.input.empty()) args.push_back(item.input);
+    for (const std::string& c : item.clips) args.insert(args.end(), {"--clip", c});
+    if (!item.method.empty()) args.insert(args.end(), {"--method", item.method});
+    for (const std::string& o : item.options) {
+        if (o == "-o" || o == "-r" || o.rfind("--output", 0) == 0 || o.rfind("--report", 0) == 0)
+            throw std::runtime_error("item " + std::to_string(index + 1) + " (" + item.name + "): option " + o +
+                                     ": batch names the outputs (use the item's \"output\")");
+        args.push_back(o);
+    }
+    args.insert(args.end(), {"-o", item.output});
+    try {
+        p.options = parse(args);
+        if (batch.quiet) p.options.common.quiet = true;
+        p.options.methods.settings.clustering.threads = batch.threads;
+        p.options.report_path = stem_of(item.output) + ".animorder.report.json";
+        p.plan = plan_optimize(p.options);
+    } catch (const std::exception& e) {
+        throw std::runtime_error("item " + std::to_string(index + 1) + " (" + item.name + "): " + e.what());
+    }
+    p.report = p.options.report_path;
+    p.error = stem_of(item.output) + ".animorder.error.json";
+    return p;
+}
+
+class Sha256 {
+public:
+    Sha256() { sha256_init(&ctx_); }
+    void add(const std::string& text) {
+        const uint64_t n = text.size();  // length-prefixed, so concatenations cannot collide
+        sha256_update(&ctx_, sizeof n, reinterpret_cast<const uint8_t*>(&n));
+        sha256_update(&ctx_, text.size(), reinterpret_cast<const uint8_t*>(text.data()));
+    }
+    // A file's bytes; a file that cannot be read hashes as its error (the item will fail to load it).
+    void add_file(const fs::path& path) {
+        add("file:" + path.filename().string());
+        std::ifstream in(path, std::ios::binary);
+        if (!in) return add("unreadable");
+        std::vector<char> block(1 << 16);
+        uint64_t total = 0;
+        while (in) {
+            in.read(block.data(), std::streamsize(block.size()));
+            const std::streamsize got = in.gcount();
+            if (got > 0) sha256_update(&ctx_, size_t(got), reinterpret_cast<const uint8_t*>(block.data()));
+            total += uint64_t(got > 0 ? got : 0);
+        }
+        add("bytes:" + std::to_string(total));
+    }
+    std::string hex() {
+        uint8_t digest[SHA256_DIGEST_SIZE];
+        sha256_digest(&ctx_, sizeof digest, digest);
+        static const char* digits = "0123456789abcdef";
+        std::string out;
+        for (uint8_t b : digest) out += {digits[b >> 4], digits[b & 15]};
+        return out;
+    }
+
+private:
+    sha256_ctx ctx_;
+};
+
+// A file or folder the item reads, with what it references: a .gltf's external buffers and images,
+// a folder's files (sorted, recursively).
+void hash_input(Sha256& hash, const std::string& path) {
+    std::error_code error;
+    if (fs::is_directory(path, error)) {
+        std::vector<fs::path> files;
+        for (auto it = fs::recursive_directory_iterator(path, error); !error && it != fs::recursive_directory_iterator();
+             it.increment(error))
+            if (it->is_regular_file(error)) files.push_back(it->path());
+        std::sort(files.begin(), files.end());
+        hash.add("folder:" + std::to_string(files.size()));
+        for (const fs::path& f : files) {
+            hash.add(fs::relative(f, path, error).string());
+            hash.add_file(f);
+        }
+        return;
+    }
+    hash.add_file(path);
+    if (fs::path(path).extension() != ".gltf") return;
+    try {
+        const nlohmann::json doc = nlohmann::json::parse(read_text(path));
+        for (const char* list : {"buffers", "images"})
+            if (doc.contains(list) && doc[list].is_array())
+                for (const nlohmann::json& entry : doc[list])
+                    if (entry.is_object() && entry.contains("uri") && entry["uri"].is_string()) {
+                        const std::string uri = entry["uri"].get<std::string>();
+                        if (uri.rfind("data:", 0) == 0) continue;  // embedded: hashed with the file
+                        hash.add("uri:" + uri);
+                        hash.add_file(fs::path(path).parent_path() / uri);
+                    }
+    } catch (const std::exception&) {
+        hash.add("unparsed");  // the loader will say what is wrong
+    }
+}
+
+// The stamp of an item: everything its outputs depend on (not --threads, which changes nothing).
+std::string item_stamp(const PlannedItem& p, const BatchOptions& batch) {
+    Sha256 hash;
+    hash.add("animorder batch stamp 1");
+    hash.add(ANIMORDER_VERSION);
+    hash.add(optimize_settings_json(p.options, p.plan, false).dump());
+    hash.add("max_memory:" + std::to_string(p.options.common.max_memory));
+    hash.add("input:" + p.options.common.input);
+    hash.add("output:" + p.options.output);
+    hash.add("eval:" + std::to_string(batch.eval_views) + "/" + std::to_string(batch.eval_resolution) +
+             (batch.no_timings ? "/no-timings" : ""));
+    if (!p.options.common.input.empty()) hash_input(hash, p.options.common.input);
+    for (const std::string& c : p.options.common.clips) {
+        hash.add("clip:" + c);
+        if (fs::exists(c)) hash_input(hash, c);
+    }
+    return hash.hex();
+}
+
+json read_json_file(const std::string& path) {
+    std::error_code error;
+    if (!fs::is_regular_file(path, error)) return json();
+    try {
+        return json::parse(read_text(path));
+    } catch (const std::exception&) {
+        return json();  // unreadable: as if absent
+    }
+}
+
+// The item's report when it is up to date: its stamp matches and every output is there.
+json current_report(const PlannedItem& p, const std::string& stamp) {
+    json report = read_json_file(p.report);
+    if (!report.is_object() || !report.contains("batch") || !report["batch"].is_object() ||
+        report["batch"].value("stamp", "") != stamp)
+        return json();
+    std::error_code error;
+    for (const std::string& out : p.plan.outputs)
+        if (!fs::is_regular_file(out, error)) return json();
+    return report;
+}
+
+// Wall times out (--no-timings): every key of seconds set to null, wherever it is.
+void drop_timings(json& value) {
+    if (value.is_array())
+        for (json& v : value) drop_timings(v);
+    if (!value.is_object()) return;
+    for (auto it = value.begin(); it != value.end(); ++it) {
+        const std::string& k = it.key();
+        if (k == "time_s" || k == "timings_s" || k == "stages_s" || k.rfind("seconds", 0) == 0) it.value() = nullptr;
+        else drop_timings(it.value());
+    }
+}
+
+// What a run killed part-way leaves of an item (atomic_write.cpp's temporaries ".NAME.tmpPID" and
+// backups ".NAME.oldPID") is removed before the item is redone, when that process is gone.
+void remove_stale_temporaries(const std::vector<std::string>& outputs) {
+    std::error_code error;
+    for (const std::string& out : outputs) {
+        const fs::path target(out);
+        const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
+        const std::string prefix = "." + target.filename().string() + ".";
+        for (auto it = fs::directory_iterator(folder, error); !error && it != fs::directory_iterator(); it.increment(error)) {
+            const std::string name = it->path().filename().string();
+            if (name.size() <= prefix.size() + 3 || name.compare(0, prefix.size(), prefix) != 0) continue;
+            const std::string kind = name.substr(prefix.size(), 3), pid = name.substr(prefix.size() + 3);
+            if ((kind != "tmp" && kind != "old") || pid.empty() || pid.size() > 9 ||
+                !std::all_of(pid.begin(), pid.end(), [](char c) { return std::isdigit(uint8_t(c)); }))
+                continue;
+            if (::kill(pid_t(std::stol(pid)), 0) == 0 || errno != ESRCH) continue;  // still running (or not ours to judge)
+            std::error_code ignored;
+            fs::remove(it->path(), ignored);
+        }
+    }
+}
+
+json number_or_null(double v, bool have) { return have ? json(v) : json(nullptr); }
+
+// Runs one item into one OutputSet (the report, with its stamp, last): all files or none.
+void run_item(const PlannedItem& p, const std::string& stamp, const BatchOptions& batch) {
+    const Clock::time_point start = Clock::now();
+    remove_stale_temporaries(p.plan.outputs);
+    OutputSet files;
+    OptimizeProduct product = produce_optimize(p.options, p.plan, files);
+    const AnimatedMesh& mesh = product.mesh;
+    const MethodResult& run = product.run;
+
+    bool have_ovr = false;
+    double ovr_before = 0, ovr_after = 0;
+    if (batch.eval_views > 0 && mesh.keyframe_count() > 0) {
+        MethodBuffers input_order;
+        input_order.orders.emplace_back(mesh.triangle_count());
+        std::iota(input_order.orders[0].begin(), input_order.orders[0].end(), 0u);
+        EvaluationSettings evaluation;
+        evaluation.views = batch.eval_views;
+        evaluation.resolution = batch.eval_resolution;
+        evaluation.threads = batch.threads;
+        const std::vector<OrderEvaluation> ovr = evaluate_methods(mesh, {input_order, run.buffers}, evaluation);
+        ovr_before = ovr[0].overall.ovr_mean;
+        ovr_after = ovr[1].overall.ovr_mean;
+        have_ovr = true;
+    }
+    const size_t buffers = run.buffers.orders.size();
+    json& report = product.report;
+    report["batch"] = {{"stamp", stamp},
+                       {"item", p.item.name},
+                       {"status", "ok"},
+                       {"triangles", mesh.triangle_count()},
+                       {"clips", mesh.clips.size()},
+                       {"keyframes", mesh.keyframe_count()},
+                       {"buffers", buffers},
+                       {"acmr_before", product.before.acmr},
+                       {"acmr_after", run.acmr_mean},
+                       {"ovr_before", number_or_null(ovr_before, have_ovr)},
+                       {"ovr_after", number_or_null(ovr_after, have_ovr)},
+                       {"eval_views", batch.eval_views},
+                       {"eval_resolution", batch.eval_resolution},
+                       {"index_bytes_added", uint64_t(buffers > 0 ? buffers - 1 : 0) * mesh.indices.size() * 4},
+                       {"time_s", std::chrono::duration<double>(Clock::now() - start).count()}};
+    if (batch.no_timings) drop_timings(report);
+    files.add(p.report, report_text(report));
+    files.commit();
+    std::error_code error;
+    fs::remove(p.error, error);  // an earlier failure of this item is over
+}
+
+// ---------------------------------------------------------------------------------------------
+// The summary, merged from the items' files in manifest order
+
+json summary_row(const PlannedItem& p, const std::string& stamp) {
+    json row = {{"name", p.item.name}, {"input", p.options.common.input.empty() ? "(bundled)" : p.options.common.input},
+                {"output", p.item.output}, {"method", method_name(p.plan.method)}};
+    const json report = current_report(p, stamp);
+    if (report.is_object()) {
+        const json& b = report["batch"];
+        for (const char* key : {"triangles", "clips", "buffers", "acmr_before", "acmr_after", "ovr_before", "ovr_after",
+                                "index_bytes_added", "time_s"})
+            row[key] = b.contains(key) ? b[key] : json(nullptr);
+        row["status"] = "ok";
+        row["error"] = nullptr;
+        return row;
+    }
+    const json failure = read_json_file(p.error);
+    const bool failed = failure.is_object() && failure.value("stamp", "") == stamp;
+    for (const char* key : {"triangles", "clips", "buffers", "acmr_before", "acmr_after", "ovr_before", "ovr_after",
+                            "index_bytes_added", "time_s"})
+        row[key] = nullptr;
+    row["status"] = failed ? "failed" : "missing";
+    row["error"] = failed ? failure.value("error", "") : "no up-to-date result (not run yet, or its inputs or options changed)";
+    return row;
+}
+
+std::string cell(const json& v, int digits) {
+    if (v.is_null()) return "—";
+    if (v.is_number_float()) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%.*f", digits, v.get<double>());
+        return text;
+    }
+    if (v.is_string()) {
+        std::string s = v.get<std::string>();
+        for (char& c : s)
+            if (c == '|' || c == '\n') c = c == '|' ? '/' : ' ';
+        return s;
+    }
+    return v.dump();
+}
+
+std::string summary_markdown(const json& summary) {
+    std::string md = "# animorder batch summary\n\n";
+    md += std::to_string(summary["items"].size()) + " items: " + summary["ok"].dump() + " ok, " +
+          summary["failed"].dump() + " failed, " + summary["missing"].dump() + " missing (animorder " +
+          summary["version"].get<std::string>() + ").\n\n";
+    md += "| item | method | triangles | clips | OVR before | OVR after | ACMR before | ACMR after | index bytes added | "
+          "time (s) | status |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+    for (const json& r : summary["items"]) {
+        std::string status = r["status"].get<std::string>();
+        if (!r["error"].is_null()) status += ": " + cell(r["error"], 0);
+        md += "| " + cell(r["name"], 0) + " | " + cell(r["method"], 0) + " | " + cell(r["triangles"], 0) + " | " +
+              cell(r["clips"], 0) + " | " + cell(r["ovr_before"], 3) + " | " + cell(r["ovr_after"], 3) + " | " +
+              cell(r["acmr_before"], 3) + " | " + cell(r["acmr_after"], 3) + " | " + cell(r["index_bytes_added"], 0) +
+              " | " + cell(r["time_s"], 1) + " | " + status + " |\n";
+    }
+    return md;
+}
+
+// Builds and writes the summary; returns the exit code it implies.
+int write_summary(const std::vector<PlannedItem>& items, const std::vector<std::string>& stamps,
+                  const std::string& stem, const std::string& manifest, const BatchOptions& batch) {
+    json summary = {{"tool", "animorder"}, {"version", ANIMORDER_VERSION},
+                    {"manifest", fs::path(manifest).filename().string()}};
+    json rows = json::array();
+    size_t ok = 0, failed = 0, missing = 0;
+    for (size_t i = 0; i < items.size(); ++i) {
+        rows.push_back(summary_row(items[i], stamps[i]));
+        const std::string status = rows.back()["status"].get<std::string>();
+        (status == "ok" ? ok : status == "failed" ? failed : missing) += 1;
+    }
+    summary["ok"] = ok;
+    summary["failed"] = failed;
+    summary["missing"] = missing;
+    summary["items"] = rows;
+    OutputSet files;
+    files.add(stem + ".json", report_text(summary));
+    files.add(stem + ".md", summary_markdown(summary));
+    files.commit();
+    if (!batch.quiet)
+        std::fprintf(stderr, "animorder: batch: summary %s.json / .md: %zu ok, %zu failed, %zu missing\n", stem.c_str(),
+                     ok, failed, missing);
+    return failed ? kExitItemsFailed : missing ? kExitItemsMissing : 0;
+}
+
+// --shard I/N or env/N → (I, N).
+std::pair<size_t, size_t> parse_shard(const std::string& text) {
+    const size_t slash = text.find('/');
+    auto number = [&](const std::string& s, const char* what) {
+        if (s.empty() || s.size() > 9 || !std::all_of(s.begin(), s.end(), [](char c) { return std::isdigit(uint8_t(c)); }))
+            throw std::runtime_error("--shard " + text + ": " + what + " must be a number (I/N, or env/N)");
+        return size_t(std::stoul(s));
+    };
+    if (slash == std::string::npos) throw std::runtime_error("--shard " + text + ": expected I/N (or env/N)");
+    std::string index = text.substr(0, slash);
+    const size_t count = number(text.substr(slash + 1), "N");
+    if (index == "env") {
+        const char* k8s = std::getenv("JOB_COMPLETION_INDEX");
+        const char* slurm = std::getenv("SLURM_ARRAY_TASK_ID");
+        if (k8s && *k8s) index = k8s;
+        else if (slurm && *slurm) index = slurm;
+        else throw std::runtime_error("--shard env/N: neither JOB_COMPLETION_INDEX nor SLURM_ARRAY_TASK_ID is set");
+    }
+    const size_t i = number(index, "I");
+    if (count == 0 || i >= count)
+        throw std::runtime_error("--shard " + text + ": needs 0 <= I < N (I = " + index + ")");
+    return {i, count};
+}
+
+}  // namespace
+
+int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
+    const std::vector<ManifestItem> manifest = read_manifest(batch.manifest);
+    std::pair<size_t, size_t> shard = {0, 1};
+    if (!batch.shard.empty()) shard = parse_shard(batch.shard);
+    if (batch.merge && !batch.shard.empty()) throw std::runtime_error("--merge builds the summary of every shard: drop --shard");
+
+    // Every item planned and every output of every item checked before any work: folders exist
+    // and are writable, no output is any item's input or the manifest, no file is named twice.
+    std::vector<PlannedItem> items;
+    for (size_t i = 0; i < manifest.size(); ++i) items.push_back(plan_item(manifest[i], i, batch, parse_item));
+    std::string summary = batch.summary;
+    if (summary.empty()) {
+        const fs::path m(batch.manifest);
+        summary = (m.parent_path() / m.stem()).string() + ".summary";
+    }
+    std::vector<std::string> outputs = {summary + ".json", summary + ".md"}, inputs = {batch.manifest};
+    for (const PlannedItem& p : items) {
+        outputs.insert(outputs.end(), p.plan.outputs.begin(), p.plan.outputs.end());
+        outputs.push_back(p.error);
+        inputs.insert(inputs.end(), p.plan.inputs.begin(), p.plan.inputs.end());
+    }
+    check_output_paths(outputs, inputs);
+
+    std::vector<std::string> stamps;
+    for (const PlannedItem& p : items) stamps.push_back(item_stamp(p, batch));
+    const bool sharded = shard.second > 1 || !batch.shard.empty();
+    if (batch.merge) return write_summary(items, stamps, summary, batch.manifest, batch);
+
+    size_t done = 0, skipped = 0, failed = 0, mine = 0;
+    for (size_t i = 0; i < items.size(); ++i) mine += i % shard.second == shard.first;
+    size_t position = 0;
+    for (size_t i = 0; i < items.size(); ++i) {
+        if (i % shard.second != shard.first) continue;
+        const PlannedItem& p = items[i];
+        const std::string label = "batch [" + std::to_string(++position) + "/" + std::to_string(mine) + "] " + p.item.name;
+        if (!batch.force && current_report(p, stamps[i]).is_object()) {
+            ++skipped;
+            note(p.options.common, label + ": up to date, skipped");
+            continue;
+        }
+        note(p.options.common, label + ": running");
+        try {
+            run_item(p, stamps[i], batch);
+            ++done;
+            note(p.options.common, label + ": done");
+        } catch (const std::exception& e) {
+            ++failed;
+            std::string message = e.what();
+            for (char& c : message)
+                if (c == '\n' || c == '\r') c = ' ';
+            std::fprintf(stderr, "animorder: %s: failed: %s\n", label.c_str(), message.c_str());
+            try {
+                write_file_atomically(p.error, report_text(json{{"stamp", stamps[i]}, {"item", p.item.name},
+                                                                {"status", "failed"}, {"error", message}}));
+            } catch (const std::exception& again) {
+                std::fprintf(stderr, "animorder: %s: cannot record the failure: %s\n", label.c_str(), again.what());
+            }
+        }
+    }
+    std::printf("batch%s: %zu items: %zu done, %zu up to date, %zu failed\n",
+                sharded ? (" shard " + std::to_string(shard.first) + "/" + std::to_string(shard.second)).c_str() : "",
+                mine, done, skipped, failed);
+    if (sharded) return failed ? kExitItemsFailed : 0;  // the summary is the merge step's
+    const int code = write_summary(items, stamps, summary, batch.manifest, batch);
+    return failed ? kExitItemsFailed : code;
+}
+
+}  // namespace animorder::tool

@@ -1,0 +1,48 @@
+// optimize's work as a library call, shared by `animorder optimize` (one item) and `animorder
+// batch` (many): plan the outputs (no file touched), then load, run the method and add every
+// output of the item to an OutputSet, returning the JSON report (the caller adds it, so a batch
+// can extend it before the set is committed).
+#pragma once
+
+#include "commands.h"
+
+#include "animorder/animated_mesh.h"
+#include "animorder/atomic_write.h"
+#include "animorder/methods.h"
+#include "animorder/vertex_cache.h"
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+#include <vector>
+
+namespace animorder::tool {
+
+struct OptimizePlan {
+    Method method = kDefaultMethod;
+    MethodSettings settings;
+    std::string gltf, sidecar, sidecar_json;  // empty when not written
+    std::vector<std::string> outputs;         // every file the run writes (the report included)
+    std::vector<std::string> inputs;          // every file or folder it reads
+};
+
+// Validates the options (method, settings, output names) and names the outputs; touches no file.
+OptimizePlan plan_optimize(const OptimizeOptions& options);
+
+// The settings as the report writes them (without "threads" when with_threads is false: the
+// thread count never changes an output).
+nlohmann::ordered_json optimize_settings_json(const OptimizeOptions& options, const OptimizePlan& plan,
+                                              bool with_threads = true);
+
+struct OptimizeProduct {
+    AnimatedMesh mesh;
+    MethodResult run;
+    VertexCacheStats before;
+    nlohmann::ordered_json report;
+};
+
+// Loads the input, runs the method and adds the glTF / sidecar files of `plan` to `files`
+// (not the report, and without committing). Throws for any error.
+OptimizeProduct produce_optimize(const OptimizeOptions& options, const OptimizePlan& plan, OutputSet& files);
+
+}  // namespace animorder::tool

@@ -235,16 +235,17 @@ private:
         }
         return std::string::npos;
     }
-    // A number, or a list of numbers ([*] references).
-    static std::vector<double> numbers(const json& v) {
-        if (v.is_number()) return {v.get<double>()};
-        if (!v.is_array()) throw PlaceholderError("expected numbers, got " + std::string(v.type_name()));
+    // A number, or a list of numbers ([*] references); `any`: count() takes values of any type.
+    static std::vector<double> numbers(const json& v, bool any) {
+        if (!v.is_array()) return {number(v, any)};
         std::vector<double> out;
-        for (const json& e : v) {
-            if (!e.is_number()) throw PlaceholderError("expected numbers, got " + std::string(e.type_name()));
-            out.push_back(e.get<double>());
-        }
+        for (const json& e : v) out.push_back(number(e, any));
         return out;
+    }
+    static double number(const json& v, bool any) {
+        if (v.is_number()) return v.get<double>();
+        if (!any) throw PlaceholderError("expected numbers, got " + std::string(v.type_name()));
+        return 0.0;
     }
     void skip() {
         while (i_ < s_.size() && std::isspace(static_cast<unsigned char>(s_[i_]))) ++i_;
@@ -296,7 +297,8 @@ private:
                 size_t after = close;
                 while (after < s_.size() && std::isspace(static_cast<unsigned char>(s_[after]))) ++after;
                 if (close != std::string::npos && after < s_.size() && (s_[after] == ',' || s_[after] == ')')) {
-                    const std::vector<double> list = numbers(lookup_(s_.substr(mark + 1, close - mark - 2)));
+                    const std::vector<double> list =
+                        numbers(lookup_(s_.substr(mark + 1, close - mark - 2)), fn[0] == 'c');
                     values.insert(values.end(), list.begin(), list.end());
                     i_ = after;
                 } else {

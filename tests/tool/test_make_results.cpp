@@ -615,6 +615,8 @@ TEST_F(Templates, ValuesAndFormats) {
               "84 in 2");
     EXPECT_EQ(render("{{= max([r.json: methods[*].ovr_mean]) - min([r.json: methods[*].ovr_mean]) | +.2}}"), "+0.33");
     EXPECT_EQ(render("{{= min(3, 1 + 1, 4) - 1 | +.1}}"), "+1.0");
+    EXPECT_EQ(render("{{= max(1, [r.json: clips[*].keyframes] , [r.json: methods[*].ovr_mean]) | int}}"), "60");
+    EXPECT_EQ(render("{{= sum( [r.json: clips[*].keyframes], 2 * [r.json: vertices] ) | int}}"), "17580");
     EXPECT_EQ(render("{{= 1 - 2 * 3 | int}} {{= -(2 - 3.5) | .1}} {{= 2 - 3 | +.1}}"), "-5 1.5 -1.0");
     EXPECT_EQ(render("{{s.tsv: [name=sub1.glb].seconds | .1}} s by `{{s.tsv: [name=sub1.glb].command}}`"),
               "1.8 s by `animorder subdivide x`");

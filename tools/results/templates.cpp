@@ -292,6 +292,7 @@ private:
             do {
                 skip();
                 if (i_ < s_.size() && s_[i_] == ',') ++i_;
+                skip();
                 const size_t mark = i_;
                 const size_t close = reference_end();
                 size_t after = close;

@@ -4,6 +4,7 @@
 #   bash scripts/results.sh            # everything from scratch (60-90 minutes on 2 loaded cores)
 #   RESUME=1 bash scripts/results.sh   # keep the reports already in build/results, run the rest
 #   BIN=/some/dir SKIP_BUILD=1 ...     # run binaries copied elsewhere (rebuilding build/ meanwhile)
+#   STEPS_FROM_LOG=results.log RESUME=1 ...  # kept reports of an older run: commands from its log
 #
 # Needs ../shared/data (the real characters); without it the script says so and stops. Each step
 # writes one `animorder evaluate --report` JSON (or a benchmark's output) into build/results/ and
@@ -59,6 +60,19 @@ run_step() {
 }
 step() { run_step "$1" 0 "${@:2}"; }
 step_stdout() { run_step "$1" 1 "${@:2}"; }
+# STEPS_FROM_LOG=FILE (with RESUME=1): reports kept from a run of an older version of this script,
+# which wrote no steps.tsv, get their command and seconds from that run's stderr log (its
+# "results: NAME: COMMAND" and "results: NAME took N s" lines).
+if [ -n "${STEPS_FROM_LOG:-}" ]; then
+  awk '/^results: [^ ]+: / { n = $2; sub(/:$/, "", n); c = $0; sub(/^results: [^ ]+: /, "", c); cmd[n] = c; order[++k] = n }
+       /^results: [^ ]+ took [0-9.]+ s$/ { t[$2] = $4 }
+       END { for (i = 1; i <= k; i++) if (order[i] in t) print order[i] "\t" t[order[i]] "\t" cmd[order[i]] }' \
+    "$STEPS_FROM_LOG" | while IFS=$'\t' read -r name seconds command; do
+    if [ -s "$OUT/$name" ] && ! { [ -s "$STEPS" ] && cut -f1 "$STEPS" | grep -qxF "$name"; }; then
+      record "$name" "$seconds" "$command"
+    fi
+  done
+fi
 
 # Table 1, Ganfaul's Idle clip, the paper's protocol: 300 random views per keyframe, 512x512.
 step ganfaul-idle.json $A evaluate "$GANFAUL" --clip Idle -q --methods "${ALL/,joint/}" --lambda 0.85,3 \

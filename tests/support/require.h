@@ -40,7 +40,8 @@ inline bool requires_component(const char* requirement, const std::string& compo
         if (item.empty()) continue;
         if (item == "all" || item == component) found = true;
         else if (!known_component(item))
-            ADD_FAILURE() << "ANIMORDER_REQUIRE names an unknown component '" << item << "' (known: gl, validator, data, results, all)";
+            ADD_FAILURE() << "ANIMORDER_REQUIRE names an unknown component '" << item
+                          << "' (known: gl, validator, data, results, all)";
     }
     return found;
 }

@@ -574,15 +574,16 @@ protected:
     Templates() : ScratchFolderTest("animorder-templates") {}
     void SetUp() override {
         ScratchFolderTest::SetUp();
-        spit(dir_ / "r.json", json({{"input", "g.gltf"},
-                                    {"triangles", 13802},
-                                    {"vertices", 8748},
-                                    {"clips", {{{"name", "Idle"}, {"keyframes", 60}}, {{"name", "Run"}, {"keyframes", 24}}}},
-                                    {"methods",
-                                     {{{"name", "original"}, {"lambda", nullptr}, {"ovr_mean", 1.36}, {"acmr", 0.74749}},
-                                      {{"name", "single"}, {"lambda", 0.85}, {"ovr_mean", 1.12}, {"time_s", 20.46}},
-                                      {{"name", "single"}, {"lambda", 3}, {"ovr_mean", 1.03}, {"time_s", 27.0}}}}})
-                                  .dump(2));
+        spit(dir_ / "r.json",
+             json({{"input", "g.gltf"},
+                   {"triangles", 13802},
+                   {"vertices", 8748},
+                   {"clips", {{{"name", "Idle"}, {"keyframes", 60}}, {{"name", "Run"}, {"keyframes", 24}}}},
+                   {"methods",
+                    {{{"name", "original"}, {"lambda", nullptr}, {"ovr_mean", 1.36}, {"acmr", 0.74749}},
+                     {{"name", "single"}, {"lambda", 0.85}, {"ovr_mean", 1.12}, {"time_s", 20.46}},
+                     {{"name", "single"}, {"lambda", 3}, {"ovr_mean", 1.03}, {"time_s", 27.0}}}}})
+                 .dump(2));
         spit(dir_ / "s.tsv", "name\tseconds\tcommand\nsub1.glb\t1.8\tanimorder subdivide x\nk.json\t12\ty\n");
         spit(dir_ / "b.txt", "a 1.5 ms\nb 2.25 ms\nratio 24.4x\n");
     }
@@ -660,8 +661,8 @@ TEST(TemplateBlock, ReplacesTheTextBetweenTheMarkers) {
     EXPECT_EQ(replace_generated_block("a\n" + begin + "\nold\nlines\n" + end + "\nb\n", "new\n", "R.md"),
               "a\n" + begin + "\nnew\n" + end + "\nb\n");
     EXPECT_EQ(replace_generated_block(begin + end, "x", "R.md"), begin + "\nx\n" + end);
-    for (const std::string& bad : {std::string("a\nb\n"), begin + "\n", end + "\n" + begin + "\n",
-                                   begin + begin + end, begin + end + end}) {
+    for (const std::string& bad :
+         {std::string("a\nb\n"), begin + "\n", end + "\n" + begin + "\n", begin + begin + end, begin + end + end}) {
         try {
             replace_generated_block(bad, "x", "R.md");
             ADD_FAILURE() << "no error for: " << bad;
@@ -725,17 +726,18 @@ protected:
 
 TEST_F(CommittedResults, RegenerateToTheCommittedFiles) {
     const fs::path source = ANIMORDER_SOURCE_DIR, reports = source / "docs" / "results" / "reports";
-    ANIMORDER_REQUIRE_OR_SKIP("results", fs::is_regular_file(reports / "MANIFEST.md"),
-                              reports.string() + "/MANIFEST.md is absent: run scripts/results.sh and commit its reports");
-    const test::Outcome sums = test::run_captured("cd " + reports.string() + " && sha256sum --quiet -c SHA256SUMS", dir_);
+    ANIMORDER_REQUIRE_OR_SKIP(
+        "results", fs::is_regular_file(reports / "MANIFEST.md"),
+        reports.string() + "/MANIFEST.md is absent: run scripts/results.sh and commit its reports");
+    const test::Outcome sums =
+        test::run_captured("cd " + reports.string() + " && sha256sum --quiet -c SHA256SUMS", dir_);
     EXPECT_EQ(sums.exit_code, 0) << sums.out << sums.err;
 
     fs::copy_file(source / "README.md", dir_ / "README.md");
-    const test::Outcome o = test::run_captured(std::string(MAKE_RESULTS_EXE) + " --notes " +
-                                                   (source / "docs" / "results-notes").string() + " --readme " +
-                                                   (dir_ / "README.md").string() + " " + reports.string() + " " +
-                                                   (dir_ / "docs").string(),
-                                               dir_);
+    const test::Outcome o = test::run_captured(
+        std::string(MAKE_RESULTS_EXE) + " --notes " + (source / "docs" / "results-notes").string() + " --readme " +
+            (dir_ / "README.md").string() + " " + reports.string() + " " + (dir_ / "docs").string(),
+        dir_);
     ASSERT_EQ(o.exit_code, 0) << o.err;
     EXPECT_TRUE(test::slurp(dir_ / "docs" / "RESULTS.md") == test::slurp(source / "docs" / "RESULTS.md"))
         << "docs/RESULTS.md differs from what make_results writes from docs/results/reports (diff "
@@ -743,7 +745,8 @@ TEST_F(CommittedResults, RegenerateToTheCommittedFiles) {
     EXPECT_TRUE(test::slurp(dir_ / "README.md") == test::slurp(source / "README.md"))
         << "README.md's generated block differs from what make_results writes from docs/results/reports";
     std::vector<std::string> ours, committed;
-    for (const auto& e : fs::directory_iterator(dir_ / "docs" / "results")) ours.push_back(e.path().filename().string());
+    for (const auto& e : fs::directory_iterator(dir_ / "docs" / "results"))
+        ours.push_back(e.path().filename().string());
     for (const auto& e : fs::directory_iterator(source / "docs" / "results"))
         if (e.path().extension() == ".svg") committed.push_back(e.path().filename().string());
     std::sort(ours.begin(), ours.end());

@@ -146,9 +146,8 @@ int main(int argc, char** argv) {
         if (!readme_arg.empty()) {
             if (!inputs.has_readme)
                 throw std::runtime_error("--readme: the notes folder has no readme.md (README.md's block)");
-            readme = replace_generated_block(read_file(readme_arg),
-                                             trimmed(rendered(resolver, inputs.readme, "readme.md")) + "\n",
-                                             readme_arg);
+            readme = replace_generated_block(
+                read_file(readme_arg), trimmed(rendered(resolver, inputs.readme, "readme.md")) + "\n", readme_arg);
         }
 
         // Everything is computed; now write the charts and the Markdown that points at them as

@@ -110,7 +110,8 @@ const json& select(const json& node, const std::string& inside, const std::strin
     if (!spec.empty() && spec.find_first_not_of("0123456789") == std::string::npos) {
         const size_t index = std::stoul(spec);
         if (index >= node.size())
-            throw PlaceholderError(where + "[" + spec + "]: out of range (" + std::to_string(node.size()) + " elements)");
+            throw PlaceholderError(where + "[" + spec + "]: out of range (" + std::to_string(node.size()) +
+                                   " elements)");
         return node[index];
     }
     std::vector<std::pair<std::string, std::string>> filters;
@@ -163,7 +164,8 @@ json walk(const json& root, const std::string& path, std::string where = "") {
             const std::string inside = trim(path.substr(i + 1, close - i - 1));
             i = close + 1;
             if (inside == "*") {
-                if (!node->is_array()) throw PlaceholderError((where.empty() ? "the file" : where) + " is not an array");
+                if (!node->is_array())
+                    throw PlaceholderError((where.empty() ? "the file" : where) + " is not an array");
                 std::string rest = path.substr(i);
                 if (!rest.empty() && rest[0] == '.') rest = rest.substr(1);
                 json all = json::array();
@@ -471,8 +473,8 @@ std::string replace_generated_block(const std::string& text, const std::string& 
     const size_t begin = text.find(kBlockBegin), end = text.find(kBlockEnd);
     if (begin == std::string::npos || end == std::string::npos || end < begin ||
         text.find(kBlockBegin, begin + 1) != std::string::npos || text.find(kBlockEnd, end + 1) != std::string::npos)
-        throw std::runtime_error(name + ": expected one line '" + kBlockBegin + "' followed by one line '" +
-                                 kBlockEnd + "'");
+        throw std::runtime_error(name + ": expected one line '" + kBlockBegin + "' followed by one line '" + kBlockEnd +
+                                 "'");
     const size_t body = begin + std::strlen(kBlockBegin);
     return text.substr(0, body) + "\n" + block + (block.empty() || block.back() == '\n' ? "" : "\n") + text.substr(end);
 }

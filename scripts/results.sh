@@ -51,11 +51,18 @@ run_step() {
   echo "results: $name: $*" >&2
   local start end
   start=$(date +%s.%N)
-  if [ "$to_stdout" = 1 ]; then "$@" > "$OUT/$name.tmp" && mv "$OUT/$name.tmp" "$OUT/$name"; else "$@"; fi
+  if [ "$to_stdout" = 1 ]; then
+    "$@" > "$OUT/$name.tmp"   # set -e stops the script here when the command fails
+    mv "$OUT/$name.tmp" "$OUT/$name"
+  else
+    "$@"
+  fi
   end=$(date +%s.%N)
   local seconds
   seconds=$(awk -v a="$start" -v b="$end" 'BEGIN { printf "%.1f", b - a }')
-  record "$name" "$seconds" "$@" $([ "$to_stdout" = 1 ] && echo "> $OUT/$name")
+  local command
+  command=$(printf '%q ' "$@")  # shell-quoted: the line can be pasted back
+  record "$name" "$seconds" "${command% }$([ "$to_stdout" = 1 ] && echo " > $OUT/$name")"
   echo "results: $name took $seconds s" >&2
 }
 step() { run_step "$1" 0 "${@:2}"; }

@@ -16,6 +16,8 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <regex>
+#include <set>
 #include <sstream>
 #include <string>
 #include <tuple>
@@ -755,4 +757,34 @@ TEST_F(CommittedResults, RegenerateToTheCommittedFiles) {
     for (const std::string& svg : ours)
         EXPECT_TRUE(test::slurp(dir_ / "docs" / "results" / svg) == test::slurp(source / "docs" / "results" / svg))
             << svg;
+}
+
+// The committed notes carry no measured figure typed by hand: outside placeholders, every number
+// with decimals, percentage or thousands separator is one of the paper's printed values or a
+// setting listed here. A new figure in a note must be a placeholder (templates.h).
+TEST(CommittedNotes, CarryNoHandTypedMeasurements) {
+    const std::set<std::string> allowed = {
+        "0.654", "1.377", "1.302", "1.211", "1.153", "1.065", "1.166", "1.088",  // JCGT 2017 Table 1, Ganfaul
+        "1.48",                                                                  // its Fig. 7 axis
+        "13,795", "55,180", "220,720", "2,500",  // its triangle counts, its joint-set seconds
+        "0.7", "3.3",                            // Tootle's published 0.7–3.3 s (and λ = 0.7)
+        "0.85", "1.25"};                         // λ, kAcmrBudget
+    const std::regex number(R"((?:^|[^\w.])(\d+\.\d+|\d+%|\d{1,3}(?:,\d{3})+))");
+    const fs::path notes = fs::path(ANIMORDER_SOURCE_DIR) / "docs" / "results-notes";
+    size_t files = 0;
+    for (const auto& entry : fs::directory_iterator(notes)) {
+        if (entry.path().extension() != ".md") continue;
+        ++files;
+        std::string text = test::slurp(entry.path());
+        for (size_t open = text.find("{{"); open != std::string::npos; open = text.find("{{", open)) {
+            const size_t close = text.find("}}", open);
+            ASSERT_NE(close, std::string::npos) << entry.path();
+            text.erase(open, close + 2 - open);
+        }
+        for (auto m = std::sregex_iterator(text.begin(), text.end(), number); m != std::sregex_iterator(); ++m)
+            EXPECT_TRUE(allowed.count((*m)[1].str()))
+                << entry.path().filename() << ": '" << (*m)[1].str()
+                << "' is typed by hand; make it a placeholder ({{FILE: PATH | FORMAT}}, tools/results/templates.h)";
+    }
+    EXPECT_GE(files, 10u);  // notes-<section>.md and readme.md
 }

@@ -759,9 +759,10 @@ TEST_F(CommittedResults, RegenerateToTheCommittedFiles) {
             << svg;
 }
 
-// The committed notes carry no measured figure typed by hand: outside placeholders, every number
-// with decimals, percentage or thousands separator is one of the paper's printed values or a
-// setting listed here. A new figure in a note must be a placeholder (templates.h).
+// The committed notes, and README.md's Results and Performance sections outside the generated
+// block, carry no measured figure typed by hand: outside placeholders, every number with decimals,
+// percentage or thousands separator is one of the paper's printed values or a setting listed here.
+// A new figure must be a placeholder (templates.h).
 TEST(CommittedNotes, CarryNoHandTypedMeasurements) {
     const std::set<std::string> allowed = {
         "0.654", "1.377", "1.302", "1.211", "1.153", "1.065", "1.166", "1.088",  // JCGT 2017 Table 1, Ganfaul
@@ -787,4 +788,16 @@ TEST(CommittedNotes, CarryNoHandTypedMeasurements) {
                 << "' is typed by hand; make it a placeholder ({{FILE: PATH | FORMAT}}, tools/results/templates.h)";
     }
     EXPECT_GE(files, 10u);  // notes-<section>.md and readme.md
+
+    // README.md's "Results" and "Performance" sections, outside the generated block, likewise.
+    const std::string readme = test::slurp(fs::path(ANIMORDER_SOURCE_DIR) / "README.md");
+    const size_t start = readme.find("\n## Results\n"), end = readme.find("\n## ", readme.find("\n## Performance\n") + 4);
+    ASSERT_NE(start, std::string::npos);
+    std::string sections = readme.substr(start, end == std::string::npos ? std::string::npos : end - start);
+    const size_t begin = sections.find(kBlockBegin), stop = sections.find(kBlockEnd);
+    ASSERT_TRUE(begin != std::string::npos && stop != std::string::npos && begin < stop);
+    sections.erase(begin, stop - begin);
+    for (auto m = std::sregex_iterator(sections.begin(), sections.end(), number); m != std::sregex_iterator(); ++m)
+        EXPECT_TRUE(allowed.count((*m)[1].str()))
+            << "README.md: '" << (*m)[1].str() << "' is typed by hand; generate it (docs/results-notes/readme.md)";
 }

@@ -1,14 +1,19 @@
 #!/usr/bin/env bash
 # Reproduces docs/RESULTS.md: every table, sweep, chart and timing in it comes from this script.
 #
-#   bash scripts/results.sh            # everything from scratch (about 45 minutes on 2 cores)
+#   bash scripts/results.sh            # everything from scratch (60-90 minutes on 2 loaded cores)
 #   RESUME=1 bash scripts/results.sh   # keep the reports already in build/results, run the rest
 #   BIN=/some/dir SKIP_BUILD=1 ...     # run binaries copied elsewhere (rebuilding build/ meanwhile)
+#   STEPS_FROM_LOG=results.log RESUME=1 ...  # kept reports of an older run: commands from its log
 #
 # Needs ../shared/data (the real characters); without it the script says so and stops. Each step
-# writes one `animorder evaluate --report` JSON (or a benchmark's output) into build/results/, then
-# build/make_results turns that folder into docs/RESULTS.md and docs/results/*.svg. The settings of
-# each step are here and are printed into RESULTS.md from the reports themselves.
+# writes one `animorder evaluate --report` JSON (or a benchmark's output) into build/results/ and
+# records its name, wall time and exact command line in build/results/steps.tsv. At the end the
+# reports (JSON and text, each under 300 KB) are kept in docs/results/reports/ with MANIFEST.md
+# (each file's sha256 and command; larger outputs are listed there, not kept) and SHA256SUMS, and
+# build/make_results turns the kept reports into docs/RESULTS.md, docs/results/*.svg and README.md's
+# generated block; the notes' figures are placeholders resolved from the same reports. To add a
+# method or a benchmark: append a `step` (or `step_stdout`) line below.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 DATA=../shared/data
@@ -29,19 +34,59 @@ A=$BIN/animorder
 GANFAUL=$DATA/mixamo-ganfaul/Ganfaul.gltf
 ALL=original,static-sander07,static-nehab06,tipsify-per-frame,meshopt,single,joint,oracle
 
-# step NAME COMMAND...: runs the command unless NAME exists (RESUME=1), and times it.
-step() {
-  local name=$1; shift
+# step NAME COMMAND...: runs the command (which writes $OUT/NAME) unless NAME exists (RESUME=1),
+# times it and records NAME, the seconds and the command line in $OUT/steps.tsv.
+# step_stdout NAME COMMAND...: the same for a command that prints its output: stdout into $OUT/NAME.
+STEPS=$OUT/steps.tsv
+record() {
+  local name=$1 seconds=$2; shift 2
+  [ -s "$STEPS" ] || printf 'name\tseconds\tcommand\n' > "$STEPS"
+  awk -F'\t' -v n="$name" '$1 != n' "$STEPS" > "$STEPS.tmp"
+  printf '%s\t%s\t%s\n' "$name" "$seconds" "$*" >> "$STEPS.tmp"
+  mv "$STEPS.tmp" "$STEPS"
+}
+run_step() {
+  local name=$1 to_stdout=$2; shift 2
   if [ -s "$OUT/$name" ]; then echo "results: $name kept"; return; fi
   echo "results: $name: $*" >&2
-  local start=$SECONDS
-  "$@"
-  echo "results: $name took $((SECONDS - start)) s" >&2
+  local start end
+  start=$(date +%s.%N)
+  if [ "$to_stdout" = 1 ]; then
+    "$@" > "$OUT/$name.tmp"   # set -e stops the script here when the command fails
+    mv "$OUT/$name.tmp" "$OUT/$name"
+  else
+    "$@"
+  fi
+  end=$(date +%s.%N)
+  local seconds
+  seconds=$(awk -v a="$start" -v b="$end" 'BEGIN { printf "%.1f", b - a }')
+  local command
+  command=$(printf '%q ' "$@")  # shell-quoted: the line can be pasted back
+  record "$name" "$seconds" "${command% }$([ "$to_stdout" = 1 ] && echo " > $OUT/$name")"
+  echo "results: $name took $seconds s" >&2
 }
+step() { run_step "$1" 0 "${@:2}"; }
+step_stdout() { run_step "$1" 1 "${@:2}"; }
+# STEPS_FROM_LOG=FILE (with RESUME=1): reports kept from a run of an older version of this script,
+# which wrote no steps.tsv, get their command and seconds from that run's stderr log (its
+# "results: NAME: COMMAND" and "results: NAME took N s" lines).
+if [ -n "${STEPS_FROM_LOG:-}" ]; then
+  awk '/^results: [^ ]+: / { n = $2; sub(/:$/, "", n); c = $0; sub(/^results: [^ ]+: /, "", c); cmd[n] = c; order[++k] = n }
+       /^results: [^ ]+ took [0-9.]+ s$/ { t[$2] = $4 }
+       END { for (i = 1; i <= k; i++) if (order[i] in t) print order[i] "\t" t[order[i]] "\t" cmd[order[i]] }' \
+    "$STEPS_FROM_LOG" | while IFS=$'\t' read -r name seconds command; do
+    if [ -s "$OUT/$name" ] && ! { [ -s "$STEPS" ] && cut -f1 "$STEPS" | grep -qxF "$name"; }; then
+      record "$name" "$seconds" "$command"
+    fi
+  done
+fi
 
 # Table 1, Ganfaul's Idle clip, the paper's protocol: 300 random views per keyframe, 512x512.
 step ganfaul-idle.json $A evaluate "$GANFAUL" --clip Idle -q --methods "${ALL/,joint/}" --lambda 0.85,3 \
   --eval-views 300 --eval-resolution 512 -r "$OUT/ganfaul-idle.json"
+# Table 1's ACMR note: the original order (Tipsify) with a 32-entry FIFO.
+step ganfaul-idle-cache32.json $A optimize -m original --cache-size 32 "$GANFAUL" --clip Idle -q \
+  --report "$OUT/ganfaul-idle-cache32.json"
 # The Loop-subdivided levels (13.8k -> 55k -> 220k triangles), one subdivision operator for all keyframes.
 for level in 1 2; do
   step "ganfaul-idle-sub$level.glb" $A subdivide "$GANFAUL" --clip Idle --levels $level -q -o "$OUT/ganfaul-idle-sub$level.glb"
@@ -82,6 +127,18 @@ character dwarf $DATA/x-dwarf/dwarf.x
 character dwarf2-b3d $DATA/b3d-dwarf2/dwarf2.b3d
 character bcn-epileptic $DATA/x-bcn-epileptic/BCN_Epileptic.X
 character mrfixit $DATA/iqm-mrfixit/mrfixit.iqm
+# static-nehab06 with --nehab-all-keyframes against the default (first keyframe), the same
+# evaluation as the character tables (their static-nehab06 rows are the default's).
+mkdir -p "$OUT/nehab06-keyframes"
+nehab_keyframes() {
+  local name=$1; shift
+  step "nehab06-keyframes/$name.json" $A evaluate "$@" -q --methods static-nehab06 \
+    --eval-views 60 --eval-resolution 256 -r "$OUT/nehab06-keyframes/$name.json"
+}
+nehab_keyframes character                     # no input: the bundled character
+nehab_keyframes character-all --nehab-all-keyframes
+nehab_keyframes mrfixit-all $DATA/iqm-mrfixit/mrfixit.iqm --nehab-all-keyframes
+nehab_keyframes dwarf2-b3d-all $DATA/b3d-dwarf2/dwarf2.b3d --nehab-all-keyframes
 # The OpenGL rendering-time check (original vs single, expensive fragment shader).
 # llvmpipe renders on the CPU: 10 views at every 4th keyframe (150 nodes) keeps it near a minute.
 if [ -x "$BIN/bench/render_time" ]; then
@@ -90,9 +147,50 @@ if [ -x "$BIN/bench/render_time" ]; then
 fi
 # Nehab 2006's preprocessing time against Tootle's published 0.7-3.3 s.
 if [ -x "$BIN/bench/bench_nehab06" ]; then
-  [ -s "$OUT/nehab06-bench.txt" ] || "$BIN/bench/bench_nehab06" > "$OUT/nehab06-bench.txt"
+  step_stdout nehab06-bench.txt "$BIN/bench/bench_nehab06"
 fi
-# The prose around the numbers (what differs from the paper and why) is committed beside them.
-cp docs/results-notes/notes-*.md "$OUT"/
-"$BIN/make_results" "$OUT" docs
-echo "results: wrote docs/RESULTS.md and docs/results/"
+# README's "Performance": Tipsify against meshoptimizer (medians of interleaved repetitions), the
+# overdraw engine against llvmpipe, and Han & Sander's preprocessing of Ganfaul Idle with its stages.
+if [ -x "$BIN/bench/bench_tipsify" ]; then
+  step_stdout bench-tipsify.txt "$BIN/bench/bench_tipsify" --benchmark_repetitions=5 \
+    --benchmark_enable_random_interleaving=true --benchmark_color=false
+fi
+if [ -x "$BIN/bench/bench_overdraw" ]; then
+  step_stdout bench-overdraw.txt "$BIN/bench/bench_overdraw"
+fi
+mkdir -p "$OUT/out"
+step optimize-ganfaul-idle.json $A optimize --method single "$GANFAUL" --clip Idle -q \
+  -o "$OUT/out/ganfaul-idle" --report "$OUT/optimize-ganfaul-idle.json"
+
+# Keep the reports: every JSON, TSV and text report under 300 KB is copied into docs/results/reports
+# (larger ones, and the subdivided meshes, are listed in MANIFEST.md with their sha256 only).
+KEEP=docs/results/reports
+rm -rf "$KEEP"
+mkdir -p "$KEEP"
+{
+  echo "# The reports behind docs/RESULTS.md"
+  echo
+  echo "Written by \`scripts/results.sh\`; \`sha256sum -c SHA256SUMS\` checks the kept files. Commands ran from the"
+  echo "repository root (\`$BIN\` holds the binaries)."
+  echo
+  echo "| file | kept | bytes | sha256 | seconds | command |"
+  echo "|---|---|---|---|---|---|"
+} > "$KEEP/MANIFEST.md"
+: > "$KEEP/SHA256SUMS"
+(cd "$OUT" && find . -type f \( -name '*.json' -o -name '*.txt' -o -name '*.tsv' -o -name '*.glb' \) \
+  ! -path './out/*' ! -name '*.tmp' | sed 's|^\./||' | LC_ALL=C sort) | while read -r f; do
+  bytes=$(stat -c %s "$OUT/$f")
+  sum=$(sha256sum "$OUT/$f" | cut -d' ' -f1)
+  kept=no
+  if [ "$bytes" -le 307200 ] && [ "${f##*.}" != glb ]; then
+    mkdir -p "$KEEP/$(dirname "$f")"
+    cp "$OUT/$f" "$KEEP/$f"
+    echo "$sum  $f" >> "$KEEP/SHA256SUMS"
+    kept=yes
+  fi
+  line=$(awk -F'\t' -v n="$f" '$1 == n { print $2 "\t" $3 }' "$STEPS" 2>/dev/null || true)
+  seconds=${line%%$'\t'*}; command=${line#*$'\t'}
+  echo "| \`$f\` | $kept | $bytes | \`$sum\` | ${seconds:-—} | \`${command:-—}\` |" >> "$KEEP/MANIFEST.md"
+done
+"$BIN/make_results" --notes docs/results-notes --readme README.md "$KEEP" docs
+echo "results: wrote docs/RESULTS.md, docs/results/ and README.md's generated block"

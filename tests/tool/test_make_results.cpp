@@ -1,6 +1,9 @@
 // make_results end to end (crafted report files in, docs/RESULTS.md and SVG charts out: exact table
 // rows, "not run" lines, byte-identical reruns, well-formed SVG with a point per value, clean
-// failure on malformed input) and its SVG chart writer (tools/results/svg_chart.h).
+// failure on malformed input), its SVG chart writer (tools/results/svg_chart.h), its templates
+// (tools/results/templates.h: placeholders of the notes and README's block, hand-worked values),
+// and the committed documents: docs/RESULTS.md and README.md's block regenerated from the committed
+// reports of docs/results/reports must equal the committed files.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -13,13 +16,17 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <regex>
+#include <set>
 #include <sstream>
 #include <string>
 #include <tuple>
 #include <vector>
 
 #include "support/files.h"
+#include "support/require.h"
 #include "svg_chart.h"
+#include "templates.h"
 
 namespace fs = std::filesystem;
 namespace test = animorder::test;
@@ -560,4 +567,237 @@ TEST_F(MakeResults, UsageErrors) {
     const int status = std::system((std::string(MAKE_RESULTS_EXE) + " only-one-argument 2>/dev/null").c_str());
     EXPECT_EQ(WEXITSTATUS(status), 2);
     EXPECT_FALSE(fs::exists(dir_ / "docs"));
+}
+
+// --- Templates (tools/results/templates.h). --------------------------------------------------
+
+class Templates : public test::ScratchFolderTest {
+protected:
+    Templates() : ScratchFolderTest("animorder-templates") {}
+    void SetUp() override {
+        ScratchFolderTest::SetUp();
+        spit(dir_ / "r.json",
+             json({{"input", "g.gltf"},
+                   {"triangles", 13802},
+                   {"vertices", 8748},
+                   {"clips", {{{"name", "Idle"}, {"keyframes", 60}}, {{"name", "Run"}, {"keyframes", 24}}}},
+                   {"methods",
+                    {{{"name", "original"}, {"lambda", nullptr}, {"ovr_mean", 1.36}, {"acmr", 0.74749}},
+                     {{"name", "single"}, {"lambda", 0.85}, {"ovr_mean", 1.12}, {"time_s", 20.46}},
+                     {{"name", "single"}, {"lambda", 3}, {"ovr_mean", 1.03}, {"time_s", 27.0}}}}})
+                 .dump(2));
+        spit(dir_ / "s.tsv", "name\tseconds\tcommand\nsub1.glb\t1.8\tanimorder subdivide x\nk.json\t12\ty\n");
+        spit(dir_ / "b.txt", "a 1.5 ms\nb 2.25 ms\nratio 24.4x\n");
+    }
+    std::string render(const std::string& text) { return TemplateResolver(dir_).render(text, "notes-x.md").text; }
+    // The error message of rendering `text` ("" when it renders).
+    std::string error(const std::string& text) {
+        try {
+            render(text);
+        } catch (const std::runtime_error& e) {
+            return e.what();
+        }
+        return "";
+    }
+};
+
+TEST_F(Templates, ValuesAndFormats) {
+    EXPECT_EQ(render("{{r.json: methods[name=single, lambda=0.85].ovr_mean | .3}}"), "1.120");
+    EXPECT_EQ(render("{{ r.json: methods[name=single,lambda=3].time_s|.1 }}"), "27.0");
+    EXPECT_EQ(render("{{r.json: methods[name=original].acmr}}"), "0.747");  // a fraction: 3 decimals
+    EXPECT_EQ(render("{{r.json: triangles}} / {{r.json: triangles | ,}}"), "13802 / 13,802");
+    EXPECT_EQ(render("{{r.json: input}}, {{r.json: clips[1].name}}"), "g.gltf, Run");
+    EXPECT_EQ(render("{{r.json: methods[name=original, lambda=null].ovr_mean | .2}}"), "1.36");
+    EXPECT_EQ(render("{{r.json: methods[name=single, lambda=0.85].time_s | int}}"), "20");
+    // (1.36 - 1.12) / 0.36 = 0.6667; 8748 / 13802 = 0.63382.
+    EXPECT_EQ(render("{{= ([r.json: methods[name=original].ovr_mean] - [r.json: methods[name=single, lambda=0.85]"
+                     ".ovr_mean]) / ([r.json: methods[name=original].ovr_mean] - 1) | %0}}"),
+              "67%");
+    EXPECT_EQ(render("{{= [r.json: vertices] / [r.json: triangles] | .3}}"), "0.634");
+    EXPECT_EQ(render("{{= sum([r.json: clips[*].keyframes]) | ,}} in {{= count([r.json: clips[*].name]) | int}}"),
+              "84 in 2");
+    EXPECT_EQ(render("{{= max([r.json: methods[*].ovr_mean]) - min([r.json: methods[*].ovr_mean]) | +.2}}"), "+0.33");
+    EXPECT_EQ(render("{{= min(3, 1 + 1, 4) - 1 | +.1}}"), "+1.0");
+    EXPECT_EQ(render("{{= max(1, [r.json: clips[*].keyframes] , [r.json: methods[*].ovr_mean]) | int}}"), "60");
+    EXPECT_EQ(render("{{= sum( [r.json: clips[*].keyframes], 2 * [r.json: vertices] ) | int}}"), "17580");
+    EXPECT_EQ(render("{{= 1 - 2 * 3 | int}} {{= -(2 - 3.5) | .1}} {{= 2 - 3 | +.1}}"), "-5 1.5 -1.0");
+    EXPECT_EQ(render("{{s.tsv: [name=sub1.glb].seconds | .1}} s by `{{s.tsv: [name=sub1.glb].command}}`"),
+              "1.8 s by `animorder subdivide x`");
+    EXPECT_EQ(render("{{b.txt: /([0-9.]+) ms/ | .2}}, {{b.txt: /([0-9.]+) ms/2}}, {{b.txt: /ratio ([0-9.]+)x/ | .0}}"),
+              "1.50, 2.250, 24");
+    EXPECT_EQ(render("{{= sum([b.txt: /([0-9.]+) ms/*]) | .2}}"), "3.75");
+    EXPECT_EQ(render("no placeholder, {single}"), "no placeholder, {single}");
+}
+
+TEST_F(Templates, ErrorsNameTheTemplateAndThePlaceholder) {
+    EXPECT_EQ(error("a {{r.json: methods[name=single].ovr_mean}} b"),
+              "notes-x.md: {{r.json: methods[name=single].ovr_mean}}: methods[name=single]: 2 elements match, not one");
+    EXPECT_EQ(error("{{r.json: methods[name=single, lambda=0.85].ovr_man}}"),
+              "notes-x.md: {{r.json: methods[name=single, lambda=0.85].ovr_man}}: no key 'ovr_man' in "
+              "methods[name=single, lambda=0.85]");
+    EXPECT_EQ(error("{{r.json: methods[name=joint].ovr_mean}}"),
+              "notes-x.md: {{r.json: methods[name=joint].ovr_mean}}: methods[name=joint]: 0 elements match, not one");
+    EXPECT_NE(error("{{r.json: triangles | .x}}").find("unknown format '.x'"), std::string::npos);
+    EXPECT_NE(error("{{r.json: triangles").find("no closing }}"), std::string::npos);
+    EXPECT_NE(error("{{= [r.json: clips[*].keyframes] + 1}}").find("a list needs min, max or sum"), std::string::npos);
+    EXPECT_NE(error("{{b.txt: /nothing/}}").find("0 matches of /nothing/"), std::string::npos);
+    EXPECT_NE(error("{{b.txt: /([0-9.]+) ms/3}}").find("2 matches of /([0-9.]+) ms/, not 3"), std::string::npos);
+    EXPECT_NE(error("{{= 1 / (2 - 2)}}").find("division by zero"), std::string::npos);
+    EXPECT_NE(error("{{r.json: input | .3}}").find("expected a number, got string"), std::string::npos);
+    EXPECT_NE(error("{{r.json}}").find("expected FILE: PATH"), std::string::npos);
+    EXPECT_NE(error("{{../r.json: triangles}}").find("bad file name"), std::string::npos);
+    EXPECT_NE(error("{{= 2 +}}").find("expression ends early"), std::string::npos);
+}
+
+TEST_F(Templates, AParagraphNamingAnAbsentFileSaysNotRun) {
+    const RenderedTemplate r = TemplateResolver(dir_).render(
+        "Intro {{r.json: triangles}}.\n\n- Lost {{gone.json: x}} and {{= [b.txt: /ratio ([0-9.]+)x/] + "
+        "[sub/gone.txt: /a/]}}.\n\nEnd {{r.json: vertices | ,}}.\n",
+        "notes-x.md");
+    EXPECT_EQ(r.text, "Intro 13802.\n\nnot run: gone.json missing\nnot run: sub/gone.txt missing\n\nEnd 8,748.\n");
+    EXPECT_EQ(r.missing, (std::set<std::string>{"gone.json", "sub/gone.txt"}));
+}
+
+TEST(TemplateBlock, ReplacesTheTextBetweenTheMarkers) {
+    const std::string begin = kBlockBegin, end = kBlockEnd;
+    EXPECT_EQ(replace_generated_block("a\n" + begin + "\nold\nlines\n" + end + "\nb\n", "new\n", "R.md"),
+              "a\n" + begin + "\nnew\n" + end + "\nb\n");
+    EXPECT_EQ(replace_generated_block(begin + end, "x", "R.md"), begin + "\nx\n" + end);
+    for (const std::string& bad :
+         {std::string("a\nb\n"), begin + "\n", end + "\n" + begin + "\n", begin + begin + end, begin + end + end}) {
+        try {
+            replace_generated_block(bad, "x", "R.md");
+            ADD_FAILURE() << "no error for: " << bad;
+        } catch (const std::runtime_error& e) {
+            EXPECT_EQ(std::string(e.what()).rfind("R.md: expected one line", 0), 0u) << e.what();
+        }
+    }
+}
+
+TEST_F(MakeResults, NotesAndReadmeBlockAreRenderedFromTheReports) {
+    write_everything();
+    const fs::path notes = dir_ / "notes", readme = dir_ / "README.md";
+    spit(notes / "notes-table1.md", "Idle has {{ganfaul-idle.json: triangles | ,}} triangles.\n");
+    spit(notes / "notes-performance.md", "Ratio {{render-time.json: time_ratio | .2}}.\n");
+    spit(notes / "readme.md", "single {{ganfaul-idle.json: methods[name=single, lambda=0.85].ovr_mean | .3}}\n");
+    const std::string before = std::string("# R\n\ntext\n") + kBlockBegin + "\nold 1.111\n" + kBlockEnd + "\nafter\n";
+    spit(readme, before);
+    const std::string command = std::string(MAKE_RESULTS_EXE) + " --notes " + notes.string() + " --readme " +
+                                readme.string() + " " + (dir_ / "in").string() + " " + (dir_ / "docs").string();
+    test::Outcome o = test::run_captured(command, dir_);
+    ASSERT_EQ(o.exit_code, 0) << o.err;
+    EXPECT_EQ(test::slurp(readme),
+              std::string("# R\n\ntext\n") + kBlockBegin + "\nsingle 1.129\n" + kBlockEnd + "\nafter\n");
+    const std::string md = test::slurp(dir_ / "docs" / "RESULTS.md");
+    EXPECT_NE(section(md, kSections[0]).find("\nIdle has 13,810 triangles.\n"), std::string::npos);
+    EXPECT_NE(section(md, "Performance").find("\nRatio 0.80.\n"), std::string::npos) << md;
+    // The notes of the results folder are not read when --notes names another.
+    EXPECT_EQ(md.find("The lead's note on Table 1."), std::string::npos);
+
+    // An unresolvable placeholder: one line naming the note and the placeholder, nothing written.
+    spit(readme, before);
+    spit(notes / "notes-table1.md", "Idle has {{ganfaul-idle.json: methods[name=single].ovr_mean}}.\n");
+    o = test::run_captured(command + "-2", dir_);
+    EXPECT_EQ(o.exit_code, 1);
+    EXPECT_EQ(o.err,
+              "make_results: notes-table1.md: {{ganfaul-idle.json: methods[name=single].ovr_mean}}: "
+              "methods[name=single]: 2 elements match, not one\n");
+    EXPECT_EQ(test::slurp(readme), before);
+    EXPECT_FALSE(fs::exists(dir_ / "docs-2"));
+
+    // --readme without a readme.md, or a README without the markers: errors.
+    spit(notes / "notes-table1.md", "fine\n");
+    fs::remove(notes / "readme.md");
+    o = test::run_captured(command, dir_);
+    EXPECT_EQ(o.exit_code, 1);
+    EXPECT_NE(o.err.find("has no readme.md"), std::string::npos) << o.err;
+    spit(notes / "readme.md", "x\n");
+    spit(readme, "no markers\n");
+    o = test::run_captured(command, dir_);
+    EXPECT_EQ(o.exit_code, 1);
+    EXPECT_NE(o.err.find("README.md: expected one line"), std::string::npos) << o.err;
+}
+
+// docs/RESULTS.md, its charts and README.md's generated block, regenerated from the committed
+// reports into a scratch folder, equal the committed files: a hand edit of a generated number,
+// or a note changed without regenerating, fails here. The kept reports match their SHA256SUMS.
+class CommittedResults : public test::ScratchFolderTest {
+protected:
+    CommittedResults() : ScratchFolderTest("animorder-committed-results") {}
+};
+
+TEST_F(CommittedResults, RegenerateToTheCommittedFiles) {
+    const fs::path source = ANIMORDER_SOURCE_DIR, reports = source / "docs" / "results" / "reports";
+    ANIMORDER_REQUIRE_OR_SKIP(
+        "results", fs::is_regular_file(reports / "MANIFEST.md"),
+        reports.string() + "/MANIFEST.md is absent: run scripts/results.sh and commit its reports");
+    const test::Outcome sums =
+        test::run_captured("cd " + reports.string() + " && sha256sum --quiet -c SHA256SUMS", dir_);
+    EXPECT_EQ(sums.exit_code, 0) << sums.out << sums.err;
+
+    fs::copy_file(source / "README.md", dir_ / "README.md");
+    const test::Outcome o = test::run_captured(
+        std::string(MAKE_RESULTS_EXE) + " --notes " + (source / "docs" / "results-notes").string() + " --readme " +
+            (dir_ / "README.md").string() + " " + reports.string() + " " + (dir_ / "docs").string(),
+        dir_);
+    ASSERT_EQ(o.exit_code, 0) << o.err;
+    EXPECT_TRUE(test::slurp(dir_ / "docs" / "RESULTS.md") == test::slurp(source / "docs" / "RESULTS.md"))
+        << "docs/RESULTS.md differs from what make_results writes from docs/results/reports (diff "
+        << (dir_ / "docs" / "RESULTS.md") << "); regenerate it, never edit it";
+    EXPECT_TRUE(test::slurp(dir_ / "README.md") == test::slurp(source / "README.md"))
+        << "README.md's generated block differs from what make_results writes from docs/results/reports";
+    std::vector<std::string> ours, committed;
+    for (const auto& e : fs::directory_iterator(dir_ / "docs" / "results"))
+        ours.push_back(e.path().filename().string());
+    for (const auto& e : fs::directory_iterator(source / "docs" / "results"))
+        if (e.path().extension() == ".svg") committed.push_back(e.path().filename().string());
+    std::sort(ours.begin(), ours.end());
+    std::sort(committed.begin(), committed.end());
+    EXPECT_EQ(ours, committed);
+    for (const std::string& svg : ours)
+        EXPECT_TRUE(test::slurp(dir_ / "docs" / "results" / svg) == test::slurp(source / "docs" / "results" / svg))
+            << svg;
+}
+
+// The committed notes, and README.md's Results and Performance sections outside the generated
+// block, carry no measured figure typed by hand: outside placeholders, every number with decimals,
+// percentage or thousands separator is one of the paper's printed values or a setting listed here.
+// A new figure must be a placeholder (templates.h).
+TEST(CommittedNotes, CarryNoHandTypedMeasurements) {
+    const std::set<std::string> allowed = {
+        "0.654", "1.377", "1.302", "1.211", "1.153", "1.065", "1.166", "1.088",  // JCGT 2017 Table 1, Ganfaul
+        "1.48",                                                                  // its Fig. 7 axis
+        "13,795", "55,180", "220,720", "2,500",  // its triangle counts, its joint-set seconds
+        "0.7", "3.3",                            // Tootle's published 0.7–3.3 s (and λ = 0.7)
+        "0.85", "1.25"};                         // λ, kAcmrBudget
+    const std::regex number(R"((?:^|[^\w.])(\d+\.\d+|\d+%|\d{1,3}(?:,\d{3})+))");
+    const fs::path notes = fs::path(ANIMORDER_SOURCE_DIR) / "docs" / "results-notes";
+    size_t files = 0;
+    for (const auto& entry : fs::directory_iterator(notes)) {
+        if (entry.path().extension() != ".md") continue;
+        ++files;
+        std::string text = test::slurp(entry.path());
+        for (size_t open = text.find("{{"); open != std::string::npos; open = text.find("{{", open)) {
+            const size_t close = text.find("}}", open);
+            ASSERT_NE(close, std::string::npos) << entry.path();
+            text.erase(open, close + 2 - open);
+        }
+        for (auto m = std::sregex_iterator(text.begin(), text.end(), number); m != std::sregex_iterator(); ++m)
+            EXPECT_TRUE(allowed.count((*m)[1].str()))
+                << entry.path().filename() << ": '" << (*m)[1].str()
+                << "' is typed by hand; make it a placeholder ({{FILE: PATH | FORMAT}}, tools/results/templates.h)";
+    }
+    EXPECT_GE(files, 10u);  // notes-<section>.md and readme.md
+
+    // README.md's "Results" and "Performance" sections, outside the generated block, likewise.
+    const std::string readme = test::slurp(fs::path(ANIMORDER_SOURCE_DIR) / "README.md");
+    const size_t start = readme.find("\n## Results\n"), end = readme.find("\n## ", readme.find("\n## Performance\n") + 4);
+    ASSERT_NE(start, std::string::npos);
+    std::string sections = readme.substr(start, end == std::string::npos ? std::string::npos : end - start);
+    const size_t begin = sections.find(kBlockBegin), stop = sections.find(kBlockEnd);
+    ASSERT_TRUE(begin != std::string::npos && stop != std::string::npos && begin < stop);
+    sections.erase(begin, stop - begin);
+    for (auto m = std::sregex_iterator(sections.begin(), sections.end(), number); m != std::sregex_iterator(); ++m)
+        EXPECT_TRUE(allowed.count((*m)[1].str()))
+            << "README.md: '" << (*m)[1].str() << "' is typed by hand; generate it (docs/results-notes/readme.md)";
 }

@@ -18,8 +18,9 @@ namespace animorder::results {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-const std::vector<std::string> kSectionIds = {"settings", "table1", "characters",  "views",   "lambda",
-                                              "clusters", "clips",  "render-time", "nehab06", "other"};
+const std::vector<std::string> kSectionIds = {"settings", "table1",      "characters", "views",
+                                              "lambda",   "clusters",    "clips",      "render-time",
+                                              "nehab06",  "performance", "other"};
 
 const Report* Inputs::get(const std::string& name) const {
     const auto it = reports.find(name);
@@ -241,8 +242,9 @@ RenderTime load_render_time(const fs::path& path, const std::string& name) {
 
 }  // namespace
 
-Inputs load_inputs(const fs::path& dir) {
+Inputs load_inputs(const fs::path& dir, const fs::path& notes_dir) {
     if (!fs::is_directory(dir)) throw std::runtime_error(dir.string() + ": not a folder");
+    if (!fs::is_directory(notes_dir)) throw std::runtime_error(notes_dir.string() + ": not a folder");
     Inputs in;
     for (const char* name : {"ganfaul-idle.json", "ganfaul-idle-sub1.json", "ganfaul-idle-sub2.json",
                              "sweep-views.json", "sweep-lambda.json", "sweep-k.json", "ganfaul-clips.json"})
@@ -265,15 +267,24 @@ Inputs load_inputs(const fs::path& dir) {
     for (const auto& entry : fs::directory_iterator(dir))
         if (entry.is_regular_file()) files.push_back(entry.path());
     std::sort(files.begin(), files.end());
+    for (const fs::path& p : files)
+        if (p.extension() == ".txt") in.texts[p.filename().string()] = read_text(p);
+    files.clear();
+    for (const auto& entry : fs::directory_iterator(notes_dir))
+        if (entry.is_regular_file()) files.push_back(entry.path());
+    std::sort(files.begin(), files.end());
     for (const fs::path& p : files) {
         const std::string name = p.filename().string();
-        if (p.extension() == ".txt") in.texts[name] = read_text(p);
+        if (name == "readme.md") {
+            in.readme = read_text(p);
+            in.has_readme = true;
+        }
         if (name.rfind("notes-", 0) == 0 && p.extension() == ".md") {
             const std::string id = name.substr(6, name.size() - 9);
             if (std::find(kSectionIds.begin(), kSectionIds.end(), id) == kSectionIds.end())
                 std::fprintf(stderr,
                              "make_results: %s names no section (ids: settings, table1, characters, views, lambda, "
-                             "clusters, clips, render-time, nehab06, other); ignored\n",
+                             "clusters, clips, render-time, nehab06, performance, other); ignored\n",
                              name.c_str());
             else
                 in.notes[id] = read_text(p);

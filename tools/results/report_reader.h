@@ -75,12 +75,15 @@ struct Inputs {
     std::vector<std::string> characters;    // "characters/x.json", sorted
     std::unique_ptr<RenderTime> render_time;
     std::map<std::string, std::string> texts;  // *.txt by name, sorted
-    std::map<std::string, std::string> notes;  // section id -> notes-<id>.md
+    std::map<std::string, std::string> notes;  // section id -> notes-<id>.md (templates.h)
+    std::string readme;                        // readme.md of the notes folder: README.md's generated block
+    bool has_readme = false;
     const Report* get(const std::string& name) const;
 };
 
-// Reads and checks every known file of `dir` (every one optional); throws std::runtime_error on
-// the first malformed one. A notes file naming no section is ignored with a line on stderr.
-Inputs load_inputs(const std::filesystem::path& dir);
+// Reads and checks every known file of `dir` (every one optional), and the notes-<id>.md and
+// readme.md of `notes_dir`; throws std::runtime_error on the first malformed one. A notes file
+// naming no section is ignored with a line on stderr.
+Inputs load_inputs(const std::filesystem::path& dir, const std::filesystem::path& notes_dir);
 
 }  // namespace animorder::results

@@ -1,7 +1,7 @@
 // RESULTS.md's benchmark sections: "Rendering time in OpenGL" from render-time.json (bench/render_time
 // --json); "Nehab et al. 2006" from the static-nehab06 rows of the evaluation reports (against the
 // other one-buffer orders, with a tally) and nehab06-bench.txt verbatim; "Other benchmark outputs",
-// every other *.txt verbatim.
+// every other *.txt verbatim; "Performance", whose figures are notes-performance.md's placeholders.
 #include <cmath>
 #include <filesystem>
 
@@ -86,6 +86,16 @@ Section nehab06_section(const Inputs& in) {
     s.body +=
         "`build/bench/bench_nehab06`, verbatim (AMD Tootle took 0.7–3.3 s for 2k–70k triangles with 42 views):\n\n" +
         code_block(it->second);
+    return s;
+}
+
+Section performance_section(const Inputs& in) {
+    Section s{"performance", "Performance", ""};
+    s.body = in.notes.count("performance")
+                 ? "Timings of this machine from the benchmarks and timed runs of `scripts/results.sh`: `steps.tsv` "
+                   "records every step's command and wall time, the benchmarks' own output is kept beside the "
+                   "reports (the text ones also under \"Other benchmark outputs\" below).\n"
+                 : "No notes-performance.md.\n";
     return s;
 }
 

@@ -6,7 +6,8 @@
 //   section_characters.cpp   characters    characters/*.json
 //   section_sweeps.cpp       views, lambda, clusters   sweep-views.json, sweep-lambda.json, sweep-k.json (Figs. 3, 6, 7)
 //   section_clips.cpp        clips         ganfaul-clips.json (Figs. 8 and 5)
-//   section_benchmarks.cpp   render-time, nehab06, other   render-time.json, the reports' static-nehab06, *.txt
+//   section_benchmarks.cpp   render-time, nehab06, performance, other   render-time.json, the reports'
+//                            static-nehab06, notes-performance.md, *.txt
 #pragma once
 
 #include <map>
@@ -49,6 +50,7 @@ Section clusters_section(const Inputs& in, Charts& charts);
 Section clips_section(const Inputs& in, Charts& charts);
 Section render_time_section(const Inputs& in);
 Section nehab06_section(const Inputs& in);
+Section performance_section(const Inputs& in);  // its figures: notes-performance.md (templates.h)
 Section other_section(const Inputs& in);  // empty body when there is no other *.txt
 
 }  // namespace animorder::results

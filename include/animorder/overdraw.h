@@ -33,6 +33,9 @@ struct OverdrawNode {
 struct ScoreSettings {
     unsigned resolution = 256;
     unsigned threads = 0;  // 0: all hardware threads
+    // Null, or one flag per triangle of the index list scored: non-zero draws both faces
+    // (NodeRasterizer::rasterize). Not owned: it must outlive the call.
+    const uint8_t* double_sided = nullptr;
     // Called now and then with (nodes done, total), from any worker thread, never concurrently.
     std::function<void(size_t, size_t)> progress;
 };

@@ -61,7 +61,8 @@ void score_nodes(uint64_t* visible, uint64_t* passed, const float* keyframe_posi
             const Mat4d vp = node_view_projection(node.direction, framing.radius);
             transform_to_clip(w.clip.data(), keyframe_positions + size_t(node.keyframe) * vertex_count * 3, vertex_count,
                               framing.centres.data() + 3 * size_t(node.keyframe), vp);
-            w.rasterizer.rasterize(w.clip.data(), vertex_count, indices, index_count, settings.resolution);
+            w.rasterizer.rasterize(w.clip.data(), vertex_count, indices, index_count, settings.resolution,
+                                   settings.double_sided);
             visible[n] = w.rasterizer.visible_pixels();
             w.rasterizer.score(passed + n * order_count, ranks, order_count);
             const size_t finished = ++done;
@@ -103,7 +104,8 @@ std::vector<NodeFragments> rasterize_nodes(const float* keyframe_positions, size
             transform_to_clip(w.clip.data(), keyframe_positions + size_t(node.keyframe) * vertex_count * 3, vertex_count,
                               framing.centres.data() + 3 * size_t(node.keyframe),
                               node_view_projection(node.direction, framing.radius));
-            w.rasterizer.rasterize(w.clip.data(), vertex_count, indices, index_count, settings.resolution);
+            w.rasterizer.rasterize(w.clip.data(), vertex_count, indices, index_count, settings.resolution,
+                                   settings.double_sided);
             kept[n] = w.rasterizer.export_fragments();
             if ((total += kept[n].bytes()) > max_bytes) too_big = true;
             const size_t finished = ++done;

@@ -46,6 +46,10 @@ std::unique_ptr<GlOverdrawReference> open_reference(unsigned resolution, std::st
 constexpr double kTolerance = 0.0002;
 constexpr size_t kProceduralExactOnLlvmpipe = 234;  // of 240 (walk, wave, torus knot); Ganfaul adds 79 of 80
 
+// Without culling (torus knot and the character's walk, 20 views x 4 counts each): measured on
+// llvmpipe as above.
+constexpr size_t kDoubleSidedExactOnLlvmpipe = 147;  // of 160; worst 0.0137% (2026-11, LLVM 15.0.6)
+
 std::string shared_data(const std::string& relative) { return animorder::test::shared_data_path(relative).string(); }
 
 struct Totals {
@@ -53,7 +57,8 @@ struct Totals {
     double worst = 0;
 };
 
-void compare_mesh(GlOverdrawReference& gl, const AnimatedMesh& mesh, size_t keyframe, unsigned resolution, Totals& totals) {
+void compare_mesh(GlOverdrawReference& gl, const AnimatedMesh& mesh, size_t keyframe, unsigned resolution, Totals& totals,
+                  bool double_sided = false) {
     SCOPED_TRACE(mesh.name + " keyframe " + std::to_string(keyframe));
     const Framing framing = frame_animated_mesh(mesh);
     const size_t n = mesh.triangle_count();
@@ -97,10 +102,12 @@ void compare_mesh(GlOverdrawReference& gl, const AnimatedMesh& mesh, size_t keyf
             pointers.push_back(o->data());
         }
         const std::vector<uint32_t> ranks = make_rank_table(pointers, n);
-        ours.rasterize(clip.data(), mesh.vertex_count, mesh.indices.data(), mesh.indices.size(), resolution);
+        const std::vector<uint8_t> both(double_sided ? n : 0, 1);
+        ours.rasterize(clip.data(), mesh.vertex_count, mesh.indices.data(), mesh.indices.size(), resolution,
+                       double_sided ? both.data() : nullptr);
         std::vector<uint64_t> passed(3);
         ours.score(passed.data(), ranks.data(), 3);
-        const GlNodeCounts reference = gl.score(clip.data(), mesh.vertex_count, index_buffers);
+        const GlNodeCounts reference = gl.score(clip.data(), mesh.vertex_count, index_buffers, double_sided);
 
         auto check = [&](uint64_t a, uint64_t b, const char* what) {
             const double relative = b ? std::fabs(double(a) - double(b)) / double(b) : double(a != b);
@@ -166,4 +173,27 @@ TEST(GlCrosscheck, ThreeMeshesTwentyViewsThreeOrdersMatchOpenGL) {
         std::printf("not llvmpipe (%s): the exact-match counts are not checked\n", gl->renderer().c_str());
     }
     ANIMORDER_REQUIRE_DATA(ganfaul);
+}
+
+// Double-sided materials: the same meshes drawn without back-face culling by both (every back
+// face becomes a fragment source), and the same counts with culling as the test above.
+TEST(GlCrosscheck, DoubleSidedMeshesMatchOpenGLWithoutCulling) {
+    const unsigned resolution = 256;
+    std::string why;
+    auto gl = open_reference(resolution, why);
+    ANIMORDER_REQUIRE_OR_SKIP("gl", gl != nullptr, why);
+    Totals culled, both;
+    const AnimatedMesh knot = make_torus_knot(10000);
+    AnimatedMesh character = make_procedural_character();
+    compare_mesh(*gl, knot, 0, resolution, culled, false);
+    compare_mesh(*gl, knot, 0, resolution, both, true);
+    compare_mesh(*gl, character, 10, resolution, both, true);
+    std::printf("double-sided cross-check: %zu counts compared, %zu exactly equal, worst relative difference %.6f%%\n",
+                both.comparisons, both.exact, 100 * both.worst);
+    EXPECT_EQ(both.comparisons, 160u);
+    EXPECT_LE(both.worst, kTolerance);
+    EXPECT_LE(culled.worst, kTolerance);
+    if (gl->renderer().find("llvmpipe") != std::string::npos) {
+        EXPECT_EQ(both.exact, kDoubleSidedExactOnLlvmpipe) << "of the 160 double-sided counts";
+    }
 }

@@ -174,6 +174,12 @@ struct AnimatedMethodResult {
 AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double lambda, unsigned cache_size,
                                     const ClusteringSettings& settings);
 
+// Reverses, in a face permutation of the whole mesh, the draw order of every blended primitive
+// (AlphaMode::Blend) in place: a front-to-back order becomes back to front. run_method applies it
+// to the buffers of every method but original. Throws InvalidInput when the order moves
+// triangles between primitives.
+void reverse_blended_primitives(const AnimatedMesh& mesh, std::vector<uint32_t>& order);
+
 // ACMR/ATVR of a whole index buffer drawn primitive by primitive, each draw starting with an
 // empty cache (a draw call does not inherit the previous draw's post-transform cache).
 VertexCacheStats analyze_mesh_vertex_cache(const AnimatedMesh& mesh, const std::vector<uint32_t>& indices,

@@ -15,6 +15,10 @@ namespace animorder {
 // window space) culled unless the triangle is double-sided, triangles clipped against the near and far planes. It keeps, for every
 // pixel, the fragments of all front-facing triangles sorted by depth, so scoring an order never
 // needs another rasterisation. Reuse one instance across nodes: its buffers are kept.
+// Per-triangle drawing modes (bits) for NodeRasterizer::rasterize.
+constexpr uint8_t kDrawBothFaces = 1;  // double-sided material: the back face is drawn too
+constexpr uint8_t kSkipTriangle = 2;   // not drawn in this pass (blended triangles in the opaque pass)
+
 class NodeRasterizer {
 public:
     NodeRasterizer();
@@ -23,11 +27,11 @@ public:
     NodeRasterizer& operator=(NodeRasterizer&&) noexcept;
 
     // Rasterises the triangle list (clip-space positions, 4 floats per vertex) into a square
-    // viewport of resolution × resolution pixels. Replaces the previous node. double_sided: null
-    // (every triangle culls its back face) or one flag per triangle, non-zero where both faces
-    // are drawn (glTF doubleSided materials; see double_sided_triangles in animated_mesh.h).
+    // viewport of resolution × resolution pixels. Replaces the previous node. modes: null (every
+    // triangle drawn, back faces culled) or one byte per triangle of kDrawBothFaces (a glTF
+    // doubleSided material) and kSkipTriangle (not in this pass) bits.
     void rasterize(const float* clip_xyzw, size_t vertex_count, const uint32_t* indices, size_t index_count,
-                   unsigned resolution, const uint8_t* double_sided = nullptr);
+                   unsigned resolution, const uint8_t* modes = nullptr);
 
     // Pixels covered by at least one fragment (what the depth buffer shows after any order).
     uint64_t visible_pixels() const;

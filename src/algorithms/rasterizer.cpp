@@ -285,7 +285,7 @@ void NodeRasterizer::visit_fragments(const std::function<void(uint32_t, uint32_t
 }
 
 void NodeRasterizer::rasterize(const float* clip_xyzw, size_t vertex_count, const uint32_t* indices,
-                               size_t index_count, unsigned resolution, const uint8_t* double_sided) {
+                               size_t index_count, unsigned resolution, const uint8_t* modes) {
     validate_indices(indices, index_count, vertex_count);
     if (resolution == 0 || resolution > 16384)
         throw InvalidInput("resolution " + std::to_string(resolution) + " is outside 1..16384");
@@ -303,7 +303,9 @@ void NodeRasterizer::rasterize(const float* clip_xyzw, size_t vertex_count, cons
     FragmentSink sink{s.raw};
     for (size_t t = 0; t < index_count / 3; ++t) {
         const uint32_t a = indices[3 * t], b = indices[3 * t + 1], c = indices[3 * t + 2];
-        const bool two_sided = double_sided && double_sided[t];
+        const uint8_t mode = modes ? modes[t] : 0;
+        if (mode & kSkipTriangle) continue;
+        const bool two_sided = (mode & kDrawBothFaces) != 0;
         if (s.unclipped[a] & s.unclipped[b] & s.unclipped[c]) {
             rasterize_window_triangle(s.window[a], s.window[b], s.window[c], uint32_t(t), resolution, sink, two_sided);
         } else {

@@ -12,6 +12,7 @@
 #include "animorder/methods.h"
 
 #include "animorder/animated_mesh.h"
+#include "animorder/blend_orders.h"
 #include "animorder/clustering.h"
 #include "animorder/evaluation.h"
 #include "animorder/invalid_input.h"
@@ -220,6 +221,8 @@ AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double
         const Framing framing = frame_subset(result.framing, keyframes);
         result.run_radius.push_back(framing.radius);
         result.runs.push_back(cluster_nodes(mesh, result.patches, framing, keyframes, settings));
+        // Blended primitives: back to front for each cluster (blend_orders.h), not front to back.
+        blended_orders_from_clusters(mesh, result.framing, framing.radius, result.runs.back());
     }
     for (size_t c = 0; c < mesh.clips.size(); ++c) {
         const size_t run = joint ? 0 : c;
@@ -348,6 +351,18 @@ void run_oracle(MethodResult& result, const AnimatedMesh& mesh, const MethodSett
 
 }  // namespace
 
+void reverse_blended_primitives(const AnimatedMesh& mesh, std::vector<uint32_t>& order) {
+    if (order.size() != mesh.triangle_count()) throw InvalidInput("an order does not cover the mesh's triangles");
+    for (const Primitive& p : mesh.primitives) {
+        if (p.alpha_mode != AlphaMode::Blend) continue;
+        const size_t first = p.first_index / 3, last = (p.first_index + p.index_count) / 3;
+        for (size_t i = first; i < last; ++i)
+            if (order[i] < first || order[i] >= last)
+                throw InvalidInput("an order moves triangles between primitives ('" + p.name + "')");
+        std::reverse(order.begin() + ptrdiff_t(first), order.begin() + ptrdiff_t(last));
+    }
+}
+
 MethodResult run_method(const AnimatedMesh& mesh, Method method, const MethodSettings& settings) {
     validate_method_settings(settings);
     validate_animated_mesh(mesh);
@@ -370,6 +385,11 @@ MethodResult run_method(const AnimatedMesh& mesh, Method method, const MethodSet
             result.seconds = seconds_since(start);
             return result;
     }
+    // Blended primitives are drawn back to front: every buffer of a single-buffer sorting method
+    // carries the reverse of its front-to-back order there (the input order stays as it is for
+    // original; single and joint sort them per cluster in run_han_sander).
+    if (method != Method::Original && method != Method::Single && method != Method::Joint)
+        for (std::vector<uint32_t>& order : result.buffers.orders) reverse_blended_primitives(mesh, order);
     // The time covers the method, not its ACMR (the oracle's ACMR sampling is part of its run).
     result.seconds = seconds_since(start);
     std::vector<uint32_t> indices(mesh.indices.size());

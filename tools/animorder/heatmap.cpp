@@ -43,9 +43,9 @@ int run_heatmap(const HeatmapOptions& options) {
     transform_to_clip(clip.data(), mesh.keyframe(options.keyframe), mesh.vertex_count,
                       &framing.centres[3 * options.keyframe], node_view_projection(direction, framing.radius));
     NodeRasterizer rasterizer;
-    const std::vector<uint8_t> double_sided = double_sided_triangles(mesh);
+    const std::vector<uint8_t> modes = opaque_pass_modes(mesh);
     rasterizer.rasterize(clip.data(), mesh.vertex_count, mesh.indices.data(), mesh.indices.size(), options.resolution,
-                         double_sided.empty() ? nullptr : double_sided.data());
+                         modes.empty() ? nullptr : modes.data());
     const std::vector<uint32_t> ranks = make_rank_table({result.order.data()}, mesh.triangle_count());
     uint64_t passed = 0;
     rasterizer.score(&passed, ranks.data(), 1);

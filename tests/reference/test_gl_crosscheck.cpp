@@ -48,9 +48,24 @@ constexpr size_t kProceduralExactOnLlvmpipe = 234;  // of 240 (walk, wave, torus
 
 // Without culling (torus knot and the character's walk, 20 views x 4 counts each): measured on
 // llvmpipe as above.
-constexpr size_t kDoubleSidedExactOnLlvmpipe = 147;  // of 160; worst 0.0137% (2026-11, LLVM 15.0.6)
+constexpr size_t kDoubleSidedExactOnLlvmpipe = 149;  // of 160; worst 0.0083% (2026-11, LLVM 15.0.6)
 
 std::string shared_data(const std::string& relative) { return animorder::test::shared_data_path(relative).string(); }
+
+// The bundled character's opaque primitives (body, shield) with their own vertices: the character
+// these counts were measured on before it gained blended hair and a cape (issue 18), whose
+// vertices come after.
+AnimatedMesh opaque_character() {
+    const AnimatedMesh full = make_procedural_character();
+    AnimatedMesh m = full;
+    m.primitives.resize(2);
+    m.indices.resize(m.primitives[1].first_index + m.primitives[1].index_count);
+    m.vertex_count = *std::max_element(m.indices.begin(), m.indices.end()) + 1;
+    m.keyframe_positions.clear();
+    for (size_t k = 0; k < full.keyframe_count(); ++k)
+        m.keyframe_positions.insert(m.keyframe_positions.end(), full.keyframe(k), full.keyframe(k) + 3 * m.vertex_count);
+    return m;
+}
 
 struct Totals {
     size_t comparisons = 0, exact = 0;
@@ -147,7 +162,7 @@ TEST(GlCrosscheck, ThreeMeshesTwentyViewsThreeOrdersMatchOpenGL) {
     ANIMORDER_REQUIRE_OR_SKIP("gl", gl != nullptr, why);
     std::printf("OpenGL renderer: %s\n", gl->renderer().c_str());
     Totals totals;
-    const AnimatedMesh character = make_procedural_character();
+    const AnimatedMesh character = opaque_character();
     compare_mesh(*gl, character, 10, resolution, totals);                                      // walk
     compare_mesh(*gl, character, character.clips[1].first_keyframe + 20, resolution, totals);  // wave
     compare_mesh(*gl, make_torus_knot(10000), 0, resolution, totals);

@@ -151,6 +151,8 @@ int main(int argc, char** argv) {
         ->capture_default_str()
         ->check(CLI::Range(16u, 8192u));
     heatmap_cmd->add_option("-o,--output", heatmap.output, "PNG file to write")->required();
+    heatmap_cmd->add_flag("--blend", heatmap.blend,
+                          "Show the blended primitives' mis-sorted fragment pairs per pixel (drawn back to front: 0)");
 
     SubdivideOptions subdivide;
     CLI::App* subdivide_cmd = app.add_subcommand(

@@ -194,7 +194,7 @@ VertexCacheStats analyze_mesh_vertex_cache(const AnimatedMesh& mesh, const std::
 }
 
 AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double lambda, unsigned cache_size,
-                                    const ClusteringSettings& settings) {
+                                    const ClusteringSettings& settings, bool blend_clusters) {
     validate_animated_mesh(mesh);
     if (mesh.clips.empty()) throw InvalidInput("the mesh has no clip to cluster");
     AnimatedMethodResult result;
@@ -221,12 +221,22 @@ AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double
         const Framing framing = frame_subset(result.framing, keyframes);
         result.run_radius.push_back(framing.radius);
         result.runs.push_back(cluster_nodes(mesh, result.patches, framing, keyframes, settings));
-        // Blended primitives: back to front for each cluster (blend_orders.h), not front to back.
-        blended_orders_from_clusters(mesh, result.framing, framing.radius, result.runs.back());
+        // Blended primitives: back to front for each cluster (blend_orders.h); with blend_clusters,
+        // by their own k clusters of the same nodes, the buffers then being the (opaque, blend)
+        // cluster pairs the nodes take.
+        if (has_blended_primitives(mesh) && !blend_clusters) {
+            blended_orders_from_clusters(mesh, result.framing, framing.radius, result.runs.back());
+        } else if (has_blended_primitives(mesh)) {
+            const BlendClustering blend =
+                cluster_blend_nodes(mesh, framing, result.runs.back(), settings.resolution, settings.threads);
+            combine_with_blend_clusters(mesh, blend, result.runs.back());
+        }
     }
     for (size_t c = 0; c < mesh.clips.size(); ++c) {
         const size_t run = joint ? 0 : c;
-        result.buffers.table_base.push_back(uint32_t(joint ? 0 : c * settings.clusters));
+        uint32_t base = 0;  // buffers of the runs before (k each without blended primitives)
+        for (size_t r = 0; r < run; ++r) base += uint32_t(result.runs[r].triangle_orders.size());
+        result.buffers.table_base.push_back(base);
         result.buffers.tables.push_back(
             build_selection_table(result.runs[run], mesh.clips[c].first_keyframe, mesh.clips[c].keyframe_count));
     }
@@ -280,10 +290,11 @@ void run_single_buffer(MethodResult& result, const AnimatedMesh& mesh, const Met
 // Han & Sander 2017; the fallback is the buffer the most clustering nodes chose.
 void run_clustered(MethodResult& result, const AnimatedMesh& mesh, const MethodSettings& settings) {
     const bool joint = result.method == Method::Joint;
-    AnimatedMethodResult r = run_han_sander(mesh, joint, settings.lambda, settings.cache_size, settings.clustering);
+    AnimatedMethodResult r =
+        run_han_sander(mesh, joint, settings.lambda, settings.cache_size, settings.clustering, settings.blend_clusters);
     std::vector<size_t> chosen(r.buffers.orders.size(), 0);
     for (size_t i = 0; i < r.runs.size(); ++i)
-        for (uint32_t c : r.runs[i].assignment) ++chosen[(joint ? 0 : i * settings.clustering.clusters) + c];
+        for (uint32_t c : r.runs[i].assignment) ++chosen[r.buffers.table_base[joint ? 0 : i] + c];
     result.fallback = uint32_t(std::max_element(chosen.begin(), chosen.end()) - chosen.begin());
     for (const ClusteringResult& run : r.runs) {
         double seconds = run.seconds_rasterization;

@@ -175,6 +175,7 @@ int run_evaluate(const EvaluateOptions& options) {
                           {"nehab_clusters", b.nehab_clusters},
                           {"nehab_views", b.nehab_views},
                           {"nehab_all_keyframes", b.nehab_all_keyframes},
+                          {"blend_clusters", b.blend_clusters},
                           {"cache_size", options.common.cache_size},
                           {"eval_views", eval.views},
                           {"eval_resolution", eval.resolution},

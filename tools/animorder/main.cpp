@@ -70,6 +70,8 @@ void add_method_options(CLI::App& command, animorder::tool::MethodOptions& optio
     command.add_option("--update", options.update,
                        "single/joint: monotone (keep a cluster's new order only if its nodes' OVR falls) or paper")
         ->capture_default_str();
+    command.add_flag("--blend-clusters", m.blend_clusters,
+                     "single/joint: blended primitives get their own k clusters (buffers: the cluster pairs, up to k^2 per clip)");
     command.add_option("--nehab-clusters", m.nehab_clusters, "static-nehab06: planar clusters (0: automatic)")
         ->capture_default_str()
         ->check(CLI::Range(size_t(0), size_t(1) << 20));

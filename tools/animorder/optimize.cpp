@@ -67,6 +67,7 @@ nlohmann::ordered_json settings_json(const OptimizeOptions& options, Method meth
             {"nehab_clusters", m.nehab_clusters},
             {"nehab_views", m.nehab_views},
             {"nehab_all_keyframes", m.nehab_all_keyframes},
+            {"blend_clusters", m.blend_clusters},
             {"threads", m.clustering.threads}};
 }
 

@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <map>
+#include <numeric>
 #include <random>
 #include <tuple>
 #include <vector>
@@ -372,4 +373,57 @@ TEST(BlendError, HiddenBlendedFragmentsDoNotCount) {
     t.rect(0, 0, 16, 16, 0.0f);
     t.rect(8, 8, 12, 12, 0.0f);
     EXPECT_EQ(blend_counts(t, {0, 0, 1, 1}, {2, 3, 0, 1}).covered, 0u);
+}
+
+TEST(BlendError, MatchesABruteForceTransparentPass) {
+    // A second implementation from the raw fragments: per pixel, the opaque minimum depth, the
+    // blended fragments strictly nearer, and every pair at different depths checked against the
+    // order's ranks.
+    std::mt19937 rng(23);
+    std::uniform_real_distribution<float> coordinate(-1.0f, 1.0f), depth(-0.9f, 0.9f);
+    Scene s(24);
+    for (int t = 0; t < 120; ++t) {
+        const uint32_t a = s.vertex(coordinate(rng), coordinate(rng), depth(rng));
+        const uint32_t b = s.vertex(coordinate(rng), coordinate(rng), depth(rng));
+        const uint32_t c = s.vertex(coordinate(rng), coordinate(rng), depth(rng));
+        s.ib.insert(s.ib.end(), {a, b, c});
+    }
+    std::vector<uint8_t> blended(s.triangles()), both(s.triangles(), kDrawBothFaces);
+    for (size_t t = 0; t < blended.size(); ++t) blended[t] = t % 3 != 0;
+    std::vector<uint32_t> order(s.triangles());
+    std::iota(order.begin(), order.end(), 0u);
+    std::shuffle(order.begin(), order.end(), rng);
+    NodeRasterizer r;
+    r.rasterize(s.clip.data(), s.clip.size() / 4, s.ib.data(), s.ib.size(), s.resolution, both.data());
+    const std::vector<uint32_t> ranks = make_rank_table({order.data()}, s.triangles());
+    BlendCounts fast;
+    score_blend(&fast, r.export_blend_fragments(blended.data()), ranks.data(), 1);
+
+    std::map<uint32_t, float> opaque;
+    std::map<uint32_t, std::vector<std::pair<float, uint32_t>>> layers;
+    r.visit_fragments([&](uint32_t p, uint32_t t, float z) {
+        if (!blended[t]) opaque[p] = opaque.count(p) ? std::min(opaque[p], z) : z;
+    });
+    r.visit_fragments([&](uint32_t p, uint32_t t, float z) {
+        if (blended[t] && (!opaque.count(p) || z < opaque[p])) layers[p].emplace_back(z, t);
+    });
+    BlendCounts slow;
+    for (const auto& [p, list] : layers) {
+        ++slow.covered;
+        uint64_t missorted = 0;
+        for (size_t i = 0; i < list.size(); ++i)
+            for (size_t j = 0; j < list.size(); ++j)
+                if (list[i].first < list[j].first) {
+                    ++slow.pairs;
+                    missorted += ranks[list[i].second] < ranks[list[j].second];
+                }
+        slow.missorted_pairs += missorted;
+        slow.missorted_pixels += missorted > 0;
+    }
+    EXPECT_GT(slow.pairs, 200u);
+    EXPECT_GT(slow.missorted_pairs, 0u);
+    EXPECT_EQ(fast.covered, slow.covered);
+    EXPECT_EQ(fast.pairs, slow.pairs);
+    EXPECT_EQ(fast.missorted_pairs, slow.missorted_pairs);
+    EXPECT_EQ(fast.missorted_pixels, slow.missorted_pixels);
 }

@@ -139,6 +139,18 @@ nehab_keyframes character                     # no input: the bundled character
 nehab_keyframes character-all --nehab-all-keyframes
 nehab_keyframes mrfixit-all $DATA/iqm-mrfixit/mrfixit.iqm --nehab-all-keyframes
 nehab_keyframes dwarf2-b3d-all $DATA/b3d-dwarf2/dwarf2.b3d --nehab-all-keyframes
+# Issue 18, materials (build/results/materials/, not yet read by make_results): the bundled
+# character's blended hair cards and cape — the blend table of `evaluate` (input order, original,
+# static-sander07 reversed, k = 5 buffers on the opaque clusters, the same with their own blend
+# clusters, the per-node back-to-front bound) — and MorphStressTest's double-sided materials (Xbot's
+# are in characters/xbot.json). 100 views at 256x256.
+mkdir -p "$OUT/materials"
+step materials/bundled.json $A evaluate -q --methods original,static-sander07,single \
+  --eval-views 100 --eval-resolution 256 -r "$OUT/materials/bundled.json"
+step materials/bundled-blend-clusters.json $A evaluate -q --methods original,single --blend-clusters \
+  --eval-views 100 --eval-resolution 256 -r "$OUT/materials/bundled-blend-clusters.json"
+step materials/morph-stress-test.json $A evaluate "$DATA/gltf-morph-stress-test/MorphStressTest.gltf" -q \
+  --methods original,static-sander07,single --eval-views 60 --eval-resolution 256 -r "$OUT/materials/morph-stress-test.json"
 # The OpenGL rendering-time check (original vs single, expensive fragment shader).
 # llvmpipe renders on the CPU: 10 views at every 4th keyframe (150 nodes) keeps it near a minute.
 if [ -x "$BIN/bench/render_time" ]; then

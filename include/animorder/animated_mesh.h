@@ -15,6 +15,14 @@
 
 namespace animorder {
 
+// How a primitive's material composites (glTF's material.alphaMode; DESIGN.md "Materials").
+// Opaque and Mask write depth and are ordered for least overdraw; Blend is drawn after the opaque
+// scene with depth test on and depth writes off, and is ordered for back-to-front correctness.
+enum class AlphaMode { Opaque, Mask, Blend };
+
+// "OPAQUE", "MASK", "BLEND" (glTF's spelling).
+const char* alpha_mode_name(AlphaMode mode);
+
 struct Primitive {
     std::string name;
     size_t first_index = 0;  // into AnimatedMesh::indices
@@ -25,6 +33,10 @@ struct Primitive {
     int source_primitive = -1;
     size_t vertex_base = 0;
     size_t vertex_count = 0;
+    // Its material: both faces drawn (glTF doubleSided; no back-face culling) and how it blends.
+    // Formats without materials (MD2, IQM, procedural shapes) give single-sided opaque.
+    bool double_sided = false;
+    AlphaMode alpha_mode = AlphaMode::Opaque;
 };
 
 struct Clip {
@@ -57,6 +69,13 @@ struct AnimatedMesh {
 // range or not a multiple of 3, primitives that do not tile the index buffer, clips outside the
 // keyframes, a keyframe array of the wrong size, or a non-finite position.
 void validate_animated_mesh(const AnimatedMesh& mesh);
+
+// Per triangle of mesh.indices: 1 where its primitive is double-sided (drawn without culling).
+// Empty when no primitive is, so that callers pass nullptr and keep the culling-only path.
+std::vector<uint8_t> double_sided_triangles(const AnimatedMesh& mesh);
+
+// True when some primitive blends (AlphaMode::Blend).
+bool has_blended_primitives(const AnimatedMesh& mesh);
 
 // The mesh with only the named clips (in the order named) and their keyframes. Throws
 // InvalidInput naming a clip that does not exist and the clips that do.

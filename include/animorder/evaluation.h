@@ -48,4 +48,34 @@ std::vector<uint32_t> front_to_back_patch_order(const float* centroids, size_t p
 std::vector<OrderEvaluation> evaluate_methods(const AnimatedMesh& mesh, const std::vector<MethodBuffers>& methods,
                                               const EvaluationSettings& settings);
 
+// Blend error (DESIGN.md "Blend error") of orders on the blended primitives, pooled over nodes:
+// at each pixel, the fragments of blended primitives nearer than the opaque scene's depth (the
+// usual transparent pass: depth test on, writes off); a pair of them at different depths is
+// mis-sorted when the nearer is drawn first.
+struct BlendSummary {
+    double missorted_pair_fraction = 0;   // Σ mis-sorted pairs / Σ pairs
+    double missorted_pixel_fraction = 0;  // Σ pixels with a mis-sorted pair / Σ covered pixels
+    uint64_t pairs = 0, missorted_pairs = 0, covered = 0, missorted_pixels = 0;
+    size_t nodes = 0;
+};
+
+struct BlendEvaluation {
+    BlendSummary overall;
+    std::vector<BlendSummary> per_clip;  // mesh.clips order
+};
+
+// The blend error of every method's buffers (picked per node as evaluate_methods does; the
+// oracle, which has no buffers, gets an empty summary), then one more entry: the bound, the
+// blended triangles sorted back to front at every node by the eye distance of their centroids.
+// Same nodes as evaluate_methods (settings); deterministic whatever the thread count. Throws
+// InvalidInput when the mesh has no blended primitive.
+std::vector<BlendEvaluation> evaluate_blend(const AnimatedMesh& mesh, const std::vector<MethodBuffers>& methods,
+                                            const EvaluationSettings& settings);
+
+// The bound's order at one node: the triangles of blended primitives farthest first by the
+// squared distance from eye to their centroid (positions: one keyframe, minus centre), ties by
+// index, in place of the blended triangles of identity; other triangles keep their place.
+std::vector<uint32_t> back_to_front_blended_order(const AnimatedMesh& mesh, const float* positions, const float centre[3],
+                                                  const float eye[3]);
+
 }  // namespace animorder

@@ -97,6 +97,11 @@ struct MethodSettings {
     size_t nehab_clusters = 0;
     size_t nehab_views = 162;
     bool nehab_all_keyframes = false;
+    // single / joint on a mesh with blended primitives (blend_orders.h): false — their back-to-
+    // front orders follow the opaque k-means clusters (k buffers per clip); true — they get their
+    // own k clusters by measured blend error, and the buffers are the (opaque, blend) cluster
+    // pairs the nodes take (up to k² per clip).
+    bool blend_clusters = false;
 };
 
 // Throws InvalidInput for settings no method can run with (non-finite λ, k outside 1..255, a
@@ -172,7 +177,13 @@ struct AnimatedMethodResult {
 };
 
 AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double lambda, unsigned cache_size,
-                                    const ClusteringSettings& settings);
+                                    const ClusteringSettings& settings, bool blend_clusters = false);
+
+// Reverses, in a face permutation of the whole mesh, the draw order of every blended primitive
+// (AlphaMode::Blend) in place: a front-to-back order becomes back to front. run_method applies it
+// to the buffers of every method but original. Throws InvalidInput when the order moves
+// triangles between primitives.
+void reverse_blended_primitives(const AnimatedMesh& mesh, std::vector<uint32_t>& order);
 
 // ACMR/ATVR of a whole index buffer drawn primitive by primitive, each draw starting with an
 // empty cache (a draw call does not inherit the previous draw's post-transform cache).

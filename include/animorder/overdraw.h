@@ -8,6 +8,7 @@
 // exactly what drawing each order separately would. No file I/O here.
 #pragma once
 
+#include "animorder/animated_mesh.h"
 #include "animorder/rasterizer.h"
 #include "animorder/viewpoints.h"
 
@@ -23,6 +24,14 @@ namespace animorder {
 // cache line per fragment for all orders.
 std::vector<uint32_t> make_rank_table(const std::vector<const uint32_t*>& orders, size_t triangle_count);
 
+// The opaque pass of a mesh (DESIGN.md "Materials"): double-sided primitives drawn without
+// culling, blended ones skipped (they are drawn after, without depth writes, and ordered for
+// blending). Empty when every triangle is single-sided and opaque (then pass nullptr).
+std::vector<uint8_t> opaque_pass_modes(const AnimatedMesh& mesh);
+// The transparent pass: every triangle drawn (the opaque ones for their depth), double-sided
+// ones without culling. Empty when none is double-sided.
+std::vector<uint8_t> full_pass_modes(const AnimatedMesh& mesh);
+
 // One (keyframe, viewpoint): keyframe indexes the keyframe arrays, direction is a unit vector
 // from the frame's centre towards the camera.
 struct OverdrawNode {
@@ -33,6 +42,9 @@ struct OverdrawNode {
 struct ScoreSettings {
     unsigned resolution = 256;
     unsigned threads = 0;  // 0: all hardware threads
+    // Null, or one mode per triangle of the index list scored (kDrawBothFaces, kSkipTriangle:
+    // NodeRasterizer::rasterize). Not owned: it must outlive the call.
+    const uint8_t* triangle_modes = nullptr;
     // Called now and then with (nodes done, total), from any worker thread, never concurrently.
     std::function<void(size_t, size_t)> progress;
 };

@@ -12,9 +12,13 @@ namespace animorder {
 // One node's rasterisation under DESIGN.md's rules: pixel centres at +0.5, top-left fill rule
 // (after flipping OpenGL's window y to point down), vertices snapped to 1/256 pixel, depth
 // linear in screen space, LESS against a buffer cleared to 1, back faces (clockwise in OpenGL
-// window space) culled, triangles clipped against the near and far planes. It keeps, for every
+// window space) culled unless the triangle is double-sided, triangles clipped against the near and far planes. It keeps, for every
 // pixel, the fragments of all front-facing triangles sorted by depth, so scoring an order never
 // needs another rasterisation. Reuse one instance across nodes: its buffers are kept.
+// Per-triangle drawing modes (bits) for NodeRasterizer::rasterize.
+constexpr uint8_t kDrawBothFaces = 1;  // double-sided material: the back face is drawn too
+constexpr uint8_t kSkipTriangle = 2;   // not drawn in this pass (blended triangles in the opaque pass)
+
 class NodeRasterizer {
 public:
     NodeRasterizer();
@@ -23,9 +27,11 @@ public:
     NodeRasterizer& operator=(NodeRasterizer&&) noexcept;
 
     // Rasterises the triangle list (clip-space positions, 4 floats per vertex) into a square
-    // viewport of resolution × resolution pixels. Replaces the previous node.
+    // viewport of resolution × resolution pixels. Replaces the previous node. modes: null (every
+    // triangle drawn, back faces culled) or one byte per triangle of kDrawBothFaces (a glTF
+    // doubleSided material) and kSkipTriangle (not in this pass) bits.
     void rasterize(const float* clip_xyzw, size_t vertex_count, const uint32_t* indices, size_t index_count,
-                   unsigned resolution);
+                   unsigned resolution, const uint8_t* modes = nullptr);
 
     // Pixels covered by at least one fragment (what the depth buffer shows after any order).
     uint64_t visible_pixels() const;
@@ -49,6 +55,10 @@ public:
     // The node's fragments in the compact form scoring needs (see NodeFragments).
     struct NodeFragments export_fragments() const;
 
+    // The node's transparent pass (see BlendFragments): blended[t] non-zero marks the triangles
+    // of blended primitives; every other triangle is opaque and writes depth.
+    struct BlendFragments export_blend_fragments(const uint8_t* blended) const;
+
     struct State;  // defined in rasterizer.cpp only
 
 private:
@@ -70,5 +80,33 @@ struct NodeFragments {
 // passed[o] for each order of the rank table, from a node's fragments (NodeRasterizer::score
 // gives the same numbers).
 void score_fragments(uint64_t* passed, const NodeFragments& node, const uint32_t* ranks, size_t order_count);
+
+// The transparent pass of a node (DESIGN.md "Blend error"): the opaque triangles drawn first fill
+// the depth buffer, then the blended ones with the depth test on (LESS) and depth writes off. A
+// blended fragment counts iff it is nearer than every opaque fragment of its pixel. Per pixel
+// with two or more such fragments, their triangles nearest first (kTieBit-style top bit: depth
+// equal to the previous one's).
+struct BlendFragments {
+    uint64_t covered = 0;             // pixels with at least one counted blended fragment
+    std::vector<uint32_t> pixels;     // the pixels with two or more
+    std::vector<uint32_t> starts;     // pixels.size() + 1
+    std::vector<uint32_t> fragments;  // triangle | tie bit
+};
+
+// Blend error of orders at a node: a pair of counted fragments of one pixel at different depths
+// is mis-sorted when the nearer one is drawn first (blending needs back to front).
+struct BlendCounts {
+    uint64_t pairs = 0;              // pairs at different depths
+    uint64_t missorted_pairs = 0;    // of which drawn nearer-before-farther
+    uint64_t missorted_pixels = 0;   // pixels with at least one mis-sorted pair
+    uint64_t covered = 0;            // BlendFragments::covered
+};
+
+// counts[o] for each order of the rank table (make_rank_table).
+void score_blend(BlendCounts* counts, const BlendFragments& node, const uint32_t* ranks, size_t order_count);
+
+// Per pixel (row 0 at the top) of a resolution² image: the mis-sorted pairs under one order.
+std::vector<uint32_t> missorted_per_pixel(const BlendFragments& node, unsigned resolution, const uint32_t* ranks,
+                                          size_t order_count, size_t order_index);
 
 }  // namespace animorder

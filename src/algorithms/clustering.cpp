@@ -167,6 +167,7 @@ struct Nodes {
     std::vector<float> average;          // per patch: its centroid averaged over the keyframes
     std::vector<uint8_t> patch_visible;  // I3D only: [n · patch_count + p], some triangle faces n
     ScoreSettings score;
+    std::vector<uint8_t> modes;          // per triangle (opaque_pass_modes): score's triangle_modes
     std::vector<NodeFragments> kept;     // every node's fragments, or empty when over budget
 };
 
@@ -433,6 +434,8 @@ ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patc
     nodes.score.resolution = settings.resolution;
     nodes.score.threads = settings.threads;
     nodes.score.progress = settings.progress;
+    nodes.modes = opaque_pass_modes(mesh);
+    nodes.score.triangle_modes = nodes.modes.empty() ? nullptr : nodes.modes.data();
 
     result.patch_orders = bootstrap_orders(nodes, settings);
 

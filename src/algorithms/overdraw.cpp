@@ -24,6 +24,20 @@
 
 namespace animorder {
 
+std::vector<uint8_t> opaque_pass_modes(const AnimatedMesh& mesh) {
+    std::vector<uint8_t> modes(mesh.triangle_count(), 0);
+    bool any = false;
+    for (const Primitive& p : mesh.primitives) {
+        const uint8_t mode = uint8_t((p.double_sided ? kDrawBothFaces : 0) | (p.alpha_mode == AlphaMode::Blend ? kSkipTriangle : 0));
+        any = any || mode;
+        for (size_t t = p.first_index / 3; t < (p.first_index + p.index_count) / 3 && t < modes.size(); ++t) modes[t] = mode;
+    }
+    if (!any) modes.clear();
+    return modes;
+}
+
+std::vector<uint8_t> full_pass_modes(const AnimatedMesh& mesh) { return double_sided_triangles(mesh); }
+
 std::vector<uint32_t> make_rank_table(const std::vector<const uint32_t*>& orders, size_t triangle_count) {
     const size_t k = orders.size();
     std::vector<uint32_t> ranks(triangle_count * k);
@@ -61,7 +75,8 @@ void score_nodes(uint64_t* visible, uint64_t* passed, const float* keyframe_posi
             const Mat4d vp = node_view_projection(node.direction, framing.radius);
             transform_to_clip(w.clip.data(), keyframe_positions + size_t(node.keyframe) * vertex_count * 3, vertex_count,
                               framing.centres.data() + 3 * size_t(node.keyframe), vp);
-            w.rasterizer.rasterize(w.clip.data(), vertex_count, indices, index_count, settings.resolution);
+            w.rasterizer.rasterize(w.clip.data(), vertex_count, indices, index_count, settings.resolution,
+                                   settings.triangle_modes);
             visible[n] = w.rasterizer.visible_pixels();
             w.rasterizer.score(passed + n * order_count, ranks, order_count);
             const size_t finished = ++done;
@@ -103,7 +118,8 @@ std::vector<NodeFragments> rasterize_nodes(const float* keyframe_positions, size
             transform_to_clip(w.clip.data(), keyframe_positions + size_t(node.keyframe) * vertex_count * 3, vertex_count,
                               framing.centres.data() + 3 * size_t(node.keyframe),
                               node_view_projection(node.direction, framing.radius));
-            w.rasterizer.rasterize(w.clip.data(), vertex_count, indices, index_count, settings.resolution);
+            w.rasterizer.rasterize(w.clip.data(), vertex_count, indices, index_count, settings.resolution,
+                                   settings.triangle_modes);
             kept[n] = w.rasterizer.export_fragments();
             if ((total += kept[n].bytes()) > max_bytes) too_big = true;
             const size_t finished = ++done;

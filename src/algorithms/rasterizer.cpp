@@ -9,7 +9,8 @@
 // - vertices snapped to 1/256 pixel after moving pixel centres to integer coordinates, rounding
 //   half away from zero (llvmpipe's subpixel_snap);
 // - orientation from the snapped coordinates: counter-clockwise in OpenGL window space is front,
-//   clockwise and zero-area triangles are culled;
+//   clockwise and zero-area triangles are culled, except that a double-sided triangle's clockwise
+//   side is drawn as a front face (its corners swapped, as llvmpipe does);
 // - y flipped to point down, then Direct3D's top-left rule (a pixel centre on an edge is covered
 //   only by a top or a left edge), with exact integer edge functions;
 // - depth linear in screen space (the plane through the three window-space vertices), a float
@@ -110,12 +111,15 @@ void project(const ClipVertex& v, unsigned resolution, WindowVertex& out) {
 
 // Rasterises one window-space triangle: culling, fill rule and depth as described at the top.
 void rasterize_window_triangle(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2,
-                               uint32_t triangle, unsigned resolution, FragmentSink& sink) {
+                               uint32_t triangle, unsigned resolution, FragmentSink& sink, bool two_sided) {
     // With y pointing down, OpenGL's counter-clockwise front faces have negative area.
     const int64_t area = (v1.X - v0.X) * (v2.Y - v0.Y) - (v2.X - v0.X) * (v1.Y - v0.Y);
-    if (area >= 0) return;  // back face or zero area: culled
-    // Corners 0, 2, 1: positive area, so edge functions are >= 0 inside.
+    if (area == 0 || (area > 0 && !two_sided)) return;  // zero area, or a culled back face
+    // Corners with positive area, so edge functions are >= 0 inside: 0, 2, 1 for a front face,
+    // 0, 1, 2 for the back face of a double-sided triangle. The fill rule depends on the edges'
+    // directions on screen only, not on which corner comes first.
     const WindowVertex* c[3] = {&v0, &v2, &v1};
+    if (area > 0) std::swap(c[1], c[2]);
 
     const int64_t min_x = std::min({c[0]->X, c[1]->X, c[2]->X}), max_x = std::max({c[0]->X, c[1]->X, c[2]->X});
     const int64_t min_y = std::min({c[0]->Y, c[1]->Y, c[2]->Y}), max_y = std::max({c[0]->Y, c[1]->Y, c[2]->Y});
@@ -190,7 +194,8 @@ bool inside_all(const ClipVertex& v) {
 
 // The rare triangle that crosses the near or far plane or leaves the guard band: clipped in
 // clip space, then drawn as a fan (shared fan edges are split exactly by the fill rule).
-void rasterize_clipped_triangle(const ClipVertex (&v)[3], uint32_t triangle, unsigned resolution, FragmentSink& sink) {
+void rasterize_clipped_triangle(const ClipVertex (&v)[3], uint32_t triangle, unsigned resolution, FragmentSink& sink,
+                                bool two_sided) {
     ClipVertex a[12], b[12];
     int n = 3;
     std::copy(v, v + 3, a);
@@ -203,7 +208,7 @@ void rasterize_clipped_triangle(const ClipVertex (&v)[3], uint32_t triangle, uns
     }
     WindowVertex w[12];
     for (int i = 0; i < n; ++i) project(a[i], resolution, w[i]);
-    for (int i = 1; i + 1 < n; ++i) rasterize_window_triangle(w[0], w[i], w[i + 1], triangle, resolution, sink);
+    for (int i = 1; i + 1 < n; ++i) rasterize_window_triangle(w[0], w[i], w[i + 1], triangle, resolution, sink, two_sided);
 }
 
 // Groups the node's fragments by pixel with an LSD radix sort on the pixel index (two passes of
@@ -280,7 +285,7 @@ void NodeRasterizer::visit_fragments(const std::function<void(uint32_t, uint32_t
 }
 
 void NodeRasterizer::rasterize(const float* clip_xyzw, size_t vertex_count, const uint32_t* indices,
-                               size_t index_count, unsigned resolution) {
+                               size_t index_count, unsigned resolution, const uint8_t* modes) {
     validate_indices(indices, index_count, vertex_count);
     if (resolution == 0 || resolution > 16384)
         throw InvalidInput("resolution " + std::to_string(resolution) + " is outside 1..16384");
@@ -298,11 +303,14 @@ void NodeRasterizer::rasterize(const float* clip_xyzw, size_t vertex_count, cons
     FragmentSink sink{s.raw};
     for (size_t t = 0; t < index_count / 3; ++t) {
         const uint32_t a = indices[3 * t], b = indices[3 * t + 1], c = indices[3 * t + 2];
+        const uint8_t mode = modes ? modes[t] : 0;
+        if (mode & kSkipTriangle) continue;
+        const bool two_sided = (mode & kDrawBothFaces) != 0;
         if (s.unclipped[a] & s.unclipped[b] & s.unclipped[c]) {
-            rasterize_window_triangle(s.window[a], s.window[b], s.window[c], uint32_t(t), resolution, sink);
+            rasterize_window_triangle(s.window[a], s.window[b], s.window[c], uint32_t(t), resolution, sink, two_sided);
         } else {
             const ClipVertex v[3] = {cv[a], cv[b], cv[c]};
-            rasterize_clipped_triangle(v, uint32_t(t), resolution, sink);
+            rasterize_clipped_triangle(v, uint32_t(t), resolution, sink, two_sided);
         }
     }
     s.raw_count = sink.count;  // the arrays keep their size: no re-zeroing on the next node
@@ -420,6 +428,92 @@ std::vector<uint32_t> NodeRasterizer::passed_per_pixel(const uint32_t* ranks, si
         uint32_t& pixel = image[s.multi_pixel[m]];
         replay_pixel(s.multi_fragment.data() + begin, s.multi_start[m + 1] - begin, ranks, order_count, scratch.data(),
                      scratch.data() + order_count, [&](size_t o) { pixel += o == order_index; });
+    }
+    return image;
+}
+
+BlendFragments NodeRasterizer::export_blend_fragments(const uint8_t* blended) const {
+    const State& s = *state_;
+    BlendFragments out;
+    // A pixel's lone fragment is counted when blended (no opaque fragment hides it); the grouped
+    // lists keep only its pixel, so its triangle comes from the raw fragments.
+    if (!s.single_pixels.empty()) {
+        std::vector<uint8_t> single(size_t(s.resolution) * s.resolution, 0);
+        for (uint32_t p : s.single_pixels) single[p] = 1;
+        for (size_t f = 0; f < s.raw_count; ++f)
+            if (single[s.raw[f].pixel] && blended[s.raw[f].triangle]) ++out.covered;
+    }
+    out.starts.push_back(0);
+    for (size_t m = 0; m < s.multi_count; ++m) {
+        const uint32_t* f = s.multi_fragment.data() + s.multi_start[m];
+        const uint32_t n = s.multi_start[m + 1] - s.multi_start[m];
+        const size_t begin = out.fragments.size();
+        for (uint32_t j = 0; j < n;) {
+            uint32_t end = j + 1;  // the group of equal depths j .. end − 1
+            while (end < n && (f[end] & kTieBit)) ++end;
+            bool opaque = false;
+            for (uint32_t i = j; i < end; ++i) opaque = opaque || !blended[f[i] & kTriangleMask];
+            if (opaque) break;  // the opaque depth: this group fails LESS, and so does all behind it
+            for (uint32_t i = j; i < end; ++i)
+                out.fragments.push_back((f[i] & kTriangleMask) | (i > j ? kTieBit : 0));
+            j = end;
+        }
+        const size_t count = out.fragments.size() - begin;
+        if (count >= 1) ++out.covered;
+        if (count >= 2) {
+            out.pixels.push_back(s.multi_pixel[m]);
+            out.starts.push_back(uint32_t(out.fragments.size()));
+        } else {
+            out.fragments.resize(begin);
+        }
+    }
+    return out;
+}
+
+namespace {
+
+// One pixel's counted fragments (nearest first) under one order: pairs at different depths, and
+// those drawn nearer-before-farther.
+void blend_pixel(const uint32_t* f, uint32_t n, const uint32_t* ranks, size_t order_count, size_t o, uint64_t& pairs,
+                 uint64_t& missorted) {
+    uint32_t group_start = 0;
+    for (uint32_t j = 0; j < n; ++j) {
+        if (!(f[j] & kTieBit)) group_start = j;
+        const uint32_t rank_far = ranks[size_t(f[j] & kTriangleMask) * order_count + o];
+        for (uint32_t i = 0; i < group_start; ++i) {  // every strictly nearer fragment
+            ++pairs;
+            missorted += ranks[size_t(f[i] & kTriangleMask) * order_count + o] < rank_far;
+        }
+    }
+}
+
+}  // namespace
+
+void score_blend(BlendCounts* counts, const BlendFragments& node, const uint32_t* ranks, size_t order_count) {
+    for (size_t o = 0; o < order_count; ++o) {
+        BlendCounts c;
+        c.covered = node.covered;
+        for (size_t m = 0; m < node.pixels.size(); ++m) {
+            uint64_t pairs = 0, missorted = 0;
+            blend_pixel(node.fragments.data() + node.starts[m], node.starts[m + 1] - node.starts[m], ranks, order_count,
+                        o, pairs, missorted);
+            c.pairs += pairs;
+            c.missorted_pairs += missorted;
+            c.missorted_pixels += missorted > 0;
+        }
+        counts[o] = c;
+    }
+}
+
+std::vector<uint32_t> missorted_per_pixel(const BlendFragments& node, unsigned resolution, const uint32_t* ranks,
+                                          size_t order_count, size_t order_index) {
+    if (order_index >= order_count) throw InvalidInput("order index out of range");
+    std::vector<uint32_t> image(size_t(resolution) * resolution, 0);
+    for (size_t m = 0; m < node.pixels.size(); ++m) {
+        uint64_t pairs = 0, missorted = 0;
+        blend_pixel(node.fragments.data() + node.starts[m], node.starts[m + 1] - node.starts[m], ranks, order_count,
+                    order_index, pairs, missorted);
+        if (node.pixels[m] < image.size()) image[node.pixels[m]] = uint32_t(missorted);
     }
     return image;
 }

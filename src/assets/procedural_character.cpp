@@ -4,7 +4,8 @@
 // their overdraw interesting: limbs and a shield that occlude the body and each other from many
 // views (a cape behind the back, shoulder pads, a shield on the left forearm), joints that bend
 // (smooth weights, so the skin stretches instead of tearing), and two
-// clips with different motion. Parts are closed capsules (surfaces of revolution) around the
+// clips with different motion. Its hair cards and cloth cape are blended and double-sided
+// (issue 18): the input on which blend orders are measured. Parts are closed capsules (surfaces of revolution) around the
 // bones of a 13-joint skeleton, about 1.8 m tall, Y up, facing +Z, its left on +X. Keyframes are
 // skinned with skin_positions at 30 samples per second, as DESIGN.md says for clips.
 #include "animorder/procedural_character.h"
@@ -68,6 +69,30 @@ struct Builder {
             joints.insert(joints.end(), {first, second});
             weights.insert(weights.end(), {float(1 - w), float(w)});
         }
+    }
+
+    // A sheet (open surface) of columns × rows quads: point(u, v) for u, v in [0, 1], counter-
+    // clockwise seen from where cross(∂u, ∂v) points; vertex weights from `first` (v = 0) to
+    // `second` (v = 1) by weight(v).
+    template <typename Point, typename Weight>
+    void sheet(int columns, int rows, Point point, uint16_t first, uint16_t second, Weight weight) {
+        const uint32_t start = uint32_t(positions.size() / 3);
+        for (int r = 0; r <= rows; ++r)
+            for (int c = 0; c <= columns; ++c) {
+                const double u = double(c) / columns, v = double(r) / rows;
+                const Vec3 p = point(u, v);
+                positions.insert(positions.end(), {p.x, p.y, p.z});
+                along.push_back(0);
+                const double w = std::clamp(weight(v), 0.0, 1.0);
+                joints.insert(joints.end(), {first, second});
+                weights.insert(weights.end(), {float(1 - w), float(w)});
+            }
+        const uint32_t stride = uint32_t(columns + 1);
+        for (int r = 0; r < rows; ++r)
+            for (int c = 0; c < columns; ++c) {
+                const uint32_t a = start + uint32_t(r) * stride + uint32_t(c), b = a + 1, d = a + stride, e = d + 1;
+                indices.insert(indices.end(), {a, b, e, a, e, d});
+            }
     }
 };
 
@@ -197,11 +222,40 @@ AnimatedMesh make_procedural_character() {
         }
     }
 
+    const size_t shield_end = body.indices.size();
+    // Hair cards (blended, double-sided, issue 18): three layers of 20 narrow strips around the
+    // back and sides of the head, each hanging from the scalp to the shoulders and overlapping
+    // its neighbours, skinned to the head. Seen from most views several layers cover a pixel.
+    for (int layer = 0; layer < 3; ++layer)
+        for (int card = 0; card < 20; ++card) {
+            const double angle = M_PI * (-0.8 + 1.6 * (card + 0.5 * (layer % 2)) / 19.0);  // 0: the back (−Z)
+            const Vec3 out = {std::sin(angle), 0, -std::cos(angle)}, side = {std::cos(angle), 0, std::sin(angle)};
+            const double r_top = 0.085 + 0.012 * layer, r_bottom = 0.125 + 0.02 * layer;
+            body.sheet(1, 5, [&](double u, double v) {
+                const double r = r_top + (r_bottom - r_top) * v;
+                return Vec3{0, 1.73 - 0.31 * v - 0.02 * layer, 0} + out * r + side * (0.05 * (u - 0.5));
+            }, kHead, kHead, [](double) { return 0.0; });
+        }
+    const size_t hair_end = body.indices.size();
+    // A cloth cape (blended, double-sided): a sheet wrapped round the back from the shoulders to
+    // the knees, widening as it falls, its top following the chest and its hem the hips.
+    body.sheet(16, 12, [&](double u, double v) {
+        const double angle = M_PI * (-0.55 + 1.1 * u), r = 0.23 + 0.12 * v;
+        return Vec3{r * std::sin(angle), 1.42 - 0.87 * v, -r * std::cos(angle) - 0.02};
+    }, kChest, kHips, [](double v) { return v * 1.4; });
+
     AnimatedMesh mesh;
     mesh.name = "procedural-character";
     mesh.vertex_count = body.positions.size() / 3;
     mesh.indices = body.indices;
-    mesh.primitives = {{"body", 0, body_indices}, {"shield", body_indices, body.indices.size() - body_indices}};
+    mesh.primitives = {{"body", 0, body_indices},
+                       {"shield", body_indices, shield_end - body_indices},
+                       {"hair", shield_end, hair_end - shield_end},
+                       {"cape", hair_end, body.indices.size() - hair_end}};
+    for (size_t p = 2; p < 4; ++p) {
+        mesh.primitives[p].double_sided = true;
+        mesh.primitives[p].alpha_mode = AlphaMode::Blend;
+    }
     mesh.joint_count = kJointCount;
     const std::vector<float> bind(body.positions.begin(), body.positions.end());
 

@@ -36,6 +36,8 @@ AnimatedMesh subdivide_animated_mesh(const AnimatedMesh& mesh, unsigned levels) 
         q.name = p.name;
         q.first_index = p.first_index * growth;
         q.index_count = p.index_count * growth;
+        q.double_sided = p.double_sided;
+        q.alpha_mode = p.alpha_mode;
         out.primitives.push_back(q);  // generated vertices: source_mesh −1, no vertex range
     }
     const size_t keyframes = mesh.keyframe_count();

@@ -32,7 +32,9 @@
 #include "checked_size.h"
 #include "isolated_import.h"
 
+#include <assimp/GltfMaterial.h>
 #include <assimp/Importer.hpp>
+#include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
@@ -149,6 +151,21 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
                 for (int c = 0; c < 3; ++c) mesh.indices.push_back(uint32_t(mesh.vertex_count + m->mFaces[f].mIndices[c]));
             }
             prim.index_count = mesh.indices.size() - prim.first_index;
+            // Material flags: AI_MATKEY_TWOSIDED != 0 is double-sided; glTF's alphaMode when
+            // assimp kept it, else an opacity below 1 is BLEND (FBX, Collada, OBJ's d/Tr).
+            if (m->mMaterialIndex < scene->mNumMaterials && scene->mMaterials[m->mMaterialIndex]) {
+                const aiMaterial* material = scene->mMaterials[m->mMaterialIndex];
+                int two_sided = 0;
+                if (material->Get(AI_MATKEY_TWOSIDED, two_sided) == AI_SUCCESS) prim.double_sided = two_sided != 0;
+                aiString alpha_mode;
+                float opacity = 1.0f;
+                if (material->Get(AI_MATKEY_GLTF_ALPHAMODE, alpha_mode) == AI_SUCCESS) {
+                    const std::string mode = alpha_mode.C_Str();
+                    prim.alpha_mode = mode == "BLEND" ? AlphaMode::Blend : mode == "MASK" ? AlphaMode::Mask : AlphaMode::Opaque;
+                } else if (material->Get(AI_MATKEY_OPACITY, opacity) == AI_SUCCESS && opacity < 1.0f) {
+                    prim.alpha_mode = AlphaMode::Blend;
+                }
+            }
             if (m->mNumBones) {
                 part.joints.assign(size_t(m->mNumVertices) * kInfluences, 0);
                 part.weights.assign(size_t(m->mNumVertices) * kInfluences, 0.0f);

@@ -112,6 +112,15 @@ std::string gltf_animated_mesh(const AnimatedMesh& mesh, bool binary) {
                 {{"POSITION", add_floats(model, values, TINYGLTF_TYPE_VEC3, 3, TINYGLTF_TARGET_ARRAY_BUFFER, true)}});
         }
         for (uint32_t v : used) local[v] = UINT32_MAX;
+        // A material only where the primitive differs from glTF's default (single-sided OPAQUE).
+        if (p.double_sided || p.alpha_mode != AlphaMode::Opaque) {
+            tinygltf::Material material;
+            material.name = p.name;
+            material.doubleSided = p.double_sided;
+            material.alphaMode = alpha_mode_name(p.alpha_mode);
+            model.materials.push_back(material);
+            prim.material = int(model.materials.size() - 1);
+        }
         gmesh.primitives.push_back(std::move(prim));
     }
     model.meshes.push_back(std::move(gmesh));

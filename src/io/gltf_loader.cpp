@@ -419,6 +419,16 @@ PrimitiveData parse_primitive(const Scene& s, size_t n, size_t p, AnimatedMesh& 
     out.source_primitive = int(p);
     out.vertex_base = d.vertex_base;
     out.vertex_count = d.vertex_count;
+    // Its material: glTF's defaults (single-sided, OPAQUE) without one.
+    if (prim.material >= 0) {
+        if (size_t(prim.material) >= s.model.materials.size()) s.reader.fail(where + " names a missing material");
+        const tinygltf::Material& material = s.model.materials[size_t(prim.material)];
+        out.double_sided = material.doubleSided;
+        if (material.alphaMode == "BLEND") out.alpha_mode = AlphaMode::Blend;
+        else if (material.alphaMode == "MASK") out.alpha_mode = AlphaMode::Mask;
+        else if (material.alphaMode.empty() || material.alphaMode == "OPAQUE") out.alpha_mode = AlphaMode::Opaque;
+        else s.reader.fail(where + ": material alphaMode '" + material.alphaMode + "' is not OPAQUE, MASK or BLEND");
+    }
     for (uint32_t i : local) mesh.indices.push_back(uint32_t(d.vertex_base + i));
     mesh.primitives.push_back(out);
     parse_morph_targets(s, prim, where, d);

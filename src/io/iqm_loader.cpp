@@ -120,7 +120,7 @@ AnimatedMesh load_iqm(const std::string& path, const LoadOptions& options) {
         mesh.indices.insert(mesh.indices.end(), {v0, v2, v1});  // clockwise → counter-clockwise
     }
     Primitive prim;
-    prim.name = "iqm";
+    prim.name = "iqm";  // no materials in the format: single-sided, opaque (the defaults)
     prim.index_count = mesh.indices.size();
     prim.vertex_count = num_vertexes;
     mesh.primitives.push_back(prim);

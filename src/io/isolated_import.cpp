@@ -143,6 +143,7 @@ void write_mesh(Writer& w, const AnimatedMesh& m) {
         w.i64(p.source_primitive);
         w.u64(p.vertex_base);
         w.u64(p.vertex_count);
+        w.u64(uint64_t(p.double_sided) | uint64_t(p.alpha_mode) << 1);
     }
     w.u64(m.clips.size());
     for (const Clip& c : m.clips) {
@@ -272,8 +273,8 @@ AnimatedMesh read_mesh(Reader& r, const std::string& path, const LoadOptions& op
     m.name = r.str();
     m.vertex_count = r.u64();
     r.array(m.indices);
-    // Each primitive takes at least 6 · 8 bytes, each clip 4 · 8: counts are bounded by the data.
-    m.primitives.resize(r.count(6 * 8));
+    // Each primitive takes at least 7 · 8 bytes, each clip 4 · 8: counts are bounded by the data.
+    m.primitives.resize(r.count(7 * 8));
     for (Primitive& p : m.primitives) {
         p.name = r.str();
         p.first_index = r.u64();
@@ -282,6 +283,10 @@ AnimatedMesh read_mesh(Reader& r, const std::string& path, const LoadOptions& op
         p.source_primitive = r.small_int();
         p.vertex_base = r.u64();
         p.vertex_count = r.u64();
+        const uint64_t material = r.u64();
+        if (material > 5) throw LoadError(path + ": the importer's material flags are corrupt");
+        p.double_sided = (material & 1) != 0;
+        p.alpha_mode = AlphaMode(material >> 1);
     }
     m.clips.resize(r.count(4 * 8));
     for (Clip& c : m.clips) {

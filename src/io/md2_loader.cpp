@@ -74,7 +74,7 @@ AnimatedMesh load_md2(const std::string& path, const LoadOptions& options) {
         mesh.indices.insert(mesh.indices.end(), {v[0], v[2], v[1]});  // clockwise → counter-clockwise
     }
     Primitive prim;
-    prim.name = "md2";
+    prim.name = "md2";  // no materials in the format: single-sided, opaque (the defaults)
     prim.index_count = mesh.indices.size();
     prim.vertex_count = mesh.vertex_count;
     mesh.primitives.push_back(prim);

@@ -8,6 +8,32 @@
 
 namespace animorder {
 
+const char* alpha_mode_name(AlphaMode mode) {
+    switch (mode) {
+        case AlphaMode::Mask: return "MASK";
+        case AlphaMode::Blend: return "BLEND";
+        case AlphaMode::Opaque: break;
+    }
+    return "OPAQUE";
+}
+
+std::vector<uint8_t> double_sided_triangles(const AnimatedMesh& mesh) {
+    bool any = false;
+    for (const Primitive& p : mesh.primitives) any = any || p.double_sided;
+    if (!any) return {};
+    std::vector<uint8_t> flags(mesh.triangle_count(), 0);
+    for (const Primitive& p : mesh.primitives)
+        if (p.double_sided)
+            for (size_t t = p.first_index / 3; t < (p.first_index + p.index_count) / 3 && t < flags.size(); ++t) flags[t] = 1;
+    return flags;
+}
+
+bool has_blended_primitives(const AnimatedMesh& mesh) {
+    for (const Primitive& p : mesh.primitives)
+        if (p.alpha_mode == AlphaMode::Blend) return true;
+    return false;
+}
+
 void validate_animated_mesh(const AnimatedMesh& mesh) {
     if (mesh.indices.size() % 3 != 0)
         throw InvalidInput("index count " + std::to_string(mesh.indices.size()) + " is not a multiple of 3");

@@ -14,6 +14,7 @@
 #include "animorder/invalid_input.h"
 #include "animorder/mesh_patches.h"
 #include "animorder/methods.h"
+#include "animorder/overdraw.h"
 #include "animorder/rasterizer.h"
 #include "animorder/selection_table.h"
 #include "animorder/triangle_order.h"
@@ -115,6 +116,7 @@ std::vector<OrderEvaluation> evaluate_methods(const AnimatedMesh& mesh, const st
             rank_of[m].push_back(std::move(rank));
         }
 
+    const std::vector<uint8_t> modes = opaque_pass_modes(mesh);
     const Framing all = frame_animated_mesh(mesh);
     const std::vector<float> directions = random_sphere_directions(settings.views, settings.seed);
     size_t total_nodes = 0, done_before = 0;
@@ -177,7 +179,7 @@ std::vector<OrderEvaluation> evaluate_methods(const AnimatedMesh& mesh, const st
                 transform_to_clip(w.clip.data(), mesh.keyframe(keyframe), mesh.vertex_count, &all.centres[3 * keyframe],
                                   node_view_projection(direction, framing.radius));
                 w.rasterizer.rasterize(w.clip.data(), mesh.vertex_count, mesh.indices.data(), mesh.indices.size(),
-                                       settings.resolution);
+                                       settings.resolution, modes.empty() ? nullptr : modes.data());
                 visible[n] = w.rasterizer.visible_pixels();
                 w.rasterizer.score(&passed[n * method_count], w.ranks.data(), method_count);
                 const size_t finished = ++done;

@@ -12,6 +12,7 @@
 #include "animorder/methods.h"
 
 #include "animorder/animated_mesh.h"
+#include "animorder/blend_orders.h"
 #include "animorder/clustering.h"
 #include "animorder/evaluation.h"
 #include "animorder/invalid_input.h"
@@ -193,7 +194,7 @@ VertexCacheStats analyze_mesh_vertex_cache(const AnimatedMesh& mesh, const std::
 }
 
 AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double lambda, unsigned cache_size,
-                                    const ClusteringSettings& settings) {
+                                    const ClusteringSettings& settings, bool blend_clusters) {
     validate_animated_mesh(mesh);
     if (mesh.clips.empty()) throw InvalidInput("the mesh has no clip to cluster");
     AnimatedMethodResult result;
@@ -220,10 +221,22 @@ AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double
         const Framing framing = frame_subset(result.framing, keyframes);
         result.run_radius.push_back(framing.radius);
         result.runs.push_back(cluster_nodes(mesh, result.patches, framing, keyframes, settings));
+        // Blended primitives: back to front for each cluster (blend_orders.h); with blend_clusters,
+        // by their own k clusters of the same nodes, the buffers then being the (opaque, blend)
+        // cluster pairs the nodes take.
+        if (has_blended_primitives(mesh) && !blend_clusters) {
+            blended_orders_from_clusters(mesh, result.framing, framing.radius, result.runs.back());
+        } else if (has_blended_primitives(mesh)) {
+            const BlendClustering blend =
+                cluster_blend_nodes(mesh, framing, result.runs.back(), settings.resolution, settings.threads);
+            combine_with_blend_clusters(mesh, blend, result.runs.back());
+        }
     }
     for (size_t c = 0; c < mesh.clips.size(); ++c) {
         const size_t run = joint ? 0 : c;
-        result.buffers.table_base.push_back(uint32_t(joint ? 0 : c * settings.clusters));
+        uint32_t base = 0;  // buffers of the runs before (k each without blended primitives)
+        for (size_t r = 0; r < run; ++r) base += uint32_t(result.runs[r].triangle_orders.size());
+        result.buffers.table_base.push_back(base);
         result.buffers.tables.push_back(
             build_selection_table(result.runs[run], mesh.clips[c].first_keyframe, mesh.clips[c].keyframe_count));
     }
@@ -277,10 +290,11 @@ void run_single_buffer(MethodResult& result, const AnimatedMesh& mesh, const Met
 // Han & Sander 2017; the fallback is the buffer the most clustering nodes chose.
 void run_clustered(MethodResult& result, const AnimatedMesh& mesh, const MethodSettings& settings) {
     const bool joint = result.method == Method::Joint;
-    AnimatedMethodResult r = run_han_sander(mesh, joint, settings.lambda, settings.cache_size, settings.clustering);
+    AnimatedMethodResult r =
+        run_han_sander(mesh, joint, settings.lambda, settings.cache_size, settings.clustering, settings.blend_clusters);
     std::vector<size_t> chosen(r.buffers.orders.size(), 0);
     for (size_t i = 0; i < r.runs.size(); ++i)
-        for (uint32_t c : r.runs[i].assignment) ++chosen[(joint ? 0 : i * settings.clustering.clusters) + c];
+        for (uint32_t c : r.runs[i].assignment) ++chosen[r.buffers.table_base[joint ? 0 : i] + c];
     result.fallback = uint32_t(std::max_element(chosen.begin(), chosen.end()) - chosen.begin());
     for (const ClusteringResult& run : r.runs) {
         double seconds = run.seconds_rasterization;
@@ -348,6 +362,18 @@ void run_oracle(MethodResult& result, const AnimatedMesh& mesh, const MethodSett
 
 }  // namespace
 
+void reverse_blended_primitives(const AnimatedMesh& mesh, std::vector<uint32_t>& order) {
+    if (order.size() != mesh.triangle_count()) throw InvalidInput("an order does not cover the mesh's triangles");
+    for (const Primitive& p : mesh.primitives) {
+        if (p.alpha_mode != AlphaMode::Blend) continue;
+        const size_t first = p.first_index / 3, last = (p.first_index + p.index_count) / 3;
+        for (size_t i = first; i < last; ++i)
+            if (order[i] < first || order[i] >= last)
+                throw InvalidInput("an order moves triangles between primitives ('" + p.name + "')");
+        std::reverse(order.begin() + ptrdiff_t(first), order.begin() + ptrdiff_t(last));
+    }
+}
+
 MethodResult run_method(const AnimatedMesh& mesh, Method method, const MethodSettings& settings) {
     validate_method_settings(settings);
     validate_animated_mesh(mesh);
@@ -370,6 +396,11 @@ MethodResult run_method(const AnimatedMesh& mesh, Method method, const MethodSet
             result.seconds = seconds_since(start);
             return result;
     }
+    // Blended primitives are drawn back to front: every buffer of a single-buffer sorting method
+    // carries the reverse of its front-to-back order there (the input order stays as it is for
+    // original; single and joint sort them per cluster in run_han_sander).
+    if (method != Method::Original && method != Method::Single && method != Method::Joint)
+        for (std::vector<uint32_t>& order : result.buffers.orders) reverse_blended_primitives(mesh, order);
     // The time covers the method, not its ACMR (the oracle's ACMR sampling is part of its run).
     result.seconds = seconds_since(start);
     std::vector<uint32_t> indices(mesh.indices.size());

@@ -232,6 +232,11 @@ GlDraw GlContext::draw(size_t id, bool timed) {
     return result;
 }
 
+void GlContext::set_culling(bool cull) {
+    if (cull) glEnable(GL_CULL_FACE);
+    else glDisable(GL_CULL_FACE);
+}
+
 uint64_t GlContext::covered_pixels() {
     const size_t pixels = size_t(state_->resolution) * state_->resolution;
     std::vector<float> depth(pixels);

@@ -55,6 +55,9 @@ public:
     // first and the draw is timed up to glFinish, with a GL_TIME_ELAPSED query beside it.
     GlDraw draw(size_t id, bool timed = false);
 
+    // Back-face culling on (the default) or off (double-sided materials) for later draws.
+    void set_culling(bool cull);
+
     // Pixels whose depth is below 1 in the framebuffer now (after a draw: the visible pixels).
     uint64_t covered_pixels();
 

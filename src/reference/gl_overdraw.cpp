@@ -21,8 +21,10 @@ GlOverdrawReference::~GlOverdrawReference() = default;
 std::string GlOverdrawReference::renderer() const { return context_->renderer(); }
 
 GlNodeCounts GlOverdrawReference::score(const float* clip_xyzw, size_t vertex_count,
-                                        const std::vector<std::vector<uint32_t>>& index_buffers) {
+                                        const std::vector<std::vector<uint32_t>>& index_buffers,
+                                        bool double_sided) {
     GlContext& gl = *context_;
+    gl.set_culling(!double_sided);
     gl.set_vertices(clip_xyzw, vertex_count);
     GlNodeCounts counts;
     const uint64_t pixels = uint64_t(gl.resolution()) * gl.resolution();
@@ -31,6 +33,7 @@ GlNodeCounts GlOverdrawReference::score(const float* clip_xyzw, size_t vertex_co
         counts.passed.push_back(gl.draw(scratch_).samples_passed);
         if (o == 0) counts.visible = gl.covered_pixels();
     }
+    gl.set_culling(true);
     for (uint64_t p : counts.passed)
         if (p < counts.visible || counts.visible > pixels)
             throw std::runtime_error("OpenGL reference: implausible query result (passed " + std::to_string(p) +

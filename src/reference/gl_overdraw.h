@@ -33,8 +33,9 @@ public:
 
     // Draws the clip-space vertices (4 floats each, the array transform_to_clip gives the CPU
     // rasteriser) once per index buffer, each into a cleared depth buffer with its own query.
+    // double_sided: every triangle drawn without back-face culling (a double-sided material).
     GlNodeCounts score(const float* clip_xyzw, size_t vertex_count,
-                       const std::vector<std::vector<uint32_t>>& index_buffers);
+                       const std::vector<std::vector<uint32_t>>& index_buffers, bool double_sided = false);
 
 private:
     std::unique_ptr<GlContext> context_;

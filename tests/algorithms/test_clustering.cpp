@@ -104,6 +104,8 @@ TEST(Clustering, AssignsEachNodeToItsBestBufferAndImproves) {
     std::vector<uint64_t> visible(nodes.size()), passed(nodes.size() * 3);
     ScoreSettings score;
     score.resolution = settings.resolution;
+    const std::vector<uint8_t> modes = opaque_pass_modes(m);  // k-means counts the opaque pass (issue 18)
+    score.triangle_modes = modes.empty() ? nullptr : modes.data();
     score_nodes(visible.data(), passed.data(), m.keyframe_positions.data(), m.vertex_count, framing, m.indices.data(),
                 m.indices.size(), nodes.data(), nodes.size(), ranks.data(), 3, score);
     ASSERT_EQ(r.assignment.size(), nodes.size());

@@ -14,7 +14,9 @@
 
 #include <algorithm>
 #include <map>
+#include <numeric>
 #include <random>
+#include <tuple>
 #include <vector>
 
 using namespace animorder;
@@ -252,4 +254,176 @@ TEST(Rasterizer, RejectsBadInput) {
     EXPECT_THROW(r.rasterize(clip.data(), 3, ib.data(), 3, 16), InvalidInput);
     const std::vector<uint32_t> ok{0, 1, 2};
     EXPECT_THROW(r.rasterize(clip.data(), 3, ok.data(), 3, 0), InvalidInput);
+}
+
+// Double-sided triangles (glTF doubleSided materials): the back face is drawn, not culled.
+TEST(Rasterizer, DoubleSidedQuadSeenFromBehindIsCounted) {
+    Scene s(16);
+    s.rect(2, 2, 10, 10, 0.0f, /*counter_clockwise=*/false);  // a back face: 8 × 8 pixels
+    EXPECT_EQ(s.rasterize().visible_pixels(), 0u) << "culled when single-sided";
+    const std::vector<uint8_t> both(s.triangles(), 1);
+    NodeRasterizer r;
+    r.rasterize(s.clip.data(), s.clip.size() / 4, s.ib.data(), s.ib.size(), s.resolution, both.data());
+    EXPECT_EQ(r.visible_pixels(), 64u);
+    EXPECT_EQ(r.fragments(), 64u) << "no double count on the shared diagonal";
+}
+
+TEST(Rasterizer, DoubleSidedBackFaceOccludesLikeAFrontFace) {
+    // Near: a back-facing double-sided rectangle over [4,12]²; far: a front face over [0,16]².
+    Scene s(16);
+    s.rect(4, 4, 12, 12, -0.5f, false);
+    s.rect(0, 0, 16, 16, 0.5f, true);
+    const std::vector<uint8_t> flags = {1, 1, 0, 0};
+    NodeRasterizer r;
+    r.rasterize(s.clip.data(), s.clip.size() / 4, s.ib.data(), s.ib.size(), s.resolution, flags.data());
+    EXPECT_EQ(r.visible_pixels(), 256u);
+    const std::vector<uint32_t> near_first = {0, 1, 2, 3}, far_first = {2, 3, 0, 1};
+    const std::vector<uint32_t> ranks = make_rank_table({near_first.data(), far_first.data()}, 4);
+    uint64_t passed[2];
+    r.score(passed, ranks.data(), 2);
+    EXPECT_EQ(passed[0], 256u);       // near first: the far quad is hidden where the near one lies
+    EXPECT_EQ(passed[1], 256u + 64u);  // far first: the 64 near fragments pass again
+}
+
+TEST(Rasterizer, DoubleSidedBackFacesCoverTheSamePixelsAsTheirFrontFaces) {
+    // The fill rule is a property of the edges on screen: a triangle and its mirror winding
+    // (drawn double-sided) must give the same fragments, with the same depths.
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> coordinate(-1.1f, 1.1f), depth(-0.9f, 0.9f);
+    Scene front(37), back(37);
+    for (int t = 0; t < 200; ++t) {
+        float v[3][3];
+        for (auto& p : v) p[0] = coordinate(rng), p[1] = coordinate(rng), p[2] = depth(rng);
+        const uint32_t a = front.vertex(v[0][0], v[0][1], v[0][2]), b = front.vertex(v[1][0], v[1][1], v[1][2]),
+                       c = front.vertex(v[2][0], v[2][1], v[2][2]);
+        back.vertex(v[0][0], v[0][1], v[0][2]), back.vertex(v[1][0], v[1][1], v[1][2]), back.vertex(v[2][0], v[2][1], v[2][2]);
+        front.ib.insert(front.ib.end(), {a, b, c});
+        back.ib.insert(back.ib.end(), {a, c, b});
+    }
+    const std::vector<uint8_t> both(front.triangles(), 1);
+    auto fragments_of = [&](const Scene& s) {
+        NodeRasterizer r;
+        r.rasterize(s.clip.data(), s.clip.size() / 4, s.ib.data(), s.ib.size(), s.resolution, both.data());
+        std::vector<std::tuple<uint32_t, uint32_t, float>> out;
+        r.visit_fragments([&](uint32_t p, uint32_t t, float z) { out.emplace_back(p, t, z); });
+        std::sort(out.begin(), out.end());
+        return out;
+    };
+    const auto a = fragments_of(front), b = fragments_of(back);
+    EXPECT_GT(a.size(), 1000u);
+    EXPECT_EQ(a, b);
+    // Single-sided, each triangle shows in exactly one of the two scenes.
+    EXPECT_EQ(front.rasterize().fragments() + back.rasterize().fragments(), a.size());
+}
+
+// Blend error (DESIGN.md): hand-worked transparent passes.
+namespace {
+BlendCounts blend_counts(const Scene& s, const std::vector<uint8_t>& blended, const std::vector<uint32_t>& order,
+                         const std::vector<uint8_t>* double_sided = nullptr) {
+    NodeRasterizer r;
+    r.rasterize(s.clip.data(), s.clip.size() / 4, s.ib.data(), s.ib.size(), s.resolution,
+                double_sided ? double_sided->data() : nullptr);
+    const std::vector<uint32_t> ranks = make_rank_table({order.data()}, s.triangles());
+    BlendCounts c;
+    score_blend(&c, r.export_blend_fragments(blended.data()), ranks.data(), 1);
+    return c;
+}
+}  // namespace
+
+TEST(BlendError, TwoParallelBlendedQuadsSeenFromBothSides) {
+    // Quads A (NDC z = −0.5) and B (z = +0.5) over the same 8 × 8 pixels, double-sided, blended.
+    // From the front A is nearer: drawing A first mis-sorts all 64 pixels, B first none. Seen from
+    // behind (z negated, as a camera on the other side sees them) the right buffer flips.
+    for (const float side : {1.0f, -1.0f}) {
+        Scene s(16);
+        s.rect(4, 4, 12, 12, -0.5f * side);  // A: triangles 0, 1
+        s.rect(4, 4, 12, 12, 0.5f * side);   // B: triangles 2, 3
+        const std::vector<uint8_t> blended(4, 1), both(4, 1);
+        const BlendCounts a_first = blend_counts(s, blended, {0, 1, 2, 3}, &both);
+        const BlendCounts b_first = blend_counts(s, blended, {2, 3, 0, 1}, &both);
+        EXPECT_EQ(a_first.covered, 64u);
+        EXPECT_EQ(a_first.pairs, 64u);
+        EXPECT_EQ(a_first.missorted_pairs, side > 0 ? 64u : 0u);
+        EXPECT_EQ(a_first.missorted_pixels, side > 0 ? 64u : 0u);
+        EXPECT_EQ(b_first.missorted_pairs, side > 0 ? 0u : 64u);
+        EXPECT_EQ(b_first.missorted_pixels, side > 0 ? 0u : 64u);
+    }
+}
+
+TEST(BlendError, HiddenBlendedFragmentsDoNotCount) {
+    // An opaque quad at z = 0 over [0,16]²; a blended shell in front (z = −0.5, over [2,6]×[2,6])
+    // and behind it (z = −0.2 and z = +0.5 over [8,12]²: one layer hidden by the opaque quad).
+    Scene s(16);
+    s.rect(0, 0, 16, 16, 0.0f);    // opaque: 0, 1
+    s.rect(2, 2, 6, 6, -0.5f);     // blended, in front: 2, 3
+    s.rect(8, 8, 12, 12, -0.2f);   // blended, in front: 4, 5
+    s.rect(8, 8, 12, 12, 0.5f);    // blended, hidden: 6, 7
+    s.rect(2, 2, 6, 6, -0.1f);     // blended, in front, behind 2/3: 8, 9
+    const std::vector<uint8_t> blended = {0, 0, 1, 1, 1, 1, 1, 1, 1, 1};
+    const BlendCounts c = blend_counts(s, blended, {0, 1, 2, 3, 4, 5, 6, 7, 8, 9});
+    EXPECT_EQ(c.covered, 16u + 16u);        // both 4 × 4 squares; the hidden layer adds nothing
+    EXPECT_EQ(c.pairs, 16u);                // only [2,6]² has two counted layers
+    EXPECT_EQ(c.missorted_pairs, 16u);      // 2/3 (nearer) drawn before 8/9
+    EXPECT_EQ(c.missorted_pixels, 16u);
+    const BlendCounts back_to_front = blend_counts(s, blended, {0, 1, 8, 9, 6, 7, 4, 5, 2, 3});
+    EXPECT_EQ(back_to_front.missorted_pairs, 0u);
+    // A blended fragment at exactly the opaque depth fails LESS: moved onto the opaque plane, the
+    // [8,12]² layer stops counting.
+    Scene t(16);
+    t.rect(0, 0, 16, 16, 0.0f);
+    t.rect(8, 8, 12, 12, 0.0f);
+    EXPECT_EQ(blend_counts(t, {0, 0, 1, 1}, {2, 3, 0, 1}).covered, 0u);
+}
+
+TEST(BlendError, MatchesABruteForceTransparentPass) {
+    // A second implementation from the raw fragments: per pixel, the opaque minimum depth, the
+    // blended fragments strictly nearer, and every pair at different depths checked against the
+    // order's ranks.
+    std::mt19937 rng(23);
+    std::uniform_real_distribution<float> coordinate(-1.0f, 1.0f), depth(-0.9f, 0.9f);
+    Scene s(24);
+    for (int t = 0; t < 120; ++t) {
+        const uint32_t a = s.vertex(coordinate(rng), coordinate(rng), depth(rng));
+        const uint32_t b = s.vertex(coordinate(rng), coordinate(rng), depth(rng));
+        const uint32_t c = s.vertex(coordinate(rng), coordinate(rng), depth(rng));
+        s.ib.insert(s.ib.end(), {a, b, c});
+    }
+    std::vector<uint8_t> blended(s.triangles()), both(s.triangles(), kDrawBothFaces);
+    for (size_t t = 0; t < blended.size(); ++t) blended[t] = t % 3 != 0;
+    std::vector<uint32_t> order(s.triangles());
+    std::iota(order.begin(), order.end(), 0u);
+    std::shuffle(order.begin(), order.end(), rng);
+    NodeRasterizer r;
+    r.rasterize(s.clip.data(), s.clip.size() / 4, s.ib.data(), s.ib.size(), s.resolution, both.data());
+    const std::vector<uint32_t> ranks = make_rank_table({order.data()}, s.triangles());
+    BlendCounts fast;
+    score_blend(&fast, r.export_blend_fragments(blended.data()), ranks.data(), 1);
+
+    std::map<uint32_t, float> opaque;
+    std::map<uint32_t, std::vector<std::pair<float, uint32_t>>> layers;
+    r.visit_fragments([&](uint32_t p, uint32_t t, float z) {
+        if (!blended[t]) opaque[p] = opaque.count(p) ? std::min(opaque[p], z) : z;
+    });
+    r.visit_fragments([&](uint32_t p, uint32_t t, float z) {
+        if (blended[t] && (!opaque.count(p) || z < opaque[p])) layers[p].emplace_back(z, t);
+    });
+    BlendCounts slow;
+    for (const auto& [p, list] : layers) {
+        ++slow.covered;
+        uint64_t missorted = 0;
+        for (size_t i = 0; i < list.size(); ++i)
+            for (size_t j = 0; j < list.size(); ++j)
+                if (list[i].first < list[j].first) {
+                    ++slow.pairs;
+                    missorted += ranks[list[i].second] < ranks[list[j].second];
+                }
+        slow.missorted_pairs += missorted;
+        slow.missorted_pixels += missorted > 0;
+    }
+    EXPECT_GT(slow.pairs, 200u);
+    EXPECT_GT(slow.missorted_pairs, 0u);
+    EXPECT_EQ(fast.covered, slow.covered);
+    EXPECT_EQ(fast.pairs, slow.pairs);
+    EXPECT_EQ(fast.missorted_pairs, slow.missorted_pairs);
+    EXPECT_EQ(fast.missorted_pixels, slow.missorted_pixels);
 }

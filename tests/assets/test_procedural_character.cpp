@@ -48,10 +48,20 @@ std::vector<uint32_t> component_of_vertex(const AnimatedMesh& m) {
 TEST(ProceduralCharacter, SizeAndStructure) {
     const AnimatedMesh& m = character();
     EXPECT_GE(m.triangle_count(), 9500u);
-    EXPECT_LE(m.triangle_count(), 11000u);
+    EXPECT_LE(m.triangle_count(), 12000u);
     EXPECT_NO_THROW(validate_animated_mesh(m));
-    ASSERT_EQ(m.primitives.size(), 2u);
+    ASSERT_EQ(m.primitives.size(), 4u);
     EXPECT_EQ(m.primitives[1].name, "shield");
+    // Issue 18: 60 hair cards of 5 quads and a 16 × 12 cape, blended and double-sided; the body
+    // and the shield single-sided and opaque.
+    EXPECT_EQ(m.primitives[2].name, "hair");
+    EXPECT_EQ(m.primitives[2].index_count, 3u * 60 * 5 * 2);
+    EXPECT_EQ(m.primitives[3].name, "cape");
+    EXPECT_EQ(m.primitives[3].index_count, 3u * 16 * 12 * 2);
+    for (size_t p = 0; p < 4; ++p) {
+        EXPECT_EQ(m.primitives[p].double_sided, p >= 2) << p;
+        EXPECT_EQ(m.primitives[p].alpha_mode, p >= 2 ? AlphaMode::Blend : AlphaMode::Opaque) << p;
+    }
     ASSERT_EQ(m.clips.size(), 2u);
     EXPECT_EQ(m.clips[0].name, "walk");
     EXPECT_EQ(m.clips[1].name, "wave");
@@ -60,8 +70,17 @@ TEST(ProceduralCharacter, SizeAndStructure) {
     EXPECT_GE(m.joint_count, 12u);
 }
 
+// The opaque primitives (body, shield): closed surfaces. The blended hair cards and cape are open
+// sheets, drawn double-sided.
+AnimatedMesh opaque_part(const AnimatedMesh& full) {
+    AnimatedMesh m = full;
+    m.indices.resize(full.primitives[1].first_index + full.primitives[1].index_count);
+    m.primitives.resize(2);
+    return m;
+}
+
 TEST(ProceduralCharacter, EveryKeyframeIsClosedAndOutward) {
-    const AnimatedMesh& m = character();
+    const AnimatedMesh m = opaque_part(character());
     std::map<std::pair<uint32_t, uint32_t>, int> edges;
     for (size_t t = 0; t < m.indices.size(); t += 3)
         for (int i = 0; i < 3; ++i) ++edges[{m.indices[t + i], m.indices[t + (i + 1) % 3]}];
@@ -85,7 +104,7 @@ TEST(ProceduralCharacter, EveryKeyframeIsClosedAndOutward) {
 
 TEST(ProceduralCharacter, EveryPartIsOutwardInEveryKeyframe) {
     // Per part, not just in total: one part wound inward would hide inside a positive sum.
-    const AnimatedMesh& m = character();
+    const AnimatedMesh m = opaque_part(character());
     const std::vector<uint32_t> component = component_of_vertex(m);
     for (size_t k = 0; k < m.keyframe_count(); ++k) {
         const float* p = m.keyframe(k);

@@ -332,3 +332,18 @@ TEST(AssimpCharacters, AnotherCharactersMixamoClipIsRefused) {
     // Her own clips pass (the same rule, the same joints).
     EXPECT_NO_THROW(load_character(witch, {kData + "pg-witch/anims/Run.fbx"}));
 }
+
+// Material flags through assimp and the isolated reader's serialisation: OBJ's `d` (dissolve)
+// below 1 is BLEND; a material without it OPAQUE; OBJ has no two-sided flag.
+TEST_F(AssimpHostile, MaterialFlagsTravelThroughTheIsolatedReader) {
+    write("veil.mtl", "newmtl solid\nKd 1 1 1\nnewmtl veil\nKd 1 1 1\nd 0.5\n");
+    const std::string obj = write("veil.obj",
+                                  "mtllib veil.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 0 1 1\n"
+                                  "o solid\nusemtl solid\nf 1 2 3\no veil\nusemtl veil\nf 4 5 6\n");
+    const AnimatedMesh m = load_character(obj);
+    ASSERT_EQ(m.primitives.size(), 2u);
+    EXPECT_EQ(m.primitives[0].alpha_mode, AlphaMode::Opaque);
+    EXPECT_EQ(m.primitives[1].alpha_mode, AlphaMode::Blend);
+    EXPECT_FALSE(m.primitives[0].double_sided);
+    EXPECT_FALSE(m.primitives[1].double_sided);
+}

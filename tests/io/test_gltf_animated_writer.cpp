@@ -34,6 +34,8 @@ AnimatedMesh small_mesh() {
     m.vertex_count = 8;
     m.indices = {0, 1, 2, 0, 3, 1, 0, 2, 3, 1, 3, 2, 5, 6, 7};
     m.primitives = {{"tet", 0, 12}, {"flag", 12, 3}};
+    m.primitives[1].double_sided = true;  // a blended double-sided flag: its material is written
+    m.primitives[1].alpha_mode = AlphaMode::Blend;
     const float rest[] = {1, 1, 1, 1, -1, -1, -1, 1, -1, -1, -1, 1, 9, 9, 9, 2, 0, 0, 3, 0, 0, 2, 1, 0};
     for (int k = 0; k < 3; ++k)
         for (size_t i = 0; i < 24; ++i) m.keyframe_positions.push_back(rest[i] + 0.25f * float(k) * float(i % 3 == 1) + 0.1f * float(k * (i % 5)));
@@ -61,6 +63,8 @@ void expect_same_animation(const AnimatedMesh& a, const AnimatedMesh& b) {
     for (size_t p = 0; p < a.primitives.size(); ++p) {
         EXPECT_EQ(a.primitives[p].first_index, b.primitives[p].first_index);
         EXPECT_EQ(a.primitives[p].index_count, b.primitives[p].index_count);
+        EXPECT_EQ(a.primitives[p].double_sided, b.primitives[p].double_sided) << p;
+        EXPECT_EQ(a.primitives[p].alpha_mode, b.primitives[p].alpha_mode) << p;
     }
     const double tolerance = 1e-5 * radius(a);
     double worst = 0;

@@ -436,3 +436,62 @@ TEST(GltfCharacters, GanfaulSkinsWithoutStretching) {
     }
     EXPECT_NEAR(test::median(ratios), 1.0, 0.01);
 }
+
+// Material flags: each primitive carries its material's doubleSided and alphaMode (glTF's
+// defaults, single-sided OPAQUE, without a material); an unknown alphaMode is a one-line error.
+TEST_F(GltfLoader, PrimitivesCarryTheirMaterialFlags) {
+    Gltf g;
+    const std::vector<float> pos = {0, 0, 0, 1, 0, 0, 1, 1, 0};
+    const int p = g.floats(pos, "VEC3", 3);
+    json prims = json::array();
+    for (int material : {-1, 0, 1, 2, 3}) {
+        json prim = {{"attributes", {{"POSITION", p}}}};
+        if (material >= 0) prim["material"] = material;
+        prims.push_back(prim);
+    }
+    g.doc["materials"] = json::array({json{{"doubleSided", true}},
+                                      json{{"alphaMode", "BLEND"}},
+                                      json{{"alphaMode", "MASK"}, {"doubleSided", true}},
+                                      json{{"alphaMode", "OPAQUE"}, {"doubleSided", false}}});
+    g.doc["meshes"] = json::array({json{{"name", "m"}, {"primitives", prims}}});
+    g.doc["nodes"] = json::array({json{{"mesh", 0}}});
+    g.doc["scenes"] = json::array({json{{"nodes", {0}}}});
+    const AnimatedMesh m = load_gltf(write("materials.gltf", g.text()));
+    ASSERT_EQ(m.primitives.size(), 5u);
+    const bool sided[] = {false, true, false, true, false};
+    const AlphaMode mode[] = {AlphaMode::Opaque, AlphaMode::Opaque, AlphaMode::Blend, AlphaMode::Mask, AlphaMode::Opaque};
+    for (size_t i = 0; i < 5; ++i) {
+        EXPECT_EQ(m.primitives[i].double_sided, sided[i]) << i;
+        EXPECT_EQ(m.primitives[i].alpha_mode, mode[i]) << i;
+    }
+    EXPECT_EQ(double_sided_triangles(m), (std::vector<uint8_t>{0, 1, 0, 1, 0}));
+    EXPECT_TRUE(has_blended_primitives(m));
+
+    g.doc["materials"][1]["alphaMode"] = "ADDITIVE";
+    expect_load_error("bad-mode.gltf", g.text(), "alphaMode 'ADDITIVE'");
+    g.doc["materials"][1]["alphaMode"] = "BLEND";
+    g.doc["meshes"][0]["primitives"][1]["material"] = 9;
+    expect_load_error("missing-material.gltf", g.text(), "names a missing material");
+}
+
+// The double-sided characters of ../shared/data, as their files say (read with Python's json module
+// from the JSON chunk: both of Xbot's materials and both of MorphStressTest's are doubleSided, all OPAQUE).
+TEST(GltfCharacters, DoubleSidedMaterialsOfSharedData) {
+    ANIMORDER_REQUIRE_DATA(shared_data(""));
+    for (const char* f : {"glb-xbot/Xbot.glb", "gltf-morph-stress-test/MorphStressTest.gltf"}) {
+        SCOPED_TRACE(f);
+        const AnimatedMesh m = load_gltf(shared_data(f));
+        ASSERT_GE(m.primitives.size(), 1u);
+        for (const Primitive& p : m.primitives) {
+            EXPECT_TRUE(p.double_sided) << p.name;
+            EXPECT_EQ(p.alpha_mode, AlphaMode::Opaque) << p.name;
+        }
+    }
+    for (const char* f : {"mixamo-ganfaul/Ganfaul.gltf", "gltf-fox/Fox.glb", "gltf-cesiumman/CesiumMan.glb"}) {
+        SCOPED_TRACE(f);
+        for (const Primitive& p : load_gltf(shared_data(f)).primitives) {
+            EXPECT_FALSE(p.double_sided) << p.name;
+            EXPECT_EQ(p.alpha_mode, AlphaMode::Opaque) << p.name;
+        }
+    }
+}

@@ -81,6 +81,8 @@ OverdrawSummary direct(const AnimatedMesh& mesh, size_t clip, const std::vector<
     std::vector<uint64_t> visible(nodes.size()), passed(nodes.size());
     ScoreSettings score;
     score.resolution = settings.resolution;
+    const std::vector<uint8_t> modes = opaque_pass_modes(mesh);  // the character's hair and cape blend
+    score.triangle_modes = modes.empty() ? nullptr : modes.data();
     score_nodes(visible.data(), passed.data(), mesh.keyframe_positions.data(), mesh.vertex_count, framing,
                 mesh.indices.data(), mesh.indices.size(), nodes.data(), nodes.size(), ranks.data(), 1, score);
     OverdrawSummary s;

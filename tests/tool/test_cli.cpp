@@ -40,6 +40,34 @@ TEST_F(Cli, InspectUsesTheBundledCharacterAndSaysSo) {
     EXPECT_EQ(j["clips"].size(), 2u);
 }
 
+// Issue 18: the materials of the bundled character, its blend table and the blend heatmap.
+TEST_F(Cli, MaterialsBlendReportAndHeatmap) {
+    const nlohmann::json j = nlohmann::json::parse(run("inspect --json -q").out);
+    ASSERT_EQ(j["primitives"].size(), 4u);
+    EXPECT_EQ(j["primitives"][0]["alpha_mode"], "OPAQUE");
+    EXPECT_EQ(j["primitives"][0]["double_sided"], false);
+    EXPECT_EQ(j["primitives"][2]["name"], "hair");
+    EXPECT_EQ(j["primitives"][2]["alpha_mode"], "BLEND");
+    EXPECT_EQ(j["primitives"][3]["double_sided"], true);
+    const test::Outcome e = run("evaluate -q --methods original,static-sander07 --eval-views 2 --eval-resolution 64 -r " +
+                                path("b.json").string());
+    ASSERT_EQ(e.exit_code, 0) << e.err;
+    EXPECT_NE(e.out.find("back-to-front per node (bound)"), std::string::npos) << e.out;
+    const nlohmann::json r = nlohmann::json::parse(test::slurp(path("b.json")));
+    for (const nlohmann::json& m : r["methods"]) {
+        const double pixels = m["blend"]["missorted_pixel_fraction"];
+        EXPECT_GE(pixels, 0.0);
+        EXPECT_LE(pixels, 1.0);
+        EXPECT_GT(m["blend"]["covered_pixels"].get<int>(), 0);
+    }
+    EXPECT_LE(r["blend_bound"]["missorted_pair_fraction"].get<double>(),
+              r["blend_input_order"]["missorted_pair_fraction"].get<double>());
+    const test::Outcome h = run("heatmap -q --blend --order original --resolution 64 -o " + path("b.png").string());
+    ASSERT_EQ(h.exit_code, 0) << h.err;
+    EXPECT_NE(h.out.find("mis-sorted pixels"), std::string::npos) << h.out;
+    EXPECT_EQ(test::slurp(path("b.png")).substr(1, 3), "PNG");
+}
+
 TEST_F(Cli, QuietSilencesStderr) {
     const test::Outcome o = run("inspect --quiet");
     ASSERT_EQ(o.exit_code, 0);
@@ -207,7 +235,9 @@ TEST_F(Cli, EvaluateReportHasARowPerMethodAndSweptValue) {
         EXPECT_EQ(m["per_clip"][0]["time_s"].is_null(), name != "single");
     }
     EXPECT_EQ(test::line_count(test::slurp(path("e.csv"))), 8u);
-    EXPECT_EQ(test::line_count(o.out), 9u);  // Markdown header, rule, 7 rows
+    // Markdown header, rule, 7 rows; then the blend table of the character's hair and cape: a blank
+    // line, header, rule, the input order, the 5 rows with buffers (not the oracle), the bound.
+    EXPECT_EQ(test::line_count(o.out), 9u + 10u);
 }
 
 TEST_F(Cli, Nehab06RunsInOptimizeAndEvaluateAndBeatsTheOriginalOrder) {
@@ -218,7 +248,7 @@ TEST_F(Cli, Nehab06RunsInOptimizeAndEvaluateAndBeatsTheOriginalOrder) {
     EXPECT_EQ(test::slurp(path("n1.animorder.bin")), test::slurp(path("n2.animorder.bin")));  // thread count changes nothing
     const nlohmann::json j = nlohmann::json::parse(test::slurp(path("r.json")));
     EXPECT_EQ(j["methods"][0]["name"], "static-nehab06");
-    EXPECT_EQ(j["methods"][0]["planar_clusters"], 16 * 2);  // 16 per primitive; the character has 2
+    EXPECT_EQ(j["methods"][0]["planar_clusters"], 16 * 4);  // 16 per primitive; the character has 4
     EXPECT_EQ(j["settings"]["nehab_views"], 42);
     const test::Outcome e = run("evaluate --methods original,static-nehab06" + fast + " --eval-views 2 --eval-resolution 96 -r " +
                           path("e.json").string());

@@ -65,6 +65,7 @@ struct HeatmapOptions {
     size_t keyframe = 0;
     unsigned resolution = EvaluationSettings{}.resolution;
     std::string output;
+    bool blend = false;  // mis-sorted blended pairs per pixel instead of overdraw (issue 18)
 };
 
 struct SubdivideOptions {

@@ -8,6 +8,7 @@
 #include "animorder/atomic_write.h"
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 #include <stdexcept>
@@ -50,6 +51,67 @@ std::vector<std::pair<Method, MethodOptions>> plan_rows(const std::vector<Method
                     plan.emplace_back(n, m);
                 }
     return plan;
+}
+
+nlohmann::ordered_json blend_json(const BlendSummary& s) {
+    return {{"missorted_pair_fraction", s.missorted_pair_fraction},
+            {"missorted_pixel_fraction", s.missorted_pixel_fraction},
+            {"pairs", s.pairs},
+            {"covered_pixels", s.covered},
+            {"nodes", s.nodes}};
+}
+
+// The blend error table (issue 18; DESIGN.md "Blend error"): every method's buffers on the blended
+// primitives, the file's own order, and the per-node back-to-front sort (the bound). "of the way"
+// is (original − method) / (original − bound) of the mis-sorted pixel fraction. Adds "blend" to
+// the report's method entries and "blend_input_order", "blend_bound" to the report. Returns seconds.
+double evaluate_blend_rows(const AnimatedMesh& mesh, const std::vector<Row>& rows, std::vector<MethodBuffers> buffers,
+                           const EvaluationSettings& eval, const EvaluateOptions& options, nlohmann::ordered_json& report) {
+    const Clock::time_point start = Clock::now();
+    MethodBuffers input;
+    input.orders.emplace_back(mesh.triangle_count());
+    for (size_t t = 0; t < mesh.triangle_count(); ++t) input.orders[0][t] = uint32_t(t);
+    buffers.push_back(input);
+    EvaluationSettings settings = eval;
+    settings.progress = progress_printer(options.common, "blend error");
+    const std::vector<BlendEvaluation> blend = evaluate_blend(mesh, buffers, settings);
+    const BlendSummary& bound = blend.back().overall;
+    double original = -1;
+    for (size_t m = 0; m < rows.size(); ++m)
+        if (rows[m].result.method == Method::Original) original = blend[m].overall.missorted_pixel_fraction;
+    std::string table = "\n| blended primitives | k | buffers | mis-sorted pairs | mis-sorted pixels | of the way to the bound |\n"
+                        "|---|---|---|---|---|---|\n";
+    auto add_row = [&](const std::string& name, const std::string& k, const std::string& count, const BlendSummary& s) {
+        char cells[256];
+        const double span = original - bound.missorted_pixel_fraction;
+        const std::string way = original >= 0 && span > 0
+                                    ? format_number(std::round(1000 * (original - s.missorted_pixel_fraction) / span) / 10) + "%"
+                                    : "";
+        std::snprintf(cells, sizeof cells, "| %s | %s | %s | %.4f | %.4f | %s |\n", name.c_str(), k.c_str(), count.c_str(),
+                      s.missorted_pair_fraction, s.missorted_pixel_fraction, way.c_str());
+        table += cells;
+    };
+    add_row("input order", "", "1", blend[rows.size()].overall);
+    for (size_t m = 0; m < rows.size(); ++m) {
+        const MethodResult& run = rows[m].result;
+        if (!method_has_buffers(run.method)) continue;
+        add_row(method_name(run.method),
+                method_uses_clusters(run.method) ? std::to_string(rows[m].settings.clustering.clusters) : "",
+                std::to_string(run.buffers.orders.size()), blend[m].overall);
+        nlohmann::ordered_json entry = blend_json(blend[m].overall);
+        entry["per_clip"] = nlohmann::ordered_json::array();
+        for (size_t c = 0; c < mesh.clips.size(); ++c) {
+            nlohmann::ordered_json clip = blend_json(blend[m].per_clip[c]);
+            clip["clip"] = mesh.clips[c].name;
+            entry["per_clip"].push_back(clip);
+        }
+        report["methods"][m]["blend"] = entry;
+    }
+    add_row("back-to-front per node (bound)", "", "per node", bound);
+    std::fputs(table.c_str(), stdout);
+    report["blend_input_order"] = blend_json(blend[rows.size()].overall);
+    report["blend_bound"] = blend_json(bound);
+    return seconds_since(start);
 }
 
 }  // namespace
@@ -113,6 +175,7 @@ int run_evaluate(const EvaluateOptions& options) {
                           {"nehab_clusters", b.nehab_clusters},
                           {"nehab_views", b.nehab_views},
                           {"nehab_all_keyframes", b.nehab_all_keyframes},
+                          {"blend_clusters", b.blend_clusters},
                           {"cache_size", options.common.cache_size},
                           {"eval_views", eval.views},
                           {"eval_resolution", eval.resolution},
@@ -169,8 +232,14 @@ int run_evaluate(const EvaluateOptions& options) {
         report["methods"].push_back(entry);
     }
     std::fputs(table.c_str(), stdout);
+    double blend_s = 0;
+    if (has_blended_primitives(mesh)) {
+        blend_s = evaluate_blend_rows(mesh, rows, buffers, eval, options, report);
+        note(options.common, "blend evaluation took " + format_number(blend_s) + " s");
+    }
     report["nodes"] = nodes;
     report["timings_s"] = {{"methods", methods_s}, {"evaluation", eval_s}, {"total", seconds_since(start)}};
+    if (blend_s > 0) report["timings_s"]["blend_evaluation"] = blend_s;
     report["machine"] = {{"threads", b.clustering.threads ? b.clustering.threads : std::thread::hardware_concurrency()}};
     OutputSet files;
     if (!options.report_path.empty()) files.add(options.report_path, report_text(report));

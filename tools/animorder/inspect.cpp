@@ -32,7 +32,8 @@ void print_inspect_text(const AnimatedMesh& mesh, const std::string& input_name,
                 mesh.keyframe_count());
     std::printf("  ACMR %.4f  ATVR %.4f  (FIFO cache of %u, current order)\n", cache.acmr, cache.atvr, cache_size);
     for (const Primitive& p : mesh.primitives)
-        std::printf("  primitive %-12s triangles %zu\n", p.name.c_str(), p.index_count / 3);
+        std::printf("  primitive %-12s triangles %zu  %s  %s\n", p.name.c_str(), p.index_count / 3,
+                    p.double_sided ? "double-sided" : "single-sided", alpha_mode_name(p.alpha_mode));
     const std::vector<float> radii = clip_radii(mesh);
     for (size_t i = 0; i < mesh.clips.size(); ++i) {
         const Clip& c = mesh.clips[i];
@@ -62,7 +63,9 @@ int run_inspect(const InspectOptions& options) {
         size_t vertices = 0;
         for (size_t i = p.first_index; i < p.first_index + p.index_count; ++i)
             vertices += used[mesh.indices[i]] ? 0 : (used[mesh.indices[i]] = 1);
-        report["primitives"].push_back({{"name", p.name}, {"triangles", p.index_count / 3}, {"vertices", vertices}});
+        report["primitives"].push_back({{"name", p.name}, {"triangles", p.index_count / 3}, {"vertices", vertices},
+                                        {"double_sided", p.double_sided},
+                                        {"alpha_mode", alpha_mode_name(p.alpha_mode)}});
     }
     const std::vector<float> radii = clip_radii(mesh);
     for (size_t i = 0; i < mesh.clips.size(); ++i)

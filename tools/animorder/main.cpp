@@ -72,6 +72,8 @@ void add_method_options(CLI::App& command, animorder::tool::MethodOptions& optio
     command.add_option("--update", options.update,
                        "single/joint: monotone (keep a cluster's new order only if its nodes' OVR falls) or paper")
         ->capture_default_str();
+    command.add_flag("--blend-clusters", m.blend_clusters,
+                     "single/joint: blended primitives get their own k clusters (buffers: the cluster pairs, up to k^2 per clip)");
     command.add_option("--nehab-clusters", m.nehab_clusters, "static-nehab06: planar clusters (0: automatic)")
         ->capture_default_str()
         ->check(CLI::Range(size_t(0), size_t(1) << 20));
@@ -171,6 +173,8 @@ int main(int argc, char** argv) {
         ->capture_default_str()
         ->check(CLI::Range(16u, 8192u));
     heatmap_cmd->add_option("-o,--output", heatmap.output, "PNG file to write")->required();
+    heatmap_cmd->add_flag("--blend", heatmap.blend,
+                          "Show the blended primitives' mis-sorted fragment pairs per pixel (drawn back to front: 0)");
 
     SubdivideOptions subdivide;
     CLI::App* subdivide_cmd = app.add_subcommand(

@@ -66,7 +66,8 @@ nlohmann::ordered_json optimize_settings_json(const OptimizeOptions& options, co
             {"update", options.methods.update},
             {"nehab_clusters", m.nehab_clusters},
             {"nehab_views", m.nehab_views},
-            {"nehab_all_keyframes", m.nehab_all_keyframes}};
+            {"nehab_all_keyframes", m.nehab_all_keyframes},
+            {"blend_clusters", m.blend_clusters}};
     if (with_threads) settings["threads"] = m.clustering.threads;
     return settings;
 }

@@ -164,6 +164,24 @@ int main(int argc, char** argv) {
                      "(vertices x keyframes x 12 bytes): keep fewer clips with --clip NAME")
         ->required();
 
+    CheckOptions check;
+    CLI::App* check_cmd = app.add_subcommand(
+        "check", "Check the ANIMORDER_animated_triangle_orders orders of a glTF file (JSON report; exit 1 when unusable)");
+    check_cmd->add_option("file", check.file, "glTF/GLB file")->required();
+
+    ReapplyOptions reapply;
+    CLI::App* reapply_cmd = app.add_subcommand(
+        "reapply", "Map an optimised file's orders onto a processed copy of it (gltfpack, gltf-pipeline...) by matching triangles");
+    reapply_cmd->add_option("optimized", reapply.optimized, "The file animorder optimize wrote")->required();
+    reapply_cmd->add_option("processed", reapply.processed, "The same file after another tool")->required();
+    reapply_cmd->add_option("-o,--output", reapply.output, "OUT.glb or OUT.gltf: PROCESSED with the orders")->required();
+    reapply_cmd->add_option("--tolerance", reapply.tolerance,
+                            "Corner distance allowed, as a fraction of the bounding-box diagonal")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 0.1));
+    reapply_cmd->add_option("--max-memory", reapply.max_memory, "Loading budget in bytes for the sampled animation")
+        ->capture_default_str();
+
     if (argc == 1) {  // no arguments: the basics, and where to look next (gltfpack style)
         std::fputs(app.help().c_str(), stderr);
         return 2;
@@ -184,6 +202,8 @@ int main(int argc, char** argv) {
         if (*evaluate_cmd) return run_evaluate(evaluate);
         if (*heatmap_cmd) return run_heatmap(heatmap);
         if (*subdivide_cmd) return run_subdivide(subdivide);
+        if (*check_cmd) return run_check(check);
+        if (*reapply_cmd) return run_reapply(reapply);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "animorder: error: %s\n", e.what());
         return 1;

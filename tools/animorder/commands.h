@@ -54,6 +54,7 @@ struct EvaluateOptions {
     EvaluationSettings evaluation;  // views, seed, resolution (threads from --threads)
     std::string report_path;
     std::string csv_path;
+    bool stored = false;  // --stored: also the orders stored in INPUT (ANIMORDER_animated_triangle_orders)
 };
 
 struct HeatmapOptions {

@@ -135,6 +135,8 @@ int main(int argc, char** argv) {
     evaluate_cmd->add_option("--eval-seed", evaluate.evaluation.seed, "Seed of the evaluation viewpoints")->capture_default_str();
     evaluate_cmd->add_option("-r,--report", evaluate.report_path, "Write the JSON report to this file");
     evaluate_cmd->add_option("--csv", evaluate.csv_path, "Write the table as CSV to this file");
+    evaluate_cmd->add_flag("--stored", evaluate.stored,
+                           "Also evaluate the orders stored in INPUT (ANIMORDER_animated_triangle_orders): row 'stored'");
 
     HeatmapOptions heatmap;
     CLI::App* heatmap_cmd = app.add_subcommand("heatmap", "Draw a per-pixel overdraw image of one node as PNG");

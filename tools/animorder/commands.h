@@ -75,12 +75,14 @@ struct SubdivideOptions {
 
 struct CheckOptions {
     std::string file;  // a glTF/GLB file with (or without) ANIMORDER_animated_triangle_orders
+    bool quiet = false;  // no error line on stderr (the JSON report still says it)
 };
 
 struct ReapplyOptions {
     std::string optimized, processed, output;
     double tolerance = 1e-3;  // corner distance allowed, as a fraction of OPTIMIZED's bounding-box diagonal
     size_t max_memory = LoadOptions{}.max_keyframe_bytes;
+    bool quiet = false;
 };
 
 int run_inspect(const InspectOptions& options);

@@ -170,6 +170,7 @@ int main(int argc, char** argv) {
     CLI::App* check_cmd = app.add_subcommand(
         "check", "Check the ANIMORDER_animated_triangle_orders orders of a glTF file (JSON report; exit 1 when unusable)");
     check_cmd->add_option("file", check.file, "glTF/GLB file")->required();
+    check_cmd->add_flag("-q,--quiet", check.quiet, "No error line on stderr (the JSON report still has it)");
 
     ReapplyOptions reapply;
     CLI::App* reapply_cmd = app.add_subcommand(
@@ -183,6 +184,7 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(0.0, 0.1));
     reapply_cmd->add_option("--max-memory", reapply.max_memory, "Loading budget in bytes for the sampled animation")
         ->capture_default_str();
+    reapply_cmd->add_flag("-q,--quiet", reapply.quiet, "No progress or notes on stderr");
 
     if (argc == 1) {  // no arguments: the basics, and where to look next (gltfpack style)
         std::fputs(app.help().c_str(), stderr);

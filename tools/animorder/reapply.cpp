@@ -99,7 +99,8 @@ int run_reapply(const ReapplyOptions& options) {
     std::vector<int64_t> b_of_a(a.triangle_count(), -1);
     for (size_t t = 0; t < m.from_of_to.size(); ++t)
         if (m.from_of_to[t] >= 0) b_of_a[a_triangles[size_t(m.from_of_to[t])]] = int64_t(t);
-    std::fprintf(stderr, "animorder: matched %zu of %zu optimised triangles to %zu processed triangles\n", m.matched,
+    if (!options.quiet)
+        std::fprintf(stderr, "animorder: matched %zu of %zu optimised triangles to %zu processed triangles\n", m.matched,
                  a_triangles.size(), b.triangle_count());
     if (m.matched != a_triangles.size())
         throw std::runtime_error(options.processed + ": only " + std::to_string(m.matched) + " of " +

@@ -4,6 +4,7 @@
 // byte-identical for the same input.
 #include "animorder/animated_mesh.h"
 #include "animorder/clustering.h"
+#include "animorder/gltf_extension.h"
 #include "animorder/gltf_loader.h"
 #include "animorder/gltf_writer.h"
 #include "animorder/load.h"
@@ -121,4 +122,39 @@ TEST_F(GltfWriter, RefusesAMeshItWasNotReadFrom) {
     const Framing framing = frame_animated_mesh(character);
     EXPECT_THROW(gltf_with_orders(input, (dir_ / "x.glb").string(), character, buffers, 0, framing, "original", true),
                  LoadError);
+}
+
+TEST_F(GltfWriter, TheExtensionHoldsEveryOrderAsOneIndexRangeAndTheTables) {
+    const std::string input = kData + "gltf-cesiumman/CesiumMan.glb";
+    ANIMORDER_REQUIRE_DATA(input);
+    const Written w = optimise_and_write(input, dir_ / "ranges.glb");
+    const OrdersExtensionCheck r = check_orders_extension(w.path.string());
+    ASSERT_TRUE(r.errors.empty()) << r.errors.front();
+    const MethodBuffers& buffers = w.method.buffers;
+    EXPECT_EQ(r.buffer_count, buffers.orders.size());
+    EXPECT_EQ(r.fallback, 1u);
+    ASSERT_EQ(r.primitives.size(), w.mesh.primitives.size());
+    for (size_t i = 0; i < w.mesh.primitives.size(); ++i) {
+        const Primitive& p = w.mesh.primitives[i];
+        const ExtensionPrimitive& e = r.primitives[i];
+        EXPECT_EQ(e.component_type, 5123);  // CesiumMan's 3273 vertices fit in 16 bits
+        // Order b is indices [b·n, (b+1)·n): the method's order b of this primitive, local.
+        for (size_t b = 0; b < buffers.orders.size(); ++b) {
+            std::vector<uint32_t> global(w.mesh.indices.size());
+            apply_triangle_order(global.data(), w.mesh.indices.data(), buffers.orders[b].data(), w.mesh.triangle_count());
+            for (size_t k = 0; k < p.index_count; ++k)
+                ASSERT_EQ(e.orders[b * p.index_count + k], global[p.first_index + k] - p.vertex_base) << b << " " << k;
+        }
+    }
+    ASSERT_EQ(r.clips.size(), w.mesh.clips.size());
+    for (size_t c = 0; c < r.clips.size(); ++c) {
+        EXPECT_EQ(r.clips[c].cells, buffers.tables[c].cells);
+        EXPECT_EQ(r.clips[c].buffer_base, buffers.table_base[c]);
+        EXPECT_EQ(r.clips[c].keyframes, w.mesh.clips[c].keyframe_count);
+        EXPECT_EQ(r.clips[c].animation, int(c));
+        const std::vector<float> centres(w.method.framing.centres.begin() + ptrdiff_t(3 * w.mesh.clips[c].first_keyframe),
+                                         w.method.framing.centres.begin() +
+                                             ptrdiff_t(3 * (w.mesh.clips[c].first_keyframe + w.mesh.clips[c].keyframe_count)));
+        EXPECT_EQ(r.clips[c].centers, centres);
+    }
 }

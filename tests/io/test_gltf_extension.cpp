@@ -7,6 +7,7 @@
 #include "animorder/load.h"
 
 #include "support/files.h"
+#include "support/require.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -180,4 +181,12 @@ TEST_F(GltfExtension, WritingIntoAnotherFileReadsBackTheSame) {
         EXPECT_EQ(r.clips[0].cells, (std::vector<uint8_t>{0, 1, 1, 0}));
         EXPECT_EQ(r.clips[0].animation, 0);
     }
+}
+
+TEST_F(GltfExtension, TheExamplePassesTheKhronosValidator) {
+    std::string why, report;
+    ANIMORDER_REQUIRE_OR_SKIP("validator", test::validator_available(why), why);
+    const fs::path example = fs::path(ANIMORDER_SOURCE_DIR) / "docs" / "extension" / "example.gltf";
+    ASSERT_TRUE(test::validate_gltf(example, report, dir_)) << report;
+    EXPECT_EQ(nlohmann::json::parse(report)["errors"], 0) << report;
 }

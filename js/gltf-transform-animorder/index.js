@@ -3,11 +3,12 @@
 // Registering AnimorderTriangleOrders makes @gltf-transform/core read, keep and write the
 // extension: the orders, table and centre accessors are graph references of extension
 // properties, so prune, dedup, resample and friends track them like any other accessor. Before
-// writing, every primitive's orders are checked against its current triangles: a transform that
-// rewrote them (reorder, simplify, a merging weld, join…) leaves orders that are no permutation
-// of the triangles, or `indices` that are no longer the fallback order; such orders are dropped
-// with a warning (and the whole extension when no primitive keeps valid orders), never written
-// stale.
+// writing, every primitive's orders are checked against its current triangles. Where a transform
+// renumbered vertices or re-sequenced triangles (weld, reorder) the orders are re-derived: each
+// triangle is found again by its corner positions as they were when the file was read, and
+// `indices` becomes the fallback order again. Where the triangles themselves changed (simplify, a
+// moved vertex, quantised positions) the orders are dropped with a warning (and the whole
+// extension when no primitive keeps valid orders): never written stale.
 import { Extension, ExtensionProperty, PropertyType, RefList } from '@gltf-transform/core';
 
 export const NAME = 'ANIMORDER_animated_triangle_orders';
@@ -86,6 +87,52 @@ function key(a, b, c) {
   return c + ',' + a + ',' + b;
 }
 
+// The triangles of `indices` (a flat array of vertex ids) as position keys: per triangle the
+// three corner positions, rotated so that the smallest comes first (windings stay apart).
+function positionKeys(primitive, indices, begin, end) {
+  const position = primitive.getAttribute('POSITION');
+  if (!position) return null;
+  const corner = (v) => { const e = position.getElement(v, []); return e.join(','); };
+  const keys = [];
+  for (let i = begin; i < end; i += 3) {
+    const c = [corner(indices[i]), corner(indices[i + 1]), corner(indices[i + 2])];
+    const r = c[0] <= c[1] && c[0] <= c[2] ? 0 : (c[1] <= c[2] ? 1 : 2);
+    keys.push({ key: c[r] + '|' + c[(r + 1) % 3] + '|' + c[(r + 2) % 3], rotation: r });
+  }
+  return keys;
+}
+
+/**
+ * The orders re-derived for a primitive whose vertex ids or triangle sequence a transform
+ * changed (weld that merged identical vertices, reorder): each stored triangle, known by its
+ * corner positions when the file was read, found among the current triangles. Returns the new
+ * K × n index array, or null when the triangles themselves changed (simplify, a moved vertex).
+ */
+export function rederive(primitive, orders, bufferCount) {
+  const stored = orders.positionKeys;
+  const indices = primitive.getIndices();
+  if (!stored || !indices || stored.length !== bufferCount) return null;
+  const current = indices.getArray(), n = indices.getCount();
+  if (stored[0].length * 3 !== n) return null;
+  const keys = positionKeys(primitive, current, 0, n);
+  if (!keys) return null;
+  const out = new Uint32Array(bufferCount * n);
+  for (let b = 0; b < bufferCount; ++b) {
+    const pool = new Map();
+    keys.forEach((k, t) => { if (!pool.has(k.key)) pool.set(k.key, []); pool.get(k.key).push(t); });
+    for (const list of pool.values()) list.reverse();
+    for (let q = 0; q < stored[b].length; ++q) {
+      const list = pool.get(stored[b][q].key);
+      if (!list || list.length === 0) return null;
+      const t = list.pop(), r = keys[t].rotation;
+      // The current triangle, rotated as the stored one was (same corner first, same winding).
+      const shift = (r - stored[b][q].rotation + 3) % 3;
+      for (let c = 0; c < 3; ++c) out[b * n + 3 * q + c] = current[3 * t + (c + shift) % 3];
+    }
+  }
+  return out;
+}
+
 /**
  * Why a primitive's orders are not usable with its current triangles (a string), or null when
  * they are: every order a permutation of the triangles of `indices` with their winding, and
@@ -148,7 +195,16 @@ export class AnimorderTriangleOrders extends Extension {
         const def = primDef.extensions && primDef.extensions[NAME];
         if (!def) return;
         const orders = this.createPrimitiveOrders().setOrders(context.accessors[def.orders]).setOrderCount(def.orderCount);
-        context.meshes[m].listPrimitives()[p].setExtension(NAME, orders);
+        const primitive = context.meshes[m].listPrimitives()[p];
+        primitive.setExtension(NAME, orders);
+        // Each order's triangles by corner positions, to re-derive the orders after a transform
+        // that renumbers vertices or re-sequences triangles (not written to the file).
+        const all = orders.getOrders() && orders.getOrders().getArray();
+        const n = primitive.getIndices() ? primitive.getIndices().getCount() : 0;
+        if (all && n > 0 && all.length === n * def.orderCount) {
+          orders.positionKeys = [];
+          for (let b = 0; b < def.orderCount; ++b) orders.positionKeys.push(positionKeys(primitive, all, b * n, (b + 1) * n));
+        }
       });
     });
     return this;
@@ -165,6 +221,23 @@ export class AnimorderTriangleOrders extends Extension {
         if (!orders) continue;
         const why = root ? staleReason(primitive, orders, root.getBufferCount(), root.getFallback()) : 'no root object';
         if (why === null) { ++kept; continue; }
+        const derived = root ? rederive(primitive, orders, root.getBufferCount()) : null;
+        if (derived) {
+          // New accessors (the old ones may be shared): the orders, and `indices` = the fallback.
+          const n = primitive.getIndices().getCount(), f = root.getFallback();
+          const small = derived.every((v) => v < 65535);
+          const make = (array) => this.document.createAccessor().setType('SCALAR').setBuffer(primitive.getIndices().getBuffer())
+            .setArray(small ? Uint16Array.from(array) : array);
+          const old = orders.getOrders();
+          orders.setOrders(make(derived));
+          if (old && old.listParents().every((p) => p.propertyType === PropertyType.ROOT)) old.dispose();
+          const oldIndices = primitive.getIndices();
+          primitive.setIndices(make(derived.slice(f * n, (f + 1) * n)));
+          if (oldIndices.listParents().every((p) => p.propertyType === PropertyType.ROOT)) oldIndices.dispose();
+          logger.warn(`${NAME}: re-derived the orders of mesh "${mesh.getName()}" (${why}).`);
+          ++kept;
+          continue;
+        }
         logger.warn(`${NAME}: dropping the orders of mesh "${mesh.getName()}": ${why}.`);
         const accessor = orders.getOrders();
         primitive.setExtension(NAME, null);

@@ -44,3 +44,38 @@ if [ ! -f "$here/.tools/node_modules/gltf-validator/package.json" ] ||
   mkdir -p "$here/.tools"
   npm install --silent --no-audit --no-fund --prefix "$here/.tools" "gltf-validator@$validator_version" >/dev/null
 fi
+
+# glTF round trips of the ANIMORDER_animated_triangle_orders extension (tests/tool/test_gltf_pipelines.cpp,
+# js/gltf-transform-animorder): gltfpack and a JSON-schema checker from Debian; glTF-Transform and
+# gltf-pipeline from npm, pinned, into .tools/ (the JS package's own node_modules gets the same).
+gltf_tool_packages=(gltfpack python3-jsonschema)
+gltf_missing=()
+for p in "${gltf_tool_packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || gltf_missing+=("$p")
+done
+if [ ${#gltf_missing[@]} -gt 0 ]; then
+  echo "install-deps: installing ${gltf_missing[*]}" >&2
+  SUDO=""
+  [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${gltf_missing[@]}" >/dev/null
+fi
+gltf_transform_version=4.5.1
+gltf_pipeline_version=4.3.1
+if [ ! -f "$here/.tools/node_modules/@gltf-transform/cli/package.json" ] ||
+   ! grep -q "\"version\": \"$gltf_transform_version\"" "$here/.tools/node_modules/@gltf-transform/cli/package.json" ||
+   [ ! -f "$here/.tools/node_modules/gltf-pipeline/package.json" ] ||
+   ! grep -q "\"version\": \"$gltf_pipeline_version\"" "$here/.tools/node_modules/gltf-pipeline/package.json"; then
+  echo "install-deps: installing @gltf-transform/* $gltf_transform_version, gltf-pipeline $gltf_pipeline_version (npm)" >&2
+  mkdir -p "$here/.tools"
+  npm install --silent --no-audit --no-fund --prefix "$here/.tools" "gltf-validator@$validator_version" \
+    "@gltf-transform/core@$gltf_transform_version" "@gltf-transform/extensions@$gltf_transform_version" \
+    "@gltf-transform/functions@$gltf_transform_version" "@gltf-transform/cli@$gltf_transform_version" \
+    "gltf-pipeline@$gltf_pipeline_version" >/dev/null
+fi
+if [ -f "$here/js/gltf-transform-animorder/package-lock.json" ] &&
+   [ ! -d "$here/js/gltf-transform-animorder/node_modules/@gltf-transform/core" ]; then
+  echo "install-deps: installing js/gltf-transform-animorder's dependencies (npm ci)" >&2
+  (cd "$here/js/gltf-transform-animorder" && npm ci --silent --no-audit --no-fund >/dev/null)
+fi

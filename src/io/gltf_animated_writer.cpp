@@ -118,6 +118,9 @@ std::string gltf_animated_mesh(const AnimatedMesh& mesh, bool binary) {
             material.name = p.name;
             material.doubleSided = p.double_sided;
             material.alphaMode = alpha_mode_name(p.alpha_mode);
+            // Blended surfaces are translucent: an alpha below 1, so that optimisers which turn a
+            // BLEND material without any transparency into OPAQUE (gltfpack does) keep it blended.
+            if (p.alpha_mode == AlphaMode::Blend) material.pbrMetallicRoughness.baseColorFactor = {1.0, 1.0, 1.0, 0.5};
             model.materials.push_back(material);
             prim.material = int(model.materials.size() - 1);
         }

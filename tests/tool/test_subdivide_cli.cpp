@@ -32,11 +32,11 @@ TEST_F(SubdivideCli, BundledCharacterOneLevelWritesTheCounts) {
     const test::Outcome o = run("subdivide --levels 1 --clip wave -o " + path("c1.glb").string());
     ASSERT_EQ(o.exit_code, 0) << o.err;
     EXPECT_NE(o.err.find("bundled procedural character"), std::string::npos) << o.err;
-    EXPECT_NE(o.out.find("triangles 10776 -> 43104"), std::string::npos) << o.out;
+    EXPECT_NE(o.out.find("triangles 11760 -> 47040"), std::string::npos) << o.out;
     EXPECT_NE(o.out.find("MB"), std::string::npos) << o.out;
     // The file holds what was printed: 4x the triangles, only the kept clip.
     const animorder::AnimatedMesh back = animorder::load_gltf(path("c1.glb").string());
-    EXPECT_EQ(back.triangle_count(), 43104u);
+    EXPECT_EQ(back.triangle_count(), 47040u);
     ASSERT_EQ(back.clips.size(), 1u);
     EXPECT_EQ(back.clips[0].name, "wave");
     const animorder::AnimatedMesh original = animorder::make_procedural_character();
@@ -53,7 +53,7 @@ TEST_F(SubdivideCli, TwoLevelsOfAGltfInputAndQuiet) {
     const test::Outcome o = run("subdivide --quiet " + path("c1.gltf").string() + " --levels 1 -o " + path("c2.glb").string());
     ASSERT_EQ(o.exit_code, 0) << o.err;
     EXPECT_EQ(o.err, "");
-    EXPECT_NE(o.out.find("triangles 43104 -> 172416"), std::string::npos) << o.out;
+    EXPECT_NE(o.out.find("triangles 47040 -> 188160"), std::string::npos) << o.out;
 }
 
 TEST_F(SubdivideCli, TooManyLevelsIsAClearError) {

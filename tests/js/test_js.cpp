@@ -1,0 +1,65 @@
+// The JavaScript side, run from CTest: the JS runtime against the C runtime on one optimised file
+// (js/test/equivalence.mjs), and the viewer in headless Chromium (viewer/test/browser.mjs).
+// Prerequisites through the requirement switch: "node" (node on the PATH) and "browser" (Debian's
+// chromium and viewer/node_modules from scripts/install-deps.sh).
+#include "support/files.h"
+#include "support/require.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <string>
+
+namespace fs = std::filesystem;
+using namespace animorder;
+
+namespace {
+
+const std::string source_dir = ANIMORDER_SOURCE_DIR;
+
+std::string sh(const fs::path& p) { return "'" + p.string() + "'"; }
+
+bool have_node(std::string& why) {
+    if (std::system("node --version >/dev/null 2>&1") == 0) return true;
+    why = "node is not on the PATH (scripts/install-deps.sh installs it)";
+    return false;
+}
+
+class JsTest : public test::ScratchFolderTest {
+protected:
+    JsTest() : ScratchFolderTest("animorder-js") {}
+    test::Outcome run(const std::string& command) { return test::run_captured(command, dir_); }
+
+    // The bundled character as a glTF (its clips as morph-weight animations), optimised with small
+    // clustering settings (k = 3, 42 views at 64²: seconds, not the 25 s of the defaults).
+    void optimise_character() {
+        const test::Outcome a = run(std::string(ANIMORDER_EXE) + " subdivide -q --levels 0 -o " + sh(path("char.glb")));
+        ASSERT_EQ(a.exit_code, 0) << a.err;
+        const test::Outcome b = run(std::string(ANIMORDER_EXE) + " optimize -q " + sh(path("char.glb")) +
+                                    " --method single -k 3 --views 42 --resolution 64 -o " + sh(path("out.glb")));
+        ASSERT_EQ(b.exit_code, 0) << b.err;
+    }
+};
+
+TEST_F(JsTest, RuntimeAnswersExactlyAsTheCRuntime) {
+    std::string why;
+    ANIMORDER_REQUIRE_OR_SKIP("node", have_node(why), why);
+    optimise_character();
+    if (HasFatalFailure()) return;
+    // The glTF extension is compared where the writer puts it in the glb (branch gltf-ext).
+    const bool extension = test::slurp(path("out.glb")).find("ANIMORDER_animated_triangle_orders") != std::string::npos;
+    if (!extension) std::cout << "note: out.glb carries no ANIMORDER_animated_triangle_orders; the sidecar alone is compared\n";
+    const test::Outcome o = run("node " + sh(source_dir + "/js/test/equivalence.mjs") + " " +
+                                sh(RUNTIME_ANSWERS_EXE) + " " + sh(path("out.animorder.bin")) + " " +
+                                sh(dir_) + " " + (extension ? sh(path("out.glb")) : std::string("-")));
+    EXPECT_EQ(o.exit_code, 0) << o.out << o.err;
+    // Every answer identical (the script prints one line per source).
+    EXPECT_NE(o.out.find("sidecar: 120000 of 120000 answers identical"), std::string::npos) << o.out << o.err;
+    if (extension) {
+        EXPECT_NE(o.out.find("glb extension: 120000 of 120000 answers identical"), std::string::npos) << o.out << o.err;
+    }
+}
+
+}  // namespace

@@ -33,6 +33,8 @@ struct Clip {
     double sample_rate = 30;     // keyframes per second (DESIGN.md default 30)
     size_t first_keyframe = 0;   // into AnimatedMesh keyframes
     size_t keyframe_count = 0;
+    int source_animation = -1;   // glTF input: the animation it was sampled from; −1 otherwise
+    double start_time_s = 0;     // glTF input: the animation time of keyframe 0 (first key time)
 };
 
 struct AnimatedMesh {

@@ -10,10 +10,11 @@
 
 namespace animorder {
 
-// The glTF file `input_path` (which `mesh` was loaded from) with the method's orders: each
-// primitive's `indices` holds buffer `fallback`, `extras.animorder.orders` lists an accessor per
-// buffer, and the root `extras.animorder` holds the clips' lookup tables and frame centres as
-// accessors. All other content is written back unchanged; buffers are embedded; relative image
+// The glTF file `input_path` (which `mesh` was loaded from) with the method's orders in the
+// ANIMORDER_animated_triangle_orders extension (docs/extension/README.md): each primitive's
+// `indices` holds buffer `fallback`, its extension object names one accessor with the k orders one
+// after the other, and the root extension object holds the clips' lookup tables and frame centres
+// as accessors. All other content is written back unchanged; buffers are embedded; relative image
 // URIs are rewritten to point, from output_path's folder, at the same files. Returns GLB bytes
 // when `binary`, else glTF JSON text.
 std::string gltf_with_orders(const std::string& input_path, const std::string& output_path, const AnimatedMesh& mesh,

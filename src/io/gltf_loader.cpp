@@ -520,6 +520,8 @@ std::vector<ClipChannels> parse_animations(const Scene& s, const std::string& pa
         c.t0 = INFINITY, c.t1 = -INFINITY;
         for (const Channel& ch : c.channels) c.t0 = std::min(c.t0, ch.times.front()), c.t1 = std::max(c.t1, ch.times.back());
         c.clip.duration_s = c.t1 - c.t0;
+        c.clip.source_animation = int(a);
+        c.clip.start_time_s = c.t0;
         c.clip.sample_rate = options.sample_rate;
         c.clip.keyframe_count = io::clip_keyframes(path, c.clip.name, c.clip.duration_s, options.sample_rate);
         clips.push_back(std::move(c));

@@ -1,11 +1,11 @@
 // glTF output: the input file with its primitives drawn in the new orders.
 //
 // Every viewer draws a primitive's `indices`: that accessor now holds the fallback order (the
-// buffer most nodes chose). All k orders of the primitive are further accessors listed in the
-// primitive's `extras.animorder.orders`; the runtime lookup tables and frame centres are
-// accessors named in the root `extras.animorder.clips`. `extras` rather than a vendor extension:
-// nothing has to be declared, no viewer warns, and a loader that knows nothing of animorder
-// still gets a valid, better-ordered file. Everything else — materials, textures, skins,
+// buffer most nodes chose). The k orders of the primitive are one accessor, order after order,
+// named by the primitive's ANIMORDER_animated_triangle_orders extension; the runtime lookup
+// tables and frame centres are accessors named by the root extension object (docs/extension).
+// The extension is used, never required: a loader that knows nothing of animorder still gets a
+// valid, better-ordered file. Everything else — materials, textures, skins,
 // animations, other extras and extensions, vertex arrays — is written back as read: the new
 // indices refer to the file's own vertices. New bytes are appended to buffer 0.
 #include "animorder/gltf_writer.h"
@@ -29,6 +29,8 @@
 
 namespace animorder {
 namespace {
+
+const char* const kOrdersExtension = "ANIMORDER_animated_triangle_orders";
 
 tinygltf::Model read_model(const std::string& path) {
     tinygltf::Model model;
@@ -60,15 +62,11 @@ int append_accessor(tinygltf::Model& model, int view, int component, int type, s
     return int(model.accessors.size() - 1);
 }
 
-// The indices of one primitive in one order, local to the primitive's vertices, as the smallest
-// component type that holds them.
-int append_indices(tinygltf::Model& model, const std::vector<uint32_t>& global, const Primitive& p, const std::string& name) {
-    std::vector<uint32_t> local(p.index_count);
-    uint32_t largest = 0;
-    for (size_t i = 0; i < p.index_count; ++i) {
-        local[i] = uint32_t(global[p.first_index + i] - p.vertex_base);
-        largest = std::max(largest, local[i]);
-    }
+// The primitive's vertex indices (local to its vertices) of `count` orders stored one after the
+// other, as one SCALAR accessor of the smallest index type that holds them, over its own buffer
+// view (ELEMENT_ARRAY_BUFFER).
+int append_indices(tinygltf::Model& model, const std::vector<uint32_t>& local, const std::string& name) {
+    const uint32_t largest = local.empty() ? 0 : *std::max_element(local.begin(), local.end());
     int view;
     int component;
     if (largest < 65535) {  // 65535 is the primitive-restart value: never used as an index
@@ -80,16 +78,18 @@ int append_indices(tinygltf::Model& model, const std::vector<uint32_t>& global, 
         component = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
     }
     const int accessor = append_accessor(model, view, component, TINYGLTF_TYPE_SCALAR, local.size(), name);
-    model.accessors[size_t(accessor)].minValues = {double(*std::min_element(local.begin(), local.end()))};
-    model.accessors[size_t(accessor)].maxValues = {double(largest)};
+    if (!local.empty()) {
+        model.accessors[size_t(accessor)].minValues = {double(*std::min_element(local.begin(), local.end()))};
+        model.accessors[size_t(accessor)].maxValues = {double(largest)};
+    }
     return accessor;
 }
 
-tinygltf::Value with_key(const tinygltf::Value& extras, const std::string& key, tinygltf::Value value) {
-    tinygltf::Value::Object object;
-    if (extras.IsObject()) object = extras.Get<tinygltf::Value::Object>();
-    object[key] = std::move(value);
-    return tinygltf::Value(object);
+void add_extension_used(tinygltf::Model& model, const std::string& name) {
+    if (std::find(model.extensionsUsed.begin(), model.extensionsUsed.end(), name) == model.extensionsUsed.end())
+        model.extensionsUsed.push_back(name);
+    model.extensionsRequired.erase(std::remove(model.extensionsRequired.begin(), model.extensionsRequired.end(), name),
+                                   model.extensionsRequired.end());
 }
 
 }  // namespace
@@ -111,21 +111,23 @@ std::string gltf_with_orders(const std::string& input_path, const std::string& o
     for (size_t b = 0; b < buffers.orders.size(); ++b)
         apply_triangle_order(index_buffers[b].data(), mesh.indices.data(), buffers.orders[b].data(), mesh.triangle_count());
 
+    const size_t k = buffers.orders.size();
     for (const Primitive& p : mesh.primitives) {
         tinygltf::Primitive& prim = model.meshes[size_t(p.source_mesh)].primitives[size_t(p.source_primitive)];
-        tinygltf::Value::Array orders;
-        int fallback_accessor = -1;
-        for (size_t b = 0; b < buffers.orders.size(); ++b) {
-            const int a = append_indices(model, index_buffers[b], p, "animorder order " + std::to_string(b));
-            orders.push_back(tinygltf::Value(a));
-            if (b == fallback) fallback_accessor = a;
-        }
-        prim.indices = fallback_accessor;
+        // Order b of the primitive is elements [b·n, (b+1)·n) of one accessor (docs/extension).
+        std::vector<uint32_t> all(k * p.index_count);
+        for (size_t b = 0; b < k; ++b)
+            for (size_t i = 0; i < p.index_count; ++i)
+                all[b * p.index_count + i] = uint32_t(index_buffers[b][p.first_index + i] - p.vertex_base);
+        const int orders = append_indices(model, all, "animorder orders");
+        const std::vector<uint32_t> shown(all.begin() + ptrdiff_t(fallback * p.index_count),
+                                          all.begin() + ptrdiff_t((fallback + 1) * p.index_count));
+        prim.indices = append_indices(model, shown, "animorder fallback order");
         prim.mode = TINYGLTF_MODE_TRIANGLES;  // strips and fans were converted to lists
         tinygltf::Value::Object ours;
         ours["orders"] = tinygltf::Value(orders);
-        ours["fallback"] = tinygltf::Value(int(fallback));
-        prim.extras = with_key(prim.extras, "animorder", tinygltf::Value(ours));
+        ours["orderCount"] = tinygltf::Value(int(k));
+        prim.extensions[kOrdersExtension] = tinygltf::Value(ours);
     }
 
     tinygltf::Value::Array clips;
@@ -141,25 +143,24 @@ std::string gltf_with_orders(const std::string& input_path, const std::string& o
                                            "animorder centres " + mesh.clips[c].name);
         tinygltf::Value::Object clip;
         clip["name"] = tinygltf::Value(mesh.clips[c].name);
+        if (mesh.clips[c].source_animation >= 0) clip["animation"] = tinygltf::Value(mesh.clips[c].source_animation);
+        clip["startTime"] = tinygltf::Value(mesh.clips[c].start_time_s);
+        clip["sampleRate"] = tinygltf::Value(mesh.clips[c].sample_rate);
         clip["keyframes"] = tinygltf::Value(int(t.keyframes));
-        clip["sample_rate"] = tinygltf::Value(mesh.clips[c].sample_rate);
-        clip["buffer_base"] = tinygltf::Value(int(buffers.table_base[c]));
-        clip["theta_steps"] = tinygltf::Value(int(t.theta_steps));
-        clip["phi_steps"] = tinygltf::Value(int(t.phi_steps));
+        clip["bufferBase"] = tinygltf::Value(int(buffers.table_base[c]));
+        clip["thetaSteps"] = tinygltf::Value(int(t.theta_steps));
+        clip["phiSteps"] = tinygltf::Value(int(t.phi_steps));
         clip["table"] = tinygltf::Value(cells);
-        clip["centres"] = tinygltf::Value(centre);
+        clip["centers"] = tinygltf::Value(centre);
         clips.push_back(tinygltf::Value(clip));
     }
     tinygltf::Value::Object root;
-    root["version"] = tinygltf::Value(1);
     root["method"] = tinygltf::Value(method);
-    root["buffers"] = tinygltf::Value(int(buffers.orders.size()));
+    root["bufferCount"] = tinygltf::Value(int(k));
     root["fallback"] = tinygltf::Value(int(fallback));
     root["clips"] = tinygltf::Value(clips);
-    root["table_layout"] = tinygltf::Value(std::string(
-        "cell (f, i, j) at f*theta_steps*phi_steps + i*phi_steps + j: theta = i*pi/(theta_steps-1) from +Y, "
-        "phi = j*2*pi/phi_steps from +Z towards +X; order = buffer_base + cell (see animorder_runtime.h)"));
-    model.extras = with_key(model.extras, "animorder", tinygltf::Value(root));
+    model.extensions[kOrdersExtension] = tinygltf::Value(root);
+    add_extension_used(model, kOrdersExtension);
     model.buffers[0].uri.clear();  // embedded: the output stands alone
     // Image files stay where they are: a relative URI is re-expressed from the output's folder.
     namespace fs = std::filesystem;

@@ -7,6 +7,7 @@
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { RoomEnvironment } from 'three/addons/environments/RoomEnvironment.js';
 import { AnimorderGLTFPlugin, EXTENSION_NAME } from '../js/three/animorder-three.js';
 
 const $ = (id) => document.getElementById(id);
@@ -21,13 +22,15 @@ renderer.setSize(innerWidth, innerHeight);
 $('view').appendChild(renderer.domElement);
 const scene = new THREE.Scene();
 scene.background = new THREE.Color(0x30343c);
+// An environment, so that glTF's default material (metallic 1) is not black.
+scene.environment = new THREE.PMREMGenerator(renderer).fromScene(new RoomEnvironment(), 0.04).texture;
 scene.add(new THREE.HemisphereLight(0xffffff, 0x404050, 2.2));
 const sun = new THREE.DirectionalLight(0xffffff, 1.5);
 sun.position.set(2, 4, 3);
 scene.add(sun);
 const camera = new THREE.PerspectiveCamera(40, innerWidth / innerHeight, 0.01, 1000);
 const controls = new OrbitControls(camera, renderer.domElement);
-const clock = new THREE.Clock();
+let lastTime = performance.now();
 
 // The counting pass: every fragment that passes the depth test (LESS, as DESIGN.md) adds 1.
 const floatBlend = renderer.extensions.has('EXT_float_blend');
@@ -60,8 +63,6 @@ function countPass(cam, b) {
     const keep = orders ? orders.buffer : -1;
     if (orders && b !== undefined) orders.setBuffer(b);
     const background = scene.background;
-    const hidden = [];
-    scene.traverse((o) => { if (o.isLight && o.visible) { hidden.push(o); } });
     scene.background = null;
     scene.overrideMaterial = countMaterial;
     renderer.setRenderTarget(countTarget);
@@ -153,7 +154,8 @@ function comparisonBuffer() {
 }
 
 function frame() {
-    const dt = clock.getDelta();
+    const now = performance.now(), dt = Math.min(0.1, (now - lastTime) / 1000);
+    lastTime = now;
     if (state.ready) {
         if ($('orbit').checked) controls.autoRotate = true, controls.autoRotateSpeed = 4;
         else controls.autoRotate = false;
@@ -197,7 +199,7 @@ function frameCamera(object) {
     const box = new THREE.Box3().setFromObject(object);
     const centre = box.getCenter(new THREE.Vector3()), radius = box.getSize(new THREE.Vector3()).length() / 2 || 1;
     controls.target.copy(centre);
-    camera.position.copy(centre).add(new THREE.Vector3(0, radius * 0.3, radius * 3));
+    camera.position.copy(centre).add(new THREE.Vector3(0, radius * 0.3, radius * 2.2));
     camera.near = radius / 100;
     camera.far = radius * 100;
     camera.updateProjectionMatrix();
@@ -276,5 +278,6 @@ window.animorderViewer = {
                       keyframe: state.orders ? state.orders.keyframe : -1 }),
 };
 
+if (params.get('overdraw') === '1') $('overdraw').checked = true;
 requestAnimationFrame(frame);
 load();

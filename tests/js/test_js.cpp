@@ -9,6 +9,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <iostream>
 #include <string>
 
 namespace fs = std::filesystem;
@@ -55,6 +56,37 @@ TEST_F(JsTest, RuntimeAnswersExactlyAsTheCRuntime) {
     // Every answer identical (the script prints one line per source).
     EXPECT_NE(o.out.find("sidecar: 120000 of 120000 answers identical"), std::string::npos) << o.out << o.err;
     EXPECT_NE(o.out.find("glb extension: 120000 of 120000 answers identical"), std::string::npos) << o.out << o.err;
+}
+
+TEST_F(JsTest, ViewerInHeadlessChromium) {
+    std::string why;
+    const fs::path modules = fs::path(source_dir) / "viewer" / "node_modules";
+    bool present = have_node(why);
+    if (present && !fs::exists("/usr/bin/chromium")) {
+        present = false;
+        why = "/usr/bin/chromium is absent (Debian package chromium; scripts/install-deps.sh installs it)";
+    }
+    if (present && (!fs::exists(modules / "puppeteer-core") || !fs::exists(modules / "three"))) {
+        present = false;
+        why = "three / puppeteer-core are not installed in " + modules.string() + " (run scripts/install-deps.sh)";
+    }
+    ANIMORDER_REQUIRE_OR_SKIP("browser", present, why);
+    optimise_character();
+    if (HasFatalFailure()) return;
+    // The screenshot goes to the build folder (the README's image is a copy of it).
+    const fs::path shot = fs::path(ANIMORDER_BINARY_DIR) / "viewer" / "screenshot.png";
+    fs::create_directories(shot.parent_path());
+    const test::Outcome o = run("node " + sh(source_dir + "/viewer/test/browser.mjs") + " --animorder " + sh(ANIMORDER_EXE) +
+                                " --answers " + sh(RUNTIME_ANSWERS_EXE) + " --node-counts " + sh(NODE_COUNTS_EXE) +
+                                " --scratch " + sh(dir_) + " --screenshot " + sh(shot));
+    std::cout << o.out;
+    EXPECT_EQ(o.exit_code, 0) << o.out << o.err;
+    // Every check printed and passed: 9 lines starting "ok", none "FAIL".
+    size_t ok = 0;
+    for (size_t at = o.out.find("ok   "); at != std::string::npos; at = o.out.find("ok   ", at + 1)) ++ok;
+    EXPECT_EQ(ok, 9u) << o.out << o.err;
+    EXPECT_EQ(o.out.find("FAIL"), std::string::npos) << o.out;
+    EXPECT_GT(fs::exists(shot) ? fs::file_size(shot) : 0u, 10000u);
 }
 
 }  // namespace

@@ -118,7 +118,7 @@ int main(int argc, char** argv) try {
             ScoreSettings settings;
             settings.resolution = resolution;
             settings.threads = 1;
-            score_nodes(&visible, passed.data(), mesh.keyframe_positions.data(), mesh.vertex_count, all,
+            score_nodes(&visible, passed.data(), mesh.keyframe_positions.data(), mesh.vertex_count, framing,
                         mesh.indices.data(), mesh.indices.size(), &node, 1, ranks.data(), orders.size(), settings);
             const Mat4d vp = node_view_projection(node.direction, framing.radius);
             out["nodes"].push_back({{"clip", c}, {"keyframe", f}, {"direction", {node.direction[0], node.direction[1], node.direction[2]}},

@@ -23,7 +23,7 @@ $('view').appendChild(renderer.domElement);
 const scene = new THREE.Scene();
 scene.background = new THREE.Color(0x30343c);
 // An environment, so that glTF's default material (metallic 1) is not black.
-scene.environment = new THREE.PMREMGenerator(renderer).fromScene(new RoomEnvironment(), 0.04).texture;
+if (params.get('environment') !== '0') scene.environment = new THREE.PMREMGenerator(renderer).fromScene(new RoomEnvironment(), 0.04).texture;
 scene.add(new THREE.HemisphereLight(0xffffff, 0x404050, 2.2));
 const sun = new THREE.DirectionalLight(0xffffff, 1.5);
 sun.position.set(2, 4, 3);
@@ -47,7 +47,7 @@ const countPixels = floatBlend ? new Float32Array(COUNT_SIZE * COUNT_SIZE * 4) :
 
 const state = {
     ready: false, error: null, hasExtension: false, message: '', gltf: null, orders: null, mixer: null,
-    clip: 0, mode: 'runtime', originalBuffer: -1, history: [], last: null,
+    clip: 0, mode: 'runtime', originalBuffer: -1, history: [], last: null, paused: false,
 };
 
 function message(text, kind = '') {
@@ -156,6 +156,10 @@ function comparisonBuffer() {
 function frame() {
     const now = performance.now(), dt = Math.min(0.1, (now - lastTime) / 1000);
     lastTime = now;
+    if (state.paused) {  // the tests drive the page themselves
+        requestAnimationFrame(frame);
+        return;
+    }
     if (state.ready) {
         if ($('orbit').checked) controls.autoRotate = true, controls.autoRotateSpeed = 4;
         else controls.autoRotate = false;

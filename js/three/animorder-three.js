@@ -121,6 +121,24 @@ export class AnimorderCharacter {
         }
     }
 
+    // The same orders for a copy of the character's scene (SkeletonUtils.clone(gltf.scene), or
+    // Object3D.clone): its meshes share the geometries, and each copy draws its own order.
+    cloneFor(root) {
+        const mine = [], theirs = [];
+        this.root.traverse((o) => { if (o.isMesh) mine.push(o); });
+        root.traverse((o) => { if (o.isMesh) theirs.push(o); });
+        if (mine.length !== theirs.length) throw new AnimorderError('the copy does not have the same meshes');
+        const meshes = this.meshes.map((entry) => {
+            const at = mine.indexOf(entry.mesh);
+            if (at < 0 || theirs[at].geometry !== entry.mesh.geometry) throw new AnimorderError('the copy does not share the geometries');
+            return { ...entry, mesh: theirs[at] };
+        });
+        const copy = new AnimorderCharacter(this.runtime, root, meshes, this.animations);
+        copy.orderCount = this.orderCount;
+        copy.setBuffer(this.buffer >= 0 ? this.buffer : this.runtime.fallback);
+        return copy;
+    }
+
     // Draw buffer `b` on every optimised primitive now (and keep it while `fixed` says so).
     setBuffer(b) {
         this.buffer = b;

@@ -58,35 +58,62 @@ TEST_F(JsTest, RuntimeAnswersExactlyAsTheCRuntime) {
     EXPECT_NE(o.out.find("glb extension: 120000 of 120000 answers identical"), std::string::npos) << o.out << o.err;
 }
 
+// Whether the browser test can run here; `why` says what is missing.
+bool have_browser(std::string& why) {
+    const fs::path modules = fs::path(source_dir) / "viewer" / "node_modules";
+    if (!have_node(why)) return false;
+    if (!fs::exists("/usr/bin/chromium")) {
+        why = "/usr/bin/chromium is absent (Debian package chromium; scripts/install-deps.sh installs it)";
+        return false;
+    }
+    if (!fs::exists(modules / "puppeteer-core") || !fs::exists(modules / "three")) {
+        why = "three / puppeteer-core are not installed in " + modules.string() + " (run scripts/install-deps.sh)";
+        return false;
+    }
+    return true;
+}
+
+// Runs viewer/test/browser.mjs with `files` (--model/--input/--sidecar...) and expects `checks`
+// lines starting "ok" and none "FAIL".
+void run_browser_test(JsTest& t, const fs::path& dir, const std::string& files, const fs::path& shot, size_t checks) {
+    fs::create_directories(shot.parent_path());
+    const test::Outcome o = test::run_captured(
+        "node " + sh(source_dir + "/viewer/test/browser.mjs") + " --animorder " + sh(ANIMORDER_EXE) + " --answers " +
+            sh(RUNTIME_ANSWERS_EXE) + " --node-counts " + sh(NODE_COUNTS_EXE) + " --scratch " + sh(dir) + " --screenshot " +
+            sh(shot) + files,
+        dir);
+    (void)t;
+    std::cout << o.out;
+    EXPECT_EQ(o.exit_code, 0) << o.out << o.err;
+    size_t ok = 0;
+    for (size_t at = o.out.find("ok   "); at != std::string::npos; at = o.out.find("ok   ", at + 1)) ++ok;
+    EXPECT_EQ(ok, checks) << o.out << o.err;
+    EXPECT_EQ(o.out.find("FAIL"), std::string::npos) << o.out;
+    EXPECT_GT(fs::exists(shot) ? fs::file_size(shot) : 0u, 10000u);
+}
+
+// The bundled character (morph-target animation, two primitives, two clips).
 TEST_F(JsTest, ViewerInHeadlessChromium) {
     std::string why;
-    const fs::path modules = fs::path(source_dir) / "viewer" / "node_modules";
-    bool present = have_node(why);
-    if (present && !fs::exists("/usr/bin/chromium")) {
-        present = false;
-        why = "/usr/bin/chromium is absent (Debian package chromium; scripts/install-deps.sh installs it)";
-    }
-    if (present && (!fs::exists(modules / "puppeteer-core") || !fs::exists(modules / "three"))) {
-        present = false;
-        why = "three / puppeteer-core are not installed in " + modules.string() + " (run scripts/install-deps.sh)";
-    }
-    ANIMORDER_REQUIRE_OR_SKIP("browser", present, why);
+    ANIMORDER_REQUIRE_OR_SKIP("browser", have_browser(why), why);
     optimise_character();
     if (HasFatalFailure()) return;
     // The screenshot goes to the build folder (the README's image is a copy of it).
-    const fs::path shot = fs::path(ANIMORDER_BINARY_DIR) / "viewer" / "screenshot.png";
-    fs::create_directories(shot.parent_path());
-    const test::Outcome o = run("node " + sh(source_dir + "/viewer/test/browser.mjs") + " --animorder " + sh(ANIMORDER_EXE) +
-                                " --answers " + sh(RUNTIME_ANSWERS_EXE) + " --node-counts " + sh(NODE_COUNTS_EXE) +
-                                " --scratch " + sh(dir_) + " --screenshot " + sh(shot));
-    std::cout << o.out;
-    EXPECT_EQ(o.exit_code, 0) << o.out << o.err;
-    // Every check printed and passed: 9 lines starting "ok", none "FAIL".
-    size_t ok = 0;
-    for (size_t at = o.out.find("ok   "); at != std::string::npos; at = o.out.find("ok   ", at + 1)) ++ok;
-    EXPECT_EQ(ok, 9u) << o.out << o.err;
-    EXPECT_EQ(o.out.find("FAIL"), std::string::npos) << o.out;
-    EXPECT_GT(fs::exists(shot) ? fs::file_size(shot) : 0u, 10000u);
+    run_browser_test(*this, dir_, "", fs::path(ANIMORDER_BINARY_DIR) / "viewer" / "screenshot.png", 10);
+}
+
+// A skinned character (CesiumMan: SkinnedMesh, node transforms, a texture) of ../shared/data.
+TEST_F(JsTest, SkinnedViewerInHeadlessChromium) {
+    std::string why;
+    ANIMORDER_REQUIRE_OR_SKIP("browser", have_browser(why), why);
+    const fs::path cesium = test::shared_data_path("gltf-cesiumman/CesiumMan.glb");
+    ANIMORDER_REQUIRE_DATA(cesium);
+    const test::Outcome o = run(std::string(ANIMORDER_EXE) + " optimize -q " + sh(cesium) +
+                                " --method single -k 3 --views 42 --resolution 64 -o " + sh(path("cesium.glb")));
+    ASSERT_EQ(o.exit_code, 0) << o.err;
+    run_browser_test(*this, dir_,
+                     " --model cesium.glb --sidecar cesium.animorder.bin --input " + sh(cesium) + " --expect-skinned 1",
+                     path("cesium.png"), 11);
 }
 
 }  // namespace

@@ -10,7 +10,7 @@
 //   2. a scripted orbit (36 camera positions × clip times) draws at least two different buffers, and
 //      each is the C runtime's choice (tests/runtime/runtime_answers on the sidecar) for the same
 //      (clip time, camera position in model space);
-//   3. for 24 protocol nodes (node_counts: DESIGN.md's camera; 12 keyframes per clip), the passed
+//   3. for 24 or more protocol nodes (node_counts: DESIGN.md's camera; keyframes spread over each clip), the passed
 //      fragments the browser counts (additive blending into a float target) for the original and
 //      the optimised order agree with the overdraw engine of `animorder evaluate` within TOLERANCE
 //      (relative, per node), and the optimised order has the lower OVR over the nodes;
@@ -18,7 +18,7 @@
 // Prints one line per check; exit 0 when all pass.
 import { spawn, execFileSync } from 'node:child_process';
 import { readFileSync, writeFileSync } from 'node:fs';
-import { join } from 'node:path';
+import { join, resolve } from 'node:path';
 import { createRequire } from 'node:module';
 
 const require = createRequire(import.meta.url);
@@ -38,15 +38,20 @@ const chromium = args.chromium || '/usr/bin/chromium';
 // script prints the largest); 1% still separates original from optimised orders, whose counts
 // differ by 5–20% at these nodes.
 const TOLERANCE = Number(args.tolerance || 0.01);
+// The files: the optimised glb, its sidecar and the input it was optimised from (relative to DIR).
+const model = resolve(scratch, args.model || 'out.glb');
+const input = resolve(scratch, args.input || 'char.glb');
+const sidecar = resolve(scratch, args.sidecar || 'out.animorder.bin');
 
 let failures = 0;
+const started = Date.now();
 function check(ok, text) {
-    console.log(`${ok ? 'ok  ' : 'FAIL'} ${text}`);
+    console.log(`${ok ? 'ok  ' : 'FAIL'} ${text} [${((Date.now() - started) / 1000).toFixed(1)} s]`);
     if (!ok) failures++;
 }
 
 // 1) the server: animorder view, loopback, any free port, bounded in time.
-const server = spawn(args.animorder, ['view', join(scratch, 'out.glb'), '--original', join(scratch, 'char.glb'),
+const server = spawn(args.animorder, ['view', model, '--original', input,
                                       '--port', '0', '--no-open', '--seconds', '300', '-q'],
                      { stdio: ['ignore', 'pipe', 'inherit'] });
 const base = await new Promise((resolve, reject) => {
@@ -76,12 +81,15 @@ try {
                                { timeout: 60000 });
     const loaded = await page.evaluate(() => ({ error: animorderViewer.state.error, has: animorderViewer.state.hasExtension,
                                                 message: animorderViewer.state.message, floatBlend: animorderViewer.floatBlend,
-                                                original: animorderViewer.state.originalBuffer }));
+                                                original: animorderViewer.state.originalBuffer,
+                                                skinned: animorderViewer.state.orders ? animorderViewer.state.orders.meshes.filter((m) => m.mesh.isSkinnedMesh).length : 0,
+                                                meshes: animorderViewer.state.orders ? animorderViewer.state.orders.meshes.length : 0 }));
     check(!loaded.error && loaded.has && loaded.original >= 0,
-          `the optimised glb loads with its orders (${loaded.message}; float blending: ${loaded.floatBlend})`);
+          `the optimised glb loads with its orders (${loaded.message}; ${loaded.meshes} optimised meshes, ${loaded.skinned} skinned; float blending: ${loaded.floatBlend})`);
+    if (args['expect-skinned']) check(loaded.skinned > 0, 'the optimised meshes include a SkinnedMesh');
 
     // 1. renders: let a few frames play, screenshot, and count non-background pixels of the canvas.
-    await page.evaluate(() => new Promise((r) => setTimeout(r, 4000)));
+    await page.evaluate(() => new Promise((r) => setTimeout(r, 2500)));
     await page.screenshot({ path: args.screenshot });
     const png = readFileSync(args.screenshot);
     const coverage = await page.evaluate(() => {
@@ -105,9 +113,11 @@ try {
     check(png.length > 10000 && coverage > 0.01 && coverage < 0.9,
           `the page renders: screenshot ${args.screenshot} (${png.length} bytes), character on ${(100 * coverage).toFixed(1)}% of the canvas`);
 
-    // 2. scripted orbit: the buffer the plugin sets each step against the C runtime.
+    // 2. scripted orbit: the buffer the plugin sets each step against the C runtime. From here the
+    // test drives the page (its own animation loop paused).
     const orbit = await page.evaluate(() => {
         const v = animorderViewer, s = v.state, orders = s.orders;
+        s.paused = true;
         document.getElementById('orbit').checked = false;
         const steps = [];
         const rt = orders.runtime;
@@ -137,7 +147,7 @@ try {
         q.camera.forEach((x, k) => records.setFloat32(40 * n + 16 + 4 * k, x, true));
     });
     writeFileSync(join(scratch, 'orbit.bin'), new Uint8Array(records.buffer));
-    execFileSync(args.answers, [join(scratch, 'out.animorder.bin'), join(scratch, 'orbit.bin'), join(scratch, 'orbit-answers.bin')]);
+    execFileSync(args.answers, [sidecar, join(scratch, 'orbit.bin'), join(scratch, 'orbit-answers.bin')]);
     const answerBytes = readFileSync(join(scratch, 'orbit-answers.bin'));
     const cAnswers = orbit.map((q, n) => answerBytes.readInt32LE(4 * n));
     const agree = orbit.filter((q, n) => q.buffer === cAnswers[n] && q.range.every(([first, n2]) => first === q.buffer * n2)).length;
@@ -146,8 +156,9 @@ try {
           `scripted orbit: ${agree} of ${orbit.length} steps draw the C runtime's buffer (draw range b·n), ${distinct.size} different buffers (${[...distinct].join(' ')})`);
 
     // 3. protocol nodes: the browser's GPU counts against evaluate's engine.
-    const nodes = JSON.parse(execFileSync(args['node-counts'], [join(scratch, 'char.glb'), join(scratch, 'out.animorder.bin'),
-                                                                 '--resolution', String(await page.evaluate(() => animorderViewer.countSize))]));
+    const nodes = JSON.parse(execFileSync(args['node-counts'], [input, sidecar,
+                                                                 '--resolution', String(await page.evaluate(() => animorderViewer.countSize)),
+                                                                 '--nodes-per-clip', String(Math.ceil(24 / await page.evaluate(() => animorderViewer.state.orders.runtime.clips.length)))]));
     const measured = await page.evaluate((list) => {
         const v = animorderViewer, orders = v.state.orders;
         return list.map((node) => {
@@ -183,8 +194,51 @@ try {
     check(ovrOpt < ovrOrig, `browser OVR over the nodes: optimised ${ovrOpt.toFixed(4)} < original ${ovrOrig.toFixed(4)} ` +
                             `(pooled ${(sumOpt / sumOrig).toFixed(4)} of the original's fragments)`);
 
+    // Copies of the character in one scene (SkeletonUtils.clone: shared geometries): each draws
+    // the order its own model space gives (onBeforeRender sets the range per object).
+    const copies = await page.evaluate(async () => {
+        const v = animorderViewer, s = v.state, orders = s.orders, THREE = await import('three');
+        const { clone } = await import('three/addons/utils/SkeletonUtils.js');
+        const box = new THREE.Box3().setFromObject(s.gltf.scene), size = box.getSize(new THREE.Vector3()).length();
+        const roots = [clone(s.gltf.scene), clone(s.gltf.scene)];
+        roots[0].position.set(size, 0, 0);
+        roots[1].position.set(-size, 0, size);
+        roots[1].rotation.y = Math.PI / 2;
+        const characters = [orders, ...roots.map((r) => { v.scene.add(r); r.traverse((o) => { o.frustumCulled = false; }); return orders.cloneFor(r); })];
+        let frames = 0, differing = 0, wrong = 0;
+        for (let k = 0; k < 12; ++k) {
+            v.pose(0, k);
+            const a = (k / 12) * 2 * Math.PI;
+            v.camera.position.set(2 * size * Math.sin(a), size * 0.5 * Math.cos(3 * a), 2 * size * Math.cos(a));
+            v.camera.lookAt(0, 0, 0);
+            v.camera.updateMatrixWorld(true);
+            const expected = characters.map((ch) => {
+                ch.root.updateMatrixWorld(true);
+                const p = v.camera.getWorldPosition(new THREE.Vector3()).applyMatrix4(ch.root.matrixWorld.clone().invert());
+                const c = orders.runtime.clips[0];
+                return orders.runtime.selectAnimationTime(0, c.startTime + k / c.sampleRate, [p.x, p.y, p.z]);
+            });
+            characters.forEach((ch) => ch.update(v.camera, s.mixer));
+            const drawn = [];
+            characters.forEach((ch, i) => ch.meshes.forEach(({ mesh, n }) => {
+                mesh.onAfterRender = (r, sc, cam, geometry) => drawn.push({ i, n, start: geometry.drawRange.start, count: geometry.drawRange.count });
+            }));
+            v.renderer.render(v.scene, v.camera);
+            characters.forEach((ch) => ch.meshes.forEach(({ mesh }) => { mesh.onAfterRender = () => {}; }));
+            frames++;
+            if (new Set(expected).size > 1) differing++;
+            for (const d of drawn) if (d.start !== expected[d.i] * d.n || d.count !== d.n) wrong++;
+            if (drawn.length !== characters.reduce((t, ch) => t + ch.meshes.length, 0)) wrong++;
+        }
+        roots.forEach((r) => v.scene.remove(r));
+        return { frames, differing, wrong };
+    });
+    check(copies.wrong === 0 && copies.differing > 0,
+          `three copies of the character in one scene: in ${copies.frames} frames every mesh drew its own copy's order ` +
+          `(${copies.wrong} wrong draws); the copies needed different orders in ${copies.differing} frames`);
+
     // 4. a glb without the extension.
-    await page.goto(`${base}viewer/?file=/original.glb`);
+    await page.goto(`${base}viewer/?file=/original.glb&environment=0`);
     await page.waitForFunction(() => window.animorderViewer && (animorderViewer.state.ready || animorderViewer.state.error), { timeout: 60000 });
     const plain = await page.evaluate(() => ({ ready: animorderViewer.state.ready, has: animorderViewer.state.hasExtension,
                                                text: document.getElementById('message').textContent }));
@@ -192,7 +246,7 @@ try {
           `a glb without the extension loads and the page says: "${plain.text}"`);
 
     // and a broken file: a clear message, no crash.
-    await page.goto(`${base}viewer/?file=/viewer/index.html`);
+    await page.goto(`${base}viewer/?file=/viewer/index.html&environment=0`);
     await page.waitForFunction(() => window.animorderViewer && (animorderViewer.state.ready || animorderViewer.state.error), { timeout: 60000 });
     const broken = await page.evaluate(() => document.getElementById('message').textContent);
     check(/cannot load/.test(broken), `a file that is not glTF: the page says "${broken}"`);

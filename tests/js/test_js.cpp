@@ -116,4 +116,18 @@ TEST_F(JsTest, SkinnedViewerInHeadlessChromium) {
                      path("cesium.png"), 11);
 }
 
+// `animorder view`: the viewer's files and the model only, GET/HEAD only, nothing above its folders.
+TEST_F(JsTest, ViewServesOnlyTheViewer) {
+    std::string why;
+    ANIMORDER_REQUIRE_OR_SKIP("node", have_node(why), why);
+    const fs::path three = fs::path(source_dir) / "viewer" / "node_modules" / "three";
+    ANIMORDER_REQUIRE_OR_SKIP("browser", fs::exists(three), three.string() + " is absent (run scripts/install-deps.sh)");
+    const test::Outcome a = run(std::string(ANIMORDER_EXE) + " subdivide -q --levels 0 -o " + sh(path("char.glb")));
+    ASSERT_EQ(a.exit_code, 0) << a.err;
+    const test::Outcome o = run("node " + sh(source_dir + "/viewer/test/server.mjs") + " " + sh(ANIMORDER_EXE) + " " + sh(path("char.glb")));
+    EXPECT_EQ(o.exit_code, 0) << o.out << o.err;
+    EXPECT_EQ(test::line_count(o.out), 17u) << o.out;
+    EXPECT_EQ(o.out.find("FAIL"), std::string::npos) << o.out;
+}
+
 }  // namespace

@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -27,6 +28,9 @@ namespace fs = std::filesystem;
 
 namespace animorder::tool {
 namespace {
+
+volatile std::sig_atomic_t interrupted = 0;  // Ctrl-C / SIGTERM: stop serving, remove the scratch folder
+void on_signal(int) { interrupted = 1; }
 
 std::string content_type(const fs::path& path) {
     const std::string e = path.extension().string();
@@ -193,15 +197,15 @@ int run_view(const ViewOptions& options) {
             std::fprintf(stderr, "view: could not start a browser; open %s\n", url.c_str());
     }
     const auto start = std::chrono::steady_clock::now();
-    while (options.seconds == 0 ||
-           std::chrono::steady_clock::now() - start < std::chrono::seconds(options.seconds)) {
-        if (options.seconds != 0) {  // wake up now and then to honour --seconds
-            timeval wait{1, 0};
-            fd_set ready;
-            FD_ZERO(&ready);
-            FD_SET(server, &ready);
-            if (::select(server + 1, &ready, nullptr, nullptr, &wait) <= 0) continue;
-        }
+    std::signal(SIGINT, on_signal);
+    std::signal(SIGTERM, on_signal);
+    while (!interrupted && (options.seconds == 0 ||
+                            std::chrono::steady_clock::now() - start < std::chrono::seconds(options.seconds))) {
+        timeval wait{1, 0};  // wake up now and then to honour --seconds and signals
+        fd_set ready;
+        FD_ZERO(&ready);
+        FD_SET(server, &ready);
+        if (::select(server + 1, &ready, nullptr, nullptr, &wait) <= 0) continue;
         const int client = ::accept(server, nullptr, nullptr);
         if (client < 0) continue;
         serve_one(client, site, options.common.quiet);

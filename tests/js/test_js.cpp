@@ -130,4 +130,14 @@ TEST_F(JsTest, ViewServesOnlyTheViewer) {
     EXPECT_EQ(o.out.find("FAIL"), std::string::npos) << o.out;
 }
 
+// The JS runtime on the extension's example file, against answers worked out by hand (and its
+// refusals of broken tables): js/test/hand-worked.mjs.
+TEST_F(JsTest, RuntimeHandWorkedOnTheSpecExample) {
+    std::string why;
+    ANIMORDER_REQUIRE_OR_SKIP("node", have_node(why), why);
+    const test::Outcome o = run("node " + sh(source_dir + "/js/test/hand-worked.mjs"));
+    EXPECT_EQ(o.exit_code, 0) << o.out << o.err;
+    EXPECT_NE(o.out.find("hand-worked: all checks passed"), std::string::npos) << o.out << o.err;
+}
+
 }  // namespace

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (fuzz/) with clang in build-fuzz/ and runs each for
 # SECONDS_PER_TARGET seconds (default 30): fuzz_runtime (the sidecar runtime header), fuzz_gltf,
-# fuzz_md2, fuzz_iqm (the loaders). Each target starts from a temporary corpus: the committed
+# fuzz_md2, fuzz_iqm (the loaders), fuzz_gltf_extension (the ANIMORDER_animated_triangle_orders reader). Each target starts from a temporary corpus: the committed
 # seeds in fuzz/corpus/<target>/ plus, when ../shared/data is there, its small files of that
 # format (read only, copied to the temporary folder). Exits non-zero when any target finds a
 # crash, leak, timeout or out-of-memory, printing the path of the input that triggers it.
@@ -17,7 +17,7 @@ set -euo pipefail
 seconds="${1:-30}"
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(fuzz_runtime fuzz_gltf fuzz_md2 fuzz_iqm)
+[ ${#targets[@]} -gt 0 ] || targets=(fuzz_runtime fuzz_gltf fuzz_md2 fuzz_iqm fuzz_gltf_extension)
 case "$seconds" in '' | *[!0-9]*) echo "fuzz.sh: SECONDS_PER_TARGET must be a number" >&2; exit 2 ;; esac
 
 here="$(cd "$(dirname "$0")/.." && pwd)"
@@ -39,7 +39,7 @@ shared_seeds() {
   local pattern
   [ -d "$data" ] || return 0
   case "$1" in
-    fuzz_gltf) pattern='-name *.glb -o -name *.gltf' ;;
+    fuzz_gltf | fuzz_gltf_extension) pattern='-name *.glb -o -name *.gltf' ;;
     fuzz_md2) pattern='-name *.md2' ;;
     fuzz_iqm) pattern='-name *.iqm' ;;
     *) return 0 ;;

@@ -2,9 +2,15 @@
 // src/io.
 #pragma once
 
+#include "animorder/load.h"
+
 #include <tiny_gltf.h>
 
 #include <cstddef>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+#include <string>
 #include <vector>
 
 namespace animorder::io {
@@ -24,6 +30,56 @@ inline int append_buffer_view(tinygltf::Model& model, const void* data, size_t b
     buffer.insert(buffer.end(), p, p + bytes);
     model.bufferViews.push_back(view);
     return int(model.bufferViews.size() - 1);
+}
+
+// The glTF file at `path` (binary when it starts with "glTF"), images left undecoded; LoadError
+// when it is no readable glTF 2.0 file.
+inline tinygltf::Model read_model(const std::string& path) {
+    tinygltf::Model model;
+    tinygltf::TinyGLTF loader;
+    loader.SetImageLoader([](tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int,
+                             void*) { return true; },
+                          nullptr);
+    std::string error, warning;
+    std::string magic(4, '\0');
+    if (FILE* f = std::fopen(path.c_str(), "rb")) {
+        if (std::fread(magic.data(), 1, 4, f) != 4) magic.clear();
+        std::fclose(f);
+    }
+    const bool ok = magic == "glTF" ? loader.LoadBinaryFromFile(&model, &error, &warning, path)
+                                     : loader.LoadASCIIFromFile(&model, &error, &warning, path);
+    if (!ok) {
+        for (char& c : error)
+            if (c == '\n' || c == '\r') c = ' ';
+        throw LoadError(path + ": not a readable glTF 2.0 file: " + error);
+    }
+    return model;
+}
+
+// The model read from input_path as a file at output_path: buffers embedded (every buffer's URI
+// cleared), relative image URIs re-pointed from output_path's folder, images never re-encoded.
+// GLB bytes when `binary`, else glTF JSON text.
+inline std::string write_model(tinygltf::Model& model, const std::string& input_path, const std::string& output_path,
+                               bool binary) {
+    for (tinygltf::Buffer& b : model.buffers) b.uri.clear();
+    namespace fs = std::filesystem;
+    const fs::path from = fs::absolute(fs::path(input_path)).parent_path();
+    const fs::path to = fs::absolute(fs::path(output_path)).parent_path();
+    for (tinygltf::Image& image : model.images)
+        if (!image.uri.empty() && image.uri.rfind("data:", 0) != 0 && image.uri.find("://") == std::string::npos &&
+            fs::path(image.uri).is_relative() && from != to)
+            image.uri = fs::relative(from / image.uri, to).generic_string();
+    tinygltf::TinyGLTF writer;
+    writer.SetImageWriter([](const std::string*, const std::string*, const tinygltf::Image* image, bool, std::string* uri,
+                             void*) {
+        *uri = image->uri;  // never decoded, never rewritten: external images keep their URIs
+        return true;
+    },
+                          nullptr);
+    std::ostringstream out;
+    if (!writer.WriteGltfSceneToStream(&model, out, !binary, binary))
+        throw LoadError(input_path + ": writing the glTF output failed");
+    return out.str();
 }
 
 }  // namespace animorder::io

@@ -4,14 +4,19 @@
 // byte-identical for the same input.
 #include "animorder/animated_mesh.h"
 #include "animorder/clustering.h"
+#include "animorder/gltf_extension.h"
 #include "animorder/gltf_loader.h"
 #include "animorder/gltf_writer.h"
 #include "animorder/load.h"
 #include "animorder/methods.h"
 #include "animorder/procedural_character.h"
+#include "animorder/sidecar.h"
 #include "animorder/triangle_order.h"
 #include "animorder/viewpoints.h"
 #include "support/meshes.h"
+
+#define ANIMORDER_RUNTIME_IMPLEMENTATION
+#include "animorder_runtime.h"
 
 #include <gtest/gtest.h>
 
@@ -19,7 +24,10 @@
 #include "support/require.h"
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -121,4 +129,96 @@ TEST_F(GltfWriter, RefusesAMeshItWasNotReadFrom) {
     const Framing framing = frame_animated_mesh(character);
     EXPECT_THROW(gltf_with_orders(input, (dir_ / "x.glb").string(), character, buffers, 0, framing, "original", true),
                  LoadError);
+}
+
+TEST_F(GltfWriter, TheExtensionHoldsEveryOrderAsOneIndexRangeAndTheTables) {
+    const std::string input = kData + "gltf-cesiumman/CesiumMan.glb";
+    ANIMORDER_REQUIRE_DATA(input);
+    const Written w = optimise_and_write(input, dir_ / "ranges.glb");
+    const OrdersExtensionCheck r = check_orders_extension(w.path.string());
+    ASSERT_TRUE(r.errors.empty()) << r.errors.front();
+    const MethodBuffers& buffers = w.method.buffers;
+    EXPECT_EQ(r.buffer_count, buffers.orders.size());
+    EXPECT_EQ(r.fallback, 1u);
+    ASSERT_EQ(r.primitives.size(), w.mesh.primitives.size());
+    for (size_t i = 0; i < w.mesh.primitives.size(); ++i) {
+        const Primitive& p = w.mesh.primitives[i];
+        const ExtensionPrimitive& e = r.primitives[i];
+        EXPECT_EQ(e.component_type, 5123);  // CesiumMan's 3273 vertices fit in 16 bits
+        // Order b is indices [b·n, (b+1)·n): the method's order b of this primitive, local.
+        for (size_t b = 0; b < buffers.orders.size(); ++b) {
+            std::vector<uint32_t> global(w.mesh.indices.size());
+            apply_triangle_order(global.data(), w.mesh.indices.data(), buffers.orders[b].data(), w.mesh.triangle_count());
+            for (size_t k = 0; k < p.index_count; ++k)
+                ASSERT_EQ(e.orders[b * p.index_count + k], global[p.first_index + k] - p.vertex_base) << b << " " << k;
+        }
+    }
+    ASSERT_EQ(r.clips.size(), w.mesh.clips.size());
+    for (size_t c = 0; c < r.clips.size(); ++c) {
+        EXPECT_EQ(r.clips[c].cells, buffers.tables[c].cells);
+        EXPECT_EQ(r.clips[c].buffer_base, buffers.table_base[c]);
+        EXPECT_EQ(r.clips[c].keyframes, w.mesh.clips[c].keyframe_count);
+        EXPECT_EQ(r.clips[c].animation, int(c));
+        const std::vector<float> centres(w.method.framing.centres.begin() + ptrdiff_t(3 * w.mesh.clips[c].first_keyframe),
+                                         w.method.framing.centres.begin() +
+                                             ptrdiff_t(3 * (w.mesh.clips[c].first_keyframe + w.mesh.clips[c].keyframe_count)));
+        EXPECT_EQ(r.clips[c].centers, centres);
+    }
+}
+
+// The extension's lookup as docs/extension/README.md states it, written out here from the text,
+// against the C runtime reading the sidecar of the same run: the same buffer for every probe, and
+// the sidecar's buffer b equal to every primitive's range b (offset by its vertex base).
+namespace {
+
+int extension_lookup(const ExtensionClip& c, double seconds_since_start, const float camera[3]) {
+    double k = (seconds_since_start) * c.sample_rate;
+    k = k != k ? 0.0 : std::floor(k + 0.5);
+    const size_t f = k <= 0 ? 0 : (k >= double(c.keyframes - 1) ? c.keyframes - 1 : size_t(k));
+    const double d[3] = {double(camera[0]) - c.centers[3 * f], double(camera[1]) - c.centers[3 * f + 1],
+                         double(camera[2]) - c.centers[3 * f + 2]};
+    const double length = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    const double theta = std::acos(std::clamp(d[1] / length, -1.0, 1.0));
+    double phi = std::atan2(d[0], d[2]);
+    if (phi < 0) phi += 2 * M_PI;
+    double x = std::floor(theta / M_PI * (c.theta_steps - 1) + 0.5);
+    const size_t i = x <= 0 ? 0 : (x >= c.theta_steps - 1 ? c.theta_steps - 1 : size_t(x));
+    x = std::floor(phi / (2 * M_PI) * c.phi_steps + 0.5);
+    const size_t j = x <= 0 || x >= c.phi_steps ? 0 : size_t(x);
+    return int(c.buffer_base + c.cells[(f * c.theta_steps + i) * c.phi_steps + j]);
+}
+
+}  // namespace
+
+TEST_F(GltfWriter, TheExtensionAndTheSidecarAnswerAlike) {
+    const std::string input = kData + "gltf-cesiumman/CesiumMan.glb";
+    ANIMORDER_REQUIRE_DATA(input);
+    const Written w = optimise_and_write(input, dir_ / "same.glb");
+    const OrdersExtensionCheck r = read_orders_extension(w.path.string());
+    const std::string sidecar = serialize_sidecar(w.mesh, w.method.buffers, w.method.framing);
+    std::vector<uint32_t> aligned((sidecar.size() + 3) / 4);
+    std::memcpy(aligned.data(), sidecar.data(), sidecar.size());
+    animorder_runtime rt;
+    ASSERT_EQ(animorder_runtime_open(&rt, aligned.data(), sidecar.size()), 0);
+    ASSERT_EQ(rt.buffer_count, r.buffer_count);
+    for (uint32_t b = 0; b < r.buffer_count; ++b) {
+        const uint32_t* indices = animorder_buffer(&rt, int(b));
+        for (size_t p = 0; p < w.mesh.primitives.size(); ++p) {
+            const Primitive& prim = w.mesh.primitives[p];
+            for (size_t k = 0; k < prim.index_count; ++k)
+                ASSERT_EQ(indices[prim.first_index + k], r.primitives[p].orders[b * prim.index_count + k] + prim.vertex_base);
+        }
+    }
+    size_t probes = 0;
+    for (uint32_t c = 0; c < r.clips.size(); ++c)
+        for (double t : {-1.0, 0.0, 0.04, 0.5, 1.0, 100.0})
+            for (int v = 0; v < 200; ++v) {
+                const double a = v * 2.399963, z = 1.0 - 2.0 * (v + 0.5) / 200;  // Fibonacci sphere
+                const float camera[3] = {float(3 * std::sqrt(1 - z * z) * std::cos(a)), float(3 * z),
+                                         float(3 * std::sqrt(1 - z * z) * std::sin(a))};
+                ASSERT_EQ(extension_lookup(r.clips[c], t, camera), animorder_select_time(&rt, c, t, camera, nullptr))
+                    << c << " " << t << " " << v;
+                ++probes;
+            }
+    EXPECT_EQ(probes, r.clips.size() * 1200);
 }

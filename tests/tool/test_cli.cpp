@@ -346,3 +346,13 @@ TEST_F(Cli, OptionRangeErrorsAreOneLineWithExitCodeOne) {
         EXPECT_EQ(o.err.rfind("animorder: error: ", 0), 0u) << args << " → " << o.err;
     }
 }
+
+TEST_F(CliOutputs, ReapplyOntoEitherInputIsRefused) {
+    ASSERT_EQ(run("optimize -q --method original " + path("in.glb").string() + " -o " + path("opt.glb").string()).exit_code, 0);
+    const std::string optimised = test::slurp(path("opt.glb"));
+    expect_refused("reapply " + path("opt.glb").string() + " " + path("in.glb").string() + " -o " + path("in.glb").string(),
+                   "in.glb");
+    expect_refused("reapply " + path("opt.glb").string() + " " + path("in.glb").string() + " -o " + path("opt.glb").string(),
+                   "opt.glb");
+    EXPECT_EQ(test::slurp(path("opt.glb")), optimised);
+}

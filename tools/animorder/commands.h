@@ -54,6 +54,7 @@ struct EvaluateOptions {
     EvaluationSettings evaluation;  // views, seed, resolution (threads from --threads)
     std::string report_path;
     std::string csv_path;
+    bool stored = false;  // --stored: also the orders stored in INPUT (ANIMORDER_animated_triangle_orders)
 };
 
 struct HeatmapOptions {
@@ -81,11 +82,25 @@ struct ViewOptions {
     std::string viewer_root;  // the folder holding viewer/ and js/ (default: the source tree)
 };
 
+struct CheckOptions {
+    std::string file;  // a glTF/GLB file with (or without) ANIMORDER_animated_triangle_orders
+    bool quiet = false;  // no error line on stderr (the JSON report still says it)
+};
+
+struct ReapplyOptions {
+    std::string optimized, processed, output;
+    double tolerance = 1e-3;  // corner distance allowed, as a fraction of OPTIMIZED's bounding-box diagonal
+    size_t max_memory = LoadOptions{}.max_keyframe_bytes;
+    bool quiet = false;
+};
+
 int run_inspect(const InspectOptions& options);
 int run_optimize(const OptimizeOptions& options);
 int run_evaluate(const EvaluateOptions& options);
 int run_heatmap(const HeatmapOptions& options);
 int run_subdivide(const SubdivideOptions& options);
 int run_view(const ViewOptions& options);
+int run_check(const CheckOptions& options);
+int run_reapply(const ReapplyOptions& options);
 
 }  // namespace animorder::tool

@@ -135,6 +135,8 @@ int main(int argc, char** argv) {
     evaluate_cmd->add_option("--eval-seed", evaluate.evaluation.seed, "Seed of the evaluation viewpoints")->capture_default_str();
     evaluate_cmd->add_option("-r,--report", evaluate.report_path, "Write the JSON report to this file");
     evaluate_cmd->add_option("--csv", evaluate.csv_path, "Write the table as CSV to this file");
+    evaluate_cmd->add_flag("--stored", evaluate.stored,
+                           "Also evaluate the orders stored in INPUT (ANIMORDER_animated_triangle_orders): row 'stored'");
 
     HeatmapOptions heatmap;
     CLI::App* heatmap_cmd = app.add_subcommand("heatmap", "Draw a per-pixel overdraw image of one node as PNG");
@@ -175,6 +177,26 @@ int main(int argc, char** argv) {
     view_cmd->add_option("--seconds", view.seconds, "Stop serving after this many seconds (0: until interrupted)");
     view_cmd->add_option("--viewer-root", view.viewer_root, "The folder holding viewer/ and js/ (default: the source tree)");
 
+    CheckOptions check;
+    CLI::App* check_cmd = app.add_subcommand(
+        "check", "Check the ANIMORDER_animated_triangle_orders orders of a glTF file (JSON report; exit 1 when unusable)");
+    check_cmd->add_option("file", check.file, "glTF/GLB file")->required();
+    check_cmd->add_flag("-q,--quiet", check.quiet, "No error line on stderr (the JSON report still has it)");
+
+    ReapplyOptions reapply;
+    CLI::App* reapply_cmd = app.add_subcommand(
+        "reapply", "Map an optimised file's orders onto a processed copy of it (gltfpack, gltf-pipeline...) by matching triangles");
+    reapply_cmd->add_option("optimized", reapply.optimized, "The file animorder optimize wrote")->required();
+    reapply_cmd->add_option("processed", reapply.processed, "The same file after another tool")->required();
+    reapply_cmd->add_option("-o,--output", reapply.output, "OUT.glb or OUT.gltf: PROCESSED with the orders")->required();
+    reapply_cmd->add_option("--tolerance", reapply.tolerance,
+                            "Corner distance allowed, as a fraction of the bounding-box diagonal")
+        ->capture_default_str()
+        ->check(CLI::Range(0.0, 0.1));
+    reapply_cmd->add_option("--max-memory", reapply.max_memory, "Loading budget in bytes for the sampled animation")
+        ->capture_default_str();
+    reapply_cmd->add_flag("-q,--quiet", reapply.quiet, "No progress or notes on stderr");
+
     if (argc == 1) {  // no arguments: the basics, and where to look next (gltfpack style)
         std::fputs(app.help().c_str(), stderr);
         return 2;
@@ -196,6 +218,8 @@ int main(int argc, char** argv) {
         if (*heatmap_cmd) return run_heatmap(heatmap);
         if (*subdivide_cmd) return run_subdivide(subdivide);
         if (*view_cmd) return run_view(view);
+        if (*check_cmd) return run_check(check);
+        if (*reapply_cmd) return run_reapply(reapply);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "animorder: error: %s\n", e.what());
         return 1;

@@ -1,0 +1,192 @@
+// The ANIMORDER_animated_triangle_orders reader and checker on the hand-written example of
+// docs/extension (a quad: order 0 = 0 1 2 0 2 3, order 1 = 0 2 3 0 1 2, a 2 x 2 table 0 1 1 0,
+// centre (0.5, 0.5, 0)), and on corrupted copies of it: each must be reported with its own
+// one-line message, and read_orders_extension (the loader path of reapply and evaluate --stored)
+// must refuse it with a LoadError.
+#include "animorder/gltf_extension.h"
+#include "animorder/load.h"
+
+#include "support/files.h"
+#include "support/require.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cstring>
+#include <fstream>
+#include <functional>
+
+using namespace animorder;
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+const char* const kExt = "ANIMORDER_animated_triangle_orders";
+
+// The example's buffer, built here from the values the README states (not read from the file),
+// with `edit` applied to the 12 order indices.
+std::string buffer_bytes(const std::function<void(std::vector<uint16_t>&)>& edit = nullptr) {
+    std::string b;
+    auto put = [&b](const void* p, size_t n) { b.append(static_cast<const char*>(p), n); };
+    const float positions[] = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+    put(positions, sizeof positions);
+    const uint16_t indices[] = {0, 1, 2, 0, 2, 3};
+    put(indices, sizeof indices);
+    std::vector<uint16_t> orders = {0, 1, 2, 0, 2, 3, 0, 2, 3, 0, 1, 2};
+    if (edit) edit(orders);
+    put(orders.data(), 24);
+    const uint8_t table[] = {0, 1, 1, 0};
+    put(table, 4);
+    const float tail[] = {0.5f, 0.5f, 0, 0, 0, 0, 0};  // centre, key time, translation
+    put(tail, sizeof tail);
+    return b;
+}
+
+class GltfExtension : public test::ScratchFolderTest {
+protected:
+    GltfExtension() : ScratchFolderTest("animorder-gltf-extension") {}
+    // The example with its buffer in example.bin, `edit` applied to its JSON; returns the path.
+    std::string variant(const std::function<void(json&)>& edit, const std::string& bytes = buffer_bytes()) {
+        json g = json::parse(test::slurp(fs::path(ANIMORDER_SOURCE_DIR) / "docs" / "extension" / "example.gltf"));
+        g["buffers"][0]["uri"] = "example.bin";
+        if (edit) edit(g);
+        std::ofstream(path("example.bin"), std::ios::binary) << bytes;
+        std::ofstream(path("example.gltf")) << g.dump(1);
+        return path("example.gltf").string();
+    }
+};
+
+}  // namespace
+
+TEST_F(GltfExtension, TheExampleReadsAsTheReadmeDescribesIt) {
+    // The shipped example itself (embedded buffer) and the rebuilt one agree.
+    for (const std::string& file : {(fs::path(ANIMORDER_SOURCE_DIR) / "docs" / "extension" / "example.gltf").string(),
+                                    variant(nullptr)}) {
+        const OrdersExtensionCheck r = check_orders_extension(file);
+        ASSERT_TRUE(r.errors.empty()) << r.errors.front();
+        EXPECT_TRUE(r.present);
+        EXPECT_EQ(r.method, "single");
+        EXPECT_EQ(r.buffer_count, 2u);
+        EXPECT_EQ(r.fallback, 0u);
+        ASSERT_EQ(r.clips.size(), 1u);
+        const ExtensionClip& c = r.clips[0];
+        EXPECT_EQ(c.name, "still");
+        EXPECT_EQ(c.animation, 0);
+        EXPECT_EQ(c.sample_rate, 30);
+        EXPECT_EQ(c.keyframes, 1u);
+        EXPECT_EQ(c.theta_steps, 2u);
+        EXPECT_EQ(c.phi_steps, 2u);
+        EXPECT_EQ(c.cells, (std::vector<uint8_t>{0, 1, 1, 0}));
+        EXPECT_EQ(c.centers, (std::vector<float>{0.5f, 0.5f, 0.f}));
+        ASSERT_EQ(r.primitives.size(), 1u);
+        const ExtensionPrimitive& p = r.primitives[0];
+        EXPECT_EQ(p.component_type, 5123);
+        EXPECT_EQ(p.indices, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3}));
+        EXPECT_EQ(p.orders, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3, 0, 2, 3, 0, 1, 2}));
+        EXPECT_TRUE(p.indices_equal_fallback);
+        EXPECT_EQ(p.order_is_permutation, (std::vector<bool>{true, true}));
+        EXPECT_NO_THROW(read_orders_extension(file));
+    }
+}
+
+TEST_F(GltfExtension, EveryCorruptionIsReportedOnOneLine) {
+    const auto root = [](json& g) -> json& { return g["extensions"][kExt]; };
+    const auto prim = [](json& g) -> json& { return g["meshes"][0]["primitives"][0]["extensions"][kExt]; };
+    struct Case {
+        const char* what;
+        std::function<void(json&)> edit;
+        std::string bytes;
+        const char* expected;
+    };
+    const std::vector<Case> cases = {
+        {"no extension", [](json& g) { g.erase("extensions"); g.erase("extensionsUsed"); }, buffer_bytes(),
+         "no ANIMORDER_animated_triangle_orders extension"},
+        {"required", [](json& g) { g["extensionsRequired"] = {kExt}; }, buffer_bytes(), "must not be listed in extensionsRequired"},
+        {"not used", [](json& g) { g["extensionsUsed"] = json::array(); }, buffer_bytes(), "not listed in extensionsUsed"},
+        {"orders out of range", [&](json& g) { prim(g)["orders"] = 99; }, buffer_bytes(), "accessor 99 does not exist"},
+        {"orders negative", [&](json& g) { prim(g)["orders"] = -1; }, buffer_bytes(), "orders = -1 is out of range"},
+        {"orders of the wrong type", [&](json& g) { prim(g)["orders"] = 0; }, buffer_bytes(), "has the wrong type"},
+        {"orders of bytes", [&](json& g) { prim(g)["orders"] = 3; }, buffer_bytes(), "UNSIGNED_BYTE"},
+        {"orders past their view", [](json& g) { g["accessors"][2]["count"] = 14; }, buffer_bytes(), "more than its buffer view holds"},
+        {"orderCount", [&](json& g) { prim(g)["orderCount"] = 3; }, buffer_bytes(), "orderCount 3 differs from bufferCount 2"},
+        {"bufferCount", [&](json& g) { root(g)["bufferCount"] = 3; prim(g)["orderCount"] = 3; }, buffer_bytes(),
+         "orders has 12 elements; orderCount x indices = 18"},
+        {"fallback out of range", [&](json& g) { root(g)["fallback"] = 2; }, buffer_bytes(), "fallback = 2 is out of range"},
+        {"indices not the fallback", [&](json& g) { root(g)["fallback"] = 1; }, buffer_bytes(), "indices differs from order 1"},
+        {"flipped winding", nullptr, buffer_bytes([](std::vector<uint16_t>& o) { std::swap(o[7], o[8]); }),
+         "order 1 is not a permutation"},
+        {"other triangle", nullptr, buffer_bytes([](std::vector<uint16_t>& o) { o[11] = 3; }), "order 1 is not a permutation"},
+        {"table of the wrong size", [&](json& g) { root(g)["clips"][0]["thetaSteps"] = 3; }, buffer_bytes(),
+         "table has 4 cells; keyframes x thetaSteps x phiSteps = 6"},
+        {"table accessor out of range", [&](json& g) { root(g)["clips"][0]["table"] = 1000; }, buffer_bytes(),
+         "accessor 1000 does not exist"},
+        {"table of shorts", [&](json& g) { root(g)["clips"][0]["table"] = 1; }, buffer_bytes(), "component type 5123"},
+        {"cell past bufferCount", [&](json& g) { root(g)["clips"][0]["bufferBase"] = 1; }, buffer_bytes(),
+         "names order 2, not below bufferCount 2"},
+        {"thetaSteps 1", [&](json& g) { root(g)["clips"][0]["thetaSteps"] = 1; }, buffer_bytes(), "thetaSteps = 1 is out of range"},
+        {"sampleRate", [&](json& g) { root(g)["clips"][0]["sampleRate"] = 0; }, buffer_bytes(), "sampleRate is missing or not a positive"},
+        {"centers of the wrong type", [&](json& g) { root(g)["clips"][0]["centers"] = 3; }, buffer_bytes(), "centers (accessor 3) has the wrong type"},
+        {"animation out of range", [&](json& g) { root(g)["clips"][0]["animation"] = 5; }, buffer_bytes(), "animation = 5 is out of range"},
+        {"no clips", [&](json& g) { root(g)["clips"] = json::array(); }, buffer_bytes(), "clips is missing or empty"},
+        {"sparse orders", [](json& g) { g["accessors"][2]["sparse"] = {{"count", 1}, {"indices", {{"bufferView", 3}, {"componentType", 5121}}}, {"values", {{"bufferView", 1}}}}; },
+         buffer_bytes(), "is sparse"},
+        {"view outside the buffer", [](json& g) { g["bufferViews"][2]["byteOffset"] = 1000; }, buffer_bytes(), "lies outside its buffer"},
+    };
+    for (const Case& c : cases) {
+        SCOPED_TRACE(c.what);
+        std::string file;
+        try {
+            file = variant(c.edit, c.bytes);
+            const OrdersExtensionCheck r = check_orders_extension(file);
+            ASSERT_FALSE(r.errors.empty());
+            bool found = false;
+            for (const std::string& e : r.errors) {
+                EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+                found = found || e.find(c.expected) != std::string::npos;
+            }
+            EXPECT_TRUE(found) << r.errors.front();
+        } catch (const LoadError& e) {  // tinygltf itself refused the file: also one line
+            EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+            EXPECT_STREQ(c.what, "view outside the buffer") << e.what();
+        }
+        try {
+            read_orders_extension(file);
+            ADD_FAILURE() << "read_orders_extension accepted it";
+        } catch (const LoadError& e) {
+            EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+        }
+    }
+}
+
+TEST_F(GltfExtension, WritingIntoAnotherFileReadsBackTheSame) {
+    const std::string input = variant([](json& g) {
+        g.erase("extensions");
+        g.erase("extensionsUsed");
+        g["meshes"][0]["primitives"][0].erase("extensions");
+    });
+    OrdersExtensionCheck root = read_orders_extension((fs::path(ANIMORDER_SOURCE_DIR) / "docs" / "extension" / "example.gltf").string());
+    root.fallback = 1;
+    PrimitiveOrders po;
+    po.mesh = 0, po.primitive = 0;
+    po.orders = {1, 2, 0, 2, 3, 0, 3, 0, 2, 0, 1, 2};  // both orders, rotated corners
+    for (const bool binary : {true, false}) {
+        const fs::path out = path(binary ? "out.glb" : "out.gltf");
+        std::ofstream(out, std::ios::binary) << gltf_with_extension_orders(input, out.string(), root, {po}, binary);
+        const OrdersExtensionCheck r = check_orders_extension(out.string());
+        ASSERT_TRUE(r.errors.empty()) << r.errors.front();
+        EXPECT_EQ(r.fallback, 1u);
+        EXPECT_EQ(r.primitives[0].orders, po.orders);
+        EXPECT_EQ(r.primitives[0].indices, (std::vector<uint32_t>{3, 0, 2, 0, 1, 2}));
+        EXPECT_EQ(r.clips[0].cells, (std::vector<uint8_t>{0, 1, 1, 0}));
+        EXPECT_EQ(r.clips[0].animation, 0);
+    }
+}
+
+TEST_F(GltfExtension, TheExamplePassesTheKhronosValidator) {
+    std::string why, report;
+    ANIMORDER_REQUIRE_OR_SKIP("validator", test::validator_available(why), why);
+    const fs::path example = fs::path(ANIMORDER_SOURCE_DIR) / "docs" / "extension" / "example.gltf";
+    ASSERT_TRUE(test::validate_gltf(example, report, dir_)) << report;
+    EXPECT_EQ(nlohmann::json::parse(report)["errors"], 0) << report;
+}

@@ -1,0 +1,219 @@
+// The orders through real glTF pipelines, on the bundled character (exported with `subdivide
+// --levels 0`) and two characters of ../shared/data: glTF-Transform (prune, dedup, resample,
+// optimize without compression, simplification or weld) with js/gltf-transform-animorder
+// registered keeps orders that `check` accepts; gltf-pipeline and gltfpack outputs are rejected
+// by `check` (their orders are gone or dangle), and `reapply` turns them into files that `check`
+// accepts and whose stored-order OVR (`evaluate --stored`) equals the optimised file's within
+// 0.001. Every output passes the Khronos glTF Validator without errors. A simplified file is
+// refused by `reapply` with one line and nothing written.
+#include "support/files.h"
+#include "support/require.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+namespace fs = std::filesystem;
+namespace test = animorder::test;
+using nlohmann::json;
+
+namespace {
+
+const fs::path kSource = ANIMORDER_SOURCE_DIR;
+const fs::path kTools = kSource / ".tools" / "node_modules" / ".bin";
+const fs::path kConfig = kSource / "js" / "gltf-transform-animorder" / "gltf-transform.config.js";
+
+bool on_path(const std::string& program) {
+    return std::system(("command -v " + program + " >/dev/null 2>&1").c_str()) == 0;
+}
+
+class GltfPipelines : public test::ScratchFolderTest {
+protected:
+    GltfPipelines() : ScratchFolderTest("animorder-gltf-pipelines") {}
+    test::Outcome run(const std::string& command) { return test::run_captured(command, dir_); }
+    std::string exe() const { return ANIMORDER_EXE; }
+    std::string q(const fs::path& p) const { return "'" + p.string() + "'"; }
+
+    bool tools_present(std::string& why) const {
+        for (const char* t : {"gltf-transform", "gltf-pipeline"})
+            if (!fs::exists(kTools / t)) {
+                why = (kTools / t).string() + " is absent (run scripts/install-deps.sh)";
+                return false;
+            }
+        if (!fs::exists(kSource / "js" / "gltf-transform-animorder" / "node_modules" / "@gltf-transform" / "core")) {
+            why = "js/gltf-transform-animorder/node_modules is absent (run scripts/install-deps.sh)";
+            return false;
+        }
+        if (!on_path("gltfpack") || !on_path("node")) {
+            why = "gltfpack or node is not on PATH (Debian packages gltfpack, nodejs)";
+            return false;
+        }
+        return true;
+    }
+
+    void expect_valid(const fs::path& file) {
+        std::string report;
+        const bool valid = test::validate_gltf(file, report, dir_);
+        EXPECT_TRUE(valid) << file << ": " << report;
+        if (valid) {
+            EXPECT_EQ(json::parse(report)["errors"], 0) << file << ": " << report;
+        }
+    }
+
+    int check(const fs::path& file) {
+        const test::Outcome o = run(exe() + " check " + q(file));
+        EXPECT_EQ(o.exit_code == 0, json::parse(o.out)["ok"].get<bool>()) << o.out;
+        if (o.exit_code != 0) {
+            EXPECT_EQ(test::line_count(o.err), 1u) << o.err;
+        }
+        return o.exit_code;
+    }
+
+    double stored_ovr(const fs::path& file) {
+        const fs::path report = path(file.stem().string() + ".evaluate.json");
+        const test::Outcome o = run(exe() + " evaluate -q --methods original --stored --eval-views 12 --eval-resolution 64 " +
+                                    q(file) + " --report " + q(report));
+        EXPECT_EQ(o.exit_code, 0) << o.err;
+        if (o.exit_code != 0) return -1;
+        const json j = json::parse(test::slurp(report));
+        EXPECT_EQ(j["methods"].back()["name"], "stored");
+        return j["methods"].back()["ovr_mean"].get<double>();
+    }
+
+    void round_trip(const fs::path& input, const std::string& name) {
+        SCOPED_TRACE(name);
+        const fs::path optimised = path(name + ".glb");
+        test::Outcome o = run(exe() + " optimize -q --method single -k 3 --views 12 --resolution 64 --max-iterations 3 " +
+                              q(input) + " -o " + q(optimised));
+        ASSERT_EQ(o.exit_code, 0) << o.err;
+        ASSERT_EQ(check(optimised), 0);
+        expect_valid(optimised);
+        const double ovr = stored_ovr(optimised);
+        ASSERT_GT(ovr, 1.0);
+
+        // glTF-Transform with the extension registered: the orders stay valid.
+        const std::string gt = q(kTools / "gltf-transform");
+        for (const std::string& step :
+             {std::string("prune"), std::string("dedup"), std::string("resample"),
+              std::string("optimize --compress false --texture-compress false --simplify false --weld false")}) {
+            SCOPED_TRACE(step);
+            const fs::path out = path(name + "-gt-" + step.substr(0, step.find(' ')) + ".glb");
+            const std::string verb = step.substr(0, step.find(' '));
+            const std::string rest = step.find(' ') == std::string::npos ? "" : step.substr(step.find(' '));
+            o = run(gt + " " + verb + " " + q(optimised) + " " + q(out) + rest + " --config " + q(kConfig));
+            ASSERT_EQ(o.exit_code, 0) << o.out << o.err;
+            EXPECT_EQ(check(out), 0);
+            expect_valid(out);
+            EXPECT_NEAR(stored_ovr(out), ovr, 1e-3);
+        }
+
+        // gltf-pipeline (dangling accessor references) and gltfpack (extension dropped, triangles
+        // reordered, positions quantised): check rejects, reapply repairs.
+        // glTF-Transform's reorder and weld rewrite the triangles: the extension drops the orders.
+        const fs::path pipeline = path(name + "-pipeline.glb"), pack = path(name + "-gltfpack.glb");
+        const fs::path reorder = path(name + "-gt-reorder.glb"), weld = path(name + "-gt-weld.glb");
+        o = run(q(kTools / "gltf-pipeline") + " -i " + q(optimised) + " -o " + q(pipeline));
+        ASSERT_EQ(o.exit_code, 0) << o.out << o.err;
+        o = run("gltfpack -i " + q(optimised) + " -o " + q(pack));
+        ASSERT_EQ(o.exit_code, 0) << o.out << o.err;
+        for (const fs::path& out : {reorder, weld}) {
+            const std::string verb = out == reorder ? "reorder" : "weld";
+            o = run(gt + " " + verb + " " + q(optimised) + " " + q(out) + " --config " + q(kConfig));
+            ASSERT_EQ(o.exit_code, 0) << o.out << o.err;
+        }
+        for (const fs::path& processed : {pipeline, pack, reorder, weld}) {
+            SCOPED_TRACE(processed.filename().string());
+            // A weld that merged nothing may keep the orders; every other tool here loses them.
+            const int checked = check(processed);
+            if (processed != weld) {
+                EXPECT_EQ(checked, 1);
+            }
+            if (processed == reorder) {
+                EXPECT_NE(test::slurp(path("stderr.txt")).find("no ANIMORDER"), std::string::npos);
+            }
+            const fs::path repaired = path(processed.stem().string() + "-reapplied.glb");
+            o = run(exe() + " reapply " + q(optimised) + " " + q(processed) + " -o " + q(repaired));
+            ASSERT_EQ(o.exit_code, 0) << o.err;
+            EXPECT_NE(o.err.find("matched"), std::string::npos) << o.err;
+            EXPECT_EQ(check(repaired), 0);
+            expect_valid(repaired);
+            EXPECT_NEAR(stored_ovr(repaired), ovr, 1e-3);
+        }
+
+        // A simplified file: refused in one line, nothing written.
+        const fs::path simplified = path(name + "-simplified.glb"), refused = path(name + "-refused.glb");
+        o = run("gltfpack -si 0.3 -sa -i " + q(optimised) + " -o " + q(simplified));
+        ASSERT_EQ(o.exit_code, 0) << o.err;
+        o = run(exe() + " reapply -q " + q(optimised) + " " + q(simplified) + " -o " + q(refused));
+        EXPECT_EQ(o.exit_code, 1);
+        EXPECT_EQ(test::line_count(o.err), 1u) << o.err;
+        EXPECT_NE(o.err.find("nothing written"), std::string::npos) << o.err;
+        EXPECT_FALSE(fs::exists(refused));
+    }
+};
+
+}  // namespace
+
+TEST_F(GltfPipelines, BundledCharacter) {
+    std::string why;
+    ANIMORDER_REQUIRE_OR_SKIP("gltf-tools", tools_present(why), why);
+    ANIMORDER_REQUIRE_OR_SKIP("validator", test::validator_available(why), why);
+    const test::Outcome o = run(exe() + " subdivide -q --levels 0 -o " + q(path("character.glb")));
+    ASSERT_EQ(o.exit_code, 0) << o.err;
+    round_trip(path("character.glb"), "character-optimised");
+}
+
+TEST_F(GltfPipelines, CesiumMan) {
+    std::string why;
+    const fs::path input = test::shared_data_path("gltf-cesiumman/CesiumMan.glb");
+    ANIMORDER_REQUIRE_DATA(input);
+    ANIMORDER_REQUIRE_OR_SKIP("gltf-tools", tools_present(why), why);
+    ANIMORDER_REQUIRE_OR_SKIP("validator", test::validator_available(why), why);
+    round_trip(input, "cesiumman");
+}
+
+TEST_F(GltfPipelines, Fox) {
+    std::string why;
+    const fs::path input = test::shared_data_path("gltf-fox/Fox.glb");
+    ANIMORDER_REQUIRE_DATA(input);
+    ANIMORDER_REQUIRE_OR_SKIP("gltf-tools", tools_present(why), why);
+    ANIMORDER_REQUIRE_OR_SKIP("validator", test::validator_available(why), why);
+    round_trip(input, "fox");
+}
+
+TEST_F(GltfPipelines, CheckAndReapplyRefuseBadInputInOneLine) {
+    // A file without the extension, and one with it corrupted (tables of the wrong size).
+    const fs::path example = kSource / "docs" / "extension" / "example.gltf";
+    json g = json::parse(test::slurp(example));
+    g["extensions"]["ANIMORDER_animated_triangle_orders"]["clips"][0]["phiSteps"] = 7;
+    std::ofstream(path("corrupt.gltf")) << g.dump();
+    g.erase("extensions");
+    g.erase("extensionsUsed");
+    std::ofstream(path("plain.gltf")) << g.dump();
+    test::Outcome o = run(exe() + " check " + q(path("plain.gltf")));
+    EXPECT_EQ(o.exit_code, 1);
+    EXPECT_EQ(test::line_count(o.err), 1u) << o.err;
+    EXPECT_NE(o.err.find("no ANIMORDER_animated_triangle_orders extension"), std::string::npos) << o.err;
+    EXPECT_FALSE(json::parse(o.out)["present"].get<bool>());
+    o = run(exe() + " check " + q(path("corrupt.gltf")));
+    EXPECT_EQ(o.exit_code, 1);
+    EXPECT_NE(o.err.find("table has 4 cells"), std::string::npos) << o.err;
+    for (const char* optimised : {"plain.gltf", "corrupt.gltf"}) {
+        o = run(exe() + " reapply " + q(path(optimised)) + " " + q(example) + " -o " + q(path("out.glb")));
+        EXPECT_EQ(o.exit_code, 1);
+        EXPECT_EQ(test::line_count(o.err), 1u) << o.err;
+        EXPECT_FALSE(fs::exists(path("out.glb")));
+    }
+    o = run(exe() + " evaluate -q --methods original --stored " + q(path("corrupt.gltf")));
+    EXPECT_EQ(o.exit_code, 1);
+    EXPECT_EQ(test::line_count(o.err), 1u) << o.err;
+    // Mismatched meshes: the example's quad is not the bundled character.
+    ASSERT_EQ(run(exe() + " subdivide -q --levels 0 -o " + q(path("character.glb"))).exit_code, 0);
+    o = run(exe() + " reapply " + q(example) + " " + q(path("character.glb")) + " -o " + q(path("out.glb")));
+    EXPECT_EQ(o.exit_code, 1);
+    EXPECT_NE(o.err.find("nothing written"), std::string::npos) << o.err;
+    EXPECT_FALSE(fs::exists(path("out.glb")));
+}

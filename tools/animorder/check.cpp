@@ -1,0 +1,58 @@
+// `animorder check FILE`: are the ANIMORDER_animated_triangle_orders orders of a glTF file usable
+// (check_orders_extension: every reference and size, every order a permutation of the
+// primitive's current triangles with their winding, `indices` equal to the fallback, tables
+// covering every clip)? A JSON report on stdout; exit 0 when usable, else 1 with the first
+// problem on stderr.
+#include "commands.h"
+
+#include "animorder/gltf_extension.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <stdexcept>
+
+namespace animorder::tool {
+
+int run_check(const CheckOptions& options) {
+    const OrdersExtensionCheck r = check_orders_extension(options.file);
+    nlohmann::json j;
+    j["file"] = options.file;
+    j["extension"] = kOrdersExtensionName;
+    j["present"] = r.present;
+    j["ok"] = r.errors.empty();
+    if (r.present) {
+        j["method"] = r.method;
+        j["buffer_count"] = r.buffer_count;
+        j["fallback"] = r.fallback;
+        j["clips"] = nlohmann::json::array();
+        for (const ExtensionClip& c : r.clips)
+            j["clips"].push_back({{"name", c.name},
+                                  {"animation", c.animation >= 0 ? nlohmann::json(c.animation) : nlohmann::json()},
+                                  {"keyframes", c.keyframes},
+                                  {"sample_rate", c.sample_rate},
+                                  {"buffer_base", c.buffer_base},
+                                  {"table_cells", c.cells.size()}});
+        j["primitives"] = nlohmann::json::array();
+        for (const ExtensionPrimitive& p : r.primitives) {
+            size_t good = 0;
+            for (bool b : p.order_is_permutation) good += b;
+            j["primitives"].push_back({{"mesh", p.mesh},
+                                       {"primitive", p.primitive},
+                                       {"triangles", p.indices.size() / 3},
+                                       {"index_type", p.component_type == 5123 ? "UNSIGNED_SHORT" : "UNSIGNED_INT"},
+                                       {"orders", p.order_count},
+                                       {"orders_valid", good},
+                                       {"indices_equal_fallback", p.indices_equal_fallback}});
+        }
+    }
+    j["errors"] = r.errors;
+    std::printf("%s\n", j.dump(2).c_str());
+    if (r.errors.empty()) return 0;
+    if (options.quiet) return 1;
+    std::fprintf(stderr, "animorder: error: %s: %s%s\n", options.file.c_str(), r.errors.front().c_str(),
+                 r.errors.size() > 1 ? (" (and " + std::to_string(r.errors.size() - 1) + " more problems)").c_str() : "");
+    return 1;
+}
+
+}  // namespace animorder::tool

@@ -1,0 +1,141 @@
+// `animorder reapply OPTIMIZED PROCESSED -o OUT`: after a tool rewrote an optimised glTF file
+// (gltfpack, gltf-pipeline, `gltf-transform reorder`…), the k orders of OPTIMIZED mapped onto
+// PROCESSED's triangles and written into a copy of PROCESSED. Triangles are matched by their
+// corners (match_triangles): the posed positions of each corner at the first keyframe of every
+// clip both files share (positions as the loader computes them: node transforms, skins, morph
+// targets and KHR_mesh_quantization dequantisation applied, so indices and vertex layouts may
+// differ). Refused, with nothing written, unless every triangle of every optimised primitive
+// matches one triangle of PROCESSED and every processed primitive is wholly matched or untouched.
+#include "commands.h"
+
+#include "animorder/atomic_write.h"
+#include "animorder/gltf_extension.h"
+#include "animorder/gltf_loader.h"
+#include "animorder/triangle_matching.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <stdexcept>
+
+namespace animorder::tool {
+namespace {
+
+// Per triangle of the listed primitives of `mesh` (or all when `only` is empty), its three
+// corners, each with xyz at every keyframe in `keyframes`.
+std::vector<float> corners(const AnimatedMesh& mesh, const std::vector<size_t>& triangles, const std::vector<size_t>& keyframes) {
+    const size_t dims = 3 * keyframes.size();
+    std::vector<float> out(triangles.size() * 3 * dims);
+    for (size_t i = 0; i < triangles.size(); ++i)
+        for (size_t c = 0; c < 3; ++c) {
+            const uint32_t v = mesh.indices[3 * triangles[i] + c];
+            for (size_t k = 0; k < keyframes.size(); ++k)
+                for (size_t a = 0; a < 3; ++a)
+                    out[(i * 3 + c) * dims + 3 * k + a] = mesh.keyframe(keyframes[k])[3 * v + a];
+        }
+    return out;
+}
+
+}  // namespace
+
+int run_reapply(const ReapplyOptions& options) {
+    const std::string extension = std::filesystem::path(options.output).extension().string();
+    if (extension != ".glb" && extension != ".gltf")
+        throw std::runtime_error(options.output + ": the output must be a .glb or .gltf file");
+    check_output_paths({options.output}, {options.optimized, options.processed});
+    const OrdersExtensionCheck orders = read_orders_extension(options.optimized);
+    LoadOptions load;
+    load.max_keyframe_bytes = options.max_memory;
+    const AnimatedMesh a = load_gltf(options.optimized, load);
+    const AnimatedMesh b = load_gltf(options.processed, load);
+
+    // The keyframes compared: the first of every clip both files have (by name), else keyframe 0.
+    std::vector<size_t> ka, kb;
+    for (const Clip& ca : a.clips)
+        for (const Clip& cb : b.clips)
+            if (ca.name == cb.name && ka.size() < 4) ka.push_back(ca.first_keyframe), kb.push_back(cb.first_keyframe);
+    if (ka.empty()) ka = {0}, kb = {0};
+
+    // OPTIMIZED's primitives with orders, and each order as a permutation of its drawn triangles.
+    struct Source {
+        const ExtensionPrimitive* ext;
+        size_t first_triangle, triangles;
+        std::vector<std::vector<uint32_t>> order_triangles;  // per order: triangle positions in `indices`
+    };
+    std::vector<Source> sources;
+    std::vector<size_t> a_triangles;
+    for (const Primitive& p : a.primitives)
+        for (const ExtensionPrimitive& e : orders.primitives)
+            if (e.mesh == p.source_mesh && e.primitive == p.source_primitive) {
+                if (e.indices.size() != p.index_count)
+                    throw std::runtime_error(options.optimized + ": primitive " + std::to_string(e.mesh) + "/" +
+                                             std::to_string(e.primitive) + " reads back with another index count");
+                for (size_t i = 0; i < p.index_count; ++i)
+                    if (a.indices[p.first_index + i] != e.indices[i] + p.vertex_base)
+                        throw std::runtime_error(options.optimized + ": primitive " + std::to_string(e.mesh) + "/" +
+                                                 std::to_string(e.primitive) + " reads back with other indices");
+                Source s{&e, p.first_index / 3, p.index_count / 3, {}};
+                const size_t n = e.indices.size();
+                for (uint32_t o = 0; o < e.order_count; ++o)
+                    s.order_triangles.push_back(triangle_permutation(e.indices.data(), e.orders.data() + o * n, n / 3));
+                for (size_t t = 0; t < s.triangles; ++t) a_triangles.push_back(s.first_triangle + t);
+                sources.push_back(std::move(s));
+            }
+    if (sources.empty()) throw std::runtime_error(options.optimized + ": no primitive with orders reads back");
+    std::vector<size_t> b_triangles(b.triangle_count());
+    for (size_t t = 0; t < b_triangles.size(); ++t) b_triangles[t] = t;
+
+    // Tolerance: relative to the diagonal of OPTIMIZED's first compared keyframe.
+    float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t v = 0; v < a.vertex_count; ++v)
+        for (int c = 0; c < 3; ++c)
+            lo[c] = std::min(lo[c], a.keyframe(ka[0])[3 * v + size_t(c)]), hi[c] = std::max(hi[c], a.keyframe(ka[0])[3 * v + size_t(c)]);
+    const float diagonal = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    const TriangleMatch m = match_triangles(corners(a, a_triangles, ka), corners(b, b_triangles, kb), 3 * ka.size(),
+                                            float(options.tolerance) * diagonal);
+    // Per triangle of OPTIMIZED (global index): its triangle of PROCESSED.
+    std::vector<int64_t> b_of_a(a.triangle_count(), -1);
+    for (size_t t = 0; t < m.from_of_to.size(); ++t)
+        if (m.from_of_to[t] >= 0) b_of_a[a_triangles[size_t(m.from_of_to[t])]] = int64_t(t);
+    if (!options.quiet)
+        std::fprintf(stderr, "animorder: matched %zu of %zu optimised triangles to %zu processed triangles\n", m.matched,
+                 a_triangles.size(), b.triangle_count());
+    if (m.matched != a_triangles.size())
+        throw std::runtime_error(options.processed + ": only " + std::to_string(m.matched) + " of " +
+                                 std::to_string(a_triangles.size()) + " optimised triangles found (simplified or changed mesh?); nothing written");
+
+    std::vector<PrimitiveOrders> out;
+    std::map<std::pair<int, int>, size_t> seen;
+    for (const Primitive& p : b.primitives) {
+        size_t hits = 0;
+        for (size_t t = p.first_index / 3; t < (p.first_index + p.index_count) / 3; ++t) hits += m.from_of_to[t] >= 0;
+        if (hits == 0) continue;
+        if (hits != p.index_count / 3)
+            throw std::runtime_error(options.processed + ": primitive " + p.name + " holds " +
+                                     std::to_string(p.index_count / 3 - hits) +
+                                     " triangles that are not OPTIMIZED's (changed mesh?); nothing written");
+        if (!seen.emplace(std::make_pair(p.source_mesh, p.source_primitive), 0).second)
+            throw std::runtime_error(options.processed + ": mesh " + std::to_string(p.source_mesh) +
+                                     " is drawn by several nodes; reapply needs one node per mesh");
+        PrimitiveOrders po;
+        po.mesh = p.source_mesh, po.primitive = p.source_primitive;
+        const size_t first = p.first_index / 3, last = first + p.index_count / 3;
+        for (uint32_t o = 0; o < orders.buffer_count; ++o)
+            for (const Source& s : sources)
+                for (uint32_t q : s.order_triangles[o]) {
+                    const int64_t t = b_of_a[s.first_triangle + q];
+                    if (t < int64_t(first) || t >= int64_t(last)) continue;
+                    for (size_t c = 0; c < 3; ++c) po.orders.push_back(uint32_t(b.indices[3 * size_t(t) + c] - p.vertex_base));
+                }
+        out.push_back(std::move(po));
+    }
+    const std::string bytes = gltf_with_extension_orders(options.processed, options.output, orders, out, extension == ".glb");
+    write_file_atomically(options.output, bytes);
+    std::printf("reapplied %u orders: %zu of %zu triangles matched, %zu primitive(s); wrote %s\n", orders.buffer_count,
+                m.matched, a_triangles.size(), out.size(), options.output.c_str());
+    return 0;
+}
+
+}  // namespace animorder::tool

@@ -79,3 +79,21 @@ if [ -f "$here/js/gltf-transform-animorder/package-lock.json" ] &&
   echo "install-deps: installing js/gltf-transform-animorder's dependencies (npm ci)" >&2
   (cd "$here/js/gltf-transform-animorder" && npm ci --silent --no-audit --no-fund >/dev/null)
 fi
+
+# The viewer and its browser tests (viewer/, tests/js): Debian's Chromium (headless, WebGL2 on
+# SwiftShader) and, from viewer/package-lock.json, three 0.187.0 and puppeteer-core 24.9.0 (no
+# browser download: the tests point puppeteer at /usr/bin/chromium).
+if ! dpkg-query -W -f='${Status}' chromium 2>/dev/null | grep -q "install ok installed"; then
+  echo "install-deps: installing chromium" >&2
+  SUDO=""
+  [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends chromium >/dev/null
+fi
+if [ ! -f "$here/viewer/node_modules/three/package.json" ] ||
+   ! grep -q '"version": "0.187.0"' "$here/viewer/node_modules/three/package.json" ||
+   [ ! -f "$here/viewer/node_modules/puppeteer-core/package.json" ]; then
+  echo "install-deps: installing the viewer's npm packages (npm ci in viewer/)" >&2
+  (cd "$here/viewer" && PUPPETEER_SKIP_DOWNLOAD=1 npm ci --silent --no-audit --no-fund >/dev/null)
+fi

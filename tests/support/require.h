@@ -1,8 +1,9 @@
 // Prerequisites of a test that a machine may lack (an OpenGL context, the Khronos glTF validator,
 // the real characters of ../shared/data): without one, the test is skipped with the reason, so
 // the skip shows in the CTest summary; and where the environment variable ANIMORDER_REQUIRE names
-// the component (a comma list of gl, validator, data, results, gltf-tools; or all), the test fails with the reason
-// instead. .ci/run sets ANIMORDER_REQUIRE=gl,validator,data, so CI cannot pass by skipping.
+// the component (a comma list of gl, validator, data, results, gltf-tools, node, browser; or all), the
+// test fails with the reason instead. .ci/run names every component CI has, so CI cannot pass by
+// skipping.
 //
 //   ANIMORDER_REQUIRE_OR_SKIP("data", fs::exists(path), path + " is absent");
 //
@@ -20,7 +21,8 @@ namespace animorder::test {
 
 // The components a test can require; anything else in ANIMORDER_REQUIRE is a typo, and fails.
 inline bool known_component(const std::string& name) {
-    return name == "gl" || name == "validator" || name == "data" || name == "results" || name == "gltf-tools";
+    return name == "gl" || name == "validator" || name == "data" || name == "results" || name == "gltf-tools" ||
+           name == "node" || name == "browser";
 }
 
 // Whether `requirement` (ANIMORDER_REQUIRE's value; null when unset) requires `component`.
@@ -41,7 +43,7 @@ inline bool requires_component(const char* requirement, const std::string& compo
         if (item == "all" || item == component) found = true;
         else if (!known_component(item))
             ADD_FAILURE() << "ANIMORDER_REQUIRE names an unknown component '" << item
-                          << "' (known: gl, validator, data, results, gltf-tools, all)";
+                          << "' (known: gl, validator, data, results, gltf-tools, node, browser, all)";
     }
     return found;
 }

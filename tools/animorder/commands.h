@@ -75,6 +75,15 @@ struct SubdivideOptions {
     std::string output;  // OUT.glb or OUT.gltf
 };
 
+struct ViewOptions {
+    CommonOptions common;     // input: the glb to show (empty: the bundled character, optimised)
+    std::string original;     // --original: the un-optimised file, for the page's comparison
+    unsigned port = 8417;     // 0: any free port
+    bool open = true;         // start the default browser
+    unsigned seconds = 0;     // stop after this long (0: until interrupted)
+    std::string viewer_root;  // the folder holding viewer/ and js/ (default: the source tree)
+};
+
 struct CheckOptions {
     std::string file;  // a glTF/GLB file with (or without) ANIMORDER_animated_triangle_orders
     bool quiet = false;  // no error line on stderr (the JSON report still says it)
@@ -92,6 +101,7 @@ int run_optimize(const OptimizeOptions& options);
 int run_evaluate(const EvaluateOptions& options);
 int run_heatmap(const HeatmapOptions& options);
 int run_subdivide(const SubdivideOptions& options);
+int run_view(const ViewOptions& options);
 int run_check(const CheckOptions& options);
 int run_reapply(const ReapplyOptions& options);
 

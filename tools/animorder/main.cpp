@@ -215,6 +215,17 @@ int main(int argc, char** argv) {
         ->capture_default_str()
         ->check(CLI::Range(0u, 1024u));
 
+    ViewOptions view;
+    CLI::App* view_cmd = app.add_subcommand(
+        "view", "Serve the viewer page and a glb on 127.0.0.1 (the bundled character, optimised, by default)");
+    view_cmd->add_option("input", view.common.input, "The optimised glb to show (default: the bundled character, optimised)");
+    view_cmd->add_flag("-q,--quiet", view.common.quiet, "No progress or notes on stderr");
+    view_cmd->add_option("--original", view.original, "The un-optimised file, to compare its order in the page");
+    view_cmd->add_option("--port", view.port, "Port on 127.0.0.1 (0: any free one)")->capture_default_str()->check(CLI::Range(0u, 65535u));
+    view_cmd->add_flag("!--no-open", view.open, "Do not start a browser; just print the address");
+    view_cmd->add_option("--seconds", view.seconds, "Stop serving after this many seconds (0: until interrupted)");
+    view_cmd->add_option("--viewer-root", view.viewer_root, "The folder holding viewer/ and js/ (default: the source tree)");
+
     CheckOptions check;
     CLI::App* check_cmd = app.add_subcommand(
         "check", "Check the ANIMORDER_animated_triangle_orders orders of a glTF file (JSON report; exit 1 when unusable)");
@@ -256,6 +267,7 @@ int main(int argc, char** argv) {
         if (*heatmap_cmd) return run_heatmap(heatmap);
         if (*subdivide_cmd) return run_subdivide(subdivide);
         if (*batch_cmd) return run_batch(batch, parse_batch_item);
+        if (*view_cmd) return run_view(view);
         if (*check_cmd) return run_check(check);
         if (*reapply_cmd) return run_reapply(reapply);
     } catch (const std::exception& e) {

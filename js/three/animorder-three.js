@@ -1,0 +1,222 @@
+// animorder for three.js: a GLTFLoader plugin that reads ANIMORDER_animated_triangle_orders into
+// each optimised primitive's geometry (all K orders in one index buffer, order b = the index range
+// [b·n, (b+1)·n)), and a per-character object whose update(camera, mixer) picks the order for the
+// current clip time and camera (js/runtime/animorder.js, identical to the C runtime) and sets the
+// draw range. Works with Mesh and SkinnedMesh, several primitives, several characters in a scene
+// (each object keeps its own range, applied in onBeforeRender, so clones that share a geometry
+// draw their own order), and files without the extension (gltf.userData.animorder stays null).
+//
+//   import { AnimorderGLTFPlugin } from './js/three/animorder-three.js';
+//   loader.register((parser) => new AnimorderGLTFPlugin(parser));
+//   const gltf = await loader.loadAsync('character.glb');
+//   const orders = gltf.userData.animorder;              // AnimorderCharacter, or null
+//   ... each frame: mixer.update(dt); orders?.update(camera, mixer); renderer.render(scene, camera);
+import { BufferAttribute, Vector3 } from 'three';
+import { AnimorderError, AnimorderRuntime, EXTENSION_NAME } from '../runtime/animorder.js';
+
+export { AnimorderRuntime, EXTENSION_NAME };
+
+const COMPONENT = { 5121: Uint8Array, 5123: Uint16Array, 5125: Uint32Array, 5126: Float32Array };
+
+export class AnimorderGLTFPlugin {
+    constructor(parser) {
+        this.parser = parser;
+        this.name = EXTENSION_NAME;
+    }
+
+    async afterRoot(gltf) {
+        gltf.userData = gltf.userData || {};
+        gltf.userData.animorder = null;
+        const json = this.parser.json;
+        const root = json.extensions && json.extensions[EXTENSION_NAME];
+        if (!root) return;
+        try {
+            gltf.userData.animorder = await this.read(gltf, root);
+        } catch (error) {
+            // The spec: a file whose orders do not check out draws its `indices` (the fallback).
+            gltf.userData.animorderError = error.message;
+            console.warn(`${EXTENSION_NAME}: ${error.message}; drawing the fallback order`);
+        }
+    }
+
+    async accessor(index) {
+        const json = this.parser.json;
+        const def = (json.accessors || [])[index];
+        if (!def) throw new AnimorderError(`accessor ${index} does not exist`);
+        const attribute = await this.parser.getDependency('accessor', index);
+        const Type = COMPONENT[def.componentType];
+        if (!Type) throw new AnimorderError(`accessor ${index} has an unexpected component type`);
+        let array = attribute.array;
+        if (attribute.isInterleavedBufferAttribute || !(array instanceof Type) || array.length !== def.count * attribute.itemSize) {
+            array = new Type(def.count * attribute.itemSize);
+            for (let e = 0; e < def.count; ++e)
+                for (let k = 0; k < attribute.itemSize; ++k) array[e * attribute.itemSize + k] = attribute.getComponent(e, k);
+        }
+        return { array, itemSize: attribute.itemSize, count: def.count, componentType: def.componentType };
+    }
+
+    async read(gltf, root) {
+        const json = this.parser.json;
+        const needed = new Map();
+        for (const clip of root.clips || [])
+            for (const index of [clip.table, clip.centers])
+                if (!needed.has(index)) needed.set(index, await this.accessor(index));
+        const runtime = AnimorderRuntime.fromExtension(root, (index) => needed.get(index));
+        const meshes = [];
+        const done = new Map(); // geometry → index count n (geometries GLTFLoader shares)
+        const objects = [];
+        for (const scene of gltf.scenes || [gltf.scene]) scene.traverse((o) => { if (o.isMesh) objects.push(o); });
+        let primitiveOrder = 0;
+        for (const mesh of objects) {
+            const where = this.parser.associations.get(mesh);
+            if (!where || where.meshes === undefined || where.primitives === undefined) continue;
+            const primitive = json.meshes[where.meshes].primitives[where.primitives];
+            const ext = primitive.extensions && primitive.extensions[EXTENSION_NAME];
+            if (!ext) continue;
+            const geometry = mesh.geometry;
+            let n = done.get(geometry);
+            if (n === undefined) {
+                if (!geometry.index) throw new AnimorderError(`mesh ${where.meshes} primitive ${where.primitives} has no indices`);
+                n = geometry.index.count;
+                if (ext.orderCount !== runtime.bufferCount)
+                    throw new AnimorderError(`mesh ${where.meshes} primitive ${where.primitives}: orderCount ${ext.orderCount} != bufferCount ${runtime.bufferCount}`);
+                const orders = await this.accessor(ext.orders);
+                if (orders.itemSize !== 1 || orders.count !== ext.orderCount * n || (orders.componentType !== 5123 && orders.componentType !== 5125))
+                    throw new AnimorderError(`mesh ${where.meshes} primitive ${where.primitives}: orders must be ${ext.orderCount}×${n} unsigned indices`);
+                const vertices = geometry.attributes.position.count;
+                for (let k = 0; k < orders.array.length; ++k)
+                    if (orders.array[k] >= vertices) throw new AnimorderError(`mesh ${where.meshes} primitive ${where.primitives}: an order names vertex ${orders.array[k]} of ${vertices}`);
+                geometry.userData.animorderFallbackIndex = geometry.index;
+                geometry.setIndex(new BufferAttribute(orders.array, 1));
+                done.set(geometry, n);
+            }
+            meshes.push({ mesh, n, mesh_index: where.meshes, primitive_index: where.primitives, drawOrder: primitiveOrder++ });
+        }
+        const character = new AnimorderCharacter(runtime, gltf.scene, meshes, gltf.animations || []);
+        character.setBuffer(runtime.fallback);
+        return character;
+    }
+}
+
+// One loaded character: its runtime, its scene root (the glTF scene's model space), its meshes.
+export class AnimorderCharacter {
+    constructor(runtime, root, meshes, animations) {
+        this.runtime = runtime;
+        this.root = root;
+        this.meshes = meshes;
+        this.animations = animations;
+        this.orderCount = runtime.bufferCount; // grows when extra orders are appended (addOrderFrom)
+        this.fixed = null;       // a buffer id to draw always, or null: the runtime chooses
+        this.buffer = -1;        // the buffer drawn now
+        this.clip = -1;          // the clip the last update used (-1: none playing → fallback)
+        this.keyframe = -1;
+        for (const entry of meshes) {
+            const mesh = entry.mesh;
+            const previous = mesh.onBeforeRender;
+            mesh.onBeforeRender = function (renderer, scene, camera, geometry, material, group) {
+                const range = mesh.userData.animorderRange;
+                if (range) geometry.setDrawRange(range[0], range[1]);
+                if (previous) previous.call(this, renderer, scene, camera, geometry, material, group);
+            };
+        }
+    }
+
+    // The same orders for a copy of the character's scene (SkeletonUtils.clone(gltf.scene), or
+    // Object3D.clone): its meshes share the geometries, and each copy draws its own order.
+    cloneFor(root) {
+        const mine = [], theirs = [];
+        this.root.traverse((o) => { if (o.isMesh) mine.push(o); });
+        root.traverse((o) => { if (o.isMesh) theirs.push(o); });
+        if (mine.length !== theirs.length) throw new AnimorderError('the copy does not have the same meshes');
+        const meshes = this.meshes.map((entry) => {
+            const at = mine.indexOf(entry.mesh);
+            if (at < 0 || theirs[at].geometry !== entry.mesh.geometry) throw new AnimorderError('the copy does not share the geometries');
+            return { ...entry, mesh: theirs[at] };
+        });
+        const copy = new AnimorderCharacter(this.runtime, root, meshes, this.animations);
+        copy.orderCount = this.orderCount;
+        copy.setBuffer(this.buffer >= 0 ? this.buffer : this.runtime.fallback);
+        return copy;
+    }
+
+    // Draw buffer `b` on every optimised primitive now (and keep it while `fixed` says so).
+    setBuffer(b) {
+        this.buffer = b;
+        for (const { mesh, n } of this.meshes) {
+            mesh.userData.animorderRange = [b * n, n];
+            mesh.geometry.setDrawRange(b * n, n);
+        }
+    }
+
+    // The camera's position in the glTF scene's model space (the space of the table's centres).
+    cameraInModelSpace(camera, target = new Vector3()) {
+        camera.updateWorldMatrix(true, false);
+        this.root.updateWorldMatrix(true, false);
+        camera.getWorldPosition(target);
+        return this.root.worldToLocal(target);
+    }
+
+    // The clip whose glTF animation plays with the largest weight in `mixer`, with its time.
+    playing(mixer) {
+        let best = null;
+        this.runtime.clips.forEach((clip, index) => {
+            const animation = this.animations[clip.animation];
+            if (!animation || !mixer) return;
+            const action = mixer.existingAction(animation, this.root) || mixer.existingAction(animation);
+            if (!action || !action.isRunning()) return;
+            const weight = action.getEffectiveWeight();
+            if (weight > 0 && (!best || weight > best.weight)) best = { clip: index, time: action.time, weight };
+        });
+        return best;
+    }
+
+    // Pick and set the buffer for this frame: `timeSource` is an AnimationMixer (the playing clip and
+    // its time) or { clip, time } (time in the glTF animation's seconds). Returns the buffer drawn.
+    update(camera, timeSource) {
+        if (this.fixed !== null) {
+            this.setBuffer(this.fixed);
+            return this.buffer;
+        }
+        const now = timeSource && typeof timeSource.existingAction === 'function' ? this.playing(timeSource) : timeSource;
+        let b = -1;
+        this.clip = -1;
+        this.keyframe = -1;
+        if (now && now.clip >= 0 && this.runtime.clips[now.clip]) {
+            const clip = this.runtime.clips[now.clip];
+            const position = this.cameraInModelSpace(camera);
+            this.clip = now.clip;
+            this.keyframe = this.runtime.keyframeAt(now.clip, now.time - clip.startTime);
+            b = this.runtime.selectAnimationTime(now.clip, now.time, [position.x, position.y, position.z]);
+        }
+        this.setBuffer(b >= 0 ? b : this.runtime.fallback);
+        return this.buffer;
+    }
+
+    // Appends another file's order of the same primitives (e.g. the un-optimised input, loaded
+    // without the extension) as buffer id orderCount, so it can be drawn with setBuffer for
+    // comparison. `other` is that file's gltf from GLTFLoader (same meshes and primitives).
+    addOrderFrom(other, parser) {
+        const byPrimitive = new Map();
+        for (const scene of other.scenes || [other.scene])
+            scene.traverse((o) => {
+                const where = o.isMesh && parser.associations.get(o);
+                if (where && where.primitives !== undefined) byPrimitive.set(`${where.meshes}/${where.primitives}`, o.geometry.index);
+            });
+        const id = this.orderCount;
+        const updated = new Set();
+        for (const { mesh, n, mesh_index, primitive_index } of this.meshes) {
+            const index = byPrimitive.get(`${mesh_index}/${primitive_index}`);
+            if (!index || index.count !== n) throw new AnimorderError(`the other file's mesh ${mesh_index} primitive ${primitive_index} does not match`);
+            const geometry = mesh.geometry;
+            if (updated.has(geometry)) continue;
+            const old = geometry.index.array;
+            const grown = new (old.constructor)(old.length + n);
+            grown.set(old);
+            grown.set(index.array.subarray(0, n), old.length);
+            geometry.setIndex(new BufferAttribute(grown, 1));
+            updated.add(geometry);
+        }
+        this.orderCount = id + 1;
+        return id;
+    }
+}

@@ -35,7 +35,10 @@ namespace animorder {
 // "Tipsify" column). Single / Joint: Han & Sander 2017 (k buffers per clip / for all clips).
 // Oracle: the patches sorted front-to-back at every evaluation node — a bound, not an order to
 // ship (it has no buffers).
-enum class Method { Original, StaticSander07, StaticNehab06, Meshopt, TipsifyPerFrame, Single, Joint, Oracle };
+// Measured / MeasuredJoint: single / joint with each cluster's patches ordered by the overdraw
+// graph measured over its own nodes (measured_order.h), not by distance — beyond the paper.
+enum class Method { Original, StaticSander07, StaticNehab06, Meshopt, TipsifyPerFrame, Single, Joint, Oracle,
+                    Measured, MeasuredJoint };
 
 // The method a user gets without asking (the paper's method).
 constexpr Method kDefaultMethod = Method::Single;
@@ -47,6 +50,10 @@ const std::vector<Method>& all_methods();
 // the unknown name and listing the known ones.
 const char* method_name(Method method);
 Method parse_method(const std::string& name);
+
+// Single, Joint, Measured, MeasuredJoint: k-means buffers; the joint ones span all clips.
+bool method_is_clustered(Method method);
+bool method_is_joint(Method method);
 
 // Which settings a method reads (reports print the others as null): λ (the patch threshold), and
 // k / views / the k-means settings.

@@ -24,6 +24,7 @@
 
 #include "animorder/animated_mesh.h"
 #include "animorder/invalid_input.h"
+#include "animorder/measured_order.h"
 #include "animorder/mesh_patches.h"
 #include "animorder/overdraw.h"
 #include "animorder/rasterizer.h"
@@ -278,6 +279,44 @@ std::vector<size_t> update_orders(const Nodes& nodes, DistanceVariant variant, c
     return members;
 }
 
+// OrderSource::Measured, not in the paper (measured_order.cpp): each non-empty cluster's patches
+// ordered by the overdraw graph measured over its own nodes' kept fragments, starting from the
+// better of the greedy order and its current one. Without kept fragments (over the memory budget)
+// the distance order is used, and said. Returns the number of nodes of each cluster.
+std::vector<size_t> measured_update_orders(const Nodes& nodes, const ClusteringSettings& settings,
+                                           const std::vector<uint32_t>& assignment,
+                                           std::vector<std::vector<uint32_t>>& patch_orders) {
+    if (nodes.kept.empty()) {
+        say(settings, "measured orders need the kept fragments: this iteration sorts by distance");
+        return update_orders(nodes, settings.distance, assignment, patch_orders);
+    }
+    const MeshPatches& patches = nodes.patches;
+    std::vector<uint32_t> unit_of_triangle(nodes.mesh.triangle_count(), 0);
+    for (size_t p = 0; p < patches.patch_count(); ++p)
+        for (uint32_t j = patches.patch_starts[p]; j < patches.patch_starts[p + 1]; ++j)
+            unit_of_triangle[patches.cache_order[j]] = uint32_t(p);
+    std::vector<std::vector<const NodeFragments*>> members(nodes.k);
+    for (size_t n = 0; n < nodes.count; ++n) members[assignment[n]].push_back(&nodes.kept[n]);
+    std::vector<size_t> sizes(nodes.k);
+    for (size_t c = 0; c < nodes.k; ++c) {
+        sizes[c] = members[c].size();
+        if (sizes[c] == 0) continue;
+        const std::vector<Arc> arcs =
+            measured_overdraw_graph(members[c].data(), members[c].size(), unit_of_triangle.data(),
+                                    unit_of_triangle.size(), patches.patch_count(), patches.patch_primitive.data(),
+                                    settings.threads);
+        MeasuredOrderStats stats;
+        patch_orders[c] = measured_unit_order(patches.patch_count(), arcs.data(), arcs.size(),
+                                              patches.patch_primitive.data(), patch_orders[c].data(), &stats);
+        say(settings, "cluster " + std::to_string(c) + ": measured graph of " + std::to_string(arcs.size()) +
+                          " arcs over " + std::to_string(sizes[c]) + " nodes; backward weight greedy " +
+                          std::to_string(stats.greedy_weight) + ", start " + std::to_string(stats.start_weight) +
+                          (stats.from_previous ? " (previous order)" : "") + ", sifted " +
+                          std::to_string(stats.final_weight));
+    }
+    return sizes;
+}
+
 // Not in the paper (DESIGN.md step 6: never drop a cluster silently): an empty cluster takes the
 // front-to-back order, by averaged centroids, from the viewpoint of the worst-served node (highest
 // OVR) not used for another cluster in this iteration. Marks the clusters re-seeded.
@@ -475,7 +514,10 @@ ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patc
 
         const Clock::time_point update_start = Clock::now();
         const std::vector<std::vector<uint32_t>> previous_orders = result.patch_orders;
-        const std::vector<size_t> members = update_orders(nodes, settings.distance, result.assignment, result.patch_orders);
+        const std::vector<size_t> members =
+            settings.order == OrderSource::Measured
+                ? measured_update_orders(nodes, settings, result.assignment, result.patch_orders)
+                : update_orders(nodes, settings.distance, result.assignment, result.patch_orders);
         std::vector<uint8_t> reseeded;
         log.reseeded = reseed_empty_clusters(nodes, members, node_ovr, settings, result.patch_orders, reseeded);
         if (settings.update == UpdateRule::Monotone)

@@ -70,8 +70,22 @@ struct PairTable {
     }
 };
 
+// Few units: a dense matrix, front × back, is faster than hashing (at most kDenseUnits² entries).
+constexpr size_t kDenseUnits = 1536;
+
+struct PairCounts {
+    size_t units = 0;
+    std::vector<uint64_t> dense;  // [front · units + back], when units <= kDenseUnits
+    PairTable sparse;
+    void add(uint32_t front, uint32_t back) {
+        if (!dense.empty()) ++dense[size_t(front) * units + back];
+        else sparse.add(front, back);
+    }
+};
+
 // One node's pixels into the table.
-void accumulate_node(PairTable& table, const NodeFragments& node, const uint32_t* unit_of_triangle,
+template <typename Table>
+void accumulate_node(Table& table, const NodeFragments& node, const uint32_t* unit_of_triangle,
                      size_t triangle_count, size_t unit_count, const uint32_t* group,
                      std::vector<std::pair<uint32_t, uint32_t>>& seen) {
     for (size_t p = 0; p + 1 < node.starts.size(); ++p) {
@@ -104,12 +118,18 @@ std::vector<Arc> measured_overdraw_graph(const NodeFragments* const* nodes, size
                                          const uint32_t* unit_of_triangle, size_t triangle_count, size_t unit_count,
                                          const uint32_t* group, unsigned threads) {
     if (unit_count >= UINT32_MAX) throw InvalidInput("measured graph: too many units");
-    tbb::enumerable_thread_specific<PairTable> tables;
+    const bool dense = unit_count <= kDenseUnits;
+    tbb::enumerable_thread_specific<PairCounts> tables([&] {
+        PairCounts t;
+        t.units = unit_count;
+        if (dense) t.dense.assign(unit_count * unit_count, 0);
+        return t;
+    });
     tbb::enumerable_thread_specific<std::vector<std::pair<uint32_t, uint32_t>>> scratch;
     tbb::task_arena arena(threads ? int(threads) : tbb::this_task_arena::max_concurrency());
     arena.execute([&] {
         tbb::parallel_for(tbb::blocked_range<size_t>(0, node_count, 4), [&](const tbb::blocked_range<size_t>& r) {
-            PairTable& table = tables.local();
+            PairCounts& table = tables.local();
             auto& seen = scratch.local();
             for (size_t n = r.begin(); n != r.end(); ++n)
                 accumulate_node(table, *nodes[n], unit_of_triangle, triangle_count, unit_count, group, seen);
@@ -117,9 +137,20 @@ std::vector<Arc> measured_overdraw_graph(const NodeFragments* const* nodes, size
     });
     // Integer sums over every worker's table, sorted by key: independent of the thread count.
     std::vector<PairTable::Slot> all;
-    for (const PairTable& t : tables)
-        for (const PairTable::Slot& s : t.slots)
-            if (s.key != UINT64_MAX) all.push_back(s);
+    if (dense) {
+        std::vector<uint64_t> sum(unit_count * unit_count, 0);
+        for (const PairCounts& t : tables)
+            for (size_t i = 0; i < sum.size(); ++i) sum[i] += t.dense[i];
+        for (uint32_t lo = 0; lo < unit_count; ++lo)
+            for (uint32_t hi = lo + 1; hi < unit_count; ++hi) {
+                const uint64_t min_front = sum[size_t(lo) * unit_count + hi], max_front = sum[size_t(hi) * unit_count + lo];
+                if (min_front || max_front) all.push_back({uint64_t(lo) << 32 | hi, min_front, max_front});
+            }
+    } else {
+        for (const PairCounts& t : tables)
+            for (const PairTable::Slot& s : t.sparse.slots)
+                if (s.key != UINT64_MAX) all.push_back(s);
+    }
     std::sort(all.begin(), all.end(), [](const PairTable::Slot& a, const PairTable::Slot& b) { return a.key < b.key; });
     std::vector<Arc> arcs;
     for (size_t i = 0; i < all.size();) {

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <map>
 #include <numeric>
 #include <random>
 #include <vector>
@@ -110,6 +111,51 @@ TEST(MeasuredGraph, SameWhateverTheThreadCountAndDropsArcsBetweenGroups) {
         EXPECT_EQ(one[i].to, two[i].to);
         EXPECT_EQ(one[i].weight, two[i].weight);
         EXPECT_EQ(group[one[i].from], group[one[i].to]);
+    }
+}
+
+// A second implementation of the graph's definition (a map of pair counts), against the library
+// on random pixels, with few units (the dense matrix) and many (the hash table).
+TEST(MeasuredGraph, MatchesASecondImplementationDenseAndSparse) {
+    for (const size_t units : {size_t(20), size_t(1700)}) {
+        std::mt19937 rng{uint32_t(units)};
+        const size_t triangles = 2 * units;
+        std::vector<uint32_t> unit(triangles);
+        for (size_t t = 0; t < triangles; ++t) unit[t] = uint32_t(rng() % units);
+        std::vector<NodeFragments> nodes;
+        std::map<std::pair<uint32_t, uint32_t>, int64_t> front_of;  // (a, b): pixels with a strictly in front of b
+        for (int n = 0; n < 5; ++n) {
+            std::vector<std::vector<uint32_t>> list;
+            for (int p = 0; p < 400; ++p) {
+                std::vector<uint32_t> px;
+                std::vector<std::pair<uint32_t, int>> first;  // unit, depth level of its nearest fragment
+                int level = 0;
+                for (int f = 0, count = 2 + int(rng() % 6); f < count; ++f) {
+                    const uint32_t t = uint32_t(rng() % (units < 100 ? triangles : 400));  // overlap often
+                    const bool tie = f > 0 && rng() % 5 == 0;
+                    px.push_back(t | (tie ? kTie : 0));
+                    if (f > 0 && !tie) ++level;
+                    bool known = false;
+                    for (auto& x : first) known |= x.first == unit[t];
+                    if (!known) first.emplace_back(unit[t], level);
+                }
+                for (auto& a : first)
+                    for (auto& b : first)
+                        if (a.second < b.second) ++front_of[{a.first, b.first}];
+                list.push_back(px);
+            }
+            nodes.push_back(pixels(list));
+        }
+        std::map<std::pair<uint32_t, uint32_t>, uint64_t> expected;
+        for (const auto& [pair, count] : front_of) {
+            const auto reverse = front_of.find({pair.second, pair.first});
+            const int64_t net = count - (reverse == front_of.end() ? 0 : reverse->second);
+            if (net > 0) expected[pair] = uint64_t(net);
+        }
+        std::map<std::pair<uint32_t, uint32_t>, uint64_t> got;
+        for (const Arc& a : graph_of(nodes, unit, units, nullptr, 2)) got[{a.from, a.to}] = a.weight;
+        EXPECT_FALSE(expected.empty());
+        EXPECT_EQ(got, expected) << units << " units";
     }
 }
 

@@ -10,6 +10,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace animorder {
@@ -28,6 +29,33 @@ namespace animorder {
 std::vector<Arc> measured_overdraw_graph(const NodeFragments* const* nodes, size_t node_count,
                                          const uint32_t* unit_of_triangle, size_t triangle_count, size_t unit_count,
                                          const uint32_t* group, unsigned threads = 0);
+
+// The counts behind measured_overdraw_graph for a set of nodes that grows and shrinks: k-means
+// moves a few nodes between clusters each iteration, and a cluster's graph follows them without
+// measuring its other nodes again. Few units (<= kDenseMeasuredUnits) keep a dense matrix of
+// unit_count² counts, more a hash table of the pairs met. Integer counts: the arcs are the same
+// whatever the order of the updates and the thread count.
+constexpr size_t kDenseMeasuredUnits = 1024;
+
+class MeasuredPairCounts {
+public:
+    // unit_of_triangle: triangle_count entries, each < unit_count; group as measured_overdraw_graph.
+    MeasuredPairCounts(size_t unit_count, const uint32_t* unit_of_triangle, size_t triangle_count,
+                       const uint32_t* group);
+    ~MeasuredPairCounts();
+    MeasuredPairCounts(MeasuredPairCounts&&) noexcept;
+    MeasuredPairCounts& operator=(MeasuredPairCounts&&) noexcept;
+
+    // Adds (sign +1) or removes (sign −1, nodes added before) the nodes' pixels.
+    void add(const NodeFragments* const* nodes, size_t node_count, int sign, unsigned threads = 0);
+    // The netted arcs, as measured_overdraw_graph returns them.
+    std::vector<Arc> arcs() const;
+
+    struct State;
+
+private:
+    std::unique_ptr<State> state_;
+};
 
 // Local search on a linear order of units under the arcs: sifting (Chanas & Kobylański 1996;
 // also "insertion" in the feedback-arc-set literature): each unit in turn is moved to the

@@ -31,12 +31,12 @@ namespace {
 
 constexpr uint32_t kTieBit = 0x80000000u;
 
-// Open-addressing table: key (min unit << 32 | max unit) → fragments with min in front, with max
-// in front. Linear probing, grown at half load.
+// Open-addressing table: key (min unit << 32 | max unit) → pixels with min in front, with max
+// in front (signed: nodes are also removed). Linear probing, grown at half load.
 struct PairTable {
     struct Slot {
         uint64_t key = UINT64_MAX;
-        uint64_t min_front = 0, max_front = 0;
+        int64_t min_front = 0, max_front = 0;
     };
     std::vector<Slot> slots = std::vector<Slot>(1024);
     size_t used = 0;
@@ -52,15 +52,15 @@ struct PairTable {
         for (size_t i = hash(key) & mask;; i = (i + 1) & mask)
             if (slots[i].key == key || slots[i].key == UINT64_MAX) return slots[i];
     }
-    void add(uint32_t front, uint32_t back) {
+    void add(uint64_t key, int64_t min_front, int64_t max_front) {
         if (2 * (used + 1) > slots.size()) grow();
-        const uint32_t lo = std::min(front, back), hi = std::max(front, back);
-        Slot& s = find(uint64_t(lo) << 32 | hi);
+        Slot& s = find(key);
         if (s.key == UINT64_MAX) {
-            s.key = uint64_t(lo) << 32 | hi;
+            s.key = key;
             ++used;
         }
-        (front == lo ? s.min_front : s.max_front) += 1;
+        s.min_front += min_front;
+        s.max_front += max_front;
     }
     void grow() {
         std::vector<Slot> old(slots.size() * 2);
@@ -70,23 +70,32 @@ struct PairTable {
     }
 };
 
-// Few units: a dense matrix, front × back, is faster than hashing (at most kDenseUnits² entries).
-constexpr size_t kDenseUnits = 1536;
-
+// Counts of pixels where `front` is strictly in front of `back`: a dense matrix or a table.
 struct PairCounts {
     size_t units = 0;
-    std::vector<uint64_t> dense;  // [front · units + back], when units <= kDenseUnits
+    std::vector<int64_t> dense;  // [front · units + back], when units <= kDenseMeasuredUnits
     PairTable sparse;
-    void add(uint32_t front, uint32_t back) {
-        if (!dense.empty()) ++dense[size_t(front) * units + back];
-        else sparse.add(front, back);
+    explicit PairCounts(size_t unit_count) : units(unit_count) {
+        if (units <= kDenseMeasuredUnits) dense.assign(units * units, 0);
+    }
+    void add(uint32_t front, uint32_t back, int64_t sign) {
+        if (!dense.empty()) {
+            dense[size_t(front) * units + back] += sign;
+        } else {
+            const uint32_t lo = std::min(front, back), hi = std::max(front, back);
+            sparse.add(uint64_t(lo) << 32 | hi, front == lo ? sign : 0, front == lo ? 0 : sign);
+        }
+    }
+    void merge(const PairCounts& other) {
+        for (size_t i = 0; i < dense.size(); ++i) dense[i] += other.dense[i];
+        for (const PairTable::Slot& s : other.sparse.slots)
+            if (s.key != UINT64_MAX) sparse.add(s.key, s.min_front, s.max_front);
     }
 };
 
-// One node's pixels into the table.
-template <typename Table>
-void accumulate_node(Table& table, const NodeFragments& node, const uint32_t* unit_of_triangle,
-                     size_t triangle_count, size_t unit_count, const uint32_t* group,
+// One node's pixels into the counts.
+void accumulate_node(PairCounts& table, const NodeFragments& node, const uint32_t* unit_of_triangle,
+                     size_t triangle_count, size_t unit_count, const uint32_t* group, int64_t sign,
                      std::vector<std::pair<uint32_t, uint32_t>>& seen) {
     for (size_t p = 0; p + 1 < node.starts.size(); ++p) {
         seen.clear();  // (unit, depth level) of each unit's nearest fragment, nearest first
@@ -106,7 +115,7 @@ void accumulate_node(Table& table, const NodeFragments& node, const uint32_t* un
             for (const auto& s : seen) known |= s.first == unit;
             if (known) continue;
             for (const auto& s : seen)
-                if (s.second < level && (!group || group[s.first] == group[unit])) table.add(s.first, unit);
+                if (s.second < level && (!group || group[s.first] == group[unit])) table.add(s.first, unit, sign);
             seen.emplace_back(unit, level);
         }
     }
@@ -114,17 +123,28 @@ void accumulate_node(Table& table, const NodeFragments& node, const uint32_t* un
 
 }  // namespace
 
-std::vector<Arc> measured_overdraw_graph(const NodeFragments* const* nodes, size_t node_count,
-                                         const uint32_t* unit_of_triangle, size_t triangle_count, size_t unit_count,
-                                         const uint32_t* group, unsigned threads) {
+struct MeasuredPairCounts::State {
+    std::vector<uint32_t> unit_of_triangle, group;
+    PairCounts counts;
+    explicit State(size_t units) : counts(units) {}
+};
+
+MeasuredPairCounts::MeasuredPairCounts(size_t unit_count, const uint32_t* unit_of_triangle, size_t triangle_count,
+                                       const uint32_t* group) {
     if (unit_count >= UINT32_MAX) throw InvalidInput("measured graph: too many units");
-    const bool dense = unit_count <= kDenseUnits;
-    tbb::enumerable_thread_specific<PairCounts> tables([&] {
-        PairCounts t;
-        t.units = unit_count;
-        if (dense) t.dense.assign(unit_count * unit_count, 0);
-        return t;
-    });
+    state_ = std::make_unique<State>(unit_count);
+    state_->unit_of_triangle.assign(unit_of_triangle, unit_of_triangle + triangle_count);
+    if (group) state_->group.assign(group, group + unit_count);
+}
+MeasuredPairCounts::~MeasuredPairCounts() = default;
+MeasuredPairCounts::MeasuredPairCounts(MeasuredPairCounts&&) noexcept = default;
+MeasuredPairCounts& MeasuredPairCounts::operator=(MeasuredPairCounts&&) noexcept = default;
+
+void MeasuredPairCounts::add(const NodeFragments* const* nodes, size_t node_count, int sign, unsigned threads) {
+    State& s = *state_;
+    const size_t units = s.counts.units;
+    const uint32_t* group = s.group.empty() ? nullptr : s.group.data();
+    tbb::enumerable_thread_specific<PairCounts> tables([units] { return PairCounts(units); });
     tbb::enumerable_thread_specific<std::vector<std::pair<uint32_t, uint32_t>>> scratch;
     tbb::task_arena arena(threads ? int(threads) : tbb::this_task_arena::max_concurrency());
     arena.execute([&] {
@@ -132,36 +152,41 @@ std::vector<Arc> measured_overdraw_graph(const NodeFragments* const* nodes, size
             PairCounts& table = tables.local();
             auto& seen = scratch.local();
             for (size_t n = r.begin(); n != r.end(); ++n)
-                accumulate_node(table, *nodes[n], unit_of_triangle, triangle_count, unit_count, group, seen);
+                accumulate_node(table, *nodes[n], s.unit_of_triangle.data(), s.unit_of_triangle.size(), units,
+                                group, sign < 0 ? -1 : 1, seen);
         });
     });
-    // Integer sums over every worker's table, sorted by key: independent of the thread count.
-    std::vector<PairTable::Slot> all;
-    if (dense) {
-        std::vector<uint64_t> sum(unit_count * unit_count, 0);
-        for (const PairCounts& t : tables)
-            for (size_t i = 0; i < sum.size(); ++i) sum[i] += t.dense[i];
-        for (uint32_t lo = 0; lo < unit_count; ++lo)
-            for (uint32_t hi = lo + 1; hi < unit_count; ++hi) {
-                const uint64_t min_front = sum[size_t(lo) * unit_count + hi], max_front = sum[size_t(hi) * unit_count + lo];
-                if (min_front || max_front) all.push_back({uint64_t(lo) << 32 | hi, min_front, max_front});
-            }
-    } else {
-        for (const PairCounts& t : tables)
-            for (const PairTable::Slot& s : t.sparse.slots)
-                if (s.key != UINT64_MAX) all.push_back(s);
-    }
-    std::sort(all.begin(), all.end(), [](const PairTable::Slot& a, const PairTable::Slot& b) { return a.key < b.key; });
+    // Integer sums: the same whatever the worker that counted a node.
+    for (const PairCounts& t : tables) s.counts.merge(t);
+}
+
+std::vector<Arc> MeasuredPairCounts::arcs() const {
+    const PairCounts& c = state_->counts;
     std::vector<Arc> arcs;
-    for (size_t i = 0; i < all.size();) {
-        uint64_t min_front = 0, max_front = 0;
-        const uint64_t key = all[i].key;
-        for (; i < all.size() && all[i].key == key; ++i) min_front += all[i].min_front, max_front += all[i].max_front;
-        const uint32_t lo = uint32_t(key >> 32), hi = uint32_t(key);
-        if (min_front > max_front) arcs.push_back({lo, hi, min_front - max_front});
-        else if (max_front > min_front) arcs.push_back({hi, lo, max_front - min_front});
+    auto net = [&](uint32_t lo, uint32_t hi, int64_t min_front, int64_t max_front) {
+        if (min_front > max_front) arcs.push_back({lo, hi, uint64_t(min_front - max_front)});
+        else if (max_front > min_front) arcs.push_back({hi, lo, uint64_t(max_front - min_front)});
+    };
+    if (!c.dense.empty()) {
+        for (uint32_t lo = 0; lo < c.units; ++lo)
+            for (uint32_t hi = lo + 1; hi < c.units; ++hi)
+                net(lo, hi, c.dense[size_t(lo) * c.units + hi], c.dense[size_t(hi) * c.units + lo]);
+    } else {
+        std::vector<PairTable::Slot> all;
+        for (const PairTable::Slot& s : c.sparse.slots)
+            if (s.key != UINT64_MAX) all.push_back(s);
+        std::sort(all.begin(), all.end(), [](const PairTable::Slot& a, const PairTable::Slot& b) { return a.key < b.key; });
+        for (const PairTable::Slot& s : all) net(uint32_t(s.key >> 32), uint32_t(s.key), s.min_front, s.max_front);
     }
     return arcs;
+}
+
+std::vector<Arc> measured_overdraw_graph(const NodeFragments* const* nodes, size_t node_count,
+                                         const uint32_t* unit_of_triangle, size_t triangle_count, size_t unit_count,
+                                         const uint32_t* group, unsigned threads) {
+    MeasuredPairCounts counts(unit_count, unit_of_triangle, triangle_count, group);
+    counts.add(nodes, node_count, +1, threads);
+    return counts.arcs();
 }
 
 uint64_t sift_order(uint32_t* order, size_t unit_count, const Arc* arcs, size_t arc_count, const uint32_t* group,

@@ -159,6 +159,33 @@ TEST(MeasuredGraph, MatchesASecondImplementationDenseAndSparse) {
     }
 }
 
+// k-means moves nodes between clusters: counting A and B, then removing A, must give B's graph.
+TEST(MeasuredGraph, RemovingNodesGivesTheGraphOfTheRest) {
+    for (const size_t units : {size_t(6), size_t(1100)}) {  // dense and hashed counts
+        std::vector<uint32_t> unit(units);
+        std::iota(unit.begin(), unit.end(), 0u);
+        const NodeFragments a = pixels({{0, 1}, {1, 2}, {3, 4, 5}, {5, 0}});
+        const NodeFragments b = pixels({{1, 0}, {1, 0}, {2, 1}, {4, 3}});
+        const NodeFragments* both[] = {&a, &b};
+        const NodeFragments* only_a[] = {&a};
+        MeasuredPairCounts counts(units, unit.data(), units, nullptr);
+        counts.add(both, 2, +1, 1);
+        counts.add(only_a, 1, -1, 1);
+        const std::vector<Arc> got = counts.arcs();
+        // b alone: 1→0 (2), 2→1 (1), 4→3 (1).
+        ASSERT_EQ(got.size(), 3u) << units;
+        EXPECT_EQ(got[0].from, 1u);
+        EXPECT_EQ(got[0].to, 0u);
+        EXPECT_EQ(got[0].weight, 2u);
+        EXPECT_EQ(got[1].from, 2u);
+        EXPECT_EQ(got[1].to, 1u);
+        EXPECT_EQ(got[1].weight, 1u);
+        EXPECT_EQ(got[2].from, 4u);
+        EXPECT_EQ(got[2].to, 3u);
+        EXPECT_EQ(got[2].weight, 1u);
+    }
+}
+
 TEST(MeasuredGraph, RejectsTrianglesAndUnitsOutOfRange) {
     const NodeFragments n = pixels({{0, 5}});
     EXPECT_THROW(graph_of({n}, {0, 1}, 2), InvalidInput);

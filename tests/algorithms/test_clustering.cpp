@@ -149,6 +149,31 @@ TEST(Clustering, DeterministicWithOneOrTwoThreadsAndBothDistances) {
     }
 }
 
+// OrderSource::Measured (measured_order.h): the same bootstrap and first assignment as the
+// paper's update, then orders from the measured graphs; the mean node OVR never rises, the result
+// does not depend on the thread count, and on this character it ends below the distance update's.
+TEST(Clustering, MeasuredOrdersAreMonotoneDeterministicAndBelowDistance) {
+    const AnimatedMesh& m = character();
+    const MeshPatches patches = build_mesh_patches(m, 0.85);
+    const Framing framing = framing_of(m);
+    const std::vector<uint32_t> keyframes = walk_keyframes(10);
+    ClusteringSettings s = small_settings();
+    const ClusteringResult distance = cluster_nodes(m, patches, framing, keyframes, s);
+    s.order = OrderSource::Measured;
+    s.threads = 1;
+    const ClusteringResult one = cluster_nodes(m, patches, framing, keyframes, s);
+    s.threads = 2;
+    const ClusteringResult two = cluster_nodes(m, patches, framing, keyframes, s);
+    EXPECT_EQ(one.assignment, two.assignment);
+    EXPECT_EQ(one.patch_orders, two.patch_orders);
+    ASSERT_FALSE(one.iterations.empty());
+    EXPECT_DOUBLE_EQ(one.iterations[0].mean_ovr, distance.iterations[0].mean_ovr);
+    for (size_t i = 1; i < one.iterations.size(); ++i)
+        EXPECT_LE(one.iterations[i].mean_ovr, one.iterations[i - 1].mean_ovr + 1e-12) << "iteration " << i;
+    EXPECT_LT(one.iterations[one.best_iteration].mean_ovr, distance.iterations[distance.best_iteration].mean_ovr);
+    for (const auto& o : one.triangle_orders) EXPECT_TRUE(test::is_permutation_of_iota(o));
+}
+
 TEST(Clustering, EmptyClustersAreReseededNotDropped) {
     // 12 views of one keyframe and 10 clusters: some clusters must end up empty at first.
     const AnimatedMesh& m = character();

@@ -76,9 +76,12 @@ struct MeasuredOrderStats {
 // The measured order of units: per group (groups in ascending id order, as primitives in file
 // order), the greedy feedback-arc-set order (order_feedback_arc_set) or `previous` (may be
 // nullptr; a permutation keeping groups in ascending order) when its backward weight is lower,
-// then sift_order. Throws InvalidInput for an arc naming a unit >= unit_count or a previous
+// then sift_order. try_greedy false (with a previous order): start from `previous` without
+// computing the greedy order (k-means does so once its buffer is a measured order; greedy_weight
+// is then 0). Throws InvalidInput for an arc naming a unit >= unit_count or a previous
 // order that is no permutation.
 std::vector<uint32_t> measured_unit_order(size_t unit_count, const Arc* arcs, size_t arc_count, const uint32_t* group,
-                                          const uint32_t* previous, MeasuredOrderStats* stats = nullptr);
+                                          const uint32_t* previous, MeasuredOrderStats* stats = nullptr,
+                                          bool try_greedy = true);
 
 }  // namespace animorder

@@ -285,6 +285,8 @@ struct MeasuredGraphs {
     std::vector<uint32_t> unit_of_triangle;
     std::vector<MeasuredPairCounts> graphs;  // per cluster, over the nodes `counted` gives it
     std::vector<uint32_t> counted;           // per node: the cluster whose graph counts it (or UINT32_MAX)
+    std::vector<std::vector<uint32_t>> last; // per cluster: the last measured order (a local optimum)
+    std::vector<std::vector<uint32_t>> start;  // per cluster: the buffer that order started from
 };
 
 // OrderSource::Measured, not in the paper (measured_order.cpp): each non-empty cluster's patches
@@ -309,6 +311,8 @@ std::vector<size_t> measured_update_orders(const Nodes& nodes, const ClusteringS
             state.graphs.emplace_back(patches.patch_count(), state.unit_of_triangle.data(),
                                       state.unit_of_triangle.size(), group);
         state.counted.assign(nodes.count, UINT32_MAX);
+        state.last.assign(nodes.k, {});
+        state.start.assign(nodes.k, {});
     }
     // Only the nodes that changed cluster since the last update are counted again.
     const Clock::time_point graph_start = Clock::now();
@@ -322,8 +326,10 @@ std::vector<size_t> measured_update_orders(const Nodes& nodes, const ClusteringS
         state.counted[n] = assignment[n];
     }
     size_t moved = 0;
+    std::vector<uint8_t> changed(nodes.k, 0);
     for (size_t c = 0; c < nodes.k; ++c) {
         moved += arriving[c].size();
+        changed[c] = !leaving[c].empty() || !arriving[c].empty();
         state.graphs[c].add(leaving[c].data(), leaving[c].size(), -1, settings.threads);
         state.graphs[c].add(arriving[c].data(), arriving[c].size(), +1, settings.threads);
     }
@@ -332,10 +338,21 @@ std::vector<size_t> measured_update_orders(const Nodes& nodes, const ClusteringS
     std::string line;
     for (size_t c = 0; c < nodes.k; ++c) {
         if (sizes[c] == 0) continue;
+        // The buffer is already the local optimum of this very graph: nothing to do. A buffer that
+        // is a measured order needs no greedy start (on real characters the greedy order's
+        // backward weight is many times a sifted order's).
+        const bool measured_before = patch_orders[c] == state.last[c];
+        if (measured_before && !changed[c]) continue;
+        if (!changed[c] && patch_orders[c] == state.start[c]) {  // the same search again (its order was not kept)
+            patch_orders[c] = state.last[c];
+            continue;
+        }
+        state.start[c] = patch_orders[c];
         const std::vector<Arc> arcs = state.graphs[c].arcs();
         MeasuredOrderStats stats;
-        patch_orders[c] =
-            measured_unit_order(patches.patch_count(), arcs.data(), arcs.size(), group, patch_orders[c].data(), &stats);
+        patch_orders[c] = measured_unit_order(patches.patch_count(), arcs.data(), arcs.size(), group,
+                                              patch_orders[c].data(), &stats, !measured_before);
+        state.last[c] = patch_orders[c];
         line += " " + std::to_string(c) + ": " + std::to_string(arcs.size()) + " arcs, greedy " +
                 std::to_string(stats.greedy_weight) + (stats.from_previous ? ", current " : ", start ") +
                 std::to_string(stats.start_weight) + ", sifted " + std::to_string(stats.final_weight) + ";";

@@ -267,7 +267,7 @@ uint64_t sift_order(uint32_t* order, size_t unit_count, const Arc* arcs, size_t 
 }
 
 std::vector<uint32_t> measured_unit_order(size_t unit_count, const Arc* arcs, size_t arc_count, const uint32_t* group,
-                                          const uint32_t* previous, MeasuredOrderStats* stats) {
+                                          const uint32_t* previous, MeasuredOrderStats* stats, bool try_greedy) {
     if (previous) {
         std::vector<uint8_t> seen(unit_count, 0);
         for (size_t i = 0; i < unit_count; ++i) {
@@ -276,6 +276,19 @@ std::vector<uint32_t> measured_unit_order(size_t unit_count, const Arc* arcs, si
                                    std::to_string(unit_count) + " units");
             seen[previous[i]] = 1;
         }
+    }
+    for (size_t a = 0; a < arc_count; ++a)
+        if (arcs[a].from >= unit_count || arcs[a].to >= unit_count)
+            throw InvalidInput("measured order: arc " + std::to_string(a) + " names a unit outside 0.." +
+                               std::to_string(unit_count));
+    if (previous && !try_greedy) {
+        MeasuredOrderStats s;
+        std::vector<uint32_t> order(previous, previous + unit_count);
+        s.start_weight = count_feedback_arcs(previous, unit_count, arcs, arc_count).weight;
+        s.from_previous = true;
+        s.final_weight = sift_order(order.data(), unit_count, arcs, arc_count, group);
+        if (stats) *stats = s;
+        return order;
     }
     // Units of each group (ascending group id, units ascending), and the arcs inside each group.
     std::vector<uint32_t> units(unit_count);
@@ -291,9 +304,6 @@ std::vector<uint32_t> measured_unit_order(size_t unit_count, const Arc* arcs, si
         for (size_t x = i; x < j; ++x) local[units[x]] = uint32_t(x - i);
         std::vector<Arc> inside;
         for (size_t a = 0; a < arc_count; ++a) {
-            if (arcs[a].from >= unit_count || arcs[a].to >= unit_count)
-                throw InvalidInput("measured order: arc " + std::to_string(a) + " names a unit outside 0.." +
-                                   std::to_string(unit_count));
             const uint32_t g = group ? group[units[i]] : 0;
             if (group && (group[arcs[a].from] != g || group[arcs[a].to] != g)) continue;
             inside.push_back({local[arcs[a].from], local[arcs[a].to], arcs[a].weight});

@@ -87,7 +87,7 @@ character mrfixit $DATA/iqm-mrfixit/mrfixit.iqm
 # (OVR and index-buffer bytes against k) with static-nehab06 for k = 1; every Ganfaul clip at the
 # lighter every-clip setting; and every skinned character at lambda 0.85 and 3.
 mkdir -p "$OUT/measured"
-step measured/ganfaul-idle.json $A evaluate "$GANFAUL" --clip Idle -q --methods single,measured,oracle \
+step measured/ganfaul-idle.json $A evaluate "$GANFAUL" --clip Idle -q --methods single,measured \
   --lambda 0.85,3 --eval-views 300 --eval-resolution 512 -r "$OUT/measured/ganfaul-idle.json"
 step measured/sweep-k.json $A evaluate "$GANFAUL" --clip Idle -q --methods single,measured,static-nehab06 \
   -k 1,2,3,5,8,12,16 --eval-views 100 --eval-resolution 256 -r "$OUT/measured/sweep-k.json"

@@ -104,6 +104,9 @@ struct MethodSettings {
     size_t nehab_clusters = 0;
     size_t nehab_views = 162;
     bool nehab_all_keyframes = false;
+    // measured / measured-joint: Nehab 2006's planar clusters (as many as λ gives patches) as the
+    // units instead of the λ patches (build_planar_units).
+    bool measured_planar_units = false;
 };
 
 // Throws InvalidInput for settings no method can run with (non-finite λ, k outside 1..255, a
@@ -178,8 +181,9 @@ struct AnimatedMethodResult {
     double seconds_patches = 0;
 };
 
+// planar_units: the units are build_planar_units' (of keyframe 0), not the λ patches.
 AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double lambda, unsigned cache_size,
-                                    const ClusteringSettings& settings);
+                                    const ClusteringSettings& settings, bool planar_units = false);
 
 // ACMR/ATVR of a whole index buffer drawn primitive by primitive, each draw starting with an
 // empty cache (a draw call does not inherit the previous draw's post-transform cache).

@@ -201,12 +201,13 @@ VertexCacheStats analyze_mesh_vertex_cache(const AnimatedMesh& mesh, const std::
 }
 
 AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double lambda, unsigned cache_size,
-                                    const ClusteringSettings& settings) {
+                                    const ClusteringSettings& settings, bool planar_units) {
     validate_animated_mesh(mesh);
     if (mesh.clips.empty()) throw InvalidInput("the mesh has no clip to cluster");
     AnimatedMethodResult result;
     const auto start = std::chrono::steady_clock::now();
     result.patches = build_mesh_patches(mesh, lambda, cache_size);
+    if (planar_units) result.patches = build_planar_units(mesh, result.patches, 0, cache_size);
     result.seconds_patches = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     result.framing = frame_animated_mesh(mesh);
 
@@ -288,7 +289,8 @@ void run_clustered(MethodResult& result, const AnimatedMesh& mesh, const MethodS
     ClusteringSettings clustering = settings.clustering;
     if (result.method == Method::Measured || result.method == Method::MeasuredJoint)
         clustering.order = OrderSource::Measured;
-    AnimatedMethodResult r = run_han_sander(mesh, joint, settings.lambda, settings.cache_size, clustering);
+    AnimatedMethodResult r = run_han_sander(mesh, joint, settings.lambda, settings.cache_size, clustering,
+                                            clustering.order == OrderSource::Measured && settings.measured_planar_units);
     std::vector<size_t> chosen(r.buffers.orders.size(), 0);
     for (size_t i = 0; i < r.runs.size(); ++i)
         for (uint32_t c : r.runs[i].assignment) ++chosen[(joint ? 0 : i * settings.clustering.clusters) + c];

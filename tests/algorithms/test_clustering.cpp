@@ -71,6 +71,32 @@ TEST(MeshPatches, CoverEveryTriangleWithinItsPrimitive) {
     for (size_t i = 0; i < body_triangles; ++i) EXPECT_LT(r[i], body_triangles);
 }
 
+// The measured method's alternative units: planar clusters, as many per primitive as λ's patches
+// (fewer only where a cluster came out empty), each a run of its own primitive's triangles.
+TEST(MeshPatches, PlanarUnitsCoverEveryTriangleWithinItsPrimitive) {
+    const AnimatedMesh& m = character();
+    const MeshPatches like = build_mesh_patches(m, 0.85);
+    const MeshPatches p = build_planar_units(m, like, 0);
+    EXPECT_TRUE(test::is_permutation_of_iota(p.cache_order));
+    ASSERT_EQ(p.patch_starts.size(), p.patch_count() + 1);
+    EXPECT_EQ(p.patch_starts.back(), m.triangle_count());
+    EXPECT_LE(p.patch_count(), like.patch_count());
+    EXPECT_GE(p.patch_count(), like.patch_count() * 9 / 10);
+    for (size_t q = 0; q < p.patch_count(); ++q) {
+        ASSERT_LT(p.patch_starts[q], p.patch_starts[q + 1]);
+        if (q > 0) {
+            EXPECT_LE(p.patch_primitive[q - 1], p.patch_primitive[q]);
+        }
+        const Primitive& prim = m.primitives[p.patch_primitive[q]];
+        for (uint32_t i = p.patch_starts[q]; i < p.patch_starts[q + 1]; ++i) {
+            const size_t t = p.cache_order[i];
+            EXPECT_GE(3 * t, prim.first_index);
+            EXPECT_LT(3 * t, prim.first_index + prim.index_count);
+        }
+    }
+    EXPECT_THROW(build_planar_units(m, like, m.keyframe_count()), InvalidInput);
+}
+
 TEST(Clustering, AssignsEachNodeToItsBestBufferAndImproves) {
     const AnimatedMesh& m = character();
     const MeshPatches patches = build_mesh_patches(m, 0.85);

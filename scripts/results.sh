@@ -151,6 +151,35 @@ step materials/bundled-blend-clusters.json $A evaluate -q --methods original,sin
   --eval-views 100 --eval-resolution 256 -r "$OUT/materials/bundled-blend-clusters.json"
 step materials/morph-stress-test.json $A evaluate "$DATA/gltf-morph-stress-test/MorphStressTest.gltf" -q \
   --methods original,static-sander07,single --eval-views 60 --eval-resolution 256 -r "$OUT/materials/morph-stress-test.json"
+# Measured cluster orders (issue 15: `measured`, `measured-joint`), beside `single` in the same runs
+# (same nodes, same bootstrap), in build/results/measured/: Table 1's setting on Idle; the k sweep
+# (OVR and index-buffer bytes against k) with static-nehab06 for k = 1; every Ganfaul clip at the
+# lighter every-clip setting; and every skinned character at lambda 0.85 and 3.
+mkdir -p "$OUT/measured"
+step measured/ganfaul-idle.json $A evaluate "$GANFAUL" --clip Idle -q --methods single,measured \
+  --lambda 0.85,3 --eval-views 300 --eval-resolution 512 -r "$OUT/measured/ganfaul-idle.json"
+step measured/sweep-k.json $A evaluate "$GANFAUL" --clip Idle -q --methods single,measured,static-nehab06 \
+  -k 1,2,3,5,8,12,16 --eval-views 100 --eval-resolution 256 -r "$OUT/measured/sweep-k.json"
+step measured/ganfaul-clips.json $A evaluate "$GANFAUL" -q --methods single,joint,measured,measured-joint \
+  --lambda 0.85 --resolution 128 --eval-views 60 --eval-resolution 256 -r "$OUT/measured/ganfaul-clips.json"
+measured_character() {
+  local name=$1; shift
+  step "measured/$name.json" $A evaluate "$@" -q --methods single,measured --lambda 0.85,3 \
+    --eval-views 60 --eval-resolution 256 -r "$OUT/measured/$name.json"
+}
+measured_character xbot $DATA/glb-xbot/Xbot.glb
+measured_character barbarian $DATA/pg-barbarian/model.fbx --clip $DATA/pg-barbarian/anims
+measured_character goblin $DATA/pg-goblin/model.fbx --clip $DATA/pg-goblin/anims
+measured_character witch $DATA/pg-witch/model.fbx --clip $DATA/pg-witch/anims
+measured_character cesiumman $DATA/gltf-cesiumman/CesiumMan.glb
+measured_character fox $DATA/gltf-fox/Fox.glb
+measured_character robot-expressive $DATA/glb-robot-expressive/RobotExpressive.glb
+measured_character bob $DATA/md5-bob/Bob.md5mesh
+measured_character wuson $DATA/x-wuson/Testwuson.X
+measured_character dwarf $DATA/x-dwarf/dwarf.x
+measured_character dwarf2-b3d $DATA/b3d-dwarf2/dwarf2.b3d
+measured_character bcn-epileptic $DATA/x-bcn-epileptic/BCN_Epileptic.X
+measured_character mrfixit $DATA/iqm-mrfixit/mrfixit.iqm
 # The OpenGL rendering-time check (original vs single, expensive fragment shader).
 # llvmpipe renders on the CPU: 10 views at every 4th keyframe (150 nodes) keeps it near a minute.
 if [ -x "$BIN/bench/render_time" ]; then

@@ -25,6 +25,13 @@ enum class UpdateRule {
                // OVR of its own nodes (measured): the mean node OVR never rises, k-means settles
 };
 
+// Where the update step's order of a cluster's patches comes from.
+enum class OrderSource {
+    Distance,  // Han & Sander 2017: the integrated distance (DistanceVariant)
+    Measured,  // not in the paper (measured_order.h): the overdraw graph measured over the
+               // cluster's own nodes, greedy feedback-arc-set order, then sifting
+};
+
 struct ClusteringSettings {
     size_t clusters = 5;               // k
     size_t views = 162;                // icosphere viewpoints (12, 42, 162, 642)
@@ -39,6 +46,7 @@ struct ClusteringSettings {
     size_t patience = 4;
     DistanceVariant distance = DistanceVariant::Jcgt;
     UpdateRule update = UpdateRule::Monotone;
+    OrderSource order = OrderSource::Distance;
     unsigned threads = 0;
     // Nodes' fragments are kept between iterations (orders change, fragments do not) while they
     // fit in this many bytes; beyond, every iteration rasterises again (slower, same result).

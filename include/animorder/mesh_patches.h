@@ -21,6 +21,13 @@ struct MeshPatches {
 
 MeshPatches build_mesh_patches(const AnimatedMesh& mesh, double lambda, unsigned cache_size = kDefaultCacheSize);
 
+// Nehab, Barczak & Sander 2006's planar clusters as the units instead of λ patches (the measured
+// method's alternative units): each primitive's triangles clustered by normal (cluster_by_normals,
+// positions of `keyframe`) into as many clusters as `like` has patches there, each Tipsified on
+// its own (tipsify_clusters). Throws InvalidInput for a keyframe out of range.
+MeshPatches build_planar_units(const AnimatedMesh& mesh, const MeshPatches& like, size_t keyframe,
+                               unsigned cache_size = kDefaultCacheSize);
+
 // A face permutation of the whole mesh from a patch permutation: primitives stay in file order
 // (patches of a primitive keep their relative order from patch_order), triangles inside a patch
 // keep their Tipsify order.

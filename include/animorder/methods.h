@@ -35,7 +35,10 @@ namespace animorder {
 // "Tipsify" column). Single / Joint: Han & Sander 2017 (k buffers per clip / for all clips).
 // Oracle: the patches sorted front-to-back at every evaluation node — a bound, not an order to
 // ship (it has no buffers).
-enum class Method { Original, StaticSander07, StaticNehab06, Meshopt, TipsifyPerFrame, Single, Joint, Oracle };
+// Measured / MeasuredJoint: single / joint with each cluster's patches ordered by the overdraw
+// graph measured over its own nodes (measured_order.h), not by distance — beyond the paper.
+enum class Method { Original, StaticSander07, StaticNehab06, Meshopt, TipsifyPerFrame, Single, Joint, Oracle,
+                    Measured, MeasuredJoint };
 
 // The method a user gets without asking (the paper's method).
 constexpr Method kDefaultMethod = Method::Single;
@@ -47,6 +50,10 @@ const std::vector<Method>& all_methods();
 // the unknown name and listing the known ones.
 const char* method_name(Method method);
 Method parse_method(const std::string& name);
+
+// Single, Joint, Measured, MeasuredJoint: k-means buffers; the joint ones span all clips.
+bool method_is_clustered(Method method);
+bool method_is_joint(Method method);
 
 // Which settings a method reads (reports print the others as null): λ (the patch threshold), and
 // k / views / the k-means settings.
@@ -102,6 +109,9 @@ struct MethodSettings {
     // own k clusters by measured blend error, and the buffers are the (opaque, blend) cluster
     // pairs the nodes take (up to k² per clip).
     bool blend_clusters = false;
+    // measured / measured-joint: Nehab 2006's planar clusters (as many as λ gives patches) as the
+    // units instead of the λ patches (build_planar_units).
+    bool measured_planar_units = false;
 };
 
 // Throws InvalidInput for settings no method can run with (non-finite λ, k outside 1..255, a
@@ -176,8 +186,10 @@ struct AnimatedMethodResult {
     double seconds_patches = 0;
 };
 
+// planar_units: the units are build_planar_units' (of keyframe 0), not the λ patches.
 AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double lambda, unsigned cache_size,
-                                    const ClusteringSettings& settings, bool blend_clusters = false);
+                                    const ClusteringSettings& settings, bool blend_clusters = false,
+                                    bool planar_units = false);
 
 // Reverses, in a face permutation of the whole mesh, the draw order of every blended primitive
 // (AlphaMode::Blend) in place: a front-to-back order becomes back to front. run_method applies it

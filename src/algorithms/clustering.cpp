@@ -24,6 +24,7 @@
 
 #include "animorder/animated_mesh.h"
 #include "animorder/invalid_input.h"
+#include "animorder/measured_order.h"
 #include "animorder/mesh_patches.h"
 #include "animorder/overdraw.h"
 #include "animorder/rasterizer.h"
@@ -279,6 +280,90 @@ std::vector<size_t> update_orders(const Nodes& nodes, DistanceVariant variant, c
     return members;
 }
 
+// OrderSource::Measured: each cluster's pair counts (measured_order.h), kept between iterations
+// and updated with the nodes that changed cluster only.
+struct MeasuredGraphs {
+    std::vector<uint32_t> unit_of_triangle;
+    std::vector<MeasuredPairCounts> graphs;  // per cluster, over the nodes `counted` gives it
+    std::vector<uint32_t> counted;           // per node: the cluster whose graph counts it (or UINT32_MAX)
+    std::vector<std::vector<uint32_t>> last; // per cluster: the last measured order (a local optimum)
+    std::vector<std::vector<uint32_t>> start;  // per cluster: the buffer that order started from
+};
+
+// OrderSource::Measured, not in the paper (measured_order.cpp): each non-empty cluster's patches
+// ordered by the overdraw graph measured over its own nodes' kept fragments, starting from the
+// better of the greedy order and its current one. Without kept fragments (over the memory budget)
+// the distance order is used, and said. Returns the number of nodes of each cluster.
+std::vector<size_t> measured_update_orders(const Nodes& nodes, const ClusteringSettings& settings,
+                                           const std::vector<uint32_t>& assignment, MeasuredGraphs& state,
+                                           std::vector<std::vector<uint32_t>>& patch_orders) {
+    if (nodes.kept.empty()) {
+        say(settings, "measured orders need the kept fragments: this iteration sorts by distance");
+        return update_orders(nodes, settings.distance, assignment, patch_orders);
+    }
+    const MeshPatches& patches = nodes.patches;
+    const uint32_t* group = patches.patch_primitive.data();
+    if (state.graphs.empty()) {
+        state.unit_of_triangle.assign(nodes.mesh.triangle_count(), 0);
+        for (size_t p = 0; p < patches.patch_count(); ++p)
+            for (uint32_t j = patches.patch_starts[p]; j < patches.patch_starts[p + 1]; ++j)
+                state.unit_of_triangle[patches.cache_order[j]] = uint32_t(p);
+        for (size_t c = 0; c < nodes.k; ++c)
+            state.graphs.emplace_back(patches.patch_count(), state.unit_of_triangle.data(),
+                                      state.unit_of_triangle.size(), group);
+        state.counted.assign(nodes.count, UINT32_MAX);
+        state.last.assign(nodes.k, {});
+        state.start.assign(nodes.k, {});
+    }
+    // Only the nodes that changed cluster since the last update are counted again.
+    const Clock::time_point graph_start = Clock::now();
+    std::vector<std::vector<const NodeFragments*>> leaving(nodes.k), arriving(nodes.k);
+    std::vector<size_t> sizes(nodes.k, 0);
+    for (size_t n = 0; n < nodes.count; ++n) {
+        ++sizes[assignment[n]];
+        if (state.counted[n] == assignment[n]) continue;
+        if (state.counted[n] != UINT32_MAX) leaving[state.counted[n]].push_back(&nodes.kept[n]);
+        arriving[assignment[n]].push_back(&nodes.kept[n]);
+        state.counted[n] = assignment[n];
+    }
+    size_t moved = 0;
+    std::vector<uint8_t> changed(nodes.k, 0);
+    for (size_t c = 0; c < nodes.k; ++c) {
+        moved += arriving[c].size();
+        changed[c] = !leaving[c].empty() || !arriving[c].empty();
+        state.graphs[c].add(leaving[c].data(), leaving[c].size(), -1, settings.threads);
+        state.graphs[c].add(arriving[c].data(), arriving[c].size(), +1, settings.threads);
+    }
+    const double graph_seconds = seconds_since(graph_start);
+    const Clock::time_point order_start = Clock::now();
+    std::string line;
+    for (size_t c = 0; c < nodes.k; ++c) {
+        if (sizes[c] == 0) continue;
+        // The buffer is already the local optimum of this very graph: nothing to do. A buffer that
+        // is a measured order needs no greedy start (on real characters the greedy order's
+        // backward weight is many times a sifted order's).
+        const bool measured_before = patch_orders[c] == state.last[c];
+        if (measured_before && !changed[c]) continue;
+        if (!changed[c] && patch_orders[c] == state.start[c]) {  // the same search again (its order was not kept)
+            patch_orders[c] = state.last[c];
+            continue;
+        }
+        state.start[c] = patch_orders[c];
+        const std::vector<Arc> arcs = state.graphs[c].arcs();
+        MeasuredOrderStats stats;
+        patch_orders[c] = measured_unit_order(patches.patch_count(), arcs.data(), arcs.size(), group,
+                                              patch_orders[c].data(), &stats, !measured_before);
+        state.last[c] = patch_orders[c];
+        line += " " + std::to_string(c) + ": " + std::to_string(arcs.size()) + " arcs, greedy " +
+                std::to_string(stats.greedy_weight) + (stats.from_previous ? ", current " : ", start ") +
+                std::to_string(stats.start_weight) + ", sifted " + std::to_string(stats.final_weight) + ";";
+    }
+    say(settings, "measured graphs: " + std::to_string(moved) + " nodes counted in " +
+                      std::to_string(graph_seconds) + " s, orders in " + std::to_string(seconds_since(order_start)) +
+                      " s; backward weights per cluster:" + line);
+    return sizes;
+}
+
 // Not in the paper (DESIGN.md step 6: never drop a cluster silently): an empty cluster takes the
 // front-to-back order, by averaged centroids, from the viewpoint of the worst-served node (highest
 // OVR) not used for another cluster in this iteration. Marks the clusters re-seeded.
@@ -452,6 +537,7 @@ ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patc
     std::vector<double> node_ovr;
     result.assignment.assign(nodes.count, UINT32_MAX);
     BestState best;
+    MeasuredGraphs measured;
     for (size_t iteration = 0;; ++iteration) {
         ClusteringIteration log;
         const Clock::time_point assignment_start = Clock::now();
@@ -478,7 +564,10 @@ ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patc
 
         const Clock::time_point update_start = Clock::now();
         const std::vector<std::vector<uint32_t>> previous_orders = result.patch_orders;
-        const std::vector<size_t> members = update_orders(nodes, settings.distance, result.assignment, result.patch_orders);
+        const std::vector<size_t> members =
+            settings.order == OrderSource::Measured
+                ? measured_update_orders(nodes, settings, result.assignment, measured, result.patch_orders)
+                : update_orders(nodes, settings.distance, result.assignment, result.patch_orders);
         std::vector<uint8_t> reseeded;
         log.reseeded = reseed_empty_clusters(nodes, members, node_ovr, settings, result.patch_orders, reseeded);
         if (settings.update == UpdateRule::Monotone)

@@ -11,10 +11,12 @@
 #include "animorder/animated_mesh.h"
 #include "animorder/invalid_input.h"
 #include "animorder/patches.h"
+#include "animorder/planar_clusters.h"
 #include "animorder/tipsify.h"
 #include "animorder/triangle_order.h"
 #include "animorder/viewpoints.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -41,6 +43,37 @@ MeshPatches build_mesh_patches(const AnimatedMesh& mesh, double lambda, unsigned
         for (uint32_t t : order) result.cache_order.push_back(first_triangle + t);
         for (size_t p = 1; p < starts.size(); ++p) {
             result.patch_starts.push_back(base + starts[p]);
+            result.patch_primitive.push_back(uint32_t(prim));
+        }
+    }
+    return result;
+}
+
+MeshPatches build_planar_units(const AnimatedMesh& mesh, const MeshPatches& like, size_t keyframe, unsigned cache_size) {
+    validate_animated_mesh(mesh);
+    if (keyframe >= mesh.keyframe_count())
+        throw InvalidInput("planar units: keyframe " + std::to_string(keyframe) + " does not exist");
+    std::vector<size_t> count(mesh.primitives.size(), 0);
+    for (uint32_t p : like.patch_primitive) ++count[p];
+    MeshPatches result;
+    result.patch_starts.push_back(0);
+    for (size_t prim = 0; prim < mesh.primitives.size(); ++prim) {
+        const Primitive& primitive = mesh.primitives[prim];
+        const uint32_t* source = mesh.indices.data() + primitive.first_index;
+        const size_t triangles = primitive.index_count / 3;
+        if (triangles == 0) continue;
+        const size_t clusters = std::max<size_t>(1, std::min(count[prim], triangles));
+        const std::vector<uint32_t> cluster_of =
+            cluster_by_normals(source, primitive.index_count, mesh.keyframe(keyframe), mesh.vertex_count, clusters);
+        std::vector<uint32_t> order(triangles);
+        const std::vector<uint32_t> starts = tipsify_clusters(order.data(), source, primitive.index_count,
+                                                              mesh.vertex_count, cluster_of.data(), clusters, cache_size);
+        const uint32_t base = uint32_t(result.cache_order.size());
+        const uint32_t first_triangle = uint32_t(primitive.first_index / 3);
+        for (uint32_t t : order) result.cache_order.push_back(first_triangle + t);
+        for (size_t c = 1; c < starts.size(); ++c) {
+            if (starts[c] == starts[c - 1]) continue;  // an empty cluster is no unit
+            result.patch_starts.push_back(base + starts[c]);
             result.patch_primitive.push_back(uint32_t(prim));
         }
     }

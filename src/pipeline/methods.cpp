@@ -7,6 +7,7 @@
 // meshopt:           meshoptimizer's vertex cache + overdraw optimisers (meshopt_order.cpp).
 // tipsify-per-frame: static-sander07 at every keyframe, one buffer each (the paper's "Tipsify").
 // single, joint:     Han & Sander 2017 (clustering.cpp): k-means over (keyframe, view) nodes.
+// measured, measured-joint: single / joint with measured cluster orders (measured_order.cpp).
 // oracle:            per evaluation node, the patches front-to-back (evaluation.cpp): a bound.
 // All run per primitive: a character's primitives are separate draws.
 #include "animorder/methods.h"
@@ -51,6 +52,8 @@ constexpr MethodInfo kMethods[] = {
     {Method::Single, "single", true, true, true, false},
     {Method::Joint, "joint", true, true, true, false},
     {Method::Oracle, "oracle", true, false, false, false},
+    {Method::Measured, "measured", true, true, true, false},
+    {Method::MeasuredJoint, "measured-joint", true, true, true, false},
 };
 
 const MethodInfo& info(Method method) {
@@ -94,6 +97,11 @@ Method parse_static_method(const std::string& name) {
 bool method_uses_lambda(Method method) { return info(method).lambda; }
 bool method_uses_clusters(Method method) { return info(method).clusters; }
 bool method_has_buffers(Method method) { return info(method).buffers; }
+bool method_is_clustered(Method method) {
+    return method == Method::Single || method == Method::Joint || method == Method::Measured ||
+           method == Method::MeasuredJoint;
+}
+bool method_is_joint(Method method) { return method == Method::Joint || method == Method::MeasuredJoint; }
 
 const char* distance_name(DistanceVariant variant) { return variant == DistanceVariant::Jcgt ? "jcgt" : "i3d"; }
 DistanceVariant parse_distance(const std::string& name) {
@@ -194,12 +202,13 @@ VertexCacheStats analyze_mesh_vertex_cache(const AnimatedMesh& mesh, const std::
 }
 
 AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double lambda, unsigned cache_size,
-                                    const ClusteringSettings& settings, bool blend_clusters) {
+                                    const ClusteringSettings& settings, bool blend_clusters, bool planar_units) {
     validate_animated_mesh(mesh);
     if (mesh.clips.empty()) throw InvalidInput("the mesh has no clip to cluster");
     AnimatedMethodResult result;
     const auto start = std::chrono::steady_clock::now();
     result.patches = build_mesh_patches(mesh, lambda, cache_size);
+    if (planar_units) result.patches = build_planar_units(mesh, result.patches, 0, cache_size);
     result.seconds_patches = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     result.framing = frame_animated_mesh(mesh);
 
@@ -289,9 +298,13 @@ void run_single_buffer(MethodResult& result, const AnimatedMesh& mesh, const Met
 
 // Han & Sander 2017; the fallback is the buffer the most clustering nodes chose.
 void run_clustered(MethodResult& result, const AnimatedMesh& mesh, const MethodSettings& settings) {
-    const bool joint = result.method == Method::Joint;
+    const bool joint = method_is_joint(result.method);
+    ClusteringSettings clustering = settings.clustering;
+    if (result.method == Method::Measured || result.method == Method::MeasuredJoint)
+        clustering.order = OrderSource::Measured;
     AnimatedMethodResult r =
-        run_han_sander(mesh, joint, settings.lambda, settings.cache_size, settings.clustering, settings.blend_clusters);
+        run_han_sander(mesh, joint, settings.lambda, settings.cache_size, clustering, settings.blend_clusters,
+                       clustering.order == OrderSource::Measured && settings.measured_planar_units);
     std::vector<size_t> chosen(r.buffers.orders.size(), 0);
     for (size_t i = 0; i < r.runs.size(); ++i)
         for (uint32_t c : r.runs[i].assignment) ++chosen[r.buffers.table_base[joint ? 0 : i] + c];
@@ -390,7 +403,9 @@ MethodResult run_method(const AnimatedMesh& mesh, Method method, const MethodSet
         case Method::Meshopt: run_single_buffer(result, mesh, settings); break;
         case Method::TipsifyPerFrame: run_tipsify_per_frame(result, mesh, settings); break;
         case Method::Single:
-        case Method::Joint: run_clustered(result, mesh, settings); break;
+        case Method::Joint:
+        case Method::Measured:
+        case Method::MeasuredJoint: run_clustered(result, mesh, settings); break;
         case Method::Oracle:
             run_oracle(result, mesh, settings);
             result.seconds = seconds_since(start);

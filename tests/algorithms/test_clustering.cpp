@@ -71,6 +71,32 @@ TEST(MeshPatches, CoverEveryTriangleWithinItsPrimitive) {
     for (size_t i = 0; i < body_triangles; ++i) EXPECT_LT(r[i], body_triangles);
 }
 
+// The measured method's alternative units: planar clusters, as many per primitive as λ's patches
+// (fewer only where a cluster came out empty), each a run of its own primitive's triangles.
+TEST(MeshPatches, PlanarUnitsCoverEveryTriangleWithinItsPrimitive) {
+    const AnimatedMesh& m = character();
+    const MeshPatches like = build_mesh_patches(m, 0.85);
+    const MeshPatches p = build_planar_units(m, like, 0);
+    EXPECT_TRUE(test::is_permutation_of_iota(p.cache_order));
+    ASSERT_EQ(p.patch_starts.size(), p.patch_count() + 1);
+    EXPECT_EQ(p.patch_starts.back(), m.triangle_count());
+    EXPECT_LE(p.patch_count(), like.patch_count());
+    EXPECT_GE(p.patch_count(), like.patch_count() * 9 / 10);
+    for (size_t q = 0; q < p.patch_count(); ++q) {
+        ASSERT_LT(p.patch_starts[q], p.patch_starts[q + 1]);
+        if (q > 0) {
+            EXPECT_LE(p.patch_primitive[q - 1], p.patch_primitive[q]);
+        }
+        const Primitive& prim = m.primitives[p.patch_primitive[q]];
+        for (uint32_t i = p.patch_starts[q]; i < p.patch_starts[q + 1]; ++i) {
+            const size_t t = p.cache_order[i];
+            EXPECT_GE(3 * t, prim.first_index);
+            EXPECT_LT(3 * t, prim.first_index + prim.index_count);
+        }
+    }
+    EXPECT_THROW(build_planar_units(m, like, m.keyframe_count()), InvalidInput);
+}
+
 TEST(Clustering, AssignsEachNodeToItsBestBufferAndImproves) {
     const AnimatedMesh& m = character();
     const MeshPatches patches = build_mesh_patches(m, 0.85);
@@ -149,6 +175,31 @@ TEST(Clustering, DeterministicWithOneOrTwoThreadsAndBothDistances) {
         EXPECT_EQ(one.patch_orders, two.patch_orders);
         EXPECT_EQ(one.iterations.size(), two.iterations.size());
     }
+}
+
+// OrderSource::Measured (measured_order.h): the same bootstrap and first assignment as the
+// paper's update, then orders from the measured graphs; the mean node OVR never rises, the result
+// does not depend on the thread count, and on this character it ends below the distance update's.
+TEST(Clustering, MeasuredOrdersAreMonotoneDeterministicAndBelowDistance) {
+    const AnimatedMesh& m = character();
+    const MeshPatches patches = build_mesh_patches(m, 0.85);
+    const Framing framing = framing_of(m);
+    const std::vector<uint32_t> keyframes = walk_keyframes(10);
+    ClusteringSettings s = small_settings();
+    const ClusteringResult distance = cluster_nodes(m, patches, framing, keyframes, s);
+    s.order = OrderSource::Measured;
+    s.threads = 1;
+    const ClusteringResult one = cluster_nodes(m, patches, framing, keyframes, s);
+    s.threads = 2;
+    const ClusteringResult two = cluster_nodes(m, patches, framing, keyframes, s);
+    EXPECT_EQ(one.assignment, two.assignment);
+    EXPECT_EQ(one.patch_orders, two.patch_orders);
+    ASSERT_FALSE(one.iterations.empty());
+    EXPECT_DOUBLE_EQ(one.iterations[0].mean_ovr, distance.iterations[0].mean_ovr);
+    for (size_t i = 1; i < one.iterations.size(); ++i)
+        EXPECT_LE(one.iterations[i].mean_ovr, one.iterations[i - 1].mean_ovr + 1e-12) << "iteration " << i;
+    EXPECT_LT(one.iterations[one.best_iteration].mean_ovr, distance.iterations[distance.best_iteration].mean_ovr);
+    for (const auto& o : one.triangle_orders) EXPECT_TRUE(test::is_permutation_of_iota(o));
 }
 
 TEST(Clustering, EmptyClustersAreReseededNotDropped) {

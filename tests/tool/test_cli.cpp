@@ -128,6 +128,29 @@ TEST_F(Cli, SingleWritesKBuffersPerClipAndReportsIterations) {
     EXPECT_EQ(nlohmann::json::parse(test::slurp(path("j.json")))["methods"][0]["buffers"], 3);
 }
 
+// The measured method (issue 15) through the tool: optimize (per clip and --joint), the same
+// bytes with one or two threads, and evaluate's row for it.
+TEST_F(Cli, MeasuredOptimizesJointAndEvaluates) {
+    const std::string fast = " -q -k 3 --views 12 --resolution 48 --max-iterations 4";
+    ASSERT_EQ(run("optimize --method measured" + fast + " --threads 1 -o " + path("m1").string() + " --report " +
+                  path("r.json").string()).exit_code, 0);
+    ASSERT_EQ(run("optimize --method measured" + fast + " --threads 2 -o " + path("m2").string()).exit_code, 0);
+    EXPECT_EQ(test::slurp(path("m1.animorder.bin")), test::slurp(path("m2.animorder.bin")));
+    const nlohmann::json j = nlohmann::json::parse(test::slurp(path("r.json")));
+    EXPECT_EQ(j["methods"][0]["name"], "measured");
+    EXPECT_EQ(j["methods"][0]["buffers"], 6);  // 3 per clip, 2 clips
+    ASSERT_EQ(run("optimize --method measured --joint" + fast + " --report " + path("j.json").string()).exit_code, 0);
+    const nlohmann::json joint = nlohmann::json::parse(test::slurp(path("j.json")));
+    EXPECT_EQ(joint["methods"][0]["name"], "measured-joint");
+    EXPECT_EQ(joint["methods"][0]["buffers"], 3);
+    const test::Outcome e = run("evaluate --methods single,measured" + fast + " --eval-views 4 --eval-resolution 64 --csv " +
+                                path("e.csv").string());
+    ASSERT_EQ(e.exit_code, 0) << e.err;
+    const std::string csv = test::slurp(path("e.csv"));
+    EXPECT_NE(csv.find("\nsingle,"), std::string::npos);
+    EXPECT_NE(csv.find("\nmeasured,"), std::string::npos);
+}
+
 TEST_F(Cli, GltfInGltfOut) {
     const std::string fox = test::shared_data_path("gltf-fox/Fox.glb").string();
     ANIMORDER_REQUIRE_DATA(fox);

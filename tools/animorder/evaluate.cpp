@@ -257,7 +257,7 @@ int run_evaluate(const EvaluateOptions& options) {
                                          {"ovr_mean", r.per_clip[c].ovr_mean},
                                          {"ovr_pooled", r.per_clip[c].ovr_pooled},
                                          {"nodes", r.per_clip[c].nodes},
-                                         {"time_s", run.method == Method::Single && c < run.run_seconds.size()
+                                         {"time_s", (run.method == Method::Single || run.method == Method::Measured) && c < run.run_seconds.size()
                                                         ? json(run.run_seconds[c])
                                                         : json(nullptr)}});
         const std::string lambda = method_uses_lambda(run.method) ? format_number(s.lambda) : "";

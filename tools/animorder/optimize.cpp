@@ -74,10 +74,12 @@ nlohmann::ordered_json optimize_settings_json(const OptimizeOptions& options, co
 
 OptimizePlan plan_optimize(const OptimizeOptions& options) {
     OptimizePlan plan;
-    const Method method = options.joint ? Method::Joint : parse_method(options.method);
+    const bool measured = options.method == method_name(Method::Measured) ||
+                          options.method == method_name(Method::MeasuredJoint);
+    const Method method = options.joint ? (measured ? Method::MeasuredJoint : Method::Joint) : parse_method(options.method);
     if (options.joint && options.method != method_name(Method::Single) && options.method != method_name(Method::Joint) &&
-        options.method != method_name(kDefaultMethod))
-        throw std::runtime_error("--joint applies to the single method, not " + options.method);
+        options.method != method_name(kDefaultMethod) && !measured)
+        throw std::runtime_error("--joint applies to the single and measured methods, not " + options.method);
     if (!method_has_buffers(method))
         throw std::runtime_error(std::string(method_name(method)) +
                                  " is a bound (a new order at every node), not an order to ship; use evaluate --methods " +

@@ -41,7 +41,7 @@ nlohmann::ordered_json clustering_details(const AnimatedMesh& mesh, const Method
                                   {"seconds_assignment", x.seconds_assignment},
                                   {"seconds_update", x.seconds_update}});
         }
-        runs.push_back({{"clips", r.method == Method::Joint ? json("all") : json(mesh.clips[i].name)},
+        runs.push_back({{"clips", method_is_joint(r.method) ? json("all") : json(mesh.clips[i].name)},
                         {"nodes", r.runs[i].assignment.size()},
                         {"view_radius", r.run_radius[i]},
                         {"converged", r.runs[i].converged},

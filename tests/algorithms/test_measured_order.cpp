@@ -1,0 +1,373 @@
+// Measured cluster orders (measured_order.cpp): the overdraw graph from kept fragments on
+// hand-built scenes whose answer is known, the order it gives, and the local search against
+// brute force on small random graphs (every permutation of up to 8 units).
+#include "animorder/invalid_input.h"
+#include "animorder/measured_order.h"
+#include "animorder/nehab06.h"
+#include "animorder/overdraw.h"
+#include "animorder/rasterizer.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <map>
+#include <numeric>
+#include <random>
+#include <vector>
+
+using namespace animorder;
+
+namespace {
+
+constexpr uint32_t kTie = 0x80000000u;
+
+// NodeFragments from explicit pixels: each pixel's triangles nearest first (kTie marks a depth
+// equal to the previous fragment's).
+NodeFragments pixels(const std::vector<std::vector<uint32_t>>& list) {
+    NodeFragments n;
+    n.starts.push_back(0);
+    for (const auto& p : list) {
+        n.fragments.insert(n.fragments.end(), p.begin(), p.end());
+        n.starts.push_back(uint32_t(n.fragments.size()));
+    }
+    n.visible = list.size();
+    return n;
+}
+
+std::vector<Arc> graph_of(const std::vector<NodeFragments>& nodes, const std::vector<uint32_t>& unit_of_triangle,
+                          size_t units, const uint32_t* group = nullptr, unsigned threads = 1) {
+    std::vector<const NodeFragments*> p;
+    for (const auto& n : nodes) p.push_back(&n);
+    return measured_overdraw_graph(p.data(), p.size(), unit_of_triangle.data(), unit_of_triangle.size(), units,
+                                   group, threads);
+}
+
+// A scene in clip space with w = 1 (orthographic): x, y, z are NDC; smaller z is nearer.
+struct Scene {
+    std::vector<float> clip;
+    std::vector<uint32_t> ib;
+    uint32_t vertex(float x, float y, float z) {
+        clip.insert(clip.end(), {x, y, z, 1.0f});
+        return uint32_t(clip.size() / 4 - 1);
+    }
+    void triangle(uint32_t a, uint32_t b, uint32_t c) { ib.insert(ib.end(), {a, b, c}); }
+    NodeFragments rasterize(unsigned resolution) const {
+        NodeRasterizer r;
+        r.rasterize(clip.data(), clip.size() / 4, ib.data(), ib.size(), resolution);
+        return r.export_fragments();
+    }
+};
+
+// Passed fragments of a face order on a node (the overdraw engine's own count).
+uint64_t passed(const NodeFragments& node, const std::vector<uint32_t>& order) {
+    const std::vector<uint32_t> ranks = make_rank_table({order.data()}, order.size());
+    uint64_t out = 0;
+    score_fragments(&out, node, ranks.data(), 1);
+    return out;
+}
+
+uint64_t cost(const std::vector<uint32_t>& order, const std::vector<Arc>& arcs) {
+    return count_feedback_arcs(order.data(), order.size(), arcs.data(), arcs.size()).weight;
+}
+
+TEST(MeasuredGraph, CountsEachUnitsNearestFragmentAgainstEveryUnitInFront) {
+    // Triangles 0,1 → unit 0; 2 → unit 1; 3 → unit 2.
+    const std::vector<uint32_t> unit = {0, 0, 1, 2};
+    // Pixel a: units 0,1,2 front to back → 0→1, 0→2, 1→2. Pixel b: 2 in front of 0 (0's two
+    // fragments count once) → 2→0. Pixel c: 1 and 0 at equal depth (tie) → nothing.
+    const NodeFragments n = pixels({{0, 2, 3}, {3, 0, 1}, {2, 1 | kTie}});
+    const std::vector<Arc> arcs = graph_of({n}, unit, 3);
+    // Net: (0,1): 1 − 0 → 0→1 (1); (0,2): 1 − 1 → none; (1,2): 1 → 1→2 (1).
+    ASSERT_EQ(arcs.size(), 2u);
+    EXPECT_EQ(arcs[0].from, 0u);
+    EXPECT_EQ(arcs[0].to, 1u);
+    EXPECT_EQ(arcs[0].weight, 1u);
+    EXPECT_EQ(arcs[1].from, 1u);
+    EXPECT_EQ(arcs[1].to, 2u);
+    EXPECT_EQ(arcs[1].weight, 1u);
+}
+
+TEST(MeasuredGraph, SameWhateverTheThreadCountAndDropsArcsBetweenGroups) {
+    std::mt19937 rng(7);
+    std::vector<NodeFragments> nodes;
+    for (int n = 0; n < 40; ++n) {
+        std::vector<std::vector<uint32_t>> list;
+        for (int p = 0; p < 200; ++p) {
+            std::vector<uint32_t> px;
+            for (int f = 0, count = 2 + int(rng() % 5); f < count; ++f) px.push_back(rng() % 30);
+            list.push_back(px);
+        }
+        nodes.push_back(pixels(list));
+    }
+    std::vector<uint32_t> unit(30), group(10);
+    for (uint32_t t = 0; t < 30; ++t) unit[t] = t / 3;
+    for (uint32_t u = 0; u < 10; ++u) group[u] = u < 5 ? 0 : 1;
+    const std::vector<Arc> one = graph_of(nodes, unit, 10, group.data(), 1);
+    const std::vector<Arc> two = graph_of(nodes, unit, 10, group.data(), 2);
+    ASSERT_EQ(one.size(), two.size());
+    ASSERT_FALSE(one.empty());
+    for (size_t i = 0; i < one.size(); ++i) {
+        EXPECT_EQ(one[i].from, two[i].from);
+        EXPECT_EQ(one[i].to, two[i].to);
+        EXPECT_EQ(one[i].weight, two[i].weight);
+        EXPECT_EQ(group[one[i].from], group[one[i].to]);
+    }
+}
+
+// A second implementation of the graph's definition (a map of pair counts), against the library
+// on random pixels, with few units (the dense matrix) and many (the hash table).
+TEST(MeasuredGraph, MatchesASecondImplementationDenseAndSparse) {
+    for (const size_t units : {size_t(20), size_t(1700)}) {
+        std::mt19937 rng{uint32_t(units)};
+        const size_t triangles = 2 * units;
+        std::vector<uint32_t> unit(triangles);
+        for (size_t t = 0; t < triangles; ++t) unit[t] = uint32_t(rng() % units);
+        std::vector<NodeFragments> nodes;
+        std::map<std::pair<uint32_t, uint32_t>, int64_t> front_of;  // (a, b): pixels with a strictly in front of b
+        for (int n = 0; n < 5; ++n) {
+            std::vector<std::vector<uint32_t>> list;
+            for (int p = 0; p < 400; ++p) {
+                std::vector<uint32_t> px;
+                std::vector<std::pair<uint32_t, int>> first;  // unit, depth level of its nearest fragment
+                int level = 0;
+                for (int f = 0, count = 2 + int(rng() % 6); f < count; ++f) {
+                    const uint32_t t = uint32_t(rng() % (units < 100 ? triangles : 400));  // overlap often
+                    const bool tie = f > 0 && rng() % 5 == 0;
+                    px.push_back(t | (tie ? kTie : 0));
+                    if (f > 0 && !tie) ++level;
+                    bool known = false;
+                    for (auto& x : first) known |= x.first == unit[t];
+                    if (!known) first.emplace_back(unit[t], level);
+                }
+                for (auto& a : first)
+                    for (auto& b : first)
+                        if (a.second < b.second) ++front_of[{a.first, b.first}];
+                list.push_back(px);
+            }
+            nodes.push_back(pixels(list));
+        }
+        std::map<std::pair<uint32_t, uint32_t>, uint64_t> expected;
+        for (const auto& [pair, count] : front_of) {
+            const auto reverse = front_of.find({pair.second, pair.first});
+            const int64_t net = count - (reverse == front_of.end() ? 0 : reverse->second);
+            if (net > 0) expected[pair] = uint64_t(net);
+        }
+        std::map<std::pair<uint32_t, uint32_t>, uint64_t> got;
+        for (const Arc& a : graph_of(nodes, unit, units, nullptr, 2)) got[{a.from, a.to}] = a.weight;
+        EXPECT_FALSE(expected.empty());
+        EXPECT_EQ(got, expected) << units << " units";
+    }
+}
+
+// k-means moves nodes between clusters: counting A and B, then removing A, must give B's graph.
+TEST(MeasuredGraph, RemovingNodesGivesTheGraphOfTheRest) {
+    for (const size_t units : {size_t(6), size_t(1100)}) {  // dense and hashed counts
+        std::vector<uint32_t> unit(units);
+        std::iota(unit.begin(), unit.end(), 0u);
+        const NodeFragments a = pixels({{0, 1}, {1, 2}, {3, 4, 5}, {5, 0}});
+        const NodeFragments b = pixels({{1, 0}, {1, 0}, {2, 1}, {4, 3}});
+        const NodeFragments* both[] = {&a, &b};
+        const NodeFragments* only_a[] = {&a};
+        MeasuredPairCounts counts(units, unit.data(), units, nullptr);
+        counts.add(both, 2, +1, 1);
+        counts.add(only_a, 1, -1, 1);
+        const std::vector<Arc> got = counts.arcs();
+        // b alone: 1→0 (2), 2→1 (1), 4→3 (1).
+        ASSERT_EQ(got.size(), 3u) << units;
+        EXPECT_EQ(got[0].from, 1u);
+        EXPECT_EQ(got[0].to, 0u);
+        EXPECT_EQ(got[0].weight, 2u);
+        EXPECT_EQ(got[1].from, 2u);
+        EXPECT_EQ(got[1].to, 1u);
+        EXPECT_EQ(got[1].weight, 1u);
+        EXPECT_EQ(got[2].from, 4u);
+        EXPECT_EQ(got[2].to, 3u);
+        EXPECT_EQ(got[2].weight, 1u);
+    }
+}
+
+TEST(MeasuredGraph, RejectsTrianglesAndUnitsOutOfRange) {
+    const NodeFragments n = pixels({{0, 5}});
+    EXPECT_THROW(graph_of({n}, {0, 1}, 2), InvalidInput);
+    EXPECT_THROW(graph_of({n}, {0, 1, 2, 3, 4, 9}, 6), InvalidInput);
+}
+
+// Nested shells: an outer plate (unit 0) and an inner plate (unit 1), each two-sided (a triangle
+// of each winding). Seen from outside (the outer plate nearer) and from inside the outer shell,
+// looking out past the inner one (the inner plate nearer; the view is mirrored, so the other
+// winding faces the camera). Two clusters of nodes, one per side: each cluster's measured order
+// must draw its own occluder first, and must pass fewer fragments than the other order.
+TEST(MeasuredOrder, NestedShellsEachClusterPutsItsOwnOccluderFirst) {
+    auto plate_scene = [](float outer_z, float inner_z, float mirror) {
+        Scene s;
+        auto plate = [&](float half, float z) {
+            const uint32_t a = s.vertex(-half * mirror, -half, z), b = s.vertex(half * mirror, -half, z),
+                           c = s.vertex(half * mirror, half, z), d = s.vertex(-half * mirror, half, z);
+            s.triangle(a, b, c);  // one winding
+            s.triangle(a, c, b);  // the other (two-sided)
+            s.triangle(a, c, d);
+            s.triangle(a, d, c);
+        };
+        plate(0.8f, outer_z);  // triangles 0–3: outer shell
+        plate(0.5f, inner_z);  // triangles 4–7: inner shell
+        return s.rasterize(32);
+    };
+    const std::vector<uint32_t> unit = {0, 0, 0, 0, 1, 1, 1, 1};
+    // Outside: outer plate nearer (z −0.5) than the inner one (0). Inside, mirrored: inner nearer.
+    const std::vector<NodeFragments> outside = {plate_scene(-0.5f, 0.0f, 1.0f), plate_scene(-0.6f, 0.1f, 1.0f)};
+    const std::vector<NodeFragments> inside = {plate_scene(0.5f, 0.0f, -1.0f), plate_scene(0.6f, -0.1f, -1.0f)};
+    // Inner plate: pixel centres inside ±0.5 NDC of a 32² view: 16 × 16 = 256 pixels, each
+    // covered by one front-facing triangle of each plate.
+    const std::vector<Arc> out_arcs = graph_of(outside, unit, 2), in_arcs = graph_of(inside, unit, 2);
+    ASSERT_EQ(out_arcs.size(), 1u);
+    EXPECT_EQ(out_arcs[0].from, 0u);
+    EXPECT_EQ(out_arcs[0].to, 1u);
+    EXPECT_EQ(out_arcs[0].weight, 2u * 256u);
+    ASSERT_EQ(in_arcs.size(), 1u);
+    EXPECT_EQ(in_arcs[0].from, 1u);
+    EXPECT_EQ(in_arcs[0].to, 0u);
+    EXPECT_EQ(in_arcs[0].weight, 2u * 256u);
+
+    const std::vector<uint32_t> out_order = measured_unit_order(2, out_arcs.data(), out_arcs.size(), nullptr, nullptr);
+    const std::vector<uint32_t> in_order = measured_unit_order(2, in_arcs.data(), in_arcs.size(), nullptr, nullptr);
+    EXPECT_EQ(out_order, (std::vector<uint32_t>{0, 1}));
+    EXPECT_EQ(in_order, (std::vector<uint32_t>{1, 0}));
+    // On the fragments themselves: outer-first passes the 256 inner pixels fewer from outside.
+    const std::vector<uint32_t> outer_first = {0, 1, 2, 3, 4, 5, 6, 7}, inner_first = {4, 5, 6, 7, 0, 1, 2, 3};
+    EXPECT_EQ(passed(outside[0], inner_first) - passed(outside[0], outer_first), 256u);
+    EXPECT_EQ(passed(inside[0], outer_first) - passed(inside[0], inner_first), 256u);
+}
+
+// A cycle 0→1 (5), 1→2 (4), 2→0 (1) measured from pixels: some arc must be violated, and the
+// order must keep the two heavier ones (drop 2→0: order 0, 1, 2, backward weight 1).
+TEST(MeasuredOrder, CyclicOcclusionKeepsTheHeavierArcs) {
+    std::vector<std::vector<uint32_t>> list;
+    for (int i = 0; i < 5; ++i) list.push_back({0, 1});
+    for (int i = 0; i < 4; ++i) list.push_back({1, 2});
+    list.push_back({2, 0});
+    const std::vector<Arc> arcs = graph_of({pixels(list)}, {0, 1, 2}, 3);
+    ASSERT_EQ(arcs.size(), 3u);
+    MeasuredOrderStats stats;
+    // Start from the worst rotation: the search must still reach the best order.
+    const std::vector<uint32_t> previous = {2, 0, 1};
+    const std::vector<uint32_t> order = measured_unit_order(3, arcs.data(), arcs.size(), nullptr, previous.data(), &stats);
+    EXPECT_EQ(order, (std::vector<uint32_t>{0, 1, 2}));
+    EXPECT_EQ(stats.final_weight, 1u);
+    EXPECT_EQ(cost(order, arcs), 1u);
+}
+
+// Two long thin patches crossing in depth, seen along −z (orthographic): A runs along x from
+// near (z −0.8 at x −0.9) to far (z 0.8 at x 0.9), its centroid at depth 0; B runs along y at
+// x ≈ 0.7, at constant depth 0.3 — farther than A's centroid, so any sort by centroid distance
+// draws A first. Where they cross (x ≈ 0.7) A is at depth ≈ 0.62, behind B: drawing A first
+// overdraws there. The measured graph says B before A, and that order passes fewer fragments.
+TEST(MeasuredOrder, CrossingPatchesGraphBeatsDistance) {
+    Scene s;
+    {
+        const uint32_t a = s.vertex(-0.9f, -0.1f, -0.8f), b = s.vertex(0.9f, -0.1f, 0.8f),
+                       c = s.vertex(0.9f, 0.1f, 0.8f), d = s.vertex(-0.9f, 0.1f, -0.8f);
+        s.triangle(a, b, c);
+        s.triangle(a, c, d);
+        const uint32_t e = s.vertex(0.6f, -0.9f, 0.3f), f = s.vertex(0.8f, -0.9f, 0.3f),
+                       g = s.vertex(0.8f, 0.9f, 0.3f), h = s.vertex(0.6f, 0.9f, 0.3f);
+        s.triangle(e, f, g);
+        s.triangle(e, g, h);
+    }
+    const NodeFragments node = s.rasterize(64);
+    // Premise: centroid depths (the distance sort's key from this eye) A = 0 < B = 0.3.
+    const float a_depth = (-0.8f + 0.8f + 0.8f + -0.8f) / 4, b_depth = 0.3f;
+    ASSERT_LT(a_depth, b_depth);
+    const std::vector<Arc> arcs = graph_of({node}, {0, 0, 1, 1}, 2);
+    ASSERT_EQ(arcs.size(), 1u);
+    EXPECT_EQ(arcs[0].from, 1u);
+    EXPECT_EQ(arcs[0].to, 0u);
+    const std::vector<uint32_t> order = measured_unit_order(2, arcs.data(), arcs.size(), nullptr, nullptr);
+    EXPECT_EQ(order, (std::vector<uint32_t>{1, 0}));
+    // The overlap: x in (0.6, 0.8) × y in (−0.1, 0.1) of a 64² view: about 6.4 × 6.4 pixels.
+    const uint64_t distance_order = passed(node, {0, 1, 2, 3}), graph_order = passed(node, {2, 3, 0, 1});
+    EXPECT_EQ(distance_order - graph_order, arcs[0].weight);
+    EXPECT_GE(arcs[0].weight, 25u);
+    EXPECT_LE(arcs[0].weight, 49u);
+}
+
+// Brute force: the least backward weight over every permutation.
+uint64_t best_cost(size_t n, const std::vector<Arc>& arcs) {
+    std::vector<uint32_t> p(n);
+    std::iota(p.begin(), p.end(), 0u);
+    uint64_t best = UINT64_MAX;
+    do best = std::min(best, cost(p, arcs));
+    while (std::next_permutation(p.begin(), p.end()));
+    return best;
+}
+
+std::vector<Arc> random_graph(std::mt19937& rng, size_t n) {
+    std::vector<Arc> arcs;
+    for (uint32_t a = 0; a < n; ++a)
+        for (uint32_t b = a + 1; b < n; ++b) {
+            if (rng() % 3 == 0) continue;
+            const uint64_t w = 1 + rng() % 20;
+            if (rng() % 2) arcs.push_back({a, b, w});
+            else arcs.push_back({b, a, w});
+        }
+    return arcs;
+}
+
+TEST(Sifting, NeverRaisesTheCostAndEndsAtALocalOptimumAgainstBruteForce) {
+    std::mt19937 rng(20170501);
+    for (int trial = 0; trial < 300; ++trial) {
+        const size_t n = 2 + trial % 7;  // 2..8 units
+        const std::vector<Arc> arcs = random_graph(rng, n);
+        std::vector<uint32_t> order(n);
+        std::iota(order.begin(), order.end(), 0u);
+        std::shuffle(order.begin(), order.end(), rng);
+        const uint64_t before = cost(order, arcs);
+        const uint64_t after = sift_order(order.data(), n, arcs.data(), arcs.size(), nullptr);
+        std::vector<uint32_t> sorted = order;
+        std::sort(sorted.begin(), sorted.end());
+        for (size_t i = 0; i < n; ++i) ASSERT_EQ(sorted[i], i);  // still a permutation
+        ASSERT_EQ(after, cost(order, arcs));
+        ASSERT_LE(after, before);
+        ASSERT_GE(after, best_cost(n, arcs));
+        // No single move (remove a unit, insert it anywhere) lowers the cost any more.
+        for (size_t from = 0; from < n; ++from)
+            for (size_t to = 0; to < n; ++to) {
+                std::vector<uint32_t> moved = order;
+                const uint32_t u = moved[from];
+                moved.erase(moved.begin() + long(from));
+                moved.insert(moved.begin() + long(to), u);
+                ASSERT_GE(cost(moved, arcs), after) << "trial " << trial;
+            }
+        // The whole step is never worse than the greedy order nor than its start.
+        MeasuredOrderStats stats;
+        measured_unit_order(n, arcs.data(), arcs.size(), nullptr, order.data(), &stats);
+        ASSERT_LE(stats.final_weight, stats.greedy_weight);
+        ASSERT_LE(stats.final_weight, after);
+    }
+}
+
+TEST(Sifting, KeepsEveryGroupInItsBlock) {
+    std::mt19937 rng(3);
+    for (int trial = 0; trial < 50; ++trial) {
+        const size_t n = 8;
+        std::vector<Arc> arcs = random_graph(rng, n);
+        const std::vector<uint32_t> group = {0, 0, 0, 1, 1, 1, 1, 2};
+        std::vector<uint32_t> previous = {2, 0, 1, 6, 3, 5, 4, 7};
+        MeasuredOrderStats stats;
+        const std::vector<uint32_t> order =
+            measured_unit_order(n, arcs.data(), arcs.size(), group.data(), previous.data(), &stats);
+        for (size_t i = 0; i < n; ++i) ASSERT_EQ(group[order[i]], group[i]) << "trial " << trial;
+        // Within groups the result is optimal or at least no worse than both starts.
+        ASSERT_LE(stats.final_weight, stats.greedy_weight);
+        ASSERT_LE(stats.final_weight, cost(previous, arcs));
+    }
+}
+
+TEST(MeasuredOrder, RejectsAPreviousOrderThatIsNoPermutation) {
+    const std::vector<Arc> arcs = {{0, 1, 1}};
+    const std::vector<uint32_t> bad = {0, 0};
+    EXPECT_THROW(measured_unit_order(2, arcs.data(), arcs.size(), nullptr, bad.data()), InvalidInput);
+    const std::vector<Arc> outside = {{0, 5, 1}};
+    EXPECT_THROW(measured_unit_order(2, outside.data(), outside.size(), nullptr, nullptr), InvalidInput);
+}
+
+}  // namespace

@@ -34,8 +34,8 @@ double seconds_since(Clock::time_point start) { return std::chrono::duration<dou
 
 // Mean OVR of each order over `views` random directions at the first keyframe.
 std::vector<double> mean_ovr(const AnimatedMesh& mesh, const std::vector<const uint32_t*>& orders, size_t views) {
-    const Framing framing = frame_keyframes(mesh.keyframe_positions.data(), 1, mesh.vertex_count, mesh.indices.data(),
-                                            mesh.indices.size());
+    const Framing framing =
+        frame_keyframes(mesh.keyframe_positions.data(), 1, mesh.vertex_count, mesh.indices.data(), mesh.indices.size());
     const std::vector<float> d = random_sphere_directions(views, 20170501);
     std::vector<OverdrawNode> nodes(views);
     for (size_t v = 0; v < views; ++v)
@@ -71,9 +71,9 @@ void row(const std::string& name, const AnimatedMesh& mesh, size_t views) {
     settings.views = views;
     std::vector<uint32_t> nehab(n), sander(n), tips(n);
     Clock::time_point start = Clock::now();
-    const Nehab06Result r = order_static_nehab06(nehab.data(), mesh.indices.data(), mesh.indices.size(),
-                                                 mesh.keyframe_positions.data(), 1, mesh.vertex_count, nullptr, 0,
-                                                 settings);
+    const Nehab06Result r =
+        order_static_nehab06(nehab.data(), mesh.indices.data(), mesh.indices.size(), mesh.keyframe_positions.data(), 1,
+                             mesh.vertex_count, nullptr, 0, settings);
     const double t_nehab = seconds_since(start);
     start = Clock::now();
     order_static_sander07(sander.data(), mesh.indices.data(), mesh.indices.size(), mesh.keyframe_positions.data(),
@@ -81,11 +81,12 @@ void row(const std::string& name, const AnimatedMesh& mesh, size_t views) {
     const double t_sander = seconds_since(start);
     tipsify(tips.data(), mesh.indices.data(), mesh.indices.size(), mesh.vertex_count);
     const std::vector<double> ovr = mean_ovr(mesh, {nehab.data(), sander.data(), tips.data()}, 40);
-    std::printf("| %-16s | %6zu | %3zu | %4zu | %6.3f | %5.3f | %5.3f | %5.3f | %5.3f | %5.3f | %7.4f | %6.0f× | %.4f | "
-                "%.4f | %.4f | %.3f | %.3f |\n",
-                name.c_str(), n, views, r.cluster_count, t_nehab, r.seconds_clustering, r.seconds_rasterization,
-                r.seconds_graph - r.seconds_rasterization, r.seconds_ordering, r.seconds_selection, t_sander,
-                t_nehab / t_sander, ovr[0], ovr[1], ovr[2], acmr(mesh, nehab), acmr(mesh, tips));
+    std::printf(
+        "| %-16s | %6zu | %3zu | %4zu | %6.3f | %5.3f | %5.3f | %5.3f | %5.3f | %5.3f | %7.4f | %6.0f× | %.4f | "
+        "%.4f | %.4f | %.3f | %.3f |\n",
+        name.c_str(), n, views, r.cluster_count, t_nehab, r.seconds_clustering, r.seconds_rasterization,
+        r.seconds_graph - r.seconds_rasterization, r.seconds_ordering, r.seconds_selection, t_sander,
+        t_nehab / t_sander, ovr[0], ovr[1], ovr[2], acmr(mesh, nehab), acmr(mesh, tips));
     std::fflush(stdout);
 }
 
@@ -94,17 +95,20 @@ void row(const std::string& name, const AnimatedMesh& mesh, size_t views) {
 int main(int argc, char** argv) {
     const bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
     std::printf("static-nehab06 vs static-sander07 (automatic cluster count, 256², all hardware threads)\n\n");
-    std::printf("| mesh | tris | views | clusters | nehab06 s | clustering | raster | pairs | ordering | "
-                "selection | sander07 s | ratio | OVR nehab06 | OVR sander07 | OVR tipsify | ACMR nehab06 | "
-                "ACMR tipsify |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    std::printf(
+        "| mesh | tris | views | clusters | nehab06 s | clustering | raster | pairs | ordering | "
+        "selection | sander07 s | ratio | OVR nehab06 | OVR sander07 | OVR tipsify | ACMR nehab06 | "
+        "ACMR tipsify |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     std::vector<std::pair<std::string, AnimatedMesh>> meshes;
     for (size_t target : quick ? std::vector<size_t>{2000, 10000} : std::vector<size_t>{2000, 10000, 70000})
         meshes.push_back({"torus knot", make_torus_knot(target)});
     if (!quick) {
         meshes.push_back({"character", make_procedural_character()});
         const std::string ganfaul = ANIMORDER_SOURCE_DIR "/../shared/data/mixamo-ganfaul/Ganfaul.gltf";
-        if (std::filesystem::exists(ganfaul)) meshes.push_back({"Ganfaul", load_character(ganfaul)});
-        else std::fprintf(stderr, "bench_nehab06: %s not found, skipped\n", ganfaul.c_str());
+        if (std::filesystem::exists(ganfaul))
+            meshes.push_back({"Ganfaul", load_character(ganfaul)});
+        else
+            std::fprintf(stderr, "bench_nehab06: %s not found, skipped\n", ganfaul.c_str());
     }
     for (const auto& [name, mesh] : meshes)
         for (size_t views : quick ? std::vector<size_t>{42} : std::vector<size_t>{42, 162}) row(name, mesh, views);

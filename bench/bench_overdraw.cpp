@@ -85,8 +85,8 @@ double engine_ms_per_node(const AnimatedMesh& mesh, const Workload& w, unsigned 
 void compare_with_gl(const AnimatedMesh& mesh, size_t keyframe_step) {
     const Workload w = make_workload(mesh, keyframe_step, 1);
     const double one = engine_ms_per_node(mesh, w, 256, 1), two = engine_ms_per_node(mesh, w, 256, 2);
-    std::printf("%-34s %6zu tris %5zu nodes  engine %.3f ms/node (1 thread) %.3f ms/node (2 threads)", mesh.name.c_str(),
-                mesh.triangle_count(), w.nodes.size(), one, two);
+    std::printf("%-34s %6zu tris %5zu nodes  engine %.3f ms/node (1 thread) %.3f ms/node (2 threads)",
+                mesh.name.c_str(), mesh.triangle_count(), w.nodes.size(), one, two);
 #ifdef ANIMORDER_HAVE_GL
     try {
         GlOverdrawReference gl(256);
@@ -98,7 +98,8 @@ void compare_with_gl(const AnimatedMesh& mesh, size_t keyframe_step) {
         std::vector<float> clip(mesh.vertex_count * 4);
         const double seconds = median_seconds([&] {
             for (const OverdrawNode& n : w.nodes) {
-                transform_to_clip(clip.data(), mesh.keyframe(n.keyframe), mesh.vertex_count, &w.framing.centres[3 * n.keyframe],
+                transform_to_clip(clip.data(), mesh.keyframe(n.keyframe), mesh.vertex_count,
+                                  &w.framing.centres[3 * n.keyframe],
                                   node_view_projection(n.direction, w.framing.radius));
                 gl.score(clip.data(), mesh.vertex_count, buffers);
             }

@@ -37,8 +37,8 @@ namespace {
 
 struct Case {
     const char* name;
-    const char* file;                 // under the data folder
-    std::vector<std::string> clips;   // empty: all
+    const char* file;                // under the data folder
+    std::vector<std::string> clips;  // empty: all
     Method method;
     const char* goal;
 };
@@ -63,8 +63,10 @@ int run_case(const Case& c, bool quick) {
     }
     const Clock::time_point start = Clock::now();
     AnimatedMesh mesh = load_character(file.string());
-    if (!c.clips.empty()) mesh = select_clips(mesh, c.clips);
-    else if (quick && mesh.clips.size() > 2) mesh = select_clips(mesh, {mesh.clips[0].name, mesh.clips[1].name});
+    if (!c.clips.empty())
+        mesh = select_clips(mesh, c.clips);
+    else if (quick && mesh.clips.size() > 2)
+        mesh = select_clips(mesh, {mesh.clips[0].name, mesh.clips[1].name});
     const double load_s = std::chrono::duration<double>(Clock::now() - start).count();
     MethodSettings settings;  // the library's defaults: the protocol
     if (quick) {
@@ -78,7 +80,8 @@ int run_case(const Case& c, bool quick) {
     size_t nodes = 0;
     for (const ClusteringResult& run : r.runs) nodes += run.assignment.size();
     std::printf("%-14s %6zu triangles %3zu clips %5zu keyframes %7zu nodes  load %.1f s  method %.1f s  total %.1f s",
-                c.name, mesh.triangle_count(), mesh.clips.size(), mesh.keyframe_count(), nodes, load_s, r.seconds, total_s);
+                c.name, mesh.triangle_count(), mesh.clips.size(), mesh.keyframe_count(), nodes, load_s, r.seconds,
+                total_s);
     std::fflush(stdout);
     return 0;
 }
@@ -105,8 +108,10 @@ int main(int argc, char** argv) {
     bool quick = false;
     std::vector<std::string> wanted;
     for (int i = 1; i < argc; ++i) {
-        if (std::strcmp(argv[i], "--quick") == 0) quick = true;
-        else wanted.push_back(argv[i]);
+        if (std::strcmp(argv[i], "--quick") == 0)
+            quick = true;
+        else
+            wanted.push_back(argv[i]);
     }
     auto selected = [&](const std::string& name) {
         if (wanted.empty()) return true;
@@ -118,14 +123,16 @@ int main(int argc, char** argv) {
         bool known = w == "engine-ratio";
         for (const Case& c : kCases) known = known || w == c.name;
         if (!known) {
-            std::fprintf(stderr, "bench_scale: unknown case '%s' (ganfaul-joint, xbot-single, clip60-single, engine-ratio)\n",
+            std::fprintf(stderr,
+                         "bench_scale: unknown case '%s' (ganfaul-joint, xbot-single, clip60-single, engine-ratio)\n",
                          w.c_str());
             return 1;
         }
     }
     std::printf("bench_scale: %s; data %s\n",
-                quick ? "QUICK smoke settings (12 views, 64^2, k 2, 1 iteration, at most 2 clips): not the goals' figures"
-                      : "default protocol (162 views, 256^2, k = 5, lambda 0.85, all cores)",
+                quick
+                    ? "QUICK smoke settings (12 views, 64^2, k 2, 1 iteration, at most 2 clips): not the goals' figures"
+                    : "default protocol (162 views, 256^2, k = 5, lambda 0.85, all cores)",
                 data_folder().string().c_str());
     std::fflush(stdout);
     for (const Case& c : kCases) {
@@ -150,7 +157,8 @@ int main(int argc, char** argv) {
         wait4(child, &status, 0, &usage);
         const double wall = std::chrono::duration<double>(Clock::now() - start).count();
         // ru_maxrss is in KiB on Linux: the child's own peak resident set.
-        std::printf("  wall %.1f s  peak RSS %.2f GB  (goal %s)\n", wall, double(usage.ru_maxrss) * 1024.0 / 1e9, c.goal);
+        std::printf("  wall %.1f s  peak RSS %.2f GB  (goal %s)\n", wall, double(usage.ru_maxrss) * 1024.0 / 1e9,
+                    c.goal);
         std::fflush(stdout);
     }
     if (selected("engine-ratio") && !quick) engine_ratio();

@@ -109,8 +109,8 @@ public:
             const Entry& ours = entries_["tipsify/" + f.name];
             const Entry& theirs = entries_["meshopt_fifo/" + f.name];
             if (ours.time_ms <= 0 || theirs.time_ms <= 0) continue;
-            std::printf("%-22s %10.3fms %10.3fms %8.3f %10.4f %10.4f\n", f.name.c_str(), ours.time_ms,
-                        theirs.time_ms, ours.time_ms / theirs.time_ms, ours.acmr, theirs.acmr);
+            std::printf("%-22s %10.3fms %10.3fms %8.3f %10.4f %10.4f\n", f.name.c_str(), ours.time_ms, theirs.time_ms,
+                        ours.time_ms / theirs.time_ms, ours.acmr, theirs.acmr);
         }
     }
 

@@ -87,7 +87,8 @@ unsigned long long parse_count(const std::string& option, const std::string& tex
         used = 0;
     }
     if (used == 0 || used != text.size() || value < minimum || value > 1000000000ull)
-        throw InvalidInput(option + " needs a whole number of at least " + std::to_string(minimum) + ", not '" + text + "'");
+        throw InvalidInput(option + " needs a whole number of at least " + std::to_string(minimum) + ", not '" + text +
+                           "'");
     return value;
 }
 
@@ -99,15 +100,24 @@ Options parse_options(int argc, char** argv) {
             if (i + 1 >= argc) throw InvalidInput(a + " needs a value");
             return argv[++i];
         };
-        if (a == "--clip") o.clips.push_back(value());
-        else if (a == "--views") o.views = parse_count(a, value(), 1);
-        else if (a == "--keyframe-stride") o.keyframe_stride = parse_count(a, value(), 1);
-        else if (a == "--resolution") o.resolution = unsigned(parse_count(a, value(), 1));
-        else if (a == "--shader-iterations") o.iterations = int(parse_count(a, value(), 0));
-        else if (a == "--repeats") o.repeats = int(parse_count(a, value(), 1));
-        else if (a == "-k") o.clusters = parse_count(a, value(), 1);
-        else if (a == "--json") o.json = value();
-        else if (a == "--quiet") o.quiet = true;
+        if (a == "--clip")
+            o.clips.push_back(value());
+        else if (a == "--views")
+            o.views = parse_count(a, value(), 1);
+        else if (a == "--keyframe-stride")
+            o.keyframe_stride = parse_count(a, value(), 1);
+        else if (a == "--resolution")
+            o.resolution = unsigned(parse_count(a, value(), 1));
+        else if (a == "--shader-iterations")
+            o.iterations = int(parse_count(a, value(), 0));
+        else if (a == "--repeats")
+            o.repeats = int(parse_count(a, value(), 1));
+        else if (a == "-k")
+            o.clusters = parse_count(a, value(), 1);
+        else if (a == "--json")
+            o.json = value();
+        else if (a == "--quiet")
+            o.quiet = true;
         else if (a == "--lambda") {
             const std::string text = value();
             char* end = nullptr;
@@ -151,12 +161,14 @@ double correlation(const std::vector<double>& x, const std::vector<double>& y) {
 std::string json_string(const std::string& s) {
     std::string out = "\"";
     for (char c : s) {
-        if (c == '"' || c == '\\') out += '\\', out += c;
+        if (c == '"' || c == '\\')
+            out += '\\', out += c;
         else if (static_cast<unsigned char>(c) < 0x20) {
             char escape[8];
             std::snprintf(escape, sizeof escape, "\\u%04x", c);
             out += escape;
-        } else out += c;
+        } else
+            out += c;
     }
     return out + "\"";
 }
@@ -195,8 +207,9 @@ int run(const Options& options) {
     settings.lambda = options.lambda;
     settings.clustering.clusters = options.clusters;
     const std::vector<uint32_t> original = run_method(mesh, Method::Original, settings).buffers.orders[0];
-    log("clustering (single, k = " + std::to_string(options.clusters) + ", " + std::to_string(settings.clustering.views) +
-        " views at " + std::to_string(settings.clustering.resolution) + "²) ...");
+    log("clustering (single, k = " + std::to_string(options.clusters) + ", " +
+        std::to_string(settings.clustering.views) + " views at " + std::to_string(settings.clustering.resolution) +
+        "²) ...");
     const MethodResult single = run_method(mesh, Method::Single, settings);
     const MethodBuffers& buffers = single.buffers;
     const double seconds_methods = std::chrono::duration<double>(Clock::now() - start).count();
@@ -220,7 +233,8 @@ int run(const Options& options) {
                 n.keyframe = clip.first_keyframe + f;
                 n.view = v;
                 n.single_buffer = buffers.table_base[c] + select_buffer(buffers.tables[c], f, &directions[3 * v]);
-                if (n.single_buffer >= buffers.orders.size()) throw InvalidInput("a lookup table names a missing buffer");
+                if (n.single_buffer >= buffers.orders.size())
+                    throw InvalidInput("a lookup table names a missing buffer");
                 nodes.push_back(n);
             }
     }
@@ -302,10 +316,11 @@ int run(const Options& options) {
     const double corr_fragments = correlation(node_fragments, node_seconds);
     const double total_seconds = std::chrono::duration<double>(Clock::now() - start).count();
 
-    std::printf("%s: %zu triangles, %zu clips, %zu nodes (%zu views, keyframe stride %zu), %u², %d shader iterations, "
-                "median of %d\nOpenGL renderer: %s\n",
-                input_name.c_str(), mesh.triangle_count(), mesh.clips.size(), nodes.size(), options.views,
-                options.keyframe_stride, options.resolution, options.iterations, options.repeats, renderer.c_str());
+    std::printf(
+        "%s: %zu triangles, %zu clips, %zu nodes (%zu views, keyframe stride %zu), %u², %d shader iterations, "
+        "median of %d\nOpenGL renderer: %s\n",
+        input_name.c_str(), mesh.triangle_count(), mesh.clips.size(), nodes.size(), options.views,
+        options.keyframe_stride, options.resolution, options.iterations, options.repeats, renderer.c_str());
     std::printf("| method   | buffers | OVR mean | OVR pooled | time (s) | GL_TIME_ELAPSED (s) |\n");
     std::printf("|----------|--------:|---------:|-----------:|---------:|--------------------:|\n");
     for (int m = 0; m < 2; ++m)
@@ -314,33 +329,39 @@ int run(const Options& options) {
                     totals[m].seconds, totals[m].gl_seconds);
     std::printf("single/original: time %.4f, OVR %.4f; per-node correlation of the two ratios %.3f\n", t_ratio, o_ratio,
                 corr);
-    std::printf("per-draw correlation of time with passed fragments %.3f; a draw without shading costs %.1f%% of "
-                "original's (%.3f s over all nodes)\n",
-                corr_fragments, 100.0 * base_seconds / totals[0].seconds, base_seconds);
+    std::printf(
+        "per-draw correlation of time with passed fragments %.3f; a draw without shading costs %.1f%% of "
+        "original's (%.3f s over all nodes)\n",
+        corr_fragments, 100.0 * base_seconds / totals[0].seconds, base_seconds);
 
     if (!options.json.empty()) {
         FILE* f = std::fopen(options.json.c_str(), "w");
         if (!f) throw std::runtime_error("cannot write " + options.json);
-        std::fprintf(f, "{\n  \"tool\": \"render_time\",\n  \"input\": %s,\n  \"renderer\": %s,\n", json_string(input_name).c_str(),
-                     json_string(renderer).c_str());
+        std::fprintf(f, "{\n  \"tool\": \"render_time\",\n  \"input\": %s,\n  \"renderer\": %s,\n",
+                     json_string(input_name).c_str(), json_string(renderer).c_str());
         const char* threads = std::getenv("LP_NUM_THREADS");
         std::fprintf(f, "  \"lp_num_threads\": %s,\n", threads ? json_string(threads).c_str() : "null");
         std::fprintf(f, "  \"triangles\": %zu,\n  \"clips\": [", mesh.triangle_count());
         for (size_t c = 0; c < mesh.clips.size(); ++c)
             std::fprintf(f, "%s%s", c ? ", " : "", json_string(mesh.clips[c].name).c_str());
-        std::fprintf(f, "],\n  \"nodes\": %zu,\n  \"views\": %zu,\n  \"keyframe_stride\": %zu,\n  \"resolution\": %u,\n"
-                        "  \"shader_iterations\": %d,\n  \"repeats\": %d,\n  \"lambda\": %.17g,\n  \"clusters\": %zu,\n"
-                        "  \"clustering_views\": %zu,\n  \"clustering_resolution\": %u,\n  \"methods\": [\n",
+        std::fprintf(f,
+                     "],\n  \"nodes\": %zu,\n  \"views\": %zu,\n  \"keyframe_stride\": %zu,\n  \"resolution\": %u,\n"
+                     "  \"shader_iterations\": %d,\n  \"repeats\": %d,\n  \"lambda\": %.17g,\n  \"clusters\": %zu,\n"
+                     "  \"clustering_views\": %zu,\n  \"clustering_resolution\": %u,\n  \"methods\": [\n",
                      nodes.size(), options.views, options.keyframe_stride, options.resolution, options.iterations,
-                     options.repeats, options.lambda, options.clusters, settings.clustering.views, settings.clustering.resolution);
+                     options.repeats, options.lambda, options.clusters, settings.clustering.views,
+                     settings.clustering.resolution);
         for (int m = 0; m < 2; ++m)
-            std::fprintf(f, "    {\"name\": \"%s\", \"buffers\": %zu, \"ovr\": %.17g, \"ovr_pooled\": %.17g, \"seconds\": %.17g, "
-                            "\"gl_time_elapsed_s\": %.17g}%s\n",
-                         totals[m].name, m == 0 ? size_t(1) : buffers.orders.size(), ovr[m], totals[m].passed / visible_total,
-                         totals[m].seconds, totals[m].gl_seconds, m == 0 ? "," : "");
-        std::fprintf(f, "  ],\n  \"time_ratio\": %.17g,\n  \"ovr_ratio\": %.17g,\n  \"correlation\": %.17g,\n"
-                        "  \"correlation_time_fragments\": %.17g,\n  \"unshaded_seconds\": %.17g,\n"
-                        "  \"seconds_methods\": %.17g,\n  \"seconds_total\": %.17g\n}\n",
+            std::fprintf(
+                f,
+                "    {\"name\": \"%s\", \"buffers\": %zu, \"ovr\": %.17g, \"ovr_pooled\": %.17g, \"seconds\": %.17g, "
+                "\"gl_time_elapsed_s\": %.17g}%s\n",
+                totals[m].name, m == 0 ? size_t(1) : buffers.orders.size(), ovr[m], totals[m].passed / visible_total,
+                totals[m].seconds, totals[m].gl_seconds, m == 0 ? "," : "");
+        std::fprintf(f,
+                     "  ],\n  \"time_ratio\": %.17g,\n  \"ovr_ratio\": %.17g,\n  \"correlation\": %.17g,\n"
+                     "  \"correlation_time_fragments\": %.17g,\n  \"unshaded_seconds\": %.17g,\n"
+                     "  \"seconds_methods\": %.17g,\n  \"seconds_total\": %.17g\n}\n",
                      t_ratio, o_ratio, corr, corr_fragments, base_seconds, seconds_methods, total_seconds);
         if (std::fclose(f) != 0) throw std::runtime_error("cannot write " + options.json);
     }

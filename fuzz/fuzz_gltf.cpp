@@ -8,7 +8,7 @@
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const bool binary = size >= 4 && std::memcmp(data, "glTF", 4) == 0;
     const std::string path = animorder_fuzz::write_input(data, size, binary ? "input.glb" : "input.gltf");
-    animorder_fuzz::run_loader([](const std::string& p, const animorder::LoadOptions& o) { return animorder::load_gltf(p, o); },
-                               path);
+    animorder_fuzz::run_loader(
+        [](const std::string& p, const animorder::LoadOptions& o) { return animorder::load_gltf(p, o); }, path);
     return 0;
 }

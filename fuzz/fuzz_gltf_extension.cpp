@@ -17,7 +17,6 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         if (r.errors.empty())
             for (const animorder::ExtensionPrimitive& p : r.primitives)
                 if (p.orders.size() != size_t(p.order_count) * p.indices.size()) std::abort();
-    } catch (const animorder::LoadError&) {
-    }
+    } catch (const animorder::LoadError&) {}
     return 0;
 }

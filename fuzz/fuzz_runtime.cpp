@@ -39,9 +39,22 @@ void exercise(const animorder_runtime& rt, const uint8_t* data, size_t size) {
     const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
     const float fnan = std::numeric_limits<float>::quiet_NaN(), finf = std::numeric_limits<float>::infinity();
     // Cameras: the axes and diagonals at distance 5, zero, NaN, infinite, and two from the bytes.
-    float cameras[20][3] = {{5, 0, 0}, {-5, 0, 0}, {0, 5, 0}, {0, -5, 0},  {0, 0, 5},     {0, 0, -5},
-                            {3, 3, 3}, {-3, 3, -3}, {0, 0, 0}, {fnan, 0, 0}, {0, finf, 0}, {-finf, finf, 1},
-                            {1e38f, -1e38f, 1e38f}, {1e-38f, 0, 0}, {-0.001f, 0, 5}, {0, -0.f, -5}};
+    float cameras[20][3] = {{5, 0, 0},
+                            {-5, 0, 0},
+                            {0, 5, 0},
+                            {0, -5, 0},
+                            {0, 0, 5},
+                            {0, 0, -5},
+                            {3, 3, 3},
+                            {-3, 3, -3},
+                            {0, 0, 0},
+                            {fnan, 0, 0},
+                            {0, finf, 0},
+                            {-finf, finf, 1},
+                            {1e38f, -1e38f, 1e38f},
+                            {1e-38f, 0, 0},
+                            {-0.001f, 0, 5},
+                            {0, -0.f, -5}};
     for (int d = 0; d < 3; ++d) {
         cameras[16][d] = f32(word(data, size, size - (size >= 12 ? 12 : size) + 4 * size_t(d)));
         cameras[17][d] = size ? float(data[(7 * size_t(d) + 3) % size] % 16) - 8.f : 1.f;
@@ -55,7 +68,16 @@ void exercise(const animorder_runtime& rt, const uint8_t* data, size_t size) {
     for (uint32_t clip : clips) {
         if (clip < rt.clip_count && clip >= clip_limit && clip != rt.clip_count - 1) continue;
         const uint32_t keyframes = clip < rt.clip_count ? word(rt.data, rt.size, 20 + 32 * size_t(clip)) : 1;
-        const double times[] = {0, 0.5, -1, double(keyframes) - 1, double(keyframes), 1e300, -1e300, nan, inf, -inf,
+        const double times[] = {0,
+                                0.5,
+                                -1,
+                                double(keyframes) - 1,
+                                double(keyframes),
+                                1e300,
+                                -1e300,
+                                nan,
+                                inf,
+                                -inf,
                                 double(word(data, size, 4)) / 7.0};
         for (const auto& camera : cameras)
             for (const float* centre : centres)

@@ -63,8 +63,7 @@ void run_loader(Load load, const std::string& path) {
         const animorder::AnimatedMesh mesh = load(path, options());
         animorder::validate_animated_mesh(mesh);  // a loaded mesh must keep its own invariants
     } catch (const animorder::LoadError&) {
-    } catch (const animorder::InvalidInput&) {
-    }
+    } catch (const animorder::InvalidInput&) {}
 }
 
 }  // namespace animorder_fuzz

@@ -117,7 +117,8 @@ typedef struct animorder__clip_info {
 } animorder__clip_info;
 
 /* The end of the clip records and index buffers, or 0 when it does not fit in the bytes. */
-static uint64_t animorder__buffers_end(uint64_t size, uint32_t clip_count, uint32_t buffer_count, uint32_t index_count) {
+static uint64_t animorder__buffers_end(uint64_t size, uint32_t clip_count, uint32_t buffer_count,
+                                       uint32_t index_count) {
     uint64_t records, buffer_bytes, end;
     if (!animorder__mul(clip_count, ANIMORDER__CLIP, &records) || !animorder__add(ANIMORDER__HEADER, records, &end))
         return 0;

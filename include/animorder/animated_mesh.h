@@ -41,28 +41,26 @@ struct Primitive {
 
 struct Clip {
     std::string name;
-    double duration_s = 0;       // last key time − first key time
-    double sample_rate = 30;     // keyframes per second (DESIGN.md default 30)
-    size_t first_keyframe = 0;   // into AnimatedMesh keyframes
+    double duration_s = 0;      // last key time − first key time
+    double sample_rate = 30;    // keyframes per second (DESIGN.md default 30)
+    size_t first_keyframe = 0;  // into AnimatedMesh keyframes
     size_t keyframe_count = 0;
-    int source_animation = -1;   // glTF input: the animation it was sampled from; −1 otherwise
-    double start_time_s = 0;     // glTF input: the animation time of keyframe 0 (first key time)
+    int source_animation = -1;  // glTF input: the animation it was sampled from; −1 otherwise
+    double start_time_s = 0;    // glTF input: the animation time of keyframe 0 (first key time)
 };
 
 struct AnimatedMesh {
     std::string name;
     size_t vertex_count = 0;
-    std::vector<uint32_t> indices;       // triangle list, CCW front faces
-    std::vector<Primitive> primitives;   // cover indices in order, without gaps
+    std::vector<uint32_t> indices;      // triangle list, CCW front faces
+    std::vector<Primitive> primitives;  // cover indices in order, without gaps
     std::vector<Clip> clips;
     std::vector<float> keyframe_positions;  // keyframe_count() × vertex_count × xyz
-    size_t joint_count = 0;              // 0 for vertex-keyframe or static meshes
+    size_t joint_count = 0;                 // 0 for vertex-keyframe or static meshes
     size_t morph_target_count = 0;
 
     size_t triangle_count() const { return indices.size() / 3; }
-    size_t keyframe_count() const {
-        return vertex_count ? keyframe_positions.size() / (3 * vertex_count) : 0;
-    }
+    size_t keyframe_count() const { return vertex_count ? keyframe_positions.size() / (3 * vertex_count) : 0; }
     const float* keyframe(size_t k) const { return keyframe_positions.data() + k * vertex_count * 3; }
     float* keyframe(size_t k) { return keyframe_positions.data() + k * vertex_count * 3; }
 };

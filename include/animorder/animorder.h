@@ -20,27 +20,27 @@
 #include "animorder/invalid_input.h"
 
 // Single-buffer building blocks: Sander, Nehab & Barczak 2007.
-#include "animorder/triangle_order.h"   // validation, applying and composing face permutations
-#include "animorder/vertex_cache.h"     // ACMR / ATVR of a FIFO cache
-#include "animorder/tipsify.h"          // §3: vertex-cache order in linear time
 #include "animorder/patches.h"          // §4: fast linear clustering into patches (λ)
 #include "animorder/static_sander07.h"  // §5: one view-independent order (equation 4)
+#include "animorder/tipsify.h"          // §3: vertex-cache order in linear time
+#include "animorder/triangle_order.h"   // validation, applying and composing face permutations
+#include "animorder/vertex_cache.h"     // ACMR / ATVR of a FIFO cache
 
 // Animation and measurement: DESIGN.md's framing, camera, viewpoints and rasterisation rules.
-#include "animorder/skinning.h"         // linear blend skinning of the keyframes
-#include "animorder/viewpoints.h"       // icosphere / random viewpoints, framing of keyframes
-#include "animorder/camera.h"           // the node camera
-#include "animorder/rasterizer.h"       // one node rasterised, its fragments kept per pixel
-#include "animorder/overdraw.h"         // many orders scored at many nodes
+#include "animorder/camera.h"      // the node camera
+#include "animorder/overdraw.h"    // many orders scored at many nodes
+#include "animorder/rasterizer.h"  // one node rasterised, its fragments kept per pixel
+#include "animorder/skinning.h"    // linear blend skinning of the keyframes
+#include "animorder/viewpoints.h"  // icosphere / random viewpoints, framing of keyframes
 
 // Han & Sander 2017: k buffers chosen per (keyframe, view) by a lookup table.
-#include "animorder/mesh_patches.h"     // a character's patches, per primitive
 #include "animorder/clustering.h"       // Algorithm 1: k-means over nodes
+#include "animorder/mesh_patches.h"     // a character's patches, per primitive
 #include "animorder/selection_table.h"  // the runtime lookup table
 
 // Nehab, Barczak & Sander 2006: one order from a measured overdraw graph.
-#include "animorder/planar_clusters.h"  // §3: planar clusters by normals
 #include "animorder/nehab06.h"          // §4–5: overdraw graph, feedback arc set
+#include "animorder/planar_clusters.h"  // §3: planar clusters by normals
 
 // The users' baseline: meshoptimizer's vertex cache and overdraw optimisers.
 #include "animorder/meshopt_order.h"

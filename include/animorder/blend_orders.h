@@ -30,9 +30,9 @@ void blended_orders_from_clusters(const AnimatedMesh& mesh, const Framing& all_k
 // their blended ranges replaced; opaque ranges untouched) and assignment.
 struct BlendClustering {
     std::vector<std::vector<uint32_t>> orders;
-    std::vector<uint32_t> assignment;           // per node, as ClusteringResult::assignment
-    std::vector<uint64_t> missorted_pixels;     // per iteration: Σ over nodes with its assigned order
-    uint64_t covered = 0;                       // Σ over nodes of the covered pixels
+    std::vector<uint32_t> assignment;        // per node, as ClusteringResult::assignment
+    std::vector<uint64_t> missorted_pixels;  // per iteration: Σ over nodes with its assigned order
+    uint64_t covered = 0;                    // Σ over nodes of the covered pixels
 };
 
 BlendClustering cluster_blend_nodes(const AnimatedMesh& mesh, const Framing& framing, const ClusteringResult& run,

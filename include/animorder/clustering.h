@@ -33,11 +33,11 @@ enum class OrderSource {
 };
 
 struct ClusteringSettings {
-    size_t clusters = 5;               // k
-    size_t views = 162;                // icosphere viewpoints (12, 42, 162, 642)
+    size_t clusters = 5;  // k
+    size_t views = 162;   // icosphere viewpoints (12, 42, 162, 642)
     unsigned resolution = 256;
     uint64_t seed = 1;
-    double min_separation_deg = 30;    // between bootstrap viewpoints (rejection sampling)
+    double min_separation_deg = 30;  // between bootstrap viewpoints (rejection sampling)
     size_t max_iterations = 30;
     // The integrated-distance update does not minimise the measured overdraw, so on real
     // characters k-means can cycle among near-equal assignments instead of settling. It stops
@@ -51,8 +51,8 @@ struct ClusteringSettings {
     // Nodes' fragments are kept between iterations (orders change, fragments do not) while they
     // fit in this many bytes; beyond, every iteration rasterises again (slower, same result).
     size_t max_cache_bytes = size_t(6) << 30;
-    std::function<void(const std::string&)> log;         // one line per event (re-seeding, …)
-    std::function<void(size_t, size_t)> progress;        // nodes scored, total, per iteration
+    std::function<void(const std::string&)> log;   // one line per event (re-seeding, …)
+    std::function<void(size_t, size_t)> progress;  // nodes scored, total, per iteration
 };
 
 struct ClusteringIteration {
@@ -65,8 +65,8 @@ struct ClusteringIteration {
 };
 
 struct ClusteringResult {
-    std::vector<uint32_t> keyframes;        // the keyframes clustered (global indices)
-    std::vector<float> directions;          // the clustering viewpoints, xyz each
+    std::vector<uint32_t> keyframes;                     // the keyframes clustered (global indices)
+    std::vector<float> directions;                       // the clustering viewpoints, xyz each
     std::vector<std::vector<uint32_t>> patch_orders;     // k patch permutations
     std::vector<std::vector<uint32_t>> triangle_orders;  // k face permutations of the whole mesh
     // assignment[i · views + v]: the cluster of node (keyframes[i], directions[v]).

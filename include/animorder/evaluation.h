@@ -37,7 +37,6 @@ struct OrderEvaluation {
     std::vector<OverdrawSummary> per_clip;  // mesh.clips order
 };
 
-
 // The oracle's order (MethodBuffers::front_to_back) at one node: patches by ascending distance from the eye (eye: a point, in
 // the same framed space as centroids, which holds 3 floats per patch), ties by patch id.
 std::vector<uint32_t> front_to_back_patch_order(const float* centroids, size_t patch_count, const float eye[3]);
@@ -75,7 +74,7 @@ std::vector<BlendEvaluation> evaluate_blend(const AnimatedMesh& mesh, const std:
 // The bound's order at one node: the triangles of blended primitives farthest first by the
 // squared distance from eye to their centroid (positions: one keyframe, minus centre), ties by
 // index, in place of the blended triangles of identity; other triangles keep their place.
-std::vector<uint32_t> back_to_front_blended_order(const AnimatedMesh& mesh, const float* positions, const float centre[3],
-                                                  const float eye[3]);
+std::vector<uint32_t> back_to_front_blended_order(const AnimatedMesh& mesh, const float* positions,
+                                                  const float centre[3], const float eye[3]);
 
 }  // namespace animorder

@@ -24,9 +24,9 @@ struct ExtensionClip {
 struct ExtensionPrimitive {
     int mesh = -1, primitive = -1;
     int orders_accessor = -1;
-    int component_type = 0;          // 5123 or 5125
-    std::vector<uint32_t> indices;   // the primitive's `indices` (n)
-    std::vector<uint32_t> orders;    // order_count × n, order after order
+    int component_type = 0;         // 5123 or 5125
+    std::vector<uint32_t> indices;  // the primitive's `indices` (n)
+    std::vector<uint32_t> orders;   // order_count × n, order after order
     uint32_t order_count = 0;
     bool indices_equal_fallback = false;
     std::vector<bool> order_is_permutation;  // per order: the triangles of `indices`, windings kept

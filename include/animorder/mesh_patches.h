@@ -31,7 +31,8 @@ MeshPatches build_planar_units(const AnimatedMesh& mesh, const MeshPatches& like
 // A face permutation of the whole mesh from a patch permutation: primitives stay in file order
 // (patches of a primitive keep their relative order from patch_order), triangles inside a patch
 // keep their Tipsify order.
-std::vector<uint32_t> patch_order_to_triangle_order(const MeshPatches& patches, const std::vector<uint32_t>& patch_order);
+std::vector<uint32_t> patch_order_to_triangle_order(const MeshPatches& patches,
+                                                    const std::vector<uint32_t>& patch_order);
 
 // Area-weighted centroid of every patch at every keyframe of the list, after framing (the
 // keyframe's centre subtracted): centroids[(i · patch_count + p) · 3 + c] for keyframes[i].

@@ -37,8 +37,18 @@ namespace animorder {
 // ship (it has no buffers).
 // Measured / MeasuredJoint: single / joint with each cluster's patches ordered by the overdraw
 // graph measured over its own nodes (measured_order.h), not by distance — beyond the paper.
-enum class Method { Original, StaticSander07, StaticNehab06, Meshopt, TipsifyPerFrame, Single, Joint, Oracle,
-                    Measured, MeasuredJoint };
+enum class Method {
+    Original,
+    StaticSander07,
+    StaticNehab06,
+    Meshopt,
+    TipsifyPerFrame,
+    Single,
+    Joint,
+    Oracle,
+    Measured,
+    MeasuredJoint
+};
 
 // The method a user gets without asking (the paper's method).
 constexpr Method kDefaultMethod = Method::Single;
@@ -93,9 +103,9 @@ struct MethodBuffers {
 
 // Every setting of every method; each method reads those it uses. Defaults are the library's.
 struct MethodSettings {
-    double lambda = kDefaultLambda;        // patch threshold (static-sander07, tipsify-per-frame, single, joint, oracle)
+    double lambda = kDefaultLambda;  // patch threshold (static-sander07, tipsify-per-frame, single, joint, oracle)
     unsigned cache_size = kDefaultCacheSize;
-    size_t keyframe = 0;                   // static methods: the keyframe whose positions they sort with
+    size_t keyframe = 0;  // static methods: the keyframe whose positions they sort with
     // single / joint: k-means (clusters is k; views, resolution, seed, ... as ClusteringSettings;
     // its log and progress callbacks are passed on). The resolution is also static-nehab06's.
     ClusteringSettings clustering;
@@ -121,12 +131,12 @@ void validate_method_settings(const MethodSettings& settings);
 struct MethodResult {
     Method method = Method::Original;
     MethodBuffers buffers;
-    Framing framing;             // every keyframe: the sidecar's and glTF's frame centres
-    uint32_t fallback = 0;       // the buffer most clustering nodes chose: what viewers without the table draw
-    double acmr_mean = 0;        // mean over buffers (oracle: over 12 views at each clip's first keyframe)
+    Framing framing;        // every keyframe: the sidecar's and glTF's frame centres
+    uint32_t fallback = 0;  // the buffer most clustering nodes chose: what viewers without the table draw
+    double acmr_mean = 0;   // mean over buffers (oracle: over 12 views at each clip's first keyframe)
     double atvr_mean = 0;
-    double seconds = 0;          // the whole run_method
-    size_t patch_count = 0;      // patches (static-nehab06: planar clusters), summed over primitives
+    double seconds = 0;              // the whole run_method
+    size_t patch_count = 0;          // patches (static-nehab06: planar clusters), summed over primitives
     size_t hard_boundary_count = 0;  // original, static-sander07
     // single / joint: the k-means runs (one per clip, or one for joint), each run's view radius,
     // the seconds spent building patches, and each run's seconds.
@@ -167,7 +177,7 @@ struct StaticMethodResult {
     // The same as a face permutation of the whole mesh (primitives drawn in file order), which
     // is what the overdraw engine's rank tables take.
     std::vector<uint32_t> order;
-    size_t patch_count = 0;         // summed over primitives (static-sander07; static-nehab06: clusters)
+    size_t patch_count = 0;  // summed over primitives (static-sander07; static-nehab06: clusters)
     size_t hard_boundary_count = 0;
 };
 
@@ -179,10 +189,10 @@ StaticMethodResult run_static_method(const AnimatedMesh& mesh, Method method, co
 // (one set for all clips). Buffers are face permutations of the whole mesh; tables pick them.
 struct AnimatedMethodResult {
     MeshPatches patches;
-    MethodBuffers buffers;                  // single: k per clip, clip after clip; joint: k
-    std::vector<ClusteringResult> runs;     // one per clip (single) or one (joint)
-    Framing framing;                        // all keyframes (centres); R per run inside runs
-    std::vector<float> run_radius;          // R used by each run
+    MethodBuffers buffers;               // single: k per clip, clip after clip; joint: k
+    std::vector<ClusteringResult> runs;  // one per clip (single) or one (joint)
+    Framing framing;                     // all keyframes (centres); R per run inside runs
+    std::vector<float> run_radius;       // R used by each run
     double seconds_patches = 0;
 };
 

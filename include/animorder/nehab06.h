@@ -46,7 +46,7 @@ struct FeedbackArcs {
 FeedbackArcs count_feedback_arcs(const uint32_t* node_order, size_t node_count, const Arc* arcs, size_t arc_count);
 
 struct OverdrawGraphSettings {
-    size_t views = 162;        // icosphere directions (12, 42, 162, 642, ...)
+    size_t views = 162;         // icosphere directions (12, 42, 162, 642, ...)
     unsigned resolution = 256;  // square viewport
     unsigned threads = 0;       // 0: all hardware threads; the result does not depend on it
 };
@@ -100,13 +100,13 @@ struct Nehab06Result {
     size_t cluster_count = 0;
     size_t arc_count = 0;
     size_t feedback_arc_count = 0;
-    double feedback_weight = 0;  // fragments the violated arcs would have saved
+    double feedback_weight = 0;                // fragments the violated arcs would have saved
     std::vector<Nehab06Candidate> candidates;  // automatic choice only: every count tried
-    double seconds_clustering = 0;     // clustering and Tipsify inside clusters, all candidates
-    double seconds_rasterization = 0;  // rasterising the nodes (part of seconds_graph)
-    double seconds_graph = 0;          // rasterisation + pair sums, all candidates
-    double seconds_ordering = 0;       // feedback-arc-set ordering, all candidates
-    double seconds_selection = 0;      // scoring candidates (automatic choice only)
+    double seconds_clustering = 0;             // clustering and Tipsify inside clusters, all candidates
+    double seconds_rasterization = 0;          // rasterising the nodes (part of seconds_graph)
+    double seconds_graph = 0;                  // rasterisation + pair sums, all candidates
+    double seconds_ordering = 0;               // feedback-arc-set ordering, all candidates
+    double seconds_selection = 0;              // scoring candidates (automatic choice only)
 };
 
 // static-nehab06: writes a face permutation of index_count/3 triangles to order. Clusters are

@@ -64,7 +64,7 @@ std::vector<NodeFragments> rasterize_nodes(const float* keyframe_positions, size
                                            size_t node_count, const ScoreSettings& settings, size_t max_bytes);
 
 // score_nodes' results from kept fragments: no rasterisation at all.
-void score_kept_nodes(uint64_t* visible, uint64_t* passed, const std::vector<NodeFragments>& nodes, const uint32_t* ranks,
-                      size_t order_count, const ScoreSettings& settings);
+void score_kept_nodes(uint64_t* visible, uint64_t* passed, const std::vector<NodeFragments>& nodes,
+                      const uint32_t* ranks, size_t order_count, const ScoreSettings& settings);
 
 }  // namespace animorder

@@ -21,12 +21,11 @@ constexpr double kDefaultLambda = 0.85;
 // entry equal to the triangle count (so patch p spans [starts[p], starts[p+1])). Empty input
 // returns {0}.
 std::vector<uint32_t> build_patches(const uint32_t* indices, size_t index_count, size_t vertex_count,
-                                    const uint32_t* hard_boundaries, size_t hard_boundary_count,
-                                    double lambda, unsigned cache_size = kDefaultCacheSize);
+                                    const uint32_t* hard_boundaries, size_t hard_boundary_count, double lambda,
+                                    unsigned cache_size = kDefaultCacheSize);
 
 // Expands a patch permutation to a triangle permutation: triangles of patch_order[0] first (in
 // their order inside the patch), then patch_order[1], and so on. order has one entry per triangle.
-void expand_patch_order(uint32_t* order, const uint32_t* patch_order, const uint32_t* patch_starts,
-                        size_t patch_count);
+void expand_patch_order(uint32_t* order, const uint32_t* patch_order, const uint32_t* patch_starts, size_t patch_count);
 
 }  // namespace animorder

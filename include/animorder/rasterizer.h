@@ -96,10 +96,10 @@ struct BlendFragments {
 // Blend error of orders at a node: a pair of counted fragments of one pixel at different depths
 // is mis-sorted when the nearer one is drawn first (blending needs back to front).
 struct BlendCounts {
-    uint64_t pairs = 0;              // pairs at different depths
-    uint64_t missorted_pairs = 0;    // of which drawn nearer-before-farther
-    uint64_t missorted_pixels = 0;   // pixels with at least one mis-sorted pair
-    uint64_t covered = 0;            // BlendFragments::covered
+    uint64_t pairs = 0;             // pairs at different depths
+    uint64_t missorted_pairs = 0;   // of which drawn nearer-before-farther
+    uint64_t missorted_pixels = 0;  // pixels with at least one mis-sorted pair
+    uint64_t covered = 0;           // BlendFragments::covered
 };
 
 // counts[o] for each order of the rank table (make_rank_table).

@@ -15,8 +15,7 @@ using Mat4 = std::array<float, 16>;
 // vertex whose weights sum to 0 keeps its bind position). joints and weights are
 // vertex_count × influences_per_vertex arrays. Throws InvalidInput for a joint index >=
 // joint_count or a non-finite weight.
-void skin_positions(float* out_positions, const float* bind_positions, size_t vertex_count,
-                    const uint16_t* joints, const float* weights, size_t influences_per_vertex,
-                    const Mat4* joint_matrices, size_t joint_count);
+void skin_positions(float* out_positions, const float* bind_positions, size_t vertex_count, const uint16_t* joints,
+                    const float* weights, size_t influences_per_vertex, const Mat4* joint_matrices, size_t joint_count);
 
 }  // namespace animorder

@@ -14,9 +14,9 @@ namespace animorder {
 // area-weighted surface centroid C(M). rank(P) = (C(P) − C(M))·N(P). Writes patch_order: patches
 // by descending rank, ties by ascending patch id. positions: vertex_count xyz floats with
 // position_stride bytes between vertices.
-void sort_patches_sander07(uint32_t* patch_order, const uint32_t* indices, size_t index_count,
-                           const float* positions, size_t vertex_count, size_t position_stride,
-                           const uint32_t* patch_starts, size_t patch_count);
+void sort_patches_sander07(uint32_t* patch_order, const uint32_t* indices, size_t index_count, const float* positions,
+                           size_t vertex_count, size_t position_stride, const uint32_t* patch_starts,
+                           size_t patch_count);
 
 struct StaticOrderResult {
     size_t patch_count = 0;
@@ -26,8 +26,7 @@ struct StaticOrderResult {
 // The whole static-sander07 method: tipsify, cut into patches with lambda, sort the patches with
 // equation 4 at the given positions. order: a face permutation of the input triangles.
 StaticOrderResult order_static_sander07(uint32_t* order, const uint32_t* indices, size_t index_count,
-                                        const float* positions, size_t vertex_count,
-                                        size_t position_stride, double lambda = kDefaultLambda,
-                                        unsigned cache_size = kDefaultCacheSize);
+                                        const float* positions, size_t vertex_count, size_t position_stride,
+                                        double lambda = kDefaultLambda, unsigned cache_size = kDefaultCacheSize);
 
 }  // namespace animorder

@@ -17,8 +17,8 @@ struct TipsifyResult {
 
 // Writes a vertex-cache-friendly face permutation of the triangles to order[0..index_count/3).
 // cache_size is the target FIFO size k (>= 3). Runs in time linear in the input.
-TipsifyResult tipsify(uint32_t* order, const uint32_t* indices, size_t index_count,
-                      size_t vertex_count, unsigned cache_size = kDefaultCacheSize);
+TipsifyResult tipsify(uint32_t* order, const uint32_t* indices, size_t index_count, size_t vertex_count,
+                      unsigned cache_size = kDefaultCacheSize);
 
 // The same order written directly as an index buffer (what tipsify + apply_triangle_order give,
 // in one pass). destination must not alias indices.

@@ -24,6 +24,7 @@ struct TriangleMatch {
     std::vector<int64_t> from_of_to;  // per triangle of `to`: its triangle of `from`, −1 when none
     size_t matched = 0;
 };
-TriangleMatch match_triangles(const std::vector<float>& from, const std::vector<float>& to, size_t dims, float tolerance);
+TriangleMatch match_triangles(const std::vector<float>& from, const std::vector<float>& to, size_t dims,
+                              float tolerance);
 
 }  // namespace animorder

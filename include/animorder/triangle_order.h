@@ -18,8 +18,7 @@ void validate_triangle_order(const uint32_t* order, size_t triangle_count);
 
 // destination[3i..3i+2] = indices[3·order[i] ..], corners in their original sequence.
 // destination must not alias indices. order must be a valid permutation (validated).
-void apply_triangle_order(uint32_t* destination, const uint32_t* indices, const uint32_t* order,
-                          size_t triangle_count);
+void apply_triangle_order(uint32_t* destination, const uint32_t* indices, const uint32_t* order, size_t triangle_count);
 
 // order = composition: result[i] = inner[outer[i]] (outer indexes positions of inner's output).
 void compose_triangle_orders(uint32_t* destination, const uint32_t* inner, const uint32_t* outer,

@@ -45,7 +45,8 @@ void blended_orders_from_clusters(const AnimatedMesh& mesh, const Framing& all_k
                 for (int d = 0; d < 3; ++d) {
                     const uint32_t* v = &mesh.indices[3 * (first + t)];
                     centroids[(i * count + t) * 3 + d] =
-                        (positions[3 * v[0] + d] + positions[3 * v[1] + d] + positions[3 * v[2] + d]) / 3.0f - centre[d];
+                        (positions[3 * v[0] + d] + positions[3 * v[1] + d] + positions[3 * v[2] + d]) / 3.0f -
+                        centre[d];
                 }
         }
         for (size_t c = 0; c < run.triangle_orders.size(); ++c) {
@@ -75,7 +76,8 @@ BlendClustering cluster_blend_nodes(const AnimatedMesh& mesh, const Framing& fra
     std::vector<uint8_t> blended(triangles, 0);
     for (const Primitive& p : mesh.primitives)
         if (p.alpha_mode == AlphaMode::Blend)
-            std::fill(blended.begin() + ptrdiff_t(p.first_index / 3), blended.begin() + ptrdiff_t((p.first_index + p.index_count) / 3), 1);
+            std::fill(blended.begin() + ptrdiff_t(p.first_index / 3),
+                      blended.begin() + ptrdiff_t((p.first_index + p.index_count) / 3), 1);
     const std::vector<uint8_t> modes = full_pass_modes(mesh);
 
     // Every node's transparent pass, once.
@@ -92,10 +94,11 @@ BlendClustering cluster_blend_nodes(const AnimatedMesh& mesh, const Framing& fra
             w.clip.resize(mesh.vertex_count * 4);
             for (size_t n = range.begin(); n != range.end(); ++n) {
                 const uint32_t keyframe = run.keyframes[n / views];
-                transform_to_clip(w.clip.data(), mesh.keyframe(keyframe), mesh.vertex_count, &framing.centres[3 * size_t(keyframe)],
+                transform_to_clip(w.clip.data(), mesh.keyframe(keyframe), mesh.vertex_count,
+                                  &framing.centres[3 * size_t(keyframe)],
                                   node_view_projection(&run.directions[3 * (n % views)], framing.radius));
-                w.rasterizer.rasterize(w.clip.data(), mesh.vertex_count, mesh.indices.data(), mesh.indices.size(), resolution,
-                                       modes.empty() ? nullptr : modes.data());
+                w.rasterizer.rasterize(w.clip.data(), mesh.vertex_count, mesh.indices.data(), mesh.indices.size(),
+                                       resolution, modes.empty() ? nullptr : modes.data());
                 kept[n] = w.rasterizer.export_blend_fragments(blended.data());
             }
         });
@@ -112,13 +115,14 @@ BlendClustering cluster_blend_nodes(const AnimatedMesh& mesh, const Framing& fra
         for (const auto& o : current.triangle_orders) pointers.push_back(o.data());
         const std::vector<uint32_t> ranks = make_rank_table(pointers, triangles);
         arena.execute([&] {
-            tbb::parallel_for(tbb::blocked_range<size_t>(0, node_count, 16), [&](const tbb::blocked_range<size_t>& range) {
-                std::vector<BlendCounts> counts(k);
-                for (size_t n = range.begin(); n != range.end(); ++n) {
-                    score_blend(counts.data(), kept[n], ranks.data(), k);
-                    for (size_t c = 0; c < k; ++c) cost[n * k + c] = counts[c].missorted_pixels;
-                }
-            });
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, node_count, 16),
+                              [&](const tbb::blocked_range<size_t>& range) {
+                                  std::vector<BlendCounts> counts(k);
+                                  for (size_t n = range.begin(); n != range.end(); ++n) {
+                                      score_blend(counts.data(), kept[n], ranks.data(), k);
+                                      for (size_t c = 0; c < k; ++c) cost[n * k + c] = counts[c].missorted_pixels;
+                                  }
+                              });
         });
         // The cost of these orders with the assignment that produced them, then the reassignment.
         uint64_t total = 0;
@@ -134,7 +138,8 @@ BlendClustering cluster_blend_nodes(const AnimatedMesh& mesh, const Framing& fra
             uint32_t choice = 0;
             for (uint32_t c = 1; c < k; ++c)
                 if (cost[n * k + c] < cost[n * k + choice]) choice = c;
-            if (cost[n * k + choice] == cost[n * k + current.assignment[n]]) choice = current.assignment[n];  // stay on ties
+            if (cost[n * k + choice] == cost[n * k + current.assignment[n]])
+                choice = current.assignment[n];  // stay on ties
             moved += choice != current.assignment[n];
             current.assignment[n] = choice;
         }
@@ -144,7 +149,8 @@ BlendClustering cluster_blend_nodes(const AnimatedMesh& mesh, const Framing& fra
 }
 
 void combine_with_blend_clusters(const AnimatedMesh& mesh, const BlendClustering& blend, ClusteringResult& run) {
-    if (blend.assignment.size() != run.assignment.size()) throw InvalidInput("blend clusters do not match the run's nodes");
+    if (blend.assignment.size() != run.assignment.size())
+        throw InvalidInput("blend clusters do not match the run's nodes");
     std::map<std::pair<uint32_t, uint32_t>, uint32_t> pairs;
     for (size_t n = 0; n < run.assignment.size(); ++n) pairs[{run.assignment[n], blend.assignment[n]}] = 0;
     if (pairs.size() > 255) throw InvalidInput("more than 255 buffers per clip");
@@ -155,11 +161,13 @@ void combine_with_blend_clusters(const AnimatedMesh& mesh, const BlendClustering
         const std::vector<uint32_t>& from = blend.orders.at(pair.second);
         for (const Primitive& p : mesh.primitives)
             if (p.alpha_mode == AlphaMode::Blend)
-                std::copy(from.begin() + ptrdiff_t(p.first_index / 3), from.begin() + ptrdiff_t((p.first_index + p.index_count) / 3),
+                std::copy(from.begin() + ptrdiff_t(p.first_index / 3),
+                          from.begin() + ptrdiff_t((p.first_index + p.index_count) / 3),
                           order.begin() + ptrdiff_t(p.first_index / 3));
         orders.push_back(std::move(order));
     }
-    for (size_t n = 0; n < run.assignment.size(); ++n) run.assignment[n] = pairs[{run.assignment[n], blend.assignment[n]}];
+    for (size_t n = 0; n < run.assignment.size(); ++n)
+        run.assignment[n] = pairs[{run.assignment[n], blend.assignment[n]}];
     run.triangle_orders = std::move(orders);
 }
 

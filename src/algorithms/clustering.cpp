@@ -168,8 +168,8 @@ struct Nodes {
     std::vector<float> average;          // per patch: its centroid averaged over the keyframes
     std::vector<uint8_t> patch_visible;  // I3D only: [n · patch_count + p], some triangle faces n
     ScoreSettings score;
-    std::vector<uint8_t> modes;          // per triangle (opaque_pass_modes): score's triangle_modes
-    std::vector<NodeFragments> kept;     // every node's fragments, or empty when over budget
+    std::vector<uint8_t> modes;       // per triangle (opaque_pass_modes): score's triangle_modes
+    std::vector<NodeFragments> kept;  // every node's fragments, or empty when over budget
 };
 
 // Measured overdraw at every node: visible[n], the pixels covered (what drawing front-to-back
@@ -273,9 +273,8 @@ std::vector<size_t> update_orders(const Nodes& nodes, DistanceVariant variant, c
         members[c] = rows[c].size();
         if (members[c] == 0) continue;
         patch_orders[c] = integrated_distance_order(
-            nodes.centroids.data(), nodes.keyframes, patch_count,
-            rows[c].data(), eyes[c].data(), rows[c].size(), variant, i3d ? visible[c].data() : nullptr,
-            nodes.patches.patch_primitive.data());
+            nodes.centroids.data(), nodes.keyframes, patch_count, rows[c].data(), eyes[c].data(), rows[c].size(),
+            variant, i3d ? visible[c].data() : nullptr, nodes.patches.patch_primitive.data());
     }
     return members;
 }
@@ -284,9 +283,9 @@ std::vector<size_t> update_orders(const Nodes& nodes, DistanceVariant variant, c
 // and updated with the nodes that changed cluster only.
 struct MeasuredGraphs {
     std::vector<uint32_t> unit_of_triangle;
-    std::vector<MeasuredPairCounts> graphs;  // per cluster, over the nodes `counted` gives it
-    std::vector<uint32_t> counted;           // per node: the cluster whose graph counts it (or UINT32_MAX)
-    std::vector<std::vector<uint32_t>> last; // per cluster: the last measured order (a local optimum)
+    std::vector<MeasuredPairCounts> graphs;    // per cluster, over the nodes `counted` gives it
+    std::vector<uint32_t> counted;             // per node: the cluster whose graph counts it (or UINT32_MAX)
+    std::vector<std::vector<uint32_t>> last;   // per cluster: the last measured order (a local optimum)
     std::vector<std::vector<uint32_t>> start;  // per cluster: the buffer that order started from
 };
 
@@ -358,8 +357,8 @@ std::vector<size_t> measured_update_orders(const Nodes& nodes, const ClusteringS
                 std::to_string(stats.greedy_weight) + (stats.from_previous ? ", current " : ", start ") +
                 std::to_string(stats.start_weight) + ", sifted " + std::to_string(stats.final_weight) + ";";
     }
-    say(settings, "measured graphs: " + std::to_string(moved) + " nodes counted in " +
-                      std::to_string(graph_seconds) + " s, orders in " + std::to_string(seconds_since(order_start)) +
+    say(settings, "measured graphs: " + std::to_string(moved) + " nodes counted in " + std::to_string(graph_seconds) +
+                      " s, orders in " + std::to_string(seconds_since(order_start)) +
                       " s; backward weights per cluster:" + line);
     return sizes;
 }
@@ -367,9 +366,9 @@ std::vector<size_t> measured_update_orders(const Nodes& nodes, const ClusteringS
 // Not in the paper (DESIGN.md step 6: never drop a cluster silently): an empty cluster takes the
 // front-to-back order, by averaged centroids, from the viewpoint of the worst-served node (highest
 // OVR) not used for another cluster in this iteration. Marks the clusters re-seeded.
-size_t reseed_empty_clusters(const Nodes& nodes, const std::vector<size_t>& members, const std::vector<double>& node_ovr,
-                             const ClusteringSettings& settings, std::vector<std::vector<uint32_t>>& patch_orders,
-                             std::vector<uint8_t>& reseeded) {
+size_t reseed_empty_clusters(const Nodes& nodes, const std::vector<size_t>& members,
+                             const std::vector<double>& node_ovr, const ClusteringSettings& settings,
+                             std::vector<std::vector<uint32_t>>& patch_orders, std::vector<uint8_t>& reseeded) {
     std::vector<uint8_t> used_as_seed(nodes.count, 0);
     reseeded.assign(nodes.k, 0);
     size_t count = 0;
@@ -405,7 +404,8 @@ size_t keep_improved_orders(const Nodes& nodes, const std::vector<uint32_t>& ass
     } else {
         // Each node only needs its own cluster's candidate: one order per node, not k.
         std::vector<std::vector<uint32_t>> single_ranks;
-        for (const auto& o : candidate) single_ranks.push_back(make_rank_table({o.data()}, nodes.mesh.triangle_count()));
+        for (const auto& o : candidate)
+            single_ranks.push_back(make_rank_table({o.data()}, nodes.mesh.triangle_count()));
         tbb::task_arena arena(threads ? int(threads) : tbb::this_task_arena::max_concurrency());
         arena.execute([&] {
             tbb::parallel_for(tbb::blocked_range<size_t>(0, nodes.count, 64), [&](const tbb::blocked_range<size_t>& r) {
@@ -426,8 +426,10 @@ size_t keep_improved_orders(const Nodes& nodes, const std::vector<uint32_t>& ass
     size_t accepted = 0;
     for (size_t c = 0; c < k; ++c) {
         if (reseeded[c]) continue;
-        if (after[c] < before[c]) ++accepted;
-        else patch_orders[c] = previous[c];  // no better: keep the old buffer
+        if (after[c] < before[c])
+            ++accepted;
+        else
+            patch_orders[c] = previous[c];  // no better: keep the old buffer
     }
     return accepted;
 }
@@ -454,7 +456,8 @@ void finish(ClusteringResult& result, const MeshPatches& patches, const BestStat
 
 void validate_settings(const std::vector<uint32_t>& keyframes, const ClusteringSettings& settings) {
     if (settings.clusters == 0 || settings.clusters > 255)
-        throw InvalidInput("the number of clusters must be between 1 and 255, not " + std::to_string(settings.clusters));
+        throw InvalidInput("the number of clusters must be between 1 and 255, not " +
+                           std::to_string(settings.clusters));
     if (keyframes.empty()) throw InvalidInput("clustering needs at least one keyframe");
     if (settings.max_iterations == 0) throw InvalidInput("clustering needs at least one iteration");
     if (!(settings.min_separation_deg >= 0) || settings.min_separation_deg > 180)
@@ -465,8 +468,8 @@ void validate_settings(const std::vector<uint32_t>& keyframes, const ClusteringS
 
 std::vector<uint32_t> integrated_distance_order(const float* centroids, size_t keyframe_count, size_t patch_count,
                                                 const uint32_t* node_keyframes, const float* node_eyes,
-                                                size_t node_count, DistanceVariant variant,
-                                                const uint8_t* node_visible, const uint32_t* patch_primitive) {
+                                                size_t node_count, DistanceVariant variant, const uint8_t* node_visible,
+                                                const uint32_t* patch_primitive) {
     const bool i3d = variant == DistanceVariant::I3d;
     std::vector<double> d(patch_count, 0.0), seen(patch_count, 0.0);
     for (size_t n = 0; n < node_count; ++n) {
@@ -510,7 +513,8 @@ ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patc
     for (size_t i = 0; i < keyframes.size(); ++i)
         for (size_t v = 0; v < nodes.views; ++v) {
             nodes.cameras[i * nodes.views + v].keyframe = keyframes[i];
-            std::copy(&result.directions[3 * v], &result.directions[3 * v] + 3, nodes.cameras[i * nodes.views + v].direction);
+            std::copy(&result.directions[3 * v], &result.directions[3 * v] + 3,
+                      nodes.cameras[i * nodes.views + v].direction);
         }
     nodes.centroids = patch_centroids(mesh, patches, framing, keyframes);
     nodes.average = average_over_keyframes(nodes.centroids, keyframes.size(), patches.patch_count());
@@ -526,12 +530,11 @@ ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patc
 
     // Rasterise every node once; later iterations only replay the kept fragments in new orders.
     const Clock::time_point raster_start = Clock::now();
-    nodes.kept = rasterize_nodes(mesh.keyframe_positions.data(), mesh.vertex_count, framing, mesh.indices.data(),
-                                 mesh.indices.size(), nodes.cameras.data(), nodes.count, nodes.score,
-                                 settings.max_cache_bytes);
+    nodes.kept =
+        rasterize_nodes(mesh.keyframe_positions.data(), mesh.vertex_count, framing, mesh.indices.data(),
+                        mesh.indices.size(), nodes.cameras.data(), nodes.count, nodes.score, settings.max_cache_bytes);
     result.seconds_rasterization = seconds_since(raster_start);
-    if (nodes.kept.empty())
-        say(settings, "node fragments exceed the cache budget: rasterising again every iteration");
+    if (nodes.kept.empty()) say(settings, "node fragments exceed the cache budget: rasterising again every iteration");
 
     NodeScores scores{std::vector<uint64_t>(nodes.count), std::vector<uint64_t>(nodes.count * nodes.k)};
     std::vector<double> node_ovr;
@@ -575,12 +578,11 @@ ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patc
                                                 settings.threads, result.patch_orders);
         log.seconds_update = seconds_since(update_start);
         result.iterations.push_back(log);
-        say(settings, "iteration " + std::to_string(iteration + 1) + ": mean OVR " + std::to_string(log.mean_ovr) + ", " +
-                          std::to_string(log.reassigned) + " nodes reassigned" +
-                          (settings.update == UpdateRule::Monotone
-                               ? ", " + std::to_string(log.accepted) + " of " + std::to_string(nodes.k) +
-                                     " buffers improved"
-                               : std::string()));
+        say(settings, "iteration " + std::to_string(iteration + 1) + ": mean OVR " + std::to_string(log.mean_ovr) +
+                          ", " + std::to_string(log.reassigned) + " nodes reassigned" +
+                          (settings.update == UpdateRule::Monotone ? ", " + std::to_string(log.accepted) + " of " +
+                                                                         std::to_string(nodes.k) + " buffers improved"
+                                                                   : std::string()));
         if (settings.update == UpdateRule::Monotone && log.accepted == 0 && log.reseeded == 0) {
             // Same buffers, so the next assignment would be this one: k-means has settled (the
             // Monotone rule's form of lines 18–19).

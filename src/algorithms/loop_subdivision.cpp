@@ -99,7 +99,8 @@ std::vector<Row> subdivide_level(const Level& in, Level& out) {
         neighbours[b].push_back(a);
         Row row;
         if (j - i == 2) {
-            row = {{a, 3.0 / 8}, {b, 3.0 / 8}, {incidences[i].opposite, 1.0 / 8}, {incidences[i + 1].opposite, 1.0 / 8}};
+            row = {
+                {a, 3.0 / 8}, {b, 3.0 / 8}, {incidences[i].opposite, 1.0 / 8}, {incidences[i + 1].opposite, 1.0 / 8}};
         } else {  // boundary (one face) or non-manifold (more than two): a crease
             row = {{a, 0.5}, {b, 0.5}};
             creases[a].push_back(b);
@@ -230,7 +231,8 @@ SubdivisionOperator build_loop_subdivision(const uint32_t* indices, size_t index
     for (unsigned l = 0; l < levels; ++l) {
         Level next;
         const std::vector<Row> rows = subdivide_level(level, next);
-        if (next.vertex_count > UINT32_MAX) throw InvalidInput("the subdivided vertex count does not fit 32-bit indices");
+        if (next.vertex_count > UINT32_MAX)
+            throw InvalidInput("the subdivided vertex count does not fit 32-bit indices");
         std::vector<Row> composed(rows.size());
         for (size_t r = 0; r < rows.size(); ++r) {
             touched.clear();

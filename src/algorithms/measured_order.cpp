@@ -152,8 +152,8 @@ void MeasuredPairCounts::add(const NodeFragments* const* nodes, size_t node_coun
             PairCounts& table = tables.local();
             auto& seen = scratch.local();
             for (size_t n = r.begin(); n != r.end(); ++n)
-                accumulate_node(table, *nodes[n], s.unit_of_triangle.data(), s.unit_of_triangle.size(), units,
-                                group, sign < 0 ? -1 : 1, seen);
+                accumulate_node(table, *nodes[n], s.unit_of_triangle.data(), s.unit_of_triangle.size(), units, group,
+                                sign < 0 ? -1 : 1, seen);
         });
     });
     // Integer sums: the same whatever the worker that counted a node.
@@ -164,8 +164,10 @@ std::vector<Arc> MeasuredPairCounts::arcs() const {
     const PairCounts& c = state_->counts;
     std::vector<Arc> arcs;
     auto net = [&](uint32_t lo, uint32_t hi, int64_t min_front, int64_t max_front) {
-        if (min_front > max_front) arcs.push_back({lo, hi, uint64_t(min_front - max_front)});
-        else if (max_front > min_front) arcs.push_back({hi, lo, uint64_t(max_front - min_front)});
+        if (min_front > max_front)
+            arcs.push_back({lo, hi, uint64_t(min_front - max_front)});
+        else if (max_front > min_front)
+            arcs.push_back({hi, lo, uint64_t(max_front - min_front)});
     };
     if (!c.dense.empty()) {
         for (uint32_t lo = 0; lo < c.units; ++lo)
@@ -175,7 +177,8 @@ std::vector<Arc> MeasuredPairCounts::arcs() const {
         std::vector<PairTable::Slot> all;
         for (const PairTable::Slot& s : c.sparse.slots)
             if (s.key != UINT64_MAX) all.push_back(s);
-        std::sort(all.begin(), all.end(), [](const PairTable::Slot& a, const PairTable::Slot& b) { return a.key < b.key; });
+        std::sort(all.begin(), all.end(),
+                  [](const PairTable::Slot& a, const PairTable::Slot& b) { return a.key < b.key; });
         for (const PairTable::Slot& s : all) net(uint32_t(s.key >> 32), uint32_t(s.key), s.min_front, s.max_front);
     }
     return arcs;

@@ -32,12 +32,13 @@ MeshPatches build_mesh_patches(const AnimatedMesh& mesh, double lambda, unsigned
         const uint32_t* source = mesh.indices.data() + primitive.first_index;
         const size_t triangles = primitive.index_count / 3;
         std::vector<uint32_t> order(triangles);
-        const TipsifyResult tipsified = tipsify(order.data(), source, primitive.index_count, mesh.vertex_count, cache_size);
+        const TipsifyResult tipsified =
+            tipsify(order.data(), source, primitive.index_count, mesh.vertex_count, cache_size);
         std::vector<uint32_t> cache_indices(primitive.index_count);
         apply_triangle_order(cache_indices.data(), source, order.data(), triangles);
         const std::vector<uint32_t> starts =
-            build_patches(cache_indices.data(), cache_indices.size(), mesh.vertex_count, tipsified.hard_boundaries.data(),
-                          tipsified.hard_boundaries.size(), lambda, cache_size);
+            build_patches(cache_indices.data(), cache_indices.size(), mesh.vertex_count,
+                          tipsified.hard_boundaries.data(), tipsified.hard_boundaries.size(), lambda, cache_size);
         const uint32_t base = uint32_t(result.cache_order.size());
         const uint32_t first_triangle = uint32_t(primitive.first_index / 3);
         for (uint32_t t : order) result.cache_order.push_back(first_triangle + t);
@@ -49,7 +50,8 @@ MeshPatches build_mesh_patches(const AnimatedMesh& mesh, double lambda, unsigned
     return result;
 }
 
-MeshPatches build_planar_units(const AnimatedMesh& mesh, const MeshPatches& like, size_t keyframe, unsigned cache_size) {
+MeshPatches build_planar_units(const AnimatedMesh& mesh, const MeshPatches& like, size_t keyframe,
+                               unsigned cache_size) {
     validate_animated_mesh(mesh);
     if (keyframe >= mesh.keyframe_count())
         throw InvalidInput("planar units: keyframe " + std::to_string(keyframe) + " does not exist");
@@ -66,8 +68,8 @@ MeshPatches build_planar_units(const AnimatedMesh& mesh, const MeshPatches& like
         const std::vector<uint32_t> cluster_of =
             cluster_by_normals(source, primitive.index_count, mesh.keyframe(keyframe), mesh.vertex_count, clusters);
         std::vector<uint32_t> order(triangles);
-        const std::vector<uint32_t> starts = tipsify_clusters(order.data(), source, primitive.index_count,
-                                                              mesh.vertex_count, cluster_of.data(), clusters, cache_size);
+        const std::vector<uint32_t> starts = tipsify_clusters(
+            order.data(), source, primitive.index_count, mesh.vertex_count, cluster_of.data(), clusters, cache_size);
         const uint32_t base = uint32_t(result.cache_order.size());
         const uint32_t first_triangle = uint32_t(primitive.first_index / 3);
         for (uint32_t t : order) result.cache_order.push_back(first_triangle + t);
@@ -80,7 +82,8 @@ MeshPatches build_planar_units(const AnimatedMesh& mesh, const MeshPatches& like
     return result;
 }
 
-std::vector<uint32_t> patch_order_to_triangle_order(const MeshPatches& patches, const std::vector<uint32_t>& patch_order) {
+std::vector<uint32_t> patch_order_to_triangle_order(const MeshPatches& patches,
+                                                    const std::vector<uint32_t>& patch_order) {
     if (patch_order.size() != patches.patch_count())
         throw InvalidInput("patch order has " + std::to_string(patch_order.size()) + " entries, there are " +
                            std::to_string(patches.patch_count()) + " patches");
@@ -116,7 +119,8 @@ std::vector<float> patch_centroids(const AnimatedMesh& mesh, const MeshPatches& 
                 const float* a = positions + 3 * size_t(tri[0]);
                 const float* b = positions + 3 * size_t(tri[1]);
                 const float* c = positions + 3 * size_t(tri[2]);
-                const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+                const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]},
+                             v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
                 const double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
                 const double w = 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
                 for (int d = 0; d < 3; ++d) {

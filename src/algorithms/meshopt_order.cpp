@@ -21,7 +21,8 @@ std::vector<uint32_t> meshopt_order(const uint32_t* indices, size_t index_count,
     (void)cache_size;  // meshopt_optimizeVertexCache targets generic hardware, not one FIFO size
     std::vector<uint32_t> cache(index_count), overdraw(index_count);
     meshopt_optimizeVertexCache(cache.data(), indices, index_count, vertex_count);
-    meshopt_optimizeOverdraw(overdraw.data(), cache.data(), index_count, positions, vertex_count, 3 * sizeof(float), 1.05f);
+    meshopt_optimizeOverdraw(overdraw.data(), cache.data(), index_count, positions, vertex_count, 3 * sizeof(float),
+                             1.05f);
 
     // Back to a face permutation: match each output triangle to an input triangle with the same
     // corners in the same cyclic order (duplicates taken in input order).

@@ -149,8 +149,8 @@ Nodes make_nodes(const uint32_t* indices, size_t index_count, const float* keyfr
                  size_t vertex_count, const std::vector<uint32_t>& keyframes, size_t views) {
     Nodes nodes;
     const std::vector<float> directions = icosphere_directions(icosphere_subdivisions_for(views));
-    nodes.framing = frame_subset(frame_keyframes(keyframe_positions, keyframe_count, vertex_count, indices, index_count),
-                                 keyframes);
+    nodes.framing = frame_subset(
+        frame_keyframes(keyframe_positions, keyframe_count, vertex_count, indices, index_count), keyframes);
     for (uint32_t k : keyframes)
         for (size_t v = 0; v < directions.size() / 3; ++v) {
             OverdrawNode node;
@@ -196,7 +196,10 @@ class NodeSource {
 public:
     NodeSource(const uint32_t* indices, size_t index_count, const float* keyframe_positions, size_t vertex_count,
                Nodes nodes, unsigned resolution, unsigned threads, bool keep)
-        : indices_(indices), index_count_(index_count), positions_(keyframe_positions), vertex_count_(vertex_count),
+        : indices_(indices),
+          index_count_(index_count),
+          positions_(keyframe_positions),
+          vertex_count_(vertex_count),
           nodes_(std::move(nodes)) {
         settings_.resolution = resolution;
         settings_.threads = threads;
@@ -204,9 +207,7 @@ public:
             kept_ = rasterize_nodes(positions_, vertex_count_, nodes_.framing, indices_, index_count_,
                                     nodes_.list.data(), nodes_.list.size(), settings_, kMaxKeptBytes);
     }
-    int threads() const {
-        return settings_.threads ? int(settings_.threads) : tbb::this_task_arena::max_concurrency();
-    }
+    int threads() const { return settings_.threads ? int(settings_.threads) : tbb::this_task_arena::max_concurrency(); }
     size_t size() const { return nodes_.list.size(); }
 
     // The graph's pair sums over every node.
@@ -259,8 +260,8 @@ public:
         if (!kept_.empty())
             score_kept_nodes(visible.data(), passed.data(), kept_, ranks.data(), 1, settings_);
         else
-            score_nodes(visible.data(), passed.data(), positions_, vertex_count_, nodes_.framing, indices_, index_count_,
-                        nodes_.list.data(), nodes_.list.size(), ranks.data(), 1, settings_);
+            score_nodes(visible.data(), passed.data(), positions_, vertex_count_, nodes_.framing, indices_,
+                        index_count_, nodes_.list.data(), nodes_.list.size(), ranks.data(), 1, settings_);
         double sum = 0;
         size_t counted = 0;
         for (size_t n = 0; n < size(); ++n)
@@ -303,7 +304,8 @@ std::vector<uint32_t> order_feedback_arc_set(size_t node_count, const Arc* arcs,
         const Arc& a = arcs[i];
         if (a.from >= node_count || a.to >= node_count)
             throw InvalidInput("feedback arc set: arc " + std::to_string(i) + " names node " +
-                               std::to_string(std::max(a.from, a.to)) + ", but there are " + std::to_string(node_count));
+                               std::to_string(std::max(a.from, a.to)) + ", but there are " +
+                               std::to_string(node_count));
         if (a.from == a.to) throw InvalidInput("feedback arc set: arc " + std::to_string(i) + " is a self-loop");
         if (a.weight == 0) throw InvalidInput("feedback arc set: arc " + std::to_string(i) + " has weight 0");
     }
@@ -343,8 +345,10 @@ std::vector<uint32_t> order_feedback_arc_set(size_t node_count, const Arc* arcs,
     std::vector<bool> removed(node_count, false);
     std::deque<uint32_t> sinks, sources;
     for (uint32_t v = 0; v < node_count; ++v) {
-        if (out_degree[v] == 0) sinks.push_back(v);
-        else if (in_degree[v] == 0) sources.push_back(v);
+        if (out_degree[v] == 0)
+            sinks.push_back(v);
+        else if (in_degree[v] == 0)
+            sources.push_back(v);
     }
     std::vector<uint32_t> head, tail;  // order = head, then tail reversed
     auto remove = [&](uint32_t v) {
@@ -400,8 +404,10 @@ std::vector<uint32_t> order_feedback_arc_set(size_t node_count, const Arc* arcs,
         if (left == 0) break;
         // Only cycles remain: the node with the largest |δ| goes to its winning side.
         const uint32_t v = candidates.begin()->second;
-        if (delta[v] >= 0) head.push_back(v);
-        else tail.push_back(v);
+        if (delta[v] >= 0)
+            head.push_back(v);
+        else
+            tail.push_back(v);
         remove(v);
         --left;
     }
@@ -438,14 +444,14 @@ std::vector<Arc> build_overdraw_graph(const uint32_t* indices, size_t index_coun
         if (cluster_of[t] >= cluster_count)
             throw InvalidInput("overdraw graph: triangle " + std::to_string(t) + " is in cluster " +
                                std::to_string(cluster_of[t]) + ", but there are " + std::to_string(cluster_count));
-    const std::vector<uint32_t> list = checked_keyframes(keyframes, keyframe_list_count, keyframe_count, keyframe_positions,
-                                                         vertex_count, indices, index_count);
+    const std::vector<uint32_t> list = checked_keyframes(keyframes, keyframe_list_count, keyframe_count,
+                                                         keyframe_positions, vertex_count, indices, index_count);
     std::vector<uint32_t> rank(triangles);
     for (size_t i = 0; i < triangles; ++i) rank[draw_order[i]] = uint32_t(i);
-    const NodeSource source(indices, index_count, keyframe_positions, vertex_count,
-                            make_nodes(indices, index_count, keyframe_positions, keyframe_count, vertex_count, list,
-                                       settings.views),
-                            settings.resolution, settings.threads, false);
+    const NodeSource source(
+        indices, index_count, keyframe_positions, vertex_count,
+        make_nodes(indices, index_count, keyframe_positions, keyframe_count, vertex_count, list, settings.views),
+        settings.resolution, settings.threads, false);
     double raster = 0;
     return arcs_from_sums(source.pair_sums(cluster_of, rank.data(), cluster_count, raster), cluster_count);
 }
@@ -481,8 +487,8 @@ struct CandidateBuilder {
         Clock::time_point t0 = Clock::now();
         const std::vector<uint32_t> cluster_of = clusterer.cluster(c.clusters);
         std::vector<uint32_t> grouped(triangles);
-        const std::vector<uint32_t> starts =
-            tipsify_clusters(grouped.data(), indices, index_count, vertex_count, cluster_of.data(), c.clusters, cache_size);
+        const std::vector<uint32_t> starts = tipsify_clusters(grouped.data(), indices, index_count, vertex_count,
+                                                              cluster_of.data(), c.clusters, cache_size);
         {
             std::vector<uint32_t> buffer(index_count);
             apply_triangle_order(buffer.data(), indices, grouped.data(), triangles);
@@ -496,8 +502,8 @@ struct CandidateBuilder {
         for (size_t i = 0; i < triangles; ++i) rank[grouped[i]] = uint32_t(i);
         std::vector<Arc> arcs;
         if (c.clusters > 1)
-            arcs = arcs_from_sums(source.pair_sums(cluster_of.data(), rank.data(), c.clusters, result.seconds_rasterization),
-                                  c.clusters);
+            arcs = arcs_from_sums(
+                source.pair_sums(cluster_of.data(), rank.data(), c.clusters, result.seconds_rasterization), c.clusters);
         result.seconds_graph += seconds_since(t0);
 
         // §5: the cluster order (feedback arc set), then each cluster's triangles in Tipsify order.
@@ -531,8 +537,8 @@ Candidate search_cluster_count(const CandidateBuilder& builder, const PlanarClus
     const size_t triangles = builder.index_count / 3;
     const size_t components = clusterer.component_count();
     Clock::time_point t0 = Clock::now();
-    const double budget = kAcmrBudget * tipsify_acmr(builder.indices, builder.index_count, builder.vertex_count,
-                                                     builder.cache_size);
+    const double budget =
+        kAcmrBudget * tipsify_acmr(builder.indices, builder.index_count, builder.vertex_count, builder.cache_size);
     result.seconds_selection += seconds_since(t0);
 
     std::vector<Candidate> tried;
@@ -549,8 +555,10 @@ Candidate search_cluster_count(const CandidateBuilder& builder, const PlanarClus
         // The stopping rule: two doublings in a row without a gain of kGain on the best. Below the
         // component count clusters are unions of whole components: the mean OVR can sit on a
         // plateau there and fall once components split, so no stall counts.
-        if (ovr < best * (1 - kGain) || k < components) stalled = 0;
-        else ++stalled;
+        if (ovr < best * (1 - kGain) || k < components)
+            stalled = 0;
+        else
+            ++stalled;
         best = std::min(best, ovr);
         if (stalled >= 2 || k >= kLargest || k >= triangles) break;
     }
@@ -572,18 +580,18 @@ Nehab06Result order_static_nehab06(uint32_t* order, const uint32_t* indices, siz
     Nehab06Result result;
     const size_t triangles = index_count / 3;
     if (triangles == 0) return result;
-    const std::vector<uint32_t> list = checked_keyframes(keyframes, keyframe_list_count, keyframe_count, keyframe_positions,
-                                                         vertex_count, indices, index_count);
+    const std::vector<uint32_t> list = checked_keyframes(keyframes, keyframe_list_count, keyframe_count,
+                                                         keyframe_positions, vertex_count, indices, index_count);
     const float* cluster_positions = keyframe_positions + size_t(list[0]) * vertex_count * 3;
     const bool automatic = settings.clusters == 0;
 
     // The measuring nodes (§4's viewpoints, at every listed keyframe); their fragments are kept
     // when several candidates will replay them.
     Clock::time_point start = Clock::now();
-    const NodeSource source(indices, index_count, keyframe_positions, vertex_count,
-                            make_nodes(indices, index_count, keyframe_positions, keyframe_count, vertex_count, list,
-                                       settings.views),
-                            settings.resolution, settings.threads, automatic);
+    const NodeSource source(
+        indices, index_count, keyframe_positions, vertex_count,
+        make_nodes(indices, index_count, keyframe_positions, keyframe_count, vertex_count, list, settings.views),
+        settings.resolution, settings.threads, automatic);
     if (source.kept()) result.seconds_rasterization = seconds_since(start);
     result.seconds_graph = result.seconds_rasterization;
 

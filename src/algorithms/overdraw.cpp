@@ -28,9 +28,11 @@ std::vector<uint8_t> opaque_pass_modes(const AnimatedMesh& mesh) {
     std::vector<uint8_t> modes(mesh.triangle_count(), 0);
     bool any = false;
     for (const Primitive& p : mesh.primitives) {
-        const uint8_t mode = uint8_t((p.double_sided ? kDrawBothFaces : 0) | (p.alpha_mode == AlphaMode::Blend ? kSkipTriangle : 0));
+        const uint8_t mode =
+            uint8_t((p.double_sided ? kDrawBothFaces : 0) | (p.alpha_mode == AlphaMode::Blend ? kSkipTriangle : 0));
         any = any || mode;
-        for (size_t t = p.first_index / 3; t < (p.first_index + p.index_count) / 3 && t < modes.size(); ++t) modes[t] = mode;
+        for (size_t t = p.first_index / 3; t < (p.first_index + p.index_count) / 3 && t < modes.size(); ++t)
+            modes[t] = mode;
     }
     if (!any) modes.clear();
     return modes;
@@ -73,8 +75,8 @@ void score_nodes(uint64_t* visible, uint64_t* passed, const float* keyframe_posi
         for (size_t n = range.begin(); n != range.end(); ++n) {
             const OverdrawNode& node = nodes[n];
             const Mat4d vp = node_view_projection(node.direction, framing.radius);
-            transform_to_clip(w.clip.data(), keyframe_positions + size_t(node.keyframe) * vertex_count * 3, vertex_count,
-                              framing.centres.data() + 3 * size_t(node.keyframe), vp);
+            transform_to_clip(w.clip.data(), keyframe_positions + size_t(node.keyframe) * vertex_count * 3,
+                              vertex_count, framing.centres.data() + 3 * size_t(node.keyframe), vp);
             w.rasterizer.rasterize(w.clip.data(), vertex_count, indices, index_count, settings.resolution,
                                    settings.triangle_modes);
             visible[n] = w.rasterizer.visible_pixels();
@@ -97,7 +99,8 @@ std::vector<NodeFragments> rasterize_nodes(const float* keyframe_positions, size
     validate_indices(indices, index_count, vertex_count);
     const size_t keyframes = framing.centres.size() / 3;
     for (size_t n = 0; n < node_count; ++n)
-        if (nodes[n].keyframe >= keyframes) throw InvalidInput("node " + std::to_string(n) + " names a missing keyframe");
+        if (nodes[n].keyframe >= keyframes)
+            throw InvalidInput("node " + std::to_string(n) + " names a missing keyframe");
 
     std::vector<NodeFragments> kept(node_count);
     // The total is the same whatever the schedule, so whether it fits is decided deterministically.
@@ -115,15 +118,16 @@ std::vector<NodeFragments> rasterize_nodes(const float* keyframe_positions, size
         w.clip.resize(vertex_count * 4);
         for (size_t n = range.begin(); n != range.end() && !too_big; ++n) {
             const OverdrawNode& node = nodes[n];
-            transform_to_clip(w.clip.data(), keyframe_positions + size_t(node.keyframe) * vertex_count * 3, vertex_count,
-                              framing.centres.data() + 3 * size_t(node.keyframe),
+            transform_to_clip(w.clip.data(), keyframe_positions + size_t(node.keyframe) * vertex_count * 3,
+                              vertex_count, framing.centres.data() + 3 * size_t(node.keyframe),
                               node_view_projection(node.direction, framing.radius));
             w.rasterizer.rasterize(w.clip.data(), vertex_count, indices, index_count, settings.resolution,
                                    settings.triangle_modes);
             kept[n] = w.rasterizer.export_fragments();
             if ((total += kept[n].bytes()) > max_bytes) too_big = true;
             const size_t finished = ++done;
-            if (settings.progress && (finished % std::max<size_t>(1, node_count / 100) == 0 || finished == node_count)) {
+            if (settings.progress &&
+                (finished % std::max<size_t>(1, node_count / 100) == 0 || finished == node_count)) {
                 std::lock_guard<std::mutex> lock(progress_mutex);
                 settings.progress(finished, node_count);
             }
@@ -136,17 +140,18 @@ std::vector<NodeFragments> rasterize_nodes(const float* keyframe_positions, size
     return kept;
 }
 
-void score_kept_nodes(uint64_t* visible, uint64_t* passed, const std::vector<NodeFragments>& nodes, const uint32_t* ranks,
-                      size_t order_count, const ScoreSettings& settings) {
+void score_kept_nodes(uint64_t* visible, uint64_t* passed, const std::vector<NodeFragments>& nodes,
+                      const uint32_t* ranks, size_t order_count, const ScoreSettings& settings) {
     const int threads = settings.threads ? int(settings.threads) : tbb::this_task_arena::max_concurrency();
     tbb::task_arena arena(threads);
     arena.execute([&] {
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, nodes.size(), 64), [&](const tbb::blocked_range<size_t>& range) {
-            for (size_t n = range.begin(); n != range.end(); ++n) {
-                visible[n] = nodes[n].visible;
-                score_fragments(passed + n * order_count, nodes[n], ranks, order_count);
-            }
-        });
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, nodes.size(), 64),
+                          [&](const tbb::blocked_range<size_t>& range) {
+                              for (size_t n = range.begin(); n != range.end(); ++n) {
+                                  visible[n] = nodes[n].visible;
+                                  score_fragments(passed + n * order_count, nodes[n], ranks, order_count);
+                              }
+                          });
     });
     if (settings.progress) settings.progress(nodes.size(), nodes.size());
 }

@@ -33,8 +33,8 @@ void validate_hard_boundaries(const uint32_t* hard_boundaries, size_t count, siz
     if (count > 0 && hard_boundaries == nullptr) throw InvalidInput("hard boundary list is null");
     for (size_t i = 0; i < count; ++i) {
         if (hard_boundaries[i] >= triangle_count)
-            throw InvalidInput("hard boundary " + std::to_string(hard_boundaries[i]) +
-                               " is past the last triangle (" + std::to_string(triangle_count) + ")");
+            throw InvalidInput("hard boundary " + std::to_string(hard_boundaries[i]) + " is past the last triangle (" +
+                               std::to_string(triangle_count) + ")");
         if (i > 0 && hard_boundaries[i] <= hard_boundaries[i - 1])
             throw InvalidInput("hard boundaries must be strictly ascending");
     }
@@ -88,8 +88,8 @@ private:
 }  // namespace
 
 std::vector<uint32_t> build_patches(const uint32_t* indices, size_t index_count, size_t vertex_count,
-                                    const uint32_t* hard_boundaries, size_t hard_boundary_count,
-                                    double lambda, unsigned cache_size) {
+                                    const uint32_t* hard_boundaries, size_t hard_boundary_count, double lambda,
+                                    unsigned cache_size) {
     validate_indices(indices, index_count, vertex_count);
     if (std::isnan(lambda)) throw InvalidInput("lambda is NaN");
     if (cache_size == 0) throw InvalidInput("cache size must be at least 1");
@@ -116,8 +116,8 @@ std::vector<uint32_t> build_patches(const uint32_t* indices, size_t index_count,
             cut = t > 0;
             ++next_hard;
         } else if (soft_boundaries && patch_triangles > 0) {
-            const double local_acmr = double(patch_misses + cache.misses_if_drawn(corners)) /
-                                      double(patch_triangles + 1);
+            const double local_acmr =
+                double(patch_misses + cache.misses_if_drawn(corners)) / double(patch_triangles + 1);
             cut = local_acmr < lambda;
         }
         if (cut) {

@@ -70,7 +70,7 @@ namespace {
 
 constexpr int kSubpixelBits = 8;
 constexpr int64_t kSubpixel = int64_t(1) << kSubpixelBits;  // 256
-constexpr float kGuardBand = 2.0f;  // |x|, |y| <= 2w: twice the viewport, never a visible pixel
+constexpr float kGuardBand = 2.0f;                          // |x|, |y| <= 2w: twice the viewport, never a visible pixel
 
 struct ClipVertex {
     float x, y, z, w;
@@ -199,7 +199,7 @@ void rasterize_clipped_triangle(const ClipVertex (&v)[3], uint32_t triangle, uns
     ClipVertex a[12], b[12];
     int n = 3;
     std::copy(v, v + 3, a);
-    const float planes[6][4] = {{0, 0, 1, 1},          {0, 0, -1, 1},          {1, 0, 0, kGuardBand},
+    const float planes[6][4] = {{0, 0, 1, 1},           {0, 0, -1, 1},         {1, 0, 0, kGuardBand},
                                 {-1, 0, 0, kGuardBand}, {0, 1, 0, kGuardBand}, {0, -1, 0, kGuardBand}};
     for (const auto& p : planes) {
         n = clip_polygon(a, n, b, p[0], p[1], p[2], p[3]);
@@ -208,7 +208,8 @@ void rasterize_clipped_triangle(const ClipVertex (&v)[3], uint32_t triangle, uns
     }
     WindowVertex w[12];
     for (int i = 0; i < n; ++i) project(a[i], resolution, w[i]);
-    for (int i = 1; i + 1 < n; ++i) rasterize_window_triangle(w[0], w[i], w[i + 1], triangle, resolution, sink, two_sided);
+    for (int i = 1; i + 1 < n; ++i)
+        rasterize_window_triangle(w[0], w[i], w[i + 1], triangle, resolution, sink, two_sided);
 }
 
 // Groups the node's fragments by pixel with an LSD radix sort on the pixel index (two passes of
@@ -284,8 +285,8 @@ void NodeRasterizer::visit_fragments(const std::function<void(uint32_t, uint32_t
     for (size_t f = 0; f < s.raw_count; ++f) visit(s.raw[f].pixel, s.raw[f].triangle, s.raw[f].depth);
 }
 
-void NodeRasterizer::rasterize(const float* clip_xyzw, size_t vertex_count, const uint32_t* indices,
-                               size_t index_count, unsigned resolution, const uint8_t* modes) {
+void NodeRasterizer::rasterize(const float* clip_xyzw, size_t vertex_count, const uint32_t* indices, size_t index_count,
+                               unsigned resolution, const uint8_t* modes) {
     validate_indices(indices, index_count, vertex_count);
     if (resolution == 0 || resolution > 16384)
         throw InvalidInput("resolution " + std::to_string(resolution) + " is outside 1..16384");
@@ -346,7 +347,8 @@ void replay_pixel(const uint32_t* fragments, uint32_t count, const uint32_t* ran
 // without equal depths (nearly all) take a branch-free path the compiler vectorises across the K
 // orders: a fragment passes under order o iff its rank is below the running minimum.
 template <size_t K>
-void replay_all(uint64_t* passed, const uint32_t* starts, size_t pixels, const uint32_t* fragments, const uint32_t* ranks) {
+void replay_all(uint64_t* passed, const uint32_t* starts, size_t pixels, const uint32_t* fragments,
+                const uint32_t* ranks) {
     uint64_t count[K] = {};
     uint32_t scratch[2 * K] = {};
     for (size_t m = 0; m < pixels; ++m) {
@@ -454,8 +456,7 @@ BlendFragments NodeRasterizer::export_blend_fragments(const uint8_t* blended) co
             bool opaque = false;
             for (uint32_t i = j; i < end; ++i) opaque = opaque || !blended[f[i] & kTriangleMask];
             if (opaque) break;  // the opaque depth: this group fails LESS, and so does all behind it
-            for (uint32_t i = j; i < end; ++i)
-                out.fragments.push_back((f[i] & kTriangleMask) | (i > j ? kTieBit : 0));
+            for (uint32_t i = j; i < end; ++i) out.fragments.push_back((f[i] & kTriangleMask) | (i > j ? kTieBit : 0));
             j = end;
         }
         const size_t count = out.fragments.size() - begin;

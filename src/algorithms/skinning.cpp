@@ -14,7 +14,8 @@
 namespace animorder {
 
 void skin_positions(float* out_positions, const float* bind_positions, size_t vertex_count, const uint16_t* joints,
-                    const float* weights, size_t influences_per_vertex, const Mat4* joint_matrices, size_t joint_count) {
+                    const float* weights, size_t influences_per_vertex, const Mat4* joint_matrices,
+                    size_t joint_count) {
     for (size_t v = 0; v < vertex_count; ++v) {
         const float* p = bind_positions + 3 * v;
         double sum = 0, x = 0, y = 0, z = 0;

@@ -80,9 +80,9 @@ void validate_positions(const float* positions, size_t vertex_count, size_t stri
 
 }  // namespace
 
-void sort_patches_sander07(uint32_t* patch_order, const uint32_t* indices, size_t index_count,
-                           const float* positions, size_t vertex_count, size_t position_stride,
-                           const uint32_t* patch_starts, size_t patch_count) {
+void sort_patches_sander07(uint32_t* patch_order, const uint32_t* indices, size_t index_count, const float* positions,
+                           size_t vertex_count, size_t position_stride, const uint32_t* patch_starts,
+                           size_t patch_count) {
     validate_indices(indices, index_count, vertex_count);
     validate_positions(positions, vertex_count, position_stride);
     const size_t triangle_count = index_count / 3;
@@ -114,13 +114,12 @@ void sort_patches_sander07(uint32_t* patch_order, const uint32_t* indices, size_
         rank[p] = dot(patches[p].centroid() - mesh_centroid, patches[p].average_normal());
 
     std::iota(patch_order, patch_order + patch_count, 0u);
-    std::stable_sort(patch_order, patch_order + patch_count,
-                     [&](uint32_t a, uint32_t b) { return rank[a] > rank[b]; });
+    std::stable_sort(patch_order, patch_order + patch_count, [&](uint32_t a, uint32_t b) { return rank[a] > rank[b]; });
 }
 
 StaticOrderResult order_static_sander07(uint32_t* order, const uint32_t* indices, size_t index_count,
-                                        const float* positions, size_t vertex_count,
-                                        size_t position_stride, double lambda, unsigned cache_size) {
+                                        const float* positions, size_t vertex_count, size_t position_stride,
+                                        double lambda, unsigned cache_size) {
     validate_positions(positions, vertex_count, position_stride);
     const size_t triangle_count = index_count / 3;
     const TipsifyResult tipsified = tipsify(order, indices, index_count, vertex_count, cache_size);

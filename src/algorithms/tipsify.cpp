@@ -31,8 +31,8 @@ namespace {
 // Vertex-triangle adjacency as an offset map into one array (counting sort over the index
 // buffer, "Build-Adjacency" in the paper).
 struct Adjacency {
-    std::vector<uint32_t> offsets;            // vertex_count + 1
-    std::unique_ptr<uint32_t[]> triangles;    // index_count, every slot written before use
+    std::vector<uint32_t> offsets;          // vertex_count + 1
+    std::unique_ptr<uint32_t[]> triangles;  // index_count, every slot written before use
 };
 
 Adjacency build_adjacency(const uint32_t* indices, size_t index_count, size_t vertex_count) {
@@ -80,8 +80,8 @@ TipsifyResult run_tipsify(uint32_t* order, uint32_t* destination, const uint32_t
     size_t dead_end_top = 0;
 
     const uint32_t k = cache_size;
-    uint32_t s = k + 1;        // time stamp; s − C[v] > k means "not in cache"
-    size_t cursor = 0;         // input-order sweep for Skip-Dead-End, never moves back
+    uint32_t s = k + 1;  // time stamp; s − C[v] > k means "not in cache"
+    size_t cursor = 0;   // input-order sweep for Skip-Dead-End, never moves back
     size_t emitted_count = 0;
 
     // The arbitrary starting vertex: the first with triangles (vertex 0 may be unreferenced).
@@ -139,8 +139,10 @@ TipsifyResult run_tipsify(uint32_t* order, uint32_t* destination, const uint32_t
             if (state[v].live > 0) best = int64_t(v);
         }
         while (best < 0) {  // terminates: some triangle is still live
-            if (state[cursor].live > 0) best = int64_t(cursor);
-            else ++cursor;
+            if (state[cursor].live > 0)
+                best = int64_t(cursor);
+            else
+                ++cursor;
         }
         fan = uint32_t(best);
     }

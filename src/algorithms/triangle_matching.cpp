@@ -22,7 +22,8 @@ std::array<uint32_t, 3> rotated(const uint32_t* t) {
 
 std::vector<uint32_t> triangle_permutation(const uint32_t* base, const uint32_t* order, size_t triangle_count) {
     std::map<std::array<uint32_t, 3>, std::vector<uint32_t>> where;
-    for (size_t t = triangle_count; t-- > 0;) where[rotated(base + 3 * t)].push_back(uint32_t(t));  // popped in sequence
+    for (size_t t = triangle_count; t-- > 0;)
+        where[rotated(base + 3 * t)].push_back(uint32_t(t));  // popped in sequence
     std::vector<uint32_t> result(triangle_count);
     for (size_t t = 0; t < triangle_count; ++t) {
         const auto it = where.find(rotated(order + 3 * t));
@@ -33,7 +34,8 @@ std::vector<uint32_t> triangle_permutation(const uint32_t* base, const uint32_t*
     return result;
 }
 
-TriangleMatch match_triangles(const std::vector<float>& from, const std::vector<float>& to, size_t dims, float tolerance) {
+TriangleMatch match_triangles(const std::vector<float>& from, const std::vector<float>& to, size_t dims,
+                              float tolerance) {
     TriangleMatch m;
     const size_t per = 3 * dims;
     if (dims < 3 || per == 0) return m;
@@ -41,7 +43,9 @@ TriangleMatch match_triangles(const std::vector<float>& from, const std::vector<
     m.from_of_to.assign(to_count, -1);
     const double cell = std::max(double(tolerance), 1e-12) * 2;
     auto centroid = [&](const std::vector<float>& v, size_t t, int axis) {
-        return (double(v[t * per + size_t(axis)]) + v[t * per + dims + size_t(axis)] + v[t * per + 2 * dims + size_t(axis)]) / 3;
+        return (double(v[t * per + size_t(axis)]) + v[t * per + dims + size_t(axis)] +
+                v[t * per + 2 * dims + size_t(axis)]) /
+               3;
     };
     struct Key {
         int64_t x, y, z;

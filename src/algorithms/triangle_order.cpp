@@ -25,9 +25,9 @@ void validate_indices(const uint32_t* indices, size_t index_count, size_t vertex
     if (index_count > 0 && largest >= vertex_count) {
         for (size_t i = 0; i < index_count; ++i)
             if (indices[i] >= vertex_count)
-                throw InvalidInput("index " + std::to_string(i) + " (triangle " + std::to_string(i / 3) +
-                                   ") is " + std::to_string(indices[i]) + ", but there are only " +
-                                   std::to_string(vertex_count) + " vertices");
+                throw InvalidInput("index " + std::to_string(i) + " (triangle " + std::to_string(i / 3) + ") is " +
+                                   std::to_string(indices[i]) + ", but there are only " + std::to_string(vertex_count) +
+                                   " vertices");
     }
 }
 
@@ -40,8 +40,8 @@ void validate_triangle_order(const uint32_t* order, size_t triangle_count) {
             throw InvalidInput("triangle order entry " + std::to_string(i) + " is " + std::to_string(t) +
                                ", but there are only " + std::to_string(triangle_count) + " triangles");
         if (seen[t])
-            throw InvalidInput("triangle order lists triangle " + std::to_string(t) +
-                               " twice (second time at entry " + std::to_string(i) + ")");
+            throw InvalidInput("triangle order lists triangle " + std::to_string(t) + " twice (second time at entry " +
+                               std::to_string(i) + ")");
         seen[t] = 1;
     }
 }

@@ -15,8 +15,8 @@
 
 namespace animorder {
 
-VertexCacheStats analyze_vertex_cache(const uint32_t* indices, size_t index_count,
-                                      size_t vertex_count, unsigned cache_size) {
+VertexCacheStats analyze_vertex_cache(const uint32_t* indices, size_t index_count, size_t vertex_count,
+                                      unsigned cache_size) {
     validate_indices(indices, index_count, vertex_count);
     if (cache_size == 0) throw InvalidInput("cache size must be at least 1");
 

@@ -36,15 +36,16 @@ Dir normalized(Dir d) {
 }  // namespace
 
 std::vector<float> icosphere_directions(unsigned subdivisions) {
-    if (subdivisions > 6) throw InvalidInput("icosphere subdivision level " + std::to_string(subdivisions) + " is too large (max 6)");
+    if (subdivisions > 6)
+        throw InvalidInput("icosphere subdivision level " + std::to_string(subdivisions) + " is too large (max 6)");
     const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-    std::vector<Dir> vertices = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                                 {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+    std::vector<Dir> vertices = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+                                 {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
     for (Dir& v : vertices) v = normalized(v);
-    std::vector<std::array<uint32_t, 3>> faces = {
-        {0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
-        {11, 10, 2}, {10, 7, 6}, {7, 1, 8}, {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8},
-        {3, 8, 9}, {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
+    std::vector<std::array<uint32_t, 3>> faces = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                                                  {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                                                  {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                                                  {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
     for (unsigned level = 0; level < subdivisions; ++level) {
         std::map<std::pair<uint32_t, uint32_t>, uint32_t> midpoints;  // ordered: deterministic ids
         auto midpoint = [&](uint32_t a, uint32_t b) {

@@ -59,7 +59,8 @@ inline uint32_t add_lathe(std::vector<double>& positions, std::vector<double>& a
             indices.insert(indices.end(), {a, b, c, a, c, d});
         }
     const size_t last = rings.size() - 1;
-    for (int s = 0; s < segments; ++s) indices.insert(indices.end(), {back, ring_vertex(last, s), ring_vertex(last, s + 1)});
+    for (int s = 0; s < segments; ++s)
+        indices.insert(indices.end(), {back, ring_vertex(last, s), ring_vertex(last, s + 1)});
     return base;
 }
 

@@ -28,8 +28,20 @@ using procedural::Ring;
 using procedural::Vec3;
 
 enum Joint : uint16_t {
-    kHips, kChest, kHead, kLeftUpperArm, kLeftForearm, kRightUpperArm, kRightForearm,
-    kLeftThigh, kLeftShin, kRightThigh, kRightShin, kLeftFoot, kRightFoot, kJointCount
+    kHips,
+    kChest,
+    kHead,
+    kLeftUpperArm,
+    kLeftForearm,
+    kRightUpperArm,
+    kRightForearm,
+    kLeftThigh,
+    kLeftShin,
+    kRightThigh,
+    kRightShin,
+    kLeftFoot,
+    kRightFoot,
+    kJointCount
 };
 
 struct Bone {
@@ -38,14 +50,19 @@ struct Bone {
 };
 
 const std::array<Bone, kJointCount> kSkeleton = {{
-    {-1, {0, 0.95, 0}},                                   // hips
-    {kHips, {0, 1.20, 0}},                                // chest
-    {kChest, {0, 1.50, 0}},                               // head (neck base)
-    {kChest, {0.22, 1.40, 0}}, {kLeftUpperArm, {0.30, 1.12, 0}},    // left shoulder, elbow
-    {kChest, {-0.22, 1.40, 0}}, {kRightUpperArm, {-0.30, 1.12, 0}}, // right shoulder, elbow
-    {kHips, {0.10, 0.92, 0}}, {kLeftThigh, {0.11, 0.51, 0}},        // left hip, knee
-    {kHips, {-0.10, 0.92, 0}}, {kRightThigh, {-0.11, 0.51, 0}},     // right hip, knee
-    {kLeftShin, {0.12, 0.09, 0}}, {kRightShin, {-0.12, 0.09, 0}},   // ankles
+    {-1, {0, 0.95, 0}},      // hips
+    {kHips, {0, 1.20, 0}},   // chest
+    {kChest, {0, 1.50, 0}},  // head (neck base)
+    {kChest, {0.22, 1.40, 0}},
+    {kLeftUpperArm, {0.30, 1.12, 0}},  // left shoulder, elbow
+    {kChest, {-0.22, 1.40, 0}},
+    {kRightUpperArm, {-0.30, 1.12, 0}},  // right shoulder, elbow
+    {kHips, {0.10, 0.92, 0}},
+    {kLeftThigh, {0.11, 0.51, 0}},  // left hip, knee
+    {kHips, {-0.10, 0.92, 0}},
+    {kRightThigh, {-0.11, 0.51, 0}},  // right hip, knee
+    {kLeftShin, {0.12, 0.09, 0}},
+    {kRightShin, {-0.12, 0.09, 0}},  // ankles
 }};
 
 struct Builder {
@@ -60,8 +77,9 @@ struct Builder {
               int cap_rings, int body_rings, int segments, double side_scale = 1.0) {
         const double length = std::sqrt(procedural::dot(b - a, b - a));
         const size_t start = positions.size() / 3;
-        procedural::add_lathe(positions, along, indices, a, b - a, -r0, procedural::capsule_rings(length, r0, r1, cap_rings, body_rings),
-                              length + r1, segments, side_scale);
+        procedural::add_lathe(positions, along, indices, a, b - a, -r0,
+                              procedural::capsule_rings(length, r0, r1, cap_rings, body_rings), length + r1, segments,
+                              side_scale);
         for (size_t v = start; v < positions.size() / 3; ++v) {
             const double s = along[v] / length - joint_at;
             const double t = std::clamp(0.5 + s * length / (2.0 * blend), 0.0, 1.0);
@@ -122,17 +140,17 @@ Pose walk_pose(double t) {  // one stride per second
     const double s = std::sin(2 * M_PI * t), c = std::cos(2 * M_PI * t);
     Pose p;
     p.root_offset = {0, 0.03 * std::fabs(std::sin(2 * M_PI * t)) - 0.015, 0};
-    p.rotation[kLeftThigh].x = -0.55 * s;   // negative X rotation swings the leg forward (+Z)
+    p.rotation[kLeftThigh].x = -0.55 * s;  // negative X rotation swings the leg forward (+Z)
     p.rotation[kRightThigh].x = 0.55 * s;
-    p.rotation[kLeftShin].x = 0.35 + 0.45 * std::max(0.0, c);   // knees bend back
+    p.rotation[kLeftShin].x = 0.35 + 0.45 * std::max(0.0, c);  // knees bend back
     p.rotation[kRightShin].x = 0.35 + 0.45 * std::max(0.0, -c);
     p.rotation[kLeftFoot].x = -0.2 * s;
     p.rotation[kRightFoot].x = 0.2 * s;
     p.rotation[kLeftUpperArm].x = 0.45 * s;  // arms swing opposite to the legs
     p.rotation[kRightUpperArm].x = -0.45 * s;
-    p.rotation[kLeftForearm].x = -0.5;      // elbows bent forward
+    p.rotation[kLeftForearm].x = -0.5;  // elbows bent forward
     p.rotation[kRightForearm].x = -0.5;
-    p.rotation[kChest].y = 0.12 * s;        // shoulders counter-rotate
+    p.rotation[kChest].y = 0.12 * s;  // shoulders counter-rotate
     p.rotation[kHead].y = -0.08 * s;
     return p;
 }
@@ -141,10 +159,10 @@ Pose wave_pose(double t) {  // 1.5 s: right arm up and waving, shield raised, to
     const double raise = std::min(1.0, t / 0.35);
     const double ease = raise * raise * (3 - 2 * raise);
     Pose p;
-    p.rotation[kRightUpperArm].z = -2.5 * ease;                            // up and out to −X
+    p.rotation[kRightUpperArm].z = -2.5 * ease;                                              // up and out to −X
     p.rotation[kRightForearm].z = -0.3 * ease + 0.55 * ease * std::sin(2 * M_PI * 2.0 * t);  // waving
-    p.rotation[kLeftUpperArm].x = -1.1 * ease;                             // shield arm forward
-    p.rotation[kLeftForearm].y = 0.9 * ease;                               // shield across the chest
+    p.rotation[kLeftUpperArm].x = -1.1 * ease;                                               // shield arm forward
+    p.rotation[kLeftForearm].y = 0.9 * ease;                                                 // shield across the chest
     p.rotation[kLeftForearm].x = -0.6 * ease;
     p.rotation[kChest].y = 0.35 * std::sin(2 * M_PI * t / 1.5);
     p.rotation[kChest].z = 0.12 * ease;
@@ -159,10 +177,11 @@ std::array<Mat4, kJointCount> skinning_matrices(const Pose& pose) {
     std::array<Mat4, kJointCount> world{}, skin{};
     for (int j = 0; j < kJointCount; ++j) {
         const Bone& bone = kSkeleton[j];
-        const Vec3 offset = bone.parent < 0 ? bone.position + pose.root_offset : bone.position - kSkeleton[bone.parent].position;
+        const Vec3 offset =
+            bone.parent < 0 ? bone.position + pose.root_offset : bone.position - kSkeleton[bone.parent].position;
         const Mat4 local = multiply_mat4(translation(offset), rotation(pose.rotation[j]));
         world[j] = bone.parent < 0 ? local : multiply_mat4(world[bone.parent], local);  // parents come first
-        skin[j] = multiply_mat4(world[j], translation(bone.position * -1.0));      // · inverse bind
+        skin[j] = multiply_mat4(world[j], translation(bone.position * -1.0));           // · inverse bind
     }
     return skin;
 }
@@ -192,7 +211,8 @@ AnimatedMesh make_procedural_character() {
         const double upper = std::sqrt(procedural::dot(knee - hip, knee - hip));
         const double total = upper + std::sqrt(procedural::dot(ankle - knee, ankle - knee));
         body.limb(hip, ankle, 0.08, 0.05, thigh, shin, upper / total, 0.06, 5, 31, 16);
-        body.limb(ankle + Vec3{0, -0.03, -0.04}, ankle + Vec3{0, -0.04, 0.16}, 0.045, 0.04, foot, foot, 0.5, 0.05, 4, 9, 12);
+        body.limb(ankle + Vec3{0, -0.03, -0.04}, ankle + Vec3{0, -0.04, 0.16}, 0.045, 0.04, foot, foot, 0.5, 0.05, 4, 9,
+                  12);
     }
     // A cape hanging from the shoulders to the knees behind the back, and shoulder pads over the
     // arms: layers that hide the back, the legs and the arms from many views.
@@ -200,8 +220,8 @@ AnimatedMesh make_procedural_character() {
     for (int side = 0; side < 2; ++side) {
         const uint16_t upper = side ? kRightUpperArm : kLeftUpperArm;
         const Vec3 shoulder = S[upper].position;
-        body.limb(shoulder + Vec3{side ? -0.03 : 0.03, 0.05, 0}, shoulder + Vec3{side ? -0.05 : 0.05, -0.06, 0}, 0.09, 0.07,
-                  upper, upper, 0.6, 0.05, 4, 4, 14);
+        body.limb(shoulder + Vec3{side ? -0.03 : 0.03, 0.05, 0}, shoulder + Vec3{side ? -0.05 : 0.05, -0.06, 0}, 0.09,
+                  0.07, upper, upper, 0.6, 0.05, 4, 4, 14);
     }
     const size_t body_indices = body.indices.size();
     // The shield: a flat disc strapped to the outside of the left forearm.
@@ -215,7 +235,8 @@ AnimatedMesh make_procedural_character() {
             rings.push_back({-0.025 * std::cos(a), 0.21 * std::sin(a)});
         }
         const size_t start = body.positions.size() / 3;
-        procedural::add_lathe(body.positions, body.along, body.indices, centre, {1, 0, 0}, -0.025, rings, 0.025, 28, 1.15);
+        procedural::add_lathe(body.positions, body.along, body.indices, centre, {1, 0, 0}, -0.025, rings, 0.025, 28,
+                              1.15);
         for (size_t v = start; v < body.positions.size() / 3; ++v) {
             body.joints.insert(body.joints.end(), {kLeftForearm, kLeftForearm});
             body.weights.insert(body.weights.end(), {1.0f, 0.0f});
@@ -231,18 +252,24 @@ AnimatedMesh make_procedural_character() {
             const double angle = M_PI * (-0.8 + 1.6 * (card + 0.5 * (layer % 2)) / 19.0);  // 0: the back (−Z)
             const Vec3 out = {std::sin(angle), 0, -std::cos(angle)}, side = {std::cos(angle), 0, std::sin(angle)};
             const double r_top = 0.085 + 0.012 * layer, r_bottom = 0.125 + 0.02 * layer;
-            body.sheet(1, 5, [&](double u, double v) {
-                const double r = r_top + (r_bottom - r_top) * v;
-                return Vec3{0, 1.73 - 0.31 * v - 0.02 * layer, 0} + out * r + side * (0.05 * (u - 0.5));
-            }, kHead, kHead, [](double) { return 0.0; });
+            body.sheet(
+                1, 5,
+                [&](double u, double v) {
+                    const double r = r_top + (r_bottom - r_top) * v;
+                    return Vec3{0, 1.73 - 0.31 * v - 0.02 * layer, 0} + out * r + side * (0.05 * (u - 0.5));
+                },
+                kHead, kHead, [](double) { return 0.0; });
         }
     const size_t hair_end = body.indices.size();
     // A cloth cape (blended, double-sided): a sheet wrapped round the back from the shoulders to
     // the knees, widening as it falls, its top following the chest and its hem the hips.
-    body.sheet(16, 12, [&](double u, double v) {
-        const double angle = M_PI * (-0.55 + 1.1 * u), r = 0.23 + 0.12 * v;
-        return Vec3{r * std::sin(angle), 1.42 - 0.87 * v, -r * std::cos(angle) - 0.02};
-    }, kChest, kHips, [](double v) { return v * 1.4; });
+    body.sheet(
+        16, 12,
+        [&](double u, double v) {
+            const double angle = M_PI * (-0.55 + 1.1 * u), r = 0.23 + 0.12 * v;
+            return Vec3{r * std::sin(angle), 1.42 - 0.87 * v, -r * std::cos(angle) - 0.02};
+        },
+        kChest, kHips, [](double v) { return v * 1.4; });
 
     AnimatedMesh mesh;
     mesh.name = "procedural-character";

@@ -63,8 +63,10 @@ AnimatedMesh make_torus_knot(size_t target_triangles, int p, int q) {
         const Vec3 n = normal[i - 1] - tangent[i] * procedural::dot(normal[i - 1], tangent[i]);
         normal[i] = procedural::normalize(n);
     }
-    const Vec3 end = procedural::normalize(normal[rings - 1] - tangent[0] * procedural::dot(normal[rings - 1], tangent[0]));
-    const double twist = std::atan2(procedural::dot(procedural::cross(end, normal[0]), tangent[0]), procedural::dot(end, normal[0]));
+    const Vec3 end =
+        procedural::normalize(normal[rings - 1] - tangent[0] * procedural::dot(normal[rings - 1], tangent[0]));
+    const double twist =
+        std::atan2(procedural::dot(procedural::cross(end, normal[0]), tangent[0]), procedural::dot(end, normal[0]));
 
     const double tube = 0.4;
     std::vector<double> positions;

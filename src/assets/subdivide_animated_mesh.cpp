@@ -43,9 +43,8 @@ AnimatedMesh subdivide_animated_mesh(const AnimatedMesh& mesh, unsigned levels) 
     const size_t keyframes = mesh.keyframe_count();
     out.keyframe_positions.resize(keyframes * out.vertex_count * 3);
     // Each keyframe is written by one task only: the same bytes whatever the thread count.
-    tbb::parallel_for(size_t(0), keyframes, [&](size_t k) {
-        apply_subdivision(out.keyframe(k), op, mesh.keyframe(k), 3 * sizeof(float));
-    });
+    tbb::parallel_for(size_t(0), keyframes,
+                      [&](size_t k) { apply_subdivision(out.keyframe(k), op, mesh.keyframe(k), 3 * sizeof(float)); });
     return out;
 }
 

@@ -33,18 +33,18 @@
 #include "isolated_import.h"
 
 #include <assimp/GltfMaterial.h>
-#include <assimp/Importer.hpp>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+#include <assimp/Importer.hpp>
 
 #include <algorithm>
 #include <cctype>
-#include <cstdio>
-#include <memory>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <map>
+#include <memory>
 
 namespace animorder {
 namespace {
@@ -102,8 +102,9 @@ void flatten(const aiNode* root, Flat& flat) {
 const aiScene* import(Assimp::Importer& importer, const std::string& path) {
     if (!std::filesystem::exists(path)) throw LoadError(path + ": cannot open file");
     importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-    const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_SortByPType |
-                                                       aiProcess_JoinIdenticalVertices | aiProcess_ValidateDataStructure);
+    const aiScene* scene =
+        importer.ReadFile(path, aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_JoinIdenticalVertices |
+                                    aiProcess_ValidateDataStructure);
     if (!scene || !scene->mRootNode) {
         std::string why = importer.GetErrorString();
         std::replace(why.begin(), why.end(), '\n', ' ');
@@ -148,7 +149,8 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
             prim.vertex_count = m->mNumVertices;
             for (unsigned f = 0; f < m->mNumFaces; ++f) {
                 if (m->mFaces[f].mNumIndices != 3) continue;  // leftovers of mixed meshes
-                for (int c = 0; c < 3; ++c) mesh.indices.push_back(uint32_t(mesh.vertex_count + m->mFaces[f].mIndices[c]));
+                for (int c = 0; c < 3; ++c)
+                    mesh.indices.push_back(uint32_t(mesh.vertex_count + m->mFaces[f].mIndices[c]));
             }
             prim.index_count = mesh.indices.size() - prim.first_index;
             // Material flags: AI_MATKEY_TWOSIDED != 0 is double-sided; glTF's alphaMode when
@@ -161,7 +163,9 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
                 float opacity = 1.0f;
                 if (material->Get(AI_MATKEY_GLTF_ALPHAMODE, alpha_mode) == AI_SUCCESS) {
                     const std::string mode = alpha_mode.C_Str();
-                    prim.alpha_mode = mode == "BLEND" ? AlphaMode::Blend : mode == "MASK" ? AlphaMode::Mask : AlphaMode::Opaque;
+                    prim.alpha_mode = mode == "BLEND"  ? AlphaMode::Blend
+                                      : mode == "MASK" ? AlphaMode::Mask
+                                                       : AlphaMode::Opaque;
                 } else if (material->Get(AI_MATKEY_OPACITY, opacity) == AI_SUCCESS && opacity < 1.0f) {
                     prim.alpha_mode = AlphaMode::Blend;
                 }
@@ -178,7 +182,8 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
                     part.offset.push_back(bone->mOffsetMatrix);
                     for (unsigned w = 0; w < bone->mNumWeights; ++w) {
                         const aiVertexWeight& vw = bone->mWeights[w];
-                        if (vw.mVertexId >= m->mNumVertices) throw LoadError(path + ": a bone weight names a missing vertex");
+                        if (vw.mVertexId >= m->mNumVertices)
+                            throw LoadError(path + ": a bone weight names a missing vertex");
                         // Keep the strongest kInfluences weights of the vertex.
                         float* ws = &part.weights[size_t(vw.mVertexId) * kInfluences];
                         uint16_t* js = &part.joints[size_t(vw.mVertexId) * kInfluences];
@@ -198,7 +203,7 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
     struct ClipSource {
         const aiAnimation* animation;
         std::string name;
-        std::string file;  // the clip file, or "" for the character's own animations
+        std::string file;                // the clip file, or "" for the character's own animations
         const aiScene* scene = nullptr;  // the clip file's
     };
     std::vector<std::unique_ptr<Assimp::Importer>> clip_importers;
@@ -217,11 +222,15 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
         for (unsigned a = 0; a < clip_scene->mNumAnimations; ++a) {
             const aiAnimation* anim = clip_scene->mAnimations[a];
             size_t matched = 0;
-            for (unsigned c = 0; c < anim->mNumChannels; ++c) matched += flat.by_name.count(anim->mChannels[c]->mNodeName.C_Str());
+            for (unsigned c = 0; c < anim->mNumChannels; ++c)
+                matched += flat.by_name.count(anim->mChannels[c]->mNodeName.C_Str());
             if (matched == 0)
-                throw LoadError(file + ": none of its " + std::to_string(anim->mNumChannels) + " animated joints is a joint of " + path);
-            sources.push_back({anim, std::filesystem::path(file).stem().string() +
-                                         (clip_scene->mNumAnimations > 1 ? "/" + std::to_string(a) : ""), file, clip_scene});
+                throw LoadError(file + ": none of its " + std::to_string(anim->mNumChannels) +
+                                " animated joints is a joint of " + path);
+            sources.push_back({anim,
+                               std::filesystem::path(file).stem().string() +
+                                   (clip_scene->mNumAnimations > 1 ? "/" + std::to_string(a) : ""),
+                               file, clip_scene});
         }
     }
 
@@ -232,7 +241,8 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
         if (anim)
             for (unsigned c = 0; c < anim->mNumChannels; ++c) {
                 const auto found = flat.by_name.find(anim->mChannels[c]->mNodeName.C_Str());
-                if (found != flat.by_name.end()) local[found->second] = interpolate(anim->mChannels[c], tick, local[found->second]);
+                if (found != flat.by_name.end())
+                    local[found->second] = interpolate(anim->mChannels[c], tick, local[found->second]);
             }
         for (size_t n = 0; n < flat.nodes.size(); ++n)
             global[n] = flat.parent[n] >= 0 ? global[size_t(flat.parent[n])] * local[n] : local[n];
@@ -247,12 +257,16 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
             const aiMesh* m = part.mesh;
             std::vector<float> bind(size_t(m->mNumVertices) * 3);
             for (unsigned v = 0; v < m->mNumVertices; ++v)
-                bind[3 * v] = m->mVertices[v].x, bind[3 * v + 1] = m->mVertices[v].y, bind[3 * v + 2] = m->mVertices[v].z;
+                bind[3 * v] = m->mVertices[v].x, bind[3 * v + 1] = m->mVertices[v].y,
+                         bind[3 * v + 2] = m->mVertices[v].z;
             if (!part.bone_node.empty()) {
                 std::vector<Mat4> joints(part.bone_node.size());
                 for (size_t b = 0; b < joints.size(); ++b) {
                     const aiMatrix4x4 j = global[part.bone_node[b]] * part.offset[b];
-                    const float rows[4][4] = {{j.a1, j.a2, j.a3, j.a4}, {j.b1, j.b2, j.b3, j.b4}, {j.c1, j.c2, j.c3, j.c4}, {j.d1, j.d2, j.d3, j.d4}};
+                    const float rows[4][4] = {{j.a1, j.a2, j.a3, j.a4},
+                                              {j.b1, j.b2, j.b3, j.b4},
+                                              {j.c1, j.c2, j.c3, j.c4},
+                                              {j.d1, j.d2, j.d3, j.d4}};
                     for (int c = 0; c < 4; ++c)
                         for (int r = 0; r < 4; ++r) joints[b][size_t(c * 4 + r)] = rows[r][c];  // to column-major
                 }
@@ -293,7 +307,8 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
         std::vector<aiMatrix4x4> rest(flat.nodes.size());
         aiVector3D low(INFINITY, INFINITY, INFINITY), high(-INFINITY, -INFINITY, -INFINITY);
         for (size_t n = 0; n < flat.nodes.size(); ++n) {
-            rest[n] = flat.parent[n] >= 0 ? rest[size_t(flat.parent[n])] * flat.nodes[n]->mTransformation : flat.nodes[n]->mTransformation;
+            rest[n] = flat.parent[n] >= 0 ? rest[size_t(flat.parent[n])] * flat.nodes[n]->mTransformation
+                                          : flat.nodes[n]->mTransformation;
             if (!is_bone[n]) continue;
             const aiVector3D p(rest[n].a4, rest[n].b4, rest[n].c4);
             low = aiVector3D(std::min(low.x, p.x), std::min(low.y, p.y), std::min(low.z, p.z));
@@ -315,20 +330,23 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
             if (found == flat.by_name.end() || !below_bone[found->second]) continue;
             const aiMatrix4x4& mine = flat.nodes[found->second]->mTransformation;
             const aiMatrix4x4& theirs = node->mTransformation;
-            const double d = double((aiVector3D(theirs.a4, theirs.b4, theirs.c4) - aiVector3D(mine.a4, mine.b4, mine.c4)).Length());
+            const double d =
+                double((aiVector3D(theirs.a4, theirs.b4, theirs.c4) - aiVector3D(mine.a4, mine.b4, mine.c4)).Length());
             if (!(d <= worst)) worst = d, worst_node = node, worst_char = found->second;
         }
         if (worst_node && !(worst <= kMaxBoneChange * size)) {
             const aiMatrix4x4& mine = flat.nodes[worst_char]->mTransformation;
             const aiMatrix4x4& theirs = worst_node->mTransformation;
             char numbers[200];
-            std::snprintf(numbers, sizeof numbers,
-                          "(%.4g, %.4g, %.4g) in the clip and (%.4g, %.4g, %.4g) in the character: %.1f%% of its size %.4g",
-                          theirs.a4, theirs.b4, theirs.c4, mine.a4, mine.b4, mine.c4, 100 * worst / size, size);
+            std::snprintf(
+                numbers, sizeof numbers,
+                "(%.4g, %.4g, %.4g) in the clip and (%.4g, %.4g, %.4g) in the character: %.1f%% of its size %.4g",
+                theirs.a4, theirs.b4, theirs.c4, mine.a4, mine.b4, mine.c4, 100 * worst / size, size);
             std::string joint = worst_node->mName.C_Str();
             joint = joint.substr(0, joint.find("_$AssimpFbx$"));  // assimp's pivot helper nodes
-            throw LoadError(source.file + ": made for another skeleton than " + path + "'s: joint '" + joint + "' is at " + numbers + " (at most " +
-                            std::to_string(int(kMaxBoneChange * 100)) + "% is accepted)");
+            throw LoadError(source.file + ": made for another skeleton than " + path + "'s: joint '" + joint +
+                            "' is at " + numbers + " (at most " + std::to_string(int(kMaxBoneChange * 100)) +
+                            "% is accepted)");
         }
     };
 
@@ -347,8 +365,10 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
         double first = INFINITY, last = -INFINITY;
         for (unsigned c = 0; c < anim->mNumChannels; ++c) {
             const aiNodeAnim* ch = anim->mChannels[c];
-            for (unsigned k = 0; k < ch->mNumPositionKeys; ++k) first = std::min(first, ch->mPositionKeys[k].mTime), last = std::max(last, ch->mPositionKeys[k].mTime);
-            for (unsigned k = 0; k < ch->mNumRotationKeys; ++k) first = std::min(first, ch->mRotationKeys[k].mTime), last = std::max(last, ch->mRotationKeys[k].mTime);
+            for (unsigned k = 0; k < ch->mNumPositionKeys; ++k)
+                first = std::min(first, ch->mPositionKeys[k].mTime), last = std::max(last, ch->mPositionKeys[k].mTime);
+            for (unsigned k = 0; k < ch->mNumRotationKeys; ++k)
+                first = std::min(first, ch->mRotationKeys[k].mTime), last = std::max(last, ch->mRotationKeys[k].mTime);
         }
         if (!(first <= last)) throw LoadError(path + ": clip '" + source.name + "' animates nothing");
         const double keyframes = std::round((last - first) / ticks_per_second * options.sample_rate) + 1;
@@ -388,8 +408,10 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
 
 }  // namespace
 
-AnimatedMesh load_assimp(const std::string& path, const std::vector<std::string>& clip_files, const LoadOptions& options) {
-    if (!(options.sample_rate > 0 && options.sample_rate <= 1000)) throw LoadError(path + ": sample rate must be in (0, 1000]");
+AnimatedMesh load_assimp(const std::string& path, const std::vector<std::string>& clip_files,
+                         const LoadOptions& options) {
+    if (!(options.sample_rate > 0 && options.sample_rate <= 1000))
+        throw LoadError(path + ": sample rate must be in (0, 1000]");
     if (!std::filesystem::exists(path)) throw LoadError(path + ": cannot open file");
     std::vector<std::string> files{path};
     files.insert(files.end(), clip_files.begin(), clip_files.end());

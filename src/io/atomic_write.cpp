@@ -2,11 +2,11 @@
 // disk, renamed into place only when every file of the run is written.
 #include "animorder/atomic_write.h"
 
+#include <unistd.h>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <unistd.h>
 
 namespace animorder {
 namespace {
@@ -50,7 +50,8 @@ void check_output_paths(const std::vector<std::string>& outputs, const std::vect
         check_writable_target(outputs[i]);
         for (const std::string& input : inputs)
             if (!input.empty() && same_file(outputs[i], input))
-                throw OutputError(outputs[i] + ": is an input of this run: refusing to overwrite the input; name another output");
+                throw OutputError(outputs[i] +
+                                  ": is an input of this run: refusing to overwrite the input; name another output");
         for (size_t j = 0; j < i; ++j)
             if (same_file(outputs[i], outputs[j]))
                 throw OutputError(outputs[i] + ": named twice as an output (" + outputs[j] + ")");

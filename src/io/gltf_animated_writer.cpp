@@ -26,7 +26,8 @@ namespace {
 
 // A float accessor of count elements of `width` components; min and max per component when
 // `bounds` (glTF requires them for POSITION and animation inputs).
-int add_floats(tinygltf::Model& model, const std::vector<float>& values, int type, size_t width, int target, bool bounds) {
+int add_floats(tinygltf::Model& model, const std::vector<float>& values, int type, size_t width, int target,
+               bool bounds) {
     tinygltf::Accessor a;
     a.bufferView = io::append_buffer_view(model, values.data(), values.size() * sizeof(float), target);
     a.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
@@ -75,7 +76,8 @@ std::string gltf_animated_mesh(const AnimatedMesh& mesh, bool binary) {
         std::vector<uint32_t> ib(p.index_count);
         for (size_t i = 0; i < p.index_count; ++i) ib[i] = local[mesh.indices[p.first_index + i]];
         tinygltf::Accessor indices;
-        indices.bufferView = io::append_buffer_view(model, ib.data(), ib.size() * 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+        indices.bufferView =
+            io::append_buffer_view(model, ib.data(), ib.size() * 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
         indices.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
         indices.type = TINYGLTF_TYPE_SCALAR;
         indices.count = ib.size();

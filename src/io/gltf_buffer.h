@@ -37,8 +37,8 @@ inline int append_buffer_view(tinygltf::Model& model, const void* data, size_t b
 inline tinygltf::Model read_model(const std::string& path) {
     tinygltf::Model model;
     tinygltf::TinyGLTF loader;
-    loader.SetImageLoader([](tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int,
-                             void*) { return true; },
+    loader.SetImageLoader([](tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*,
+                             int, void*) { return true; },
                           nullptr);
     std::string error, warning;
     std::string magic(4, '\0');
@@ -47,7 +47,7 @@ inline tinygltf::Model read_model(const std::string& path) {
         std::fclose(f);
     }
     const bool ok = magic == "glTF" ? loader.LoadBinaryFromFile(&model, &error, &warning, path)
-                                     : loader.LoadASCIIFromFile(&model, &error, &warning, path);
+                                    : loader.LoadASCIIFromFile(&model, &error, &warning, path);
     if (!ok) {
         for (char& c : error)
             if (c == '\n' || c == '\r') c = ' ';
@@ -70,12 +70,12 @@ inline std::string write_model(tinygltf::Model& model, const std::string& input_
             fs::path(image.uri).is_relative() && from != to)
             image.uri = fs::relative(from / image.uri, to).generic_string();
     tinygltf::TinyGLTF writer;
-    writer.SetImageWriter([](const std::string*, const std::string*, const tinygltf::Image* image, bool, std::string* uri,
-                             void*) {
-        *uri = image->uri;  // never decoded, never rewritten: external images keep their URIs
-        return true;
-    },
-                          nullptr);
+    writer.SetImageWriter(
+        [](const std::string*, const std::string*, const tinygltf::Image* image, bool, std::string* uri, void*) {
+            *uri = image->uri;  // never decoded, never rewritten: external images keep their URIs
+            return true;
+        },
+        nullptr);
     std::ostringstream out;
     if (!writer.WriteGltfSceneToStream(&model, out, !binary, binary))
         throw LoadError(input_path + ": writing the glTF output failed");

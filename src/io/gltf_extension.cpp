@@ -32,9 +32,11 @@ struct Problems {
 std::string accessor_bytes(const tinygltf::Model& model, int index, int type, const std::vector<int>& components,
                            const std::string& what, std::vector<unsigned char>& out, int& component_type) {
     const std::string name = what + " (accessor " + std::to_string(index) + ")";
-    if (index < 0 || size_t(index) >= model.accessors.size()) return what + ": accessor " + std::to_string(index) + " does not exist";
+    if (index < 0 || size_t(index) >= model.accessors.size())
+        return what + ": accessor " + std::to_string(index) + " does not exist";
     const tinygltf::Accessor& a = model.accessors[size_t(index)];
-    if (a.type != type) return name + " has the wrong type (expected " + (type == TINYGLTF_TYPE_VEC3 ? "VEC3" : "SCALAR") + ")";
+    if (a.type != type)
+        return name + " has the wrong type (expected " + (type == TINYGLTF_TYPE_VEC3 ? "VEC3" : "SCALAR") + ")";
     if (std::find(components.begin(), components.end(), a.componentType) == components.end())
         return name + " has component type " + std::to_string(a.componentType) + ", not one the extension allows";
     if (a.normalized) return name + " is normalized";
@@ -67,10 +69,11 @@ std::string accessor_bytes(const tinygltf::Model& model, int index, int type, co
 std::string read_indices(const tinygltf::Model& model, int index, const std::string& what, std::vector<uint32_t>& out,
                          int& component_type) {
     std::vector<unsigned char> bytes;
-    const std::string error = accessor_bytes(model, index, TINYGLTF_TYPE_SCALAR,
-                                             {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
-                                              TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT},
-                                             what, bytes, component_type);
+    const std::string error =
+        accessor_bytes(model, index, TINYGLTF_TYPE_SCALAR,
+                       {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
+                        TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT},
+                       what, bytes, component_type);
     if (!error.empty()) return error;
     const size_t size = size_t(tinygltf::GetComponentSizeInBytes(uint32_t(component_type)));
     out.resize(bytes.size() / size);
@@ -134,7 +137,8 @@ void read_clip(const tinygltf::Model& model, const tinygltf::Value& value, size_
         if (!bounded(o, "animation", 0, int64_t(model.animations.size()) - 1, where, p, v)) return;
         clip.animation = int(v);
     }
-    if (o.count("startTime") && !number(o, "startTime", clip.start_time)) return p.add(where + ".startTime is not a finite number");
+    if (o.count("startTime") && !number(o, "startTime", clip.start_time))
+        return p.add(where + ".startTime is not a finite number");
     if (!number(o, "sampleRate", clip.sample_rate) || !(clip.sample_rate > 0))
         return p.add(where + ".sampleRate is missing or not a positive number");
     bool ok = bounded(o, "keyframes", 1, 100000, where, p, v);
@@ -157,8 +161,8 @@ void read_clip(const tinygltf::Model& model, const tinygltf::Value& value, size_
     if (!error.empty()) return p.add(error);
     const uint64_t cells = uint64_t(clip.keyframes) * clip.theta_steps * clip.phi_steps;
     if (bytes.size() != cells)
-        return p.add(where + ".table has " + std::to_string(bytes.size()) + " cells; keyframes x thetaSteps x phiSteps = " +
-                     std::to_string(cells));
+        return p.add(where + ".table has " + std::to_string(bytes.size()) +
+                     " cells; keyframes x thetaSteps x phiSteps = " + std::to_string(cells));
     clip.cells.assign(bytes.begin(), bytes.end());
     for (size_t i = 0; i < clip.cells.size(); ++i)
         if (uint64_t(clip.buffer_base) + clip.cells[i] >= buffer_count)
@@ -169,8 +173,8 @@ void read_clip(const tinygltf::Model& model, const tinygltf::Value& value, size_
                            where + ".centers", bytes, component);
     if (!error.empty()) return p.add(error);
     if (bytes.size() != size_t(clip.keyframes) * 12)
-        return p.add(where + ".centers has " + std::to_string(bytes.size() / 12) + " elements, not keyframes = " +
-                     std::to_string(clip.keyframes));
+        return p.add(where + ".centers has " + std::to_string(bytes.size() / 12) +
+                     " elements, not keyframes = " + std::to_string(clip.keyframes));
     clip.centers.resize(bytes.size() / 4);
     std::memcpy(clip.centers.data(), bytes.data(), bytes.size());
     for (float f : clip.centers)
@@ -199,8 +203,8 @@ void read_clip(const tinygltf::Model& model, const tinygltf::Value& value, size_
     clips.push_back(std::move(clip));
 }
 
-void read_primitive(const tinygltf::Model& model, size_t m, size_t pi, const Object& o, const OrdersExtensionCheck& root,
-                    Problems& p, std::vector<ExtensionPrimitive>& out) {
+void read_primitive(const tinygltf::Model& model, size_t m, size_t pi, const Object& o,
+                    const OrdersExtensionCheck& root, Problems& p, std::vector<ExtensionPrimitive>& out) {
     const std::string where = "meshes[" + std::to_string(m) + "].primitives[" + std::to_string(pi) + "]";
     const tinygltf::Primitive& prim = model.meshes[m].primitives[pi];
     ExtensionPrimitive e;
@@ -224,12 +228,15 @@ void read_primitive(const tinygltf::Model& model, size_t m, size_t pi, const Obj
     const size_t n = e.indices.size();
     if (n % 3 != 0) return p.add(where + ".indices holds " + std::to_string(n) + " indices, not whole triangles");
     if (e.orders.size() != n * e.order_count)
-        return p.add(where + ".orders has " + std::to_string(e.orders.size()) + " elements; orderCount x indices = " +
-                     std::to_string(n * e.order_count));
-    e.indices_equal_fallback = std::equal(e.indices.begin(), e.indices.end(), e.orders.begin() + ptrdiff_t(root.fallback * n));
-    if (!e.indices_equal_fallback) p.add(where + ".indices differs from order " + std::to_string(root.fallback) + " (fallback)");
+        return p.add(where + ".orders has " + std::to_string(e.orders.size()) +
+                     " elements; orderCount x indices = " + std::to_string(n * e.order_count));
+    e.indices_equal_fallback =
+        std::equal(e.indices.begin(), e.indices.end(), e.orders.begin() + ptrdiff_t(root.fallback * n));
+    if (!e.indices_equal_fallback)
+        p.add(where + ".indices differs from order " + std::to_string(root.fallback) + " (fallback)");
     for (uint32_t b = 0; b < e.order_count; ++b) {
-        const bool permutation = !triangle_permutation(e.indices.data(), e.orders.data() + b * n, n / 3).empty() || n == 0;
+        const bool permutation =
+            !triangle_permutation(e.indices.data(), e.orders.data() + b * n, n / 3).empty() || n == 0;
         e.order_is_permutation.push_back(permutation);
         if (!permutation)
             p.add(where + " order " + std::to_string(b) +
@@ -250,7 +257,8 @@ OrdersExtensionCheck check_orders_extension(const std::string& path) {
         return r;
     }
     r.present = true;
-    if (std::find(model.extensionsUsed.begin(), model.extensionsUsed.end(), kOrdersExtensionName) == model.extensionsUsed.end())
+    if (std::find(model.extensionsUsed.begin(), model.extensionsUsed.end(), kOrdersExtensionName) ==
+        model.extensionsUsed.end())
         p.add(std::string(kOrdersExtensionName) + " is not listed in extensionsUsed");
     if (std::find(model.extensionsRequired.begin(), model.extensionsRequired.end(), kOrdersExtensionName) !=
         model.extensionsRequired.end())
@@ -270,13 +278,15 @@ OrdersExtensionCheck check_orders_extension(const std::string& path) {
     if (clips == o.end() || !clips->second.IsArray() || clips->second.ArrayLen() == 0)
         p.add("root.clips is missing or empty");
     else
-        for (size_t c = 0; c < clips->second.ArrayLen(); ++c) read_clip(model, clips->second.Get(int(c)), c, r.buffer_count, p, r.clips);
+        for (size_t c = 0; c < clips->second.ArrayLen(); ++c)
+            read_clip(model, clips->second.Get(int(c)), c, r.buffer_count, p, r.clips);
     for (size_t m = 0; m < model.meshes.size(); ++m)
         for (size_t pi = 0; pi < model.meshes[m].primitives.size(); ++pi) {
             const auto e = model.meshes[m].primitives[pi].extensions.find(kOrdersExtensionName);
             if (e == model.meshes[m].primitives[pi].extensions.end()) continue;
             if (!e->second.IsObject()) {
-                p.add("meshes[" + std::to_string(m) + "].primitives[" + std::to_string(pi) + "] extension is not an object");
+                p.add("meshes[" + std::to_string(m) + "].primitives[" + std::to_string(pi) +
+                      "] extension is not an object");
                 continue;
             }
             read_primitive(model, m, pi, e->second.Get<Object>(), r, p, r.primitives);
@@ -312,8 +322,9 @@ int append_indices(tinygltf::Model& model, const std::vector<uint32_t>& local, b
     } else {
         view = io::append_buffer_view(model, local.data(), local.size() * 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
     }
-    const int a = append_accessor(model, view, shorts ? TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT : TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
-                                  TINYGLTF_TYPE_SCALAR, local.size(), name);
+    const int a = append_accessor(
+        model, view, shorts ? TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT : TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
+        TINYGLTF_TYPE_SCALAR, local.size(), name);
     if (!local.empty()) {
         model.accessors[size_t(a)].minValues = {double(*std::min_element(local.begin(), local.end()))};
         model.accessors[size_t(a)].maxValues = {double(*std::max_element(local.begin(), local.end()))};
@@ -327,13 +338,15 @@ std::string gltf_with_extension_orders(const std::string& input_path, const std:
                                        const OrdersExtensionCheck& root, const std::vector<PrimitiveOrders>& primitives,
                                        bool binary) {
     tinygltf::Model model = io::read_model(input_path);
-    if (root.buffer_count == 0 || root.fallback >= root.buffer_count) throw LoadError(input_path + ": no fallback order");
+    if (root.buffer_count == 0 || root.fallback >= root.buffer_count)
+        throw LoadError(input_path + ": no fallback order");
     for (tinygltf::Mesh& mesh : model.meshes)
         for (tinygltf::Primitive& prim : mesh.primitives) prim.extensions.erase(kOrdersExtensionName);
     for (const PrimitiveOrders& po : primitives) {
         if (po.mesh < 0 || size_t(po.mesh) >= model.meshes.size() || po.primitive < 0 ||
             size_t(po.primitive) >= model.meshes[size_t(po.mesh)].primitives.size())
-            throw LoadError(input_path + ": no primitive " + std::to_string(po.mesh) + "/" + std::to_string(po.primitive));
+            throw LoadError(input_path + ": no primitive " + std::to_string(po.mesh) + "/" +
+                            std::to_string(po.primitive));
         if (po.orders.size() % (3 * size_t(root.buffer_count)) != 0)
             throw LoadError(input_path + ": orders of primitive " + std::to_string(po.mesh) + "/" +
                             std::to_string(po.primitive) + " are not whole triangles");
@@ -355,12 +368,13 @@ std::string gltf_with_extension_orders(const std::string& input_path, const std:
         const int cells = append_accessor(model, io::append_buffer_view(model, c.cells.data(), c.cells.size(), 0),
                                           TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_TYPE_SCALAR, c.cells.size(),
                                           "animorder table " + c.name);
-        const int centers = append_accessor(model, io::append_buffer_view(model, c.centers.data(), c.centers.size() * 4, 0),
-                                            TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, c.centers.size() / 3,
-                                            "animorder centres " + c.name);
+        const int centers = append_accessor(
+            model, io::append_buffer_view(model, c.centers.data(), c.centers.size() * 4, 0),
+            TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, c.centers.size() / 3, "animorder centres " + c.name);
         Object clip;
         clip["name"] = tinygltf::Value(c.name);
-        if (c.animation >= 0 && size_t(c.animation) < model.animations.size()) clip["animation"] = tinygltf::Value(c.animation);
+        if (c.animation >= 0 && size_t(c.animation) < model.animations.size())
+            clip["animation"] = tinygltf::Value(c.animation);
         clip["startTime"] = tinygltf::Value(c.start_time);
         clip["sampleRate"] = tinygltf::Value(c.sample_rate);
         clip["keyframes"] = tinygltf::Value(int(c.keyframes));
@@ -377,7 +391,8 @@ std::string gltf_with_extension_orders(const std::string& input_path, const std:
     r["fallback"] = tinygltf::Value(int(root.fallback));
     r["clips"] = tinygltf::Value(clips);
     model.extensions[kOrdersExtensionName] = tinygltf::Value(r);
-    if (std::find(model.extensionsUsed.begin(), model.extensionsUsed.end(), kOrdersExtensionName) == model.extensionsUsed.end())
+    if (std::find(model.extensionsUsed.begin(), model.extensionsUsed.end(), kOrdersExtensionName) ==
+        model.extensionsUsed.end())
         model.extensionsUsed.push_back(kOrdersExtensionName);
     model.extensionsRequired.erase(
         std::remove(model.extensionsRequired.begin(), model.extensionsRequired.end(), kOrdersExtensionName),

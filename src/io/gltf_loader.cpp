@@ -30,10 +30,10 @@
 namespace animorder {
 namespace {
 
-using io::Mat;
-using io::Quat;
 using io::identity;
+using io::Mat;
 using io::mul;
+using io::Quat;
 using io::trs;
 
 // A number from a file for an error message: an integer when it is one, without converting a
@@ -57,14 +57,16 @@ public:
     // or [−1, 1] as the spec says), sparse substitution applied, every byte range checked before
     // anything is allocated or read.
     std::vector<double> read(int index, int expected_components = 0) const {
-        if (index < 0 || size_t(index) >= model_.accessors.size()) fail("accessor " + std::to_string(index) + " does not exist");
+        if (index < 0 || size_t(index) >= model_.accessors.size())
+            fail("accessor " + std::to_string(index) + " does not exist");
         const tinygltf::Accessor& a = model_.accessors[size_t(index)];
         const std::string name = "accessor " + std::to_string(index);
         const int components = tinygltf::GetNumComponentsInType(uint32_t(a.type));
         const int size = tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType));
         if (components <= 0 || size <= 0) fail(name + " has an unknown type");
         if (expected_components && components != expected_components)
-            fail(name + " has " + std::to_string(components) + " components, expected " + std::to_string(expected_components));
+            fail(name + " has " + std::to_string(components) + " components, expected " +
+                 std::to_string(expected_components));
         const size_t element = size_t(components) * size_t(size);
         // The count is the file's: checked against the buffer view (and the budget) first.
         size_t stride = element;
@@ -82,27 +84,32 @@ public:
         if (base)
             for (size_t i = 0; i < a.count; ++i)
                 for (int c = 0; c < components; ++c)
-                    out[i * size_t(components) + size_t(c)] = convert(base + i * stride + size_t(c * size), a.componentType, a.normalized);
+                    out[i * size_t(components) + size_t(c)] =
+                        convert(base + i * stride + size_t(c * size), a.componentType, a.normalized);
         if (a.sparse.isSparse) {
             if (a.sparse.count < 0 || size_t(a.sparse.count) > a.count)
-                fail("sparse " + name + " substitutes " + std::to_string(a.sparse.count) + " of " + std::to_string(a.count) + " elements");
+                fail("sparse " + name + " substitutes " + std::to_string(a.sparse.count) + " of " +
+                     std::to_string(a.count) + " elements");
             const int index_type = a.sparse.indices.componentType;
-            if (index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE && index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+            if (index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+                index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
                 index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
                 fail("sparse " + name + " has indices that are not unsigned integers");
             const size_t n = size_t(a.sparse.count);
             const size_t index_size = size_t(tinygltf::GetComponentSizeInBytes(uint32_t(index_type)));
             size_t unused = 0;
-            const unsigned char* idx = view_bytes(a.sparse.indices.bufferView, offset_of(a.sparse.indices.byteOffset, index), n,
-                                                  index_size, false, index, unused);
-            const unsigned char* val = view_bytes(a.sparse.values.bufferView, offset_of(a.sparse.values.byteOffset, index), n,
-                                                  element, false, index, unused);
+            const unsigned char* idx =
+                view_bytes(a.sparse.indices.bufferView, offset_of(a.sparse.indices.byteOffset, index), n, index_size,
+                           false, index, unused);
+            const unsigned char* val =
+                view_bytes(a.sparse.values.bufferView, offset_of(a.sparse.values.byteOffset, index), n, element, false,
+                           index, unused);
             for (size_t i = 0; i < n; ++i) {
                 const size_t target = size_t(convert(idx + i * index_size, index_type, false));
                 if (target >= a.count) fail("sparse " + name + " names element " + std::to_string(target));
                 for (int c = 0; c < components; ++c)
-                    out[target * size_t(components) + size_t(c)] =
-                        convert(val + (i * size_t(components) + size_t(c)) * size_t(size), a.componentType, a.normalized);
+                    out[target * size_t(components) + size_t(c)] = convert(
+                        val + (i * size_t(components) + size_t(c)) * size_t(size), a.componentType, a.normalized);
             }
         }
         for (double v : out)
@@ -135,18 +142,38 @@ private:
         if (count > 0 && (!io::checked_mul(stride, count - 1, last) || !io::checked_add(end, last, end) ||
                           !io::checked_add(end, element, end)))
             end = SIZE_MAX;
-        if (end > view.byteLength) fail("accessor " + std::to_string(accessor) + " runs past the end of its buffer view");
+        if (end > view.byteLength)
+            fail("accessor " + std::to_string(accessor) + " runs past the end of its buffer view");
         return data.data() + view.byteOffset + offset;
     }
 
     static double convert(const unsigned char* p, int type, bool normalized) {
         switch (type) {
-            case TINYGLTF_COMPONENT_TYPE_FLOAT: { float f; std::memcpy(&f, p, 4); return f; }
+            case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+                float f;
+                std::memcpy(&f, p, 4);
+                return f;
+            }
             case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return normalized ? p[0] / 255.0 : p[0];
-            case TINYGLTF_COMPONENT_TYPE_BYTE: { const int8_t v = int8_t(p[0]); return normalized ? std::max(v / 127.0, -1.0) : v; }
-            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: { uint16_t v; std::memcpy(&v, p, 2); return normalized ? v / 65535.0 : v; }
-            case TINYGLTF_COMPONENT_TYPE_SHORT: { int16_t v; std::memcpy(&v, p, 2); return normalized ? std::max(v / 32767.0, -1.0) : v; }
-            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: { uint32_t v; std::memcpy(&v, p, 4); return v; }
+            case TINYGLTF_COMPONENT_TYPE_BYTE: {
+                const int8_t v = int8_t(p[0]);
+                return normalized ? std::max(v / 127.0, -1.0) : v;
+            }
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+                uint16_t v;
+                std::memcpy(&v, p, 2);
+                return normalized ? v / 65535.0 : v;
+            }
+            case TINYGLTF_COMPONENT_TYPE_SHORT: {
+                int16_t v;
+                std::memcpy(&v, p, 2);
+                return normalized ? std::max(v / 32767.0, -1.0) : v;
+            }
+            case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+                uint32_t v;
+                std::memcpy(&v, p, 4);
+                return v;
+            }
             default: return NAN;
         }
     }
@@ -160,7 +187,7 @@ private:
 struct PrimitiveData {
     size_t node = 0;
     size_t vertex_base = 0, vertex_count = 0;
-    std::vector<double> positions;            // V × 3
+    std::vector<double> positions;             // V × 3
     std::vector<std::vector<double>> targets;  // per morph target: V × 3 deltas
     std::vector<uint16_t> joints;              // V × influences
     std::vector<float> weights;                // V × influences
@@ -191,8 +218,10 @@ std::vector<uint32_t> triangle_list(const std::vector<double>& raw, int mode, si
     }
     if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {  // every other triangle flipped to keep the winding
         for (size_t i = 2; i < idx.size(); ++i)
-            if (i % 2 == 0) out.insert(out.end(), {idx[i - 2], idx[i - 1], idx[i]});
-            else out.insert(out.end(), {idx[i - 1], idx[i - 2], idx[i]});
+            if (i % 2 == 0)
+                out.insert(out.end(), {idx[i - 2], idx[i - 1], idx[i]});
+            else
+                out.insert(out.end(), {idx[i - 1], idx[i - 2], idx[i]});
         return out;
     }
     if (mode == TINYGLTF_MODE_TRIANGLE_FAN) {
@@ -297,8 +326,8 @@ size_t channel_components(const Scene& s, size_t node, const std::string& path) 
 tinygltf::Model parse_file(const std::string& path) {
     tinygltf::Model model;
     tinygltf::TinyGLTF loader;
-    loader.SetImageLoader([](tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int,
-                             void*) { return true; },  // textures pass through untouched: never decoded
+    loader.SetImageLoader([](tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*,
+                             int, void*) { return true; },  // textures pass through untouched: never decoded
                           nullptr);
     std::string error, warning;
     std::string magic(4, '\0');
@@ -310,7 +339,7 @@ tinygltf::Model parse_file(const std::string& path) {
         throw LoadError(path + ": cannot open file");
     }
     const bool ok = magic == "glTF" ? loader.LoadBinaryFromFile(&model, &error, &warning, path)
-                                     : loader.LoadASCIIFromFile(&model, &error, &warning, path);
+                                    : loader.LoadASCIIFromFile(&model, &error, &warning, path);
     if (!ok) {
         std::replace(error.begin(), error.end(), '\n', ' ');
         throw LoadError(path + ": not a readable glTF 2.0 file: " + error);
@@ -325,12 +354,14 @@ void parse_node_hierarchy(Scene& s) {
     s.parent.assign(model.nodes.size(), -1);
     for (size_t n = 0; n < model.nodes.size(); ++n)
         for (int c : model.nodes[n].children) {
-            if (c < 0 || size_t(c) >= model.nodes.size() || s.parent[size_t(c)] >= 0) s.reader.fail("node hierarchy is not a tree");
+            if (c < 0 || size_t(c) >= model.nodes.size() || s.parent[size_t(c)] >= 0)
+                s.reader.fail("node hierarchy is not a tree");
             s.parent[size_t(c)] = int(n);
         }
     std::vector<int> roots;
     const int scene = model.defaultScene >= 0 ? model.defaultScene : 0;
-    if (size_t(scene) < model.scenes.size()) roots = model.scenes[size_t(scene)].nodes;
+    if (size_t(scene) < model.scenes.size())
+        roots = model.scenes[size_t(scene)].nodes;
     else
         for (size_t n = 0; n < model.nodes.size(); ++n)
             if (s.parent[n] < 0) roots.push_back(int(n));
@@ -339,7 +370,8 @@ void parse_node_hierarchy(Scene& s) {
     while (!stack.empty()) {
         const int n = stack.back();
         stack.pop_back();
-        if (n < 0 || size_t(n) >= model.nodes.size() || seen[size_t(n)]) s.reader.fail("scene names a bad or repeated node");
+        if (n < 0 || size_t(n) >= model.nodes.size() || seen[size_t(n)])
+            s.reader.fail("scene names a bad or repeated node");
         seen[size_t(n)] = 1;
         s.order.push_back(size_t(n));
         const auto& children = model.nodes[size_t(n)].children;
@@ -351,7 +383,8 @@ void parse_node_hierarchy(Scene& s) {
 void parse_morph_targets(const Scene& s, const tinygltf::Primitive& prim, const std::string& where, PrimitiveData& d) {
     for (const auto& target : prim.targets) {
         const auto t = target.find("POSITION");
-        d.targets.push_back(t == target.end() ? std::vector<double>(d.positions.size(), 0.0) : s.reader.read(t->second, 3));
+        d.targets.push_back(t == target.end() ? std::vector<double>(d.positions.size(), 0.0)
+                                              : s.reader.read(t->second, 3));
         if (d.targets.back().size() != d.positions.size()) s.reader.fail(where + ": a morph target has the wrong size");
     }
 }
@@ -408,8 +441,10 @@ PrimitiveData parse_primitive(const Scene& s, size_t n, size_t p, AnimatedMesh& 
     d.vertex_count = d.positions.size() / 3;
     d.vertex_base = mesh.vertex_count;
     std::vector<double> raw;
-    if (prim.indices >= 0) raw = s.reader.read(prim.indices, 1);
-    else for (size_t i = 0; i < d.vertex_count; ++i) raw.push_back(double(i));  // non-indexed
+    if (prim.indices >= 0)
+        raw = s.reader.read(prim.indices, 1);
+    else
+        for (size_t i = 0; i < d.vertex_count; ++i) raw.push_back(double(i));  // non-indexed
     const std::vector<uint32_t> local = triangle_list(raw, prim.mode, d.vertex_count, s.reader, where);
     Primitive out;
     out.name = m.name.empty() ? "primitive" + std::to_string(s.prims.size()) : m.name + "/" + std::to_string(p);
@@ -424,10 +459,14 @@ PrimitiveData parse_primitive(const Scene& s, size_t n, size_t p, AnimatedMesh& 
         if (size_t(prim.material) >= s.model.materials.size()) s.reader.fail(where + " names a missing material");
         const tinygltf::Material& material = s.model.materials[size_t(prim.material)];
         out.double_sided = material.doubleSided;
-        if (material.alphaMode == "BLEND") out.alpha_mode = AlphaMode::Blend;
-        else if (material.alphaMode == "MASK") out.alpha_mode = AlphaMode::Mask;
-        else if (material.alphaMode.empty() || material.alphaMode == "OPAQUE") out.alpha_mode = AlphaMode::Opaque;
-        else s.reader.fail(where + ": material alphaMode '" + material.alphaMode + "' is not OPAQUE, MASK or BLEND");
+        if (material.alphaMode == "BLEND")
+            out.alpha_mode = AlphaMode::Blend;
+        else if (material.alphaMode == "MASK")
+            out.alpha_mode = AlphaMode::Mask;
+        else if (material.alphaMode.empty() || material.alphaMode == "OPAQUE")
+            out.alpha_mode = AlphaMode::Opaque;
+        else
+            s.reader.fail(where + ": material alphaMode '" + material.alphaMode + "' is not OPAQUE, MASK or BLEND");
     }
     for (uint32_t i : local) mesh.indices.push_back(uint32_t(d.vertex_base + i));
     mesh.primitives.push_back(out);
@@ -449,7 +488,8 @@ void parse_primitives(Scene& s, AnimatedMesh& mesh) {
     for (size_t n : s.order) {
         const tinygltf::Node& node = s.model.nodes[n];
         if (node.mesh < 0) continue;
-        if (size_t(node.mesh) >= s.model.meshes.size()) s.reader.fail("node " + std::to_string(n) + " names a missing mesh");
+        if (size_t(node.mesh) >= s.model.meshes.size())
+            s.reader.fail("node " + std::to_string(n) + " names a missing mesh");
         for (size_t p = 0; p < s.model.meshes[size_t(node.mesh)].primitives.size(); ++p)
             s.prims.push_back(parse_primitive(s, n, p, mesh));
     }
@@ -470,7 +510,8 @@ void parse_rest_pose(Scene& s) {
         if (node.translation.size() == 3) std::copy(node.translation.begin(), node.translation.end(), p.t.begin());
         if (node.rotation.size() == 4) std::copy(node.rotation.begin(), node.rotation.end(), p.r.begin());
         if (node.scale.size() == 3) std::copy(node.scale.begin(), node.scale.end(), p.s.begin());
-        if (node.mesh >= 0 && size_t(node.mesh) < s.model.meshes.size()) p.weights = s.model.meshes[size_t(node.mesh)].weights;
+        if (node.mesh >= 0 && size_t(node.mesh) < s.model.meshes.size())
+            p.weights = s.model.meshes[size_t(node.mesh)].weights;
         if (!node.weights.empty()) p.weights = node.weights;
     }
 }
@@ -482,7 +523,8 @@ void parse_skins(Scene& s) {
         std::vector<double> m;
         if (skin.inverseBindMatrices >= 0) m = s.reader.read(skin.inverseBindMatrices, 16);
         for (size_t j = 0; j < skin.joints.size(); ++j) {
-            if (skin.joints[j] < 0 || size_t(skin.joints[j]) >= s.model.nodes.size()) s.reader.fail("a skin names a missing joint node");
+            if (skin.joints[j] < 0 || size_t(skin.joints[j]) >= s.model.nodes.size())
+                s.reader.fail("a skin names a missing joint node");
             Mat ibm = identity();
             if (!m.empty()) {
                 if (m.size() < 16 * (j + 1)) s.reader.fail("a skin has fewer inverse bind matrices than joints");
@@ -497,7 +539,8 @@ void parse_skins(Scene& s) {
 // the path need).
 Channel parse_channel(const Scene& s, const tinygltf::Animation& anim, const tinygltf::AnimationChannel& ch,
                       const std::string& name) {
-    if (ch.sampler < 0 || size_t(ch.sampler) >= anim.samplers.size()) s.reader.fail("clip '" + name + "' names a missing sampler");
+    if (ch.sampler < 0 || size_t(ch.sampler) >= anim.samplers.size())
+        s.reader.fail("clip '" + name + "' names a missing sampler");
     const tinygltf::AnimationSampler& sampler = anim.samplers[size_t(ch.sampler)];
     Channel c;
     c.node = size_t(ch.target_node);
@@ -506,7 +549,8 @@ Channel parse_channel(const Scene& s, const tinygltf::Animation& anim, const tin
     c.times = s.reader.read(sampler.input, 1);
     c.values = s.reader.read(sampler.output);
     if (c.times.empty()) s.reader.fail("clip '" + name + "' has a channel without keys");
-    if (!std::is_sorted(c.times.begin(), c.times.end())) s.reader.fail("clip '" + name + "' has key times out of order");
+    if (!std::is_sorted(c.times.begin(), c.times.end()))
+        s.reader.fail("clip '" + name + "' has key times out of order");
     const size_t components = channel_components(s, c.node, c.path);
     const size_t per_key = (c.interpolation == "CUBICSPLINE" ? 3 : 1) * components;
     if (components == 0 || c.values.size() != per_key * c.times.size())
@@ -528,7 +572,8 @@ std::vector<ClipChannels> parse_animations(const Scene& s, const std::string& pa
                 c.channels.push_back(parse_channel(s, anim, ch, c.clip.name));
         if (c.channels.empty()) s.reader.fail("clip '" + c.clip.name + "' animates nothing");
         c.t0 = INFINITY, c.t1 = -INFINITY;
-        for (const Channel& ch : c.channels) c.t0 = std::min(c.t0, ch.times.front()), c.t1 = std::max(c.t1, ch.times.back());
+        for (const Channel& ch : c.channels)
+            c.t0 = std::min(c.t0, ch.times.front()), c.t1 = std::max(c.t1, ch.times.back());
         c.clip.duration_s = c.t1 - c.t0;
         c.clip.source_animation = int(a);
         c.clip.start_time_s = c.t0;
@@ -576,7 +621,9 @@ void evaluate_pose(const Scene& s, const std::vector<NodePose>& pose, float* out
             const Mat& m = global[d.node];
             for (size_t v = 0; v < d.vertex_count; ++v) {
                 const double x = morphed[3 * v], y = morphed[3 * v + 1], z = morphed[3 * v + 2];
-                for (int r = 0; r < 3; ++r) dst[3 * v + size_t(r)] = float(m[size_t(r)] * x + m[size_t(4 + r)] * y + m[size_t(8 + r)] * z + m[size_t(12 + r)]);
+                for (int r = 0; r < 3; ++r)
+                    dst[3 * v + size_t(r)] =
+                        float(m[size_t(r)] * x + m[size_t(4 + r)] * y + m[size_t(8 + r)] * z + m[size_t(12 + r)]);
             }
         }
     }
@@ -595,12 +642,17 @@ std::vector<NodePose> pose_at(const Scene& s, const std::vector<Channel>& channe
     std::vector<NodePose> pose = s.rest;
     for (const Channel& c : channels) {
         const bool rotation = c.path == "rotation";
-        const std::vector<double> v = sample(c.times, c.values, channel_components(s, c.node, c.path), c.interpolation, rotation, t);
+        const std::vector<double> v =
+            sample(c.times, c.values, channel_components(s, c.node, c.path), c.interpolation, rotation, t);
         NodePose& p = pose[c.node];
-        if (c.path == "translation") std::copy(v.begin(), v.end(), p.t.begin());
-        else if (rotation) std::copy(v.begin(), v.end(), p.r.begin());
-        else if (c.path == "scale") std::copy(v.begin(), v.end(), p.s.begin());
-        else if (c.path == "weights") p.weights = v;
+        if (c.path == "translation")
+            std::copy(v.begin(), v.end(), p.t.begin());
+        else if (rotation)
+            std::copy(v.begin(), v.end(), p.r.begin());
+        else if (c.path == "scale")
+            std::copy(v.begin(), v.end(), p.s.begin());
+        else if (c.path == "weights")
+            p.weights = v;
         p.has_matrix = p.has_matrix && c.path == "weights";  // an animated TRS replaces a matrix
     }
     return pose;
@@ -620,7 +672,8 @@ void sample_keyframes(const Scene& s, ClipChannels& c, const LoadOptions& option
 // The steps, in order: the file, the node hierarchy, primitives (with morph targets and skin
 // weights), rest pose, skins, animations into clips; then, within the loading budget, keyframes.
 AnimatedMesh load_gltf(const std::string& path, const LoadOptions& options) {
-    if (!(options.sample_rate > 0 && options.sample_rate <= 1000)) throw LoadError(path + ": sample rate must be in (0, 1000]");
+    if (!(options.sample_rate > 0 && options.sample_rate <= 1000))
+        throw LoadError(path + ": sample rate must be in (0, 1000]");
     const tinygltf::Model model = parse_file(path);
     const Reader reader(model, path, options.max_keyframe_bytes);
     Scene scene{model, reader, {}, {}, {}, {}, {}, {}};

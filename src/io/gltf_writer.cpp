@@ -22,8 +22,8 @@
 #include <tiny_gltf.h>
 
 #include <algorithm>
-#include <filesystem>
 #include <cstring>
+#include <filesystem>
 #include <map>
 #include <sstream>
 
@@ -35,8 +35,8 @@ const char* const kOrdersExtension = "ANIMORDER_animated_triangle_orders";
 tinygltf::Model read_model(const std::string& path) {
     tinygltf::Model model;
     tinygltf::TinyGLTF loader;
-    loader.SetImageLoader([](tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int,
-                             void*) { return true; },
+    loader.SetImageLoader([](tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*,
+                             int, void*) { return true; },
                           nullptr);
     std::string error, warning;
     std::string magic(4, '\0');
@@ -45,7 +45,7 @@ tinygltf::Model read_model(const std::string& path) {
         std::fclose(f);
     }
     const bool ok = magic == "glTF" ? loader.LoadBinaryFromFile(&model, &error, &warning, path)
-                                     : loader.LoadASCIIFromFile(&model, &error, &warning, path);
+                                    : loader.LoadASCIIFromFile(&model, &error, &warning, path);
     if (!ok) throw LoadError(path + ": not a readable glTF 2.0 file: " + error);
     return model;
 }
@@ -109,7 +109,8 @@ std::string gltf_with_orders(const std::string& input_path, const std::string& o
     }
     std::vector<std::vector<uint32_t>> index_buffers(buffers.orders.size(), std::vector<uint32_t>(mesh.indices.size()));
     for (size_t b = 0; b < buffers.orders.size(); ++b)
-        apply_triangle_order(index_buffers[b].data(), mesh.indices.data(), buffers.orders[b].data(), mesh.triangle_count());
+        apply_triangle_order(index_buffers[b].data(), mesh.indices.data(), buffers.orders[b].data(),
+                             mesh.triangle_count());
 
     const size_t k = buffers.orders.size();
     for (const Primitive& p : mesh.primitives) {
@@ -136,11 +137,12 @@ std::string gltf_with_orders(const std::string& input_path, const std::string& o
         const int cells = append_accessor(model, io::append_buffer_view(model, t.cells.data(), t.cells.size(), 0),
                                           TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_TYPE_SCALAR, t.cells.size(),
                                           "animorder table " + mesh.clips[c].name);
-        std::vector<float> centres(framing.centres.begin() + ptrdiff_t(3 * mesh.clips[c].first_keyframe),
-                                   framing.centres.begin() + ptrdiff_t(3 * (mesh.clips[c].first_keyframe + mesh.clips[c].keyframe_count)));
+        std::vector<float> centres(
+            framing.centres.begin() + ptrdiff_t(3 * mesh.clips[c].first_keyframe),
+            framing.centres.begin() + ptrdiff_t(3 * (mesh.clips[c].first_keyframe + mesh.clips[c].keyframe_count)));
         const int centre = append_accessor(model, io::append_buffer_view(model, centres.data(), centres.size() * 4, 0),
-                                           TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, mesh.clips[c].keyframe_count,
-                                           "animorder centres " + mesh.clips[c].name);
+                                           TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3,
+                                           mesh.clips[c].keyframe_count, "animorder centres " + mesh.clips[c].name);
         tinygltf::Value::Object clip;
         clip["name"] = tinygltf::Value(mesh.clips[c].name);
         if (mesh.clips[c].source_animation >= 0) clip["animation"] = tinygltf::Value(mesh.clips[c].source_animation);
@@ -172,12 +174,12 @@ std::string gltf_with_orders(const std::string& input_path, const std::string& o
             image.uri = fs::relative(from / image.uri, to).generic_string();
 
     tinygltf::TinyGLTF writer;
-    writer.SetImageWriter([](const std::string*, const std::string*, const tinygltf::Image* image, bool, std::string* uri,
-                             void*) {
-        *uri = image->uri;  // never decoded, never rewritten: external images keep their URIs
-        return true;
-    },
-                          nullptr);
+    writer.SetImageWriter(
+        [](const std::string*, const std::string*, const tinygltf::Image* image, bool, std::string* uri, void*) {
+            *uri = image->uri;  // never decoded, never rewritten: external images keep their URIs
+            return true;
+        },
+        nullptr);
     std::ostringstream out;
     if (!writer.WriteGltfSceneToStream(&model, out, !binary, binary))
         throw LoadError(input_path + ": writing the glTF output failed");

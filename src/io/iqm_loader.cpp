@@ -38,9 +38,21 @@ public:
         if (offset > d_.size() || count > (d_.size() - offset) / std::max<size_t>(size, 1))
             throw fail(std::string("file is truncated (") + what + " past its end)");
     }
-    uint32_t u32(size_t at) const { uint32_t v; std::memcpy(&v, d_.data() + at, 4); return v; }
-    float f32(size_t at) const { float v; std::memcpy(&v, d_.data() + at, 4); return v; }
-    uint16_t u16(size_t at) const { uint16_t v; std::memcpy(&v, d_.data() + at, 2); return v; }
+    uint32_t u32(size_t at) const {
+        uint32_t v;
+        std::memcpy(&v, d_.data() + at, 4);
+        return v;
+    }
+    float f32(size_t at) const {
+        float v;
+        std::memcpy(&v, d_.data() + at, 4);
+        return v;
+    }
+    uint16_t u16(size_t at) const {
+        uint16_t v;
+        std::memcpy(&v, d_.data() + at, 2);
+        return v;
+    }
     uint8_t u8(size_t at) const { return d_[at]; }
     size_t size() const { return d_.size(); }
     std::string text(size_t ofs_text, size_t num_text, uint32_t at) const {
@@ -63,10 +75,12 @@ Mat pose_matrix(const double t[3], const double q_in[4], const double s[3]) {
 }  // namespace
 
 AnimatedMesh load_iqm(const std::string& path, const LoadOptions& options) {
-    if (!(options.sample_rate > 0 && options.sample_rate <= 1000)) throw LoadError(path + ": sample rate must be in (0, 1000]");
+    if (!(options.sample_rate > 0 && options.sample_rate <= 1000))
+        throw LoadError(path + ": sample rate must be in (0, 1000]");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw LoadError(path + ": cannot open file");
-    const Bytes b(path, std::vector<unsigned char>((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()));
+    const Bytes b(path,
+                  std::vector<unsigned char>((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()));
     if (b.size() < 124) throw b.fail("file is truncated (no IQM header)");
     static const char kMagic[16] = "INTERQUAKEMODEL";
     std::vector<unsigned char> magic(16);
@@ -101,8 +115,10 @@ AnimatedMesh load_iqm(const std::string& path, const LoadOptions& options) {
             if (type == 4 ? !joints.empty() : !weights.empty()) throw b.fail("two blend index or weight vertex arrays");
             b.need(offset, num_vertexes * 4, 1, "blend data");
             for (size_t i = 0; i < num_vertexes * 4; ++i)
-                if (type == 4) joints.push_back(b.u8(offset + i));
-                else weights.push_back(float(b.u8(offset + i)) / 255.0f);
+                if (type == 4)
+                    joints.push_back(b.u8(offset + i));
+                else
+                    weights.push_back(float(b.u8(offset + i)) / 255.0f);
         }
     }
     if (positions.empty()) throw b.fail("no POSITION vertex array");
@@ -132,7 +148,8 @@ AnimatedMesh load_iqm(const std::string& path, const LoadOptions& options) {
     for (size_t j = 0; j < num_joints; ++j) {
         const size_t at = ofs_joints + 48 * j;
         parent[j] = int32_t(b.u32(at + 4));
-        if (parent[j] >= 0 && size_t(parent[j]) >= j) throw b.fail("joint " + std::to_string(j) + " has a parent that does not come before it");
+        if (parent[j] >= 0 && size_t(parent[j]) >= j)
+            throw b.fail("joint " + std::to_string(j) + " has a parent that does not come before it");
         double t[3], q[4], s[3];
         for (int c = 0; c < 3; ++c) t[c] = b.f32(at + 8 + 4 * size_t(c));
         for (int c = 0; c < 4; ++c) q[c] = b.f32(at + 20 + 4 * size_t(c));
@@ -144,7 +161,8 @@ AnimatedMesh load_iqm(const std::string& path, const LoadOptions& options) {
     const bool skinned = num_joints > 0 && joints.size() == num_vertexes * 4 && weights.size() == num_vertexes * 4;
     if (skinned)
         for (uint16_t j : joints)
-            if (j >= num_joints) throw b.fail("a vertex names joint " + std::to_string(j) + ", there are " + std::to_string(num_joints));
+            if (j >= num_joints)
+                throw b.fail("a vertex names joint " + std::to_string(j) + ", there are " + std::to_string(num_joints));
 
     // Positions at one frame (or the bind pose when frame < 0).
     auto frame_positions = [&](long frame) {
@@ -170,7 +188,8 @@ AnimatedMesh load_iqm(const std::string& path, const LoadOptions& options) {
             for (int k = 0; k < 16; ++k) skin[j][size_t(k)] = float(m[size_t(k)]);
         }
         try {
-            skin_positions(out.data(), positions.data(), num_vertexes, joints.data(), weights.data(), 4, skin.data(), num_joints);
+            skin_positions(out.data(), positions.data(), num_vertexes, joints.data(), weights.data(), 4, skin.data(),
+                           num_joints);
         } catch (const InvalidInput& e) {
             throw b.fail(e.what());
         }
@@ -189,7 +208,8 @@ AnimatedMesh load_iqm(const std::string& path, const LoadOptions& options) {
         const size_t at = ofs_anims + 20 * a;
         const uint32_t first = b.u32(at + 4), count = b.u32(at + 8);
         const double rate = b.f32(at + 12) > 0 ? b.f32(at + 12) : 24.0;
-        if (count == 0 || size_t(first) + count > num_frames) throw b.fail("animation " + std::to_string(a) + " names missing frames");
+        if (count == 0 || size_t(first) + count > num_frames)
+            throw b.fail("animation " + std::to_string(a) + " names missing frames");
         if (!std::isfinite(rate)) throw b.fail("animation " + std::to_string(a) + " has an infinite frame rate");
         io::check_keyframe_budget(path, count, num_vertexes, options);  // its frames, skinned before resampling
         Clip clip;

@@ -15,12 +15,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <climits>
+#include <csignal>
 #include <cstdint>
 #include <cstring>
-#include <csignal>
-#include <algorithm>
 #include <new>
 
 namespace animorder::io {
@@ -229,7 +229,8 @@ public:
     size_t count(size_t element) { return count(element, u64()); }
     size_t count(size_t element, uint64_t n) {
         size_t total = 0;
-        if (n > SIZE_MAX || !checked_mul(size_t(n), element, total) || total > left_) bad("a count larger than its data");
+        if (n > SIZE_MAX || !checked_mul(size_t(n), element, total) || total > left_)
+            bad("a count larger than its data");
         return size_t(n);
     }
     std::string str() {
@@ -245,7 +246,8 @@ public:
     template <class T>
     void array(std::vector<T>& v, uint64_t n) {
         size_t total = 0;
-        if (n > SIZE_MAX || !checked_mul(size_t(n), sizeof(T), total) || total > left_) bad("a count larger than its data");
+        if (n > SIZE_MAX || !checked_mul(size_t(n), sizeof(T), total) || total > left_)
+            bad("a count larger than its data");
         v.resize(size_t(n));
         bytes(v.data(), total);
     }
@@ -347,7 +349,8 @@ AnimatedMesh load_isolated(const std::vector<std::string>& files, const LoadOpti
     const std::string& path = files[0];
     const Fd data(::memfd_create("animorder-child-mesh", MFD_CLOEXEC));
     const Fd log(::memfd_create("animorder-child-log", MFD_CLOEXEC));
-    if (data.fd < 0 || log.fd < 0) throw LoadError(path + ": cannot create the isolated reader's buffer: " + errno_text());
+    if (data.fd < 0 || log.fd < 0)
+        throw LoadError(path + ": cannot create the isolated reader's buffer: " + errno_text());
     const Mapping shared(::mmap(nullptr, sizeof(uint64_t), PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0),
                          sizeof(uint64_t));
     if (shared.data == MAP_FAILED) throw LoadError(path + ": cannot map the isolated reader's page: " + errno_text());
@@ -366,18 +369,22 @@ AnimatedMesh load_isolated(const std::vector<std::string>& files, const LoadOpti
 
     const uint64_t index = *reading_index;
     const std::string& blamed = index < files.size() ? files[size_t(index)] : path;
-    if (WIFSIGNALED(status) || (WIFEXITED(status) && WEXITSTATUS(status) != 0 && WEXITSTATUS(status) != kCannotWriteBack)) {
-        std::string why = WIFSIGNALED(status) ? "signal " + std::to_string(WTERMSIG(status)) + ": " + signal_name(WTERMSIG(status))
-                                              : "exit code " + std::to_string(WEXITSTATUS(status));
+    if (WIFSIGNALED(status) ||
+        (WIFEXITED(status) && WEXITSTATUS(status) != 0 && WEXITSTATUS(status) != kCannotWriteBack)) {
+        std::string why = WIFSIGNALED(status)
+                              ? "signal " + std::to_string(WTERMSIG(status)) + ": " + signal_name(WTERMSIG(status))
+                              : "exit code " + std::to_string(WEXITSTATUS(status));
         const std::string said = last_words(log.fd);
-        throw LoadError(blamed + ": assimp crashed reading it (" + why + ")" + (said.empty() ? "" : "; it said: " + said));
+        throw LoadError(blamed + ": assimp crashed reading it (" + why + ")" +
+                        (said.empty() ? "" : "; it said: " + said));
     }
     if (!WIFEXITED(status)) throw LoadError(path + ": the isolated reader stopped abnormally");
     if (WEXITSTATUS(status) == kCannotWriteBack)
         throw LoadError(path + ": the isolated reader could not pass the mesh back (out of memory?)");
 
     struct stat st {};
-    if (::fstat(data.fd, &st) != 0 || st.st_size <= 0) throw LoadError(path + ": the isolated reader passed nothing back");
+    if (::fstat(data.fd, &st) != 0 || st.st_size <= 0)
+        throw LoadError(path + ": the isolated reader passed nothing back");
     const size_t size = size_t(st.st_size);
     const Mapping bytes(::mmap(nullptr, size, PROT_READ, MAP_PRIVATE, data.fd, 0), size);
     if (bytes.data == MAP_FAILED) throw LoadError(path + ": cannot read the isolated reader's mesh: " + errno_text());

@@ -14,7 +14,8 @@
 
 namespace animorder {
 
-AnimatedMesh load_character(const std::string& path, const std::vector<std::string>& clip_files, const LoadOptions& options) {
+AnimatedMesh load_character(const std::string& path, const std::vector<std::string>& clip_files,
+                            const LoadOptions& options) {
     std::vector<std::string> files;
     for (const std::string& c : clip_files) {
         if (std::filesystem::is_directory(c)) {
@@ -29,9 +30,11 @@ AnimatedMesh load_character(const std::string& path, const std::vector<std::stri
         }
     }
     std::string extension = std::filesystem::path(path).extension().string();
-    std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char ch) { return char(std::tolower(ch)); });
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char ch) { return char(std::tolower(ch)); });
     if (extension == ".gltf" || extension == ".glb" || extension == ".md2" || extension == ".iqm") {
-        if (!files.empty()) throw LoadError(path + ": clip files apply to assimp formats (this file carries its clips)");
+        if (!files.empty())
+            throw LoadError(path + ": clip files apply to assimp formats (this file carries its clips)");
         if (extension == ".md2") return load_md2(path, options);
         if (extension == ".iqm") return load_iqm(path, options);
         return load_gltf(path, options);

@@ -39,7 +39,8 @@ int32_t i32(const std::vector<unsigned char>& d, size_t at) {
 }  // namespace
 
 AnimatedMesh load_md2(const std::string& path, const LoadOptions& options) {
-    if (!(options.sample_rate > 0 && options.sample_rate <= 1000)) throw LoadError(path + ": sample rate must be in (0, 1000]");
+    if (!(options.sample_rate > 0 && options.sample_rate <= 1000))
+        throw LoadError(path + ": sample rate must be in (0, 1000]");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw LoadError(path + ": cannot open file");
     const std::vector<unsigned char> d((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -55,7 +56,8 @@ AnimatedMesh load_md2(const std::string& path, const LoadOptions& options) {
     size_t tris_end = 0, frames_end = 0;
     if (ofs_tris < 0 || ofs_frames < 0 || !io::checked_add(size_t(ofs_tris), size_t(triangles) * 12, tris_end) ||
         tris_end > d.size() ||
-        !io::checked_add(size_t(ofs_frames), io::mul_or_throw(path + ": frames", size_t(frames), size_t(frame_size)), frames_end) ||
+        !io::checked_add(size_t(ofs_frames), io::mul_or_throw(path + ": frames", size_t(frames), size_t(frame_size)),
+                         frames_end) ||
         frames_end > d.size())
         throw fail("file is truncated (triangles or frames past its end)");
     // The file's own frames, then the resampled clips, must fit the loading budget.
@@ -95,7 +97,8 @@ AnimatedMesh load_md2(const std::string& path, const LoadOptions& options) {
         group[size_t(f)] = name.empty() ? "frames" : name;
         for (int32_t v = 0; v < vertices; ++v)
             for (int c = 0; c < 3; ++c)
-                frame_positions[size_t(f)][size_t(v) * 3 + size_t(c)] = float(p[40 + 4 * size_t(v) + size_t(c)]) * scale[c] + translate[c];
+                frame_positions[size_t(f)][size_t(v) * 3 + size_t(c)] =
+                    float(p[40 + 4 * size_t(v) + size_t(c)]) * scale[c] + translate[c];
     }
 
     // One clip per run of frames with the same group name, resampled from 10 frames per second;
@@ -126,7 +129,8 @@ AnimatedMesh load_md2(const std::string& path, const LoadOptions& options) {
             const size_t a = size_t(begin) + size_t(at), b = std::min(a + 1, size_t(end - 1));
             const float u = float(at - std::floor(at));
             for (size_t i = 0; i < size_t(vertices) * 3; ++i)
-                mesh.keyframe_positions.push_back(frame_positions[a][i] + u * (frame_positions[b][i] - frame_positions[a][i]));
+                mesh.keyframe_positions.push_back(frame_positions[a][i] +
+                                                  u * (frame_positions[b][i] - frame_positions[a][i]));
         }
     }
     try {

@@ -32,7 +32,8 @@ std::string serialize_sidecar(const AnimatedMesh& mesh, const MethodBuffers& buf
     if (buffers.tables.size() != mesh.clips.size() || buffers.table_base.size() != mesh.clips.size())
         throw InvalidInput("the sidecar needs one lookup table per clip");
     const size_t header = 20, clip_record = 32;
-    const size_t buffers_end = header + clip_record * mesh.clips.size() + buffers.orders.size() * mesh.indices.size() * 4;
+    const size_t buffers_end =
+        header + clip_record * mesh.clips.size() + buffers.orders.size() * mesh.indices.size() * 4;
     std::string out;
     out.append("AOR1", 4);
     put_u32(out, 1);
@@ -90,8 +91,9 @@ std::string sidecar_json(const AnimatedMesh& mesh, const MethodBuffers& buffers,
                               {"buffer_base", buffers.table_base[c]},
                               {"theta_steps", buffers.tables[c].theta_steps},
                               {"phi_steps", buffers.tables[c].phi_steps}});
-    j["table"] = "cell (f, i, j): theta = i*pi/(theta_steps-1) from +Y, phi = j*2*pi/phi_steps from +Z towards +X; "
-                 "buffer = buffer_base + cell (see animorder_runtime.h)";
+    j["table"] =
+        "cell (f, i, j): theta = i*pi/(theta_steps-1) from +Y, phi = j*2*pi/phi_steps from +Z towards +X; "
+        "buffer = buffer_base + cell (see animorder_runtime.h)";
     return j.dump(2) + "\n";
 }
 

@@ -16,10 +16,22 @@ inline Mat identity() { return {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
 inline Mat mul(const Mat& a, const Mat& b) { return multiply_mat4(a, b); }
 inline Mat trs(const std::array<double, 3>& t, const Quat& q, const std::array<double, 3>& s) {
     const double x = q[0], y = q[1], z = q[2], w = q[3];
-    Mat m = {1 - 2 * (y * y + z * z), 2 * (x * y + z * w), 2 * (x * z - y * w), 0,
-             2 * (x * y - z * w), 1 - 2 * (x * x + z * z), 2 * (y * z + x * w), 0,
-             2 * (x * z + y * w), 2 * (y * z - x * w), 1 - 2 * (x * x + y * y), 0,
-             t[0], t[1], t[2], 1};
+    Mat m = {1 - 2 * (y * y + z * z),
+             2 * (x * y + z * w),
+             2 * (x * z - y * w),
+             0,
+             2 * (x * y - z * w),
+             1 - 2 * (x * x + z * z),
+             2 * (y * z + x * w),
+             0,
+             2 * (x * z + y * w),
+             2 * (y * z - x * w),
+             1 - 2 * (x * x + y * y),
+             0,
+             t[0],
+             t[1],
+             t[2],
+             1};
     for (int c = 0; c < 3; ++c)
         for (int r = 0; r < 3; ++r) m[c * 4 + r] *= s[c];
     return m;

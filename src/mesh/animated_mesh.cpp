@@ -24,7 +24,8 @@ std::vector<uint8_t> double_sided_triangles(const AnimatedMesh& mesh) {
     std::vector<uint8_t> flags(mesh.triangle_count(), 0);
     for (const Primitive& p : mesh.primitives)
         if (p.double_sided)
-            for (size_t t = p.first_index / 3; t < (p.first_index + p.index_count) / 3 && t < flags.size(); ++t) flags[t] = 1;
+            for (size_t t = p.first_index / 3; t < (p.first_index + p.index_count) / 3 && t < flags.size(); ++t)
+                flags[t] = 1;
     return flags;
 }
 

@@ -50,8 +50,8 @@ struct BlendAccumulator {
 
 }  // namespace
 
-std::vector<uint32_t> back_to_front_blended_order(const AnimatedMesh& mesh, const float* positions, const float centre[3],
-                                                  const float eye[3]) {
+std::vector<uint32_t> back_to_front_blended_order(const AnimatedMesh& mesh, const float* positions,
+                                                  const float centre[3], const float eye[3]) {
     std::vector<uint32_t> order(mesh.triangle_count());
     std::iota(order.begin(), order.end(), 0u);
     for (const Primitive& p : mesh.primitives) {
@@ -61,8 +61,11 @@ std::vector<uint32_t> back_to_front_blended_order(const AnimatedMesh& mesh, cons
         for (size_t t = first; t < last; ++t) {
             double d2 = 0;
             for (int d = 0; d < 3; ++d) {
-                const double c = (double(positions[3 * mesh.indices[3 * t] + d]) + positions[3 * mesh.indices[3 * t + 1] + d] +
-                                  positions[3 * mesh.indices[3 * t + 2] + d]) / 3.0 - centre[d];
+                const double c =
+                    (double(positions[3 * mesh.indices[3 * t] + d]) + positions[3 * mesh.indices[3 * t + 1] + d] +
+                     positions[3 * mesh.indices[3 * t + 2] + d]) /
+                        3.0 -
+                    centre[d];
                 d2 += (c - eye[d]) * (c - eye[d]);
             }
             distance[t - first] = d2;
@@ -104,7 +107,8 @@ std::vector<BlendEvaluation> evaluate_blend(const AnimatedMesh& mesh, const std:
     std::vector<uint8_t> blended(triangles, 0);
     for (const Primitive& p : mesh.primitives)
         if (p.alpha_mode == AlphaMode::Blend)
-            std::fill(blended.begin() + ptrdiff_t(p.first_index / 3), blended.begin() + ptrdiff_t((p.first_index + p.index_count) / 3), 1);
+            std::fill(blended.begin() + ptrdiff_t(p.first_index / 3),
+                      blended.begin() + ptrdiff_t((p.first_index + p.index_count) / 3), 1);
     const std::vector<uint8_t> modes = full_pass_modes(mesh);
 
     const Framing all = frame_animated_mesh(mesh);
@@ -143,8 +147,10 @@ std::vector<BlendEvaluation> evaluate_blend(const AnimatedMesh& mesh, const std:
                     const MethodBuffers& method = methods[m];
                     if (method.front_to_back) continue;  // no buffers: scored with rank 0 everywhere, ignored
                     size_t buffer = 0;
-                    if (!method.keyframe_buffer.empty()) buffer = method.keyframe_buffer[keyframe];
-                    else if (!method.tables.empty()) buffer = method.table_base[c] + select_buffer(method.tables[c], f, direction);
+                    if (!method.keyframe_buffer.empty())
+                        buffer = method.keyframe_buffer[keyframe];
+                    else if (!method.tables.empty())
+                        buffer = method.table_base[c] + select_buffer(method.tables[c], f, direction);
                     if (buffer >= rank_of[m].size()) throw InvalidInput("a lookup table names a missing buffer");
                     const uint32_t* rank = rank_of[m][buffer].data();
                     for (size_t t = 0; t < triangles; ++t) w.ranks[t * order_count + m] = rank[t];
@@ -153,13 +159,14 @@ std::vector<BlendEvaluation> evaluate_blend(const AnimatedMesh& mesh, const std:
                                       3 * framing.radius * direction[2]};
                 const std::vector<uint32_t> bound =
                     back_to_front_blended_order(mesh, mesh.keyframe(keyframe), &all.centres[3 * keyframe], eye);
-                for (size_t i = 0; i < triangles; ++i) w.ranks[size_t(bound[i]) * order_count + method_count] = uint32_t(i);
+                for (size_t i = 0; i < triangles; ++i)
+                    w.ranks[size_t(bound[i]) * order_count + method_count] = uint32_t(i);
                 transform_to_clip(w.clip.data(), mesh.keyframe(keyframe), mesh.vertex_count, &all.centres[3 * keyframe],
                                   node_view_projection(direction, framing.radius));
                 w.rasterizer.rasterize(w.clip.data(), mesh.vertex_count, mesh.indices.data(), mesh.indices.size(),
                                        settings.resolution, modes.empty() ? nullptr : modes.data());
-                score_blend(&counts[n * order_count], w.rasterizer.export_blend_fragments(blended.data()), w.ranks.data(),
-                            order_count);
+                score_blend(&counts[n * order_count], w.rasterizer.export_blend_fragments(blended.data()),
+                            w.ranks.data(), order_count);
                 const size_t finished = ++done;
                 if (settings.progress && (finished % report_every == 0 || finished == node_count)) {
                     std::lock_guard<std::mutex> lock(progress_mutex);

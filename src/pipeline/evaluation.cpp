@@ -59,7 +59,8 @@ void check_method(const AnimatedMesh& mesh, const MethodBuffers& m) {
         const MeshPatches& p = *m.front_to_back;
         if (p.cache_order.size() != triangles || p.patch_starts.size() != p.patch_count() + 1 ||
             p.patch_starts.back() != triangles)
-            throw InvalidInput("the oracle's patches do not cover the mesh's " + std::to_string(triangles) + " triangles");
+            throw InvalidInput("the oracle's patches do not cover the mesh's " + std::to_string(triangles) +
+                               " triangles");
         validate_triangle_order(p.cache_order.data(), triangles);
         return;
     }
@@ -142,7 +143,8 @@ std::vector<OrderEvaluation> evaluate_methods(const AnimatedMesh& mesh, const st
         // The oracles' patch centroids at every keyframe of the clip.
         std::vector<std::vector<float>> centroids(method_count);
         for (size_t m = 0; m < method_count; ++m)
-            if (methods[m].front_to_back) centroids[m] = patch_centroids(mesh, *methods[m].front_to_back, all, keyframes);
+            if (methods[m].front_to_back)
+                centroids[m] = patch_centroids(mesh, *methods[m].front_to_back, all, keyframes);
 
         const size_t node_count = keyframes.size() * settings.views;
         std::vector<uint64_t> visible(node_count), passed(node_count * method_count);
@@ -164,7 +166,8 @@ std::vector<OrderEvaluation> evaluate_methods(const AnimatedMesh& mesh, const st
                         const std::vector<uint32_t> order = patch_order_to_triangle_order(
                             patches, front_to_back_patch_order(&centroids[m][f * patches.patch_count() * 3],
                                                                patches.patch_count(), eye));
-                        for (size_t i = 0; i < triangles; ++i) w.ranks[size_t(order[i]) * method_count + m] = uint32_t(i);
+                        for (size_t i = 0; i < triangles; ++i)
+                            w.ranks[size_t(order[i]) * method_count + m] = uint32_t(i);
                         continue;
                     }
                     size_t buffer = 0;

@@ -170,9 +170,9 @@ StaticMethodResult run_static_method(const AnimatedMesh& mesh, StaticMethod meth
                                                        mesh.vertex_count, keyframes.data(), keyframes.size(), nehab)
                                       .cluster_count;
         } else {
-            const StaticOrderResult r = order_static_sander07(
-                order.data(), source, primitive.index_count, mesh.keyframe(settings.keyframe), mesh.vertex_count,
-                3 * sizeof(float), settings.lambda, settings.cache_size);
+            const StaticOrderResult r =
+                order_static_sander07(order.data(), source, primitive.index_count, mesh.keyframe(settings.keyframe),
+                                      mesh.vertex_count, 3 * sizeof(float), settings.lambda, settings.cache_size);
             result.patch_count += r.patch_count;
             result.hard_boundary_count += r.hard_boundary_count;
         }
@@ -188,8 +188,8 @@ VertexCacheStats analyze_mesh_vertex_cache(const AnimatedMesh& mesh, const std::
     VertexCacheStats total;
     size_t referenced = 0;
     for (const Primitive& primitive : mesh.primitives) {
-        const VertexCacheStats s = analyze_vertex_cache(indices.data() + primitive.first_index,
-                                                        primitive.index_count, mesh.vertex_count, cache_size);
+        const VertexCacheStats s = analyze_vertex_cache(indices.data() + primitive.first_index, primitive.index_count,
+                                                        mesh.vertex_count, cache_size);
         total.misses += s.misses;
         total.triangles += s.triangles;
         referenced += s.referenced_vertices;

@@ -93,14 +93,16 @@ GlContext::GlContext(unsigned resolution, const char* fragment_shader) : state_(
     if (resolution == 0) throw std::runtime_error("OpenGL reference: the resolution must be at least one pixel");
     s.resolution = resolution;
     s.display = open_display();
-    const EGLint config_attributes[] = {EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
+    const EGLint config_attributes[] = {EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT,
+                                        EGL_NONE};
     EGLConfig config;
     EGLint configs = 0;
     if (!eglChooseConfig(s.display, config_attributes, &config, 1, &configs) || configs < 1)
         throw std::runtime_error("OpenGL reference: no EGL config for desktop OpenGL");
     if (!eglBindAPI(EGL_OPENGL_API)) throw std::runtime_error("OpenGL reference: eglBindAPI(EGL_OPENGL_API) failed");
-    const EGLint context_attributes[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
-                                         EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+    const EGLint context_attributes[] = {
+        EGL_CONTEXT_MAJOR_VERSION,           4,       EGL_CONTEXT_MINOR_VERSION, 5, EGL_CONTEXT_OPENGL_PROFILE_MASK,
+        EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
     s.context = eglCreateContext(s.display, config, EGL_NO_CONTEXT, context_attributes);
     if (s.context == EGL_NO_CONTEXT) throw std::runtime_error("OpenGL reference: no OpenGL 4.5 core context");
     if (!eglMakeCurrent(s.display, EGL_NO_SURFACE, EGL_NO_SURFACE, s.context))
@@ -119,8 +121,9 @@ GlContext::GlContext(unsigned resolution, const char* fragment_shader) : state_(
     if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
         throw std::runtime_error("OpenGL reference: incomplete framebuffer");
 
-    const GLuint vs = compile(GL_VERTEX_SHADER,
-                              "#version 450 core\nlayout(location = 0) in vec4 clip;\nvoid main() { gl_Position = clip; }\n");
+    const GLuint vs =
+        compile(GL_VERTEX_SHADER,
+                "#version 450 core\nlayout(location = 0) in vec4 clip;\nvoid main() { gl_Position = clip; }\n");
     const GLuint fs = compile(GL_FRAGMENT_SHADER, fragment_shader);
     s.program = glCreateProgram();
     glAttachShader(s.program, vs);
@@ -193,7 +196,8 @@ size_t GlContext::add_index_buffer(const uint32_t* indices, size_t index_count) 
 
 void GlContext::set_index_buffer(size_t id, const uint32_t* indices, size_t index_count) {
     State& s = *state_;
-    if (id >= s.index_buffers.size()) throw std::runtime_error("OpenGL reference: no index buffer " + std::to_string(id));
+    if (id >= s.index_buffers.size())
+        throw std::runtime_error("OpenGL reference: no index buffer " + std::to_string(id));
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, s.index_buffers[id]);
     glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(index_count * sizeof(uint32_t)), indices, GL_STATIC_DRAW);
     s.index_counts[id] = index_count;
@@ -202,7 +206,8 @@ void GlContext::set_index_buffer(size_t id, const uint32_t* indices, size_t inde
 GlDraw GlContext::draw(size_t id, bool timed) {
     using Clock = std::chrono::steady_clock;
     State& s = *state_;
-    if (id >= s.index_buffers.size()) throw std::runtime_error("OpenGL reference: no index buffer " + std::to_string(id));
+    if (id >= s.index_buffers.size())
+        throw std::runtime_error("OpenGL reference: no index buffer " + std::to_string(id));
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, s.index_buffers[id]);
     glClear(GL_DEPTH_BUFFER_BIT | GL_COLOR_BUFFER_BIT);
     Clock::time_point start;
@@ -233,8 +238,10 @@ GlDraw GlContext::draw(size_t id, bool timed) {
 }
 
 void GlContext::set_culling(bool cull) {
-    if (cull) glEnable(GL_CULL_FACE);
-    else glDisable(GL_CULL_FACE);
+    if (cull)
+        glEnable(GL_CULL_FACE);
+    else
+        glDisable(GL_CULL_FACE);
 }
 
 uint64_t GlContext::covered_pixels() {

@@ -21,8 +21,7 @@ GlOverdrawReference::~GlOverdrawReference() = default;
 std::string GlOverdrawReference::renderer() const { return context_->renderer(); }
 
 GlNodeCounts GlOverdrawReference::score(const float* clip_xyzw, size_t vertex_count,
-                                        const std::vector<std::vector<uint32_t>>& index_buffers,
-                                        bool double_sided) {
+                                        const std::vector<std::vector<uint32_t>>& index_buffers, bool double_sided) {
     GlContext& gl = *context_;
     gl.set_culling(!double_sided);
     gl.set_vertices(clip_xyzw, vertex_count);

@@ -16,8 +16,8 @@
 namespace animorder {
 
 struct GlNodeCounts {
-    uint64_t visible = 0;             // pixels whose depth < 1 after drawing
-    std::vector<uint64_t> passed;     // per order: GL_SAMPLES_PASSED
+    uint64_t visible = 0;          // pixels whose depth < 1 after drawing
+    std::vector<uint64_t> passed;  // per order: GL_SAMPLES_PASSED
 };
 
 class GlOverdrawReference {

@@ -23,8 +23,7 @@ AnimatedMesh layers() {
     const float z[4] = {-5, 0, 1, -1};
     for (int t = 0; t < 4; ++t) {
         const float x = t == 0 ? 3.0f : 0.0f;
-        m.keyframe_positions.insert(m.keyframe_positions.end(),
-                                    {x, 0, z[t], x + 0.1f, 0, z[t], x, 0.1f, z[t]});
+        m.keyframe_positions.insert(m.keyframe_positions.end(), {x, 0, z[t], x + 0.1f, 0, z[t], x, 0.1f, z[t]});
         m.indices.insert(m.indices.end(), {uint32_t(3 * t), uint32_t(3 * t + 1), uint32_t(3 * t + 2)});
     }
     m.vertex_count = 12;

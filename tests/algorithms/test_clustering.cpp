@@ -41,9 +41,7 @@ ClusteringSettings small_settings() {
     return s;
 }
 
-Framing framing_of(const AnimatedMesh& m) {
-    return frame_animated_mesh(m);
-}
+Framing framing_of(const AnimatedMesh& m) { return frame_animated_mesh(m); }
 }  // namespace
 
 TEST(MeshPatches, CoverEveryTriangleWithinItsPrimitive) {
@@ -63,7 +61,8 @@ TEST(MeshPatches, CoverEveryTriangleWithinItsPrimitive) {
     }
     // The identity patch order is the Tipsify order; a reversed one keeps primitives in file order.
     std::vector<uint32_t> identity(p.patch_count()), reversed(p.patch_count());
-    for (size_t q = 0; q < p.patch_count(); ++q) identity[q] = uint32_t(q), reversed[q] = uint32_t(p.patch_count() - 1 - q);
+    for (size_t q = 0; q < p.patch_count(); ++q)
+        identity[q] = uint32_t(q), reversed[q] = uint32_t(p.patch_count() - 1 - q);
     EXPECT_EQ(patch_order_to_triangle_order(p, identity), p.cache_order);
     const std::vector<uint32_t> r = patch_order_to_triangle_order(p, reversed);
     EXPECT_TRUE(test::is_permutation_of_iota(r));
@@ -251,7 +250,8 @@ TEST(SelectionTable, ReturnsTheNodesClusterAtEveryClusteringViewpoint) {
     EXPECT_EQ(table.keyframes, walk.keyframe_count);
     for (size_t f = 0; f < walk.keyframe_count; ++f)
         for (size_t v = 0; v < 162; ++v)
-            ASSERT_EQ(select_buffer(table, f, &r.directions[3 * v]), r.assignment[f * 162 + v]) << "keyframe " << f << " view " << v;
+            ASSERT_EQ(select_buffer(table, f, &r.directions[3 * v]), r.assignment[f * 162 + v])
+                << "keyframe " << f << " view " << v;
     // Directions need not be unit length; keyframes past the end clamp to the last.
     const float scaled[3] = {5 * r.directions[0], 5 * r.directions[1], 5 * r.directions[2]};
     EXPECT_EQ(select_buffer(table, 0, scaled), r.assignment[0]);

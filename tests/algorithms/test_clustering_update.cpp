@@ -180,8 +180,8 @@ MeshPatches two_patches() {
 
 ClusteringResult cluster_two_patches(DistanceVariant distance, UpdateRule update, size_t max_iterations) {
     const AnimatedMesh mesh = two_patch_mesh();
-    const Framing framing = frame_keyframes(mesh.keyframe_positions.data(), 2, mesh.vertex_count, mesh.indices.data(),
-                                            mesh.indices.size());
+    const Framing framing =
+        frame_keyframes(mesh.keyframe_positions.data(), 2, mesh.vertex_count, mesh.indices.data(), mesh.indices.size());
     // The framing worked out above.
     EXPECT_EQ(framing.centres, (std::vector<float>{0, 1.5f, 0, 0, 1.5f, 0}));
     EXPECT_NEAR(framing.radius, std::sqrt(29.25), 1e-4);  // (frame_keyframes adds a 1e-6 margin)

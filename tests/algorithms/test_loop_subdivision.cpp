@@ -44,8 +44,10 @@ Mesh octahedron() {
         for (int sy = 0; sy < 2; ++sy)
             for (int sz = 0; sz < 2; ++sz) {
                 const uint32_t x = uint32_t(sx), y = uint32_t(2 + sy), z = uint32_t(4 + sz);
-                if ((sx + sy + sz) % 2 == 0) m.indices.insert(m.indices.end(), {x, y, z});
-                else m.indices.insert(m.indices.end(), {x, z, y});
+                if ((sx + sy + sz) % 2 == 0)
+                    m.indices.insert(m.indices.end(), {x, y, z});
+                else
+                    m.indices.insert(m.indices.end(), {x, z, y});
             }
     return m;
 }
@@ -226,7 +228,8 @@ TEST(LoopSubdivision, FlatOpenGridStaysPlanarAndRegularInteriorPointsStay) {
     Mesh m;
     const int n = 6;
     for (int j = 0; j <= n; ++j)
-        for (int i = 0; i <= n; ++i) m.positions.insert(m.positions.end(), {float(i), float(j), 0.3f * i - 0.2f * j + 1});
+        for (int i = 0; i <= n; ++i)
+            m.positions.insert(m.positions.end(), {float(i), float(j), 0.3f * i - 0.2f * j + 1});
     for (int j = 0; j < n; ++j)
         for (int i = 0; i < n; ++i) {
             const uint32_t a = uint32_t(j * (n + 1) + i), b = a + 1, c = a + uint32_t(n + 1), d = c + 1;
@@ -252,7 +255,8 @@ TEST(LoopSubdivision, FlatOpenGridStaysPlanarAndRegularInteriorPointsStay) {
 TEST(LoopSubdivision, ClosedStaysClosedWithWindingAndEulerCharacteristic) {
     const AnimatedMesh sphere = make_uv_sphere(400), knot = make_torus_knot(600);
     for (const AnimatedMesh* input : {&sphere, &knot}) {
-        const Mesh m{std::vector<float>(input->keyframe(0), input->keyframe(0) + 3 * input->vertex_count), input->indices};
+        const Mesh m{std::vector<float>(input->keyframe(0), input->keyframe(0) + 3 * input->vertex_count),
+                     input->indices};
         const Topology before = topology(welded(m.positions, m.indices));
         ASSERT_TRUE(before.closed_and_consistent);
         EXPECT_EQ(before.euler, input == &sphere ? 2 : 0);
@@ -315,7 +319,8 @@ TEST(LoopSubdivision, OperatorMatchesADirectImplementation) {
 
 TEST(LoopSubdivision, ReusedOperatorEqualsAFreshOneAndLevelsCompose) {
     const AnimatedMesh sphere = make_uv_sphere(300);
-    const Mesh rest{std::vector<float>(sphere.keyframe(0), sphere.keyframe(0) + 3 * sphere.vertex_count), sphere.indices};
+    const Mesh rest{std::vector<float>(sphere.keyframe(0), sphere.keyframe(0) + 3 * sphere.vertex_count),
+                    sphere.indices};
     const SubdivisionOperator op = build(rest, 2);
     for (float amount : {0.5f, 1.5f}) {
         // Keyframe f through the operator built at rest, and through one built at keyframe f.
@@ -349,7 +354,8 @@ TEST(LoopSubdivision, BadInputThrows) {
     EXPECT_THROW(build_loop_subdivision(m.indices.data(), 4, m.positions.data(), 4, 12, 1), InvalidInput);
     std::vector<float> nan_positions = m.positions;
     nan_positions[4] = NAN;
-    EXPECT_THROW(build_loop_subdivision(m.indices.data(), m.indices.size(), nan_positions.data(), 4, 12, 1), InvalidInput);
+    EXPECT_THROW(build_loop_subdivision(m.indices.data(), m.indices.size(), nan_positions.data(), 4, 12, 1),
+                 InvalidInput);
     // 4 levels multiply by 256: 2^31 / 256 = 8,388,608 indices is the most.
     const std::vector<uint32_t> many(8388609, 0);  // 2^31 / 256 + 1, a multiple of 3
     try {

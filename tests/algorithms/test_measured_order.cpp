@@ -38,8 +38,8 @@ std::vector<Arc> graph_of(const std::vector<NodeFragments>& nodes, const std::ve
                           size_t units, const uint32_t* group = nullptr, unsigned threads = 1) {
     std::vector<const NodeFragments*> p;
     for (const auto& n : nodes) p.push_back(&n);
-    return measured_overdraw_graph(p.data(), p.size(), unit_of_triangle.data(), unit_of_triangle.size(), units,
-                                   group, threads);
+    return measured_overdraw_graph(p.data(), p.size(), unit_of_triangle.data(), unit_of_triangle.size(), units, group,
+                                   threads);
 }
 
 // A scene in clip space with w = 1 (orthographic): x, y, z are NDC; smaller z is nearer.
@@ -250,7 +250,8 @@ TEST(MeasuredOrder, CyclicOcclusionKeepsTheHeavierArcs) {
     MeasuredOrderStats stats;
     // Start from the worst rotation: the search must still reach the best order.
     const std::vector<uint32_t> previous = {2, 0, 1};
-    const std::vector<uint32_t> order = measured_unit_order(3, arcs.data(), arcs.size(), nullptr, previous.data(), &stats);
+    const std::vector<uint32_t> order =
+        measured_unit_order(3, arcs.data(), arcs.size(), nullptr, previous.data(), &stats);
     EXPECT_EQ(order, (std::vector<uint32_t>{0, 1, 2}));
     EXPECT_EQ(stats.final_weight, 1u);
     EXPECT_EQ(cost(order, arcs), 1u);
@@ -268,8 +269,8 @@ TEST(MeasuredOrder, CrossingPatchesGraphBeatsDistance) {
                        c = s.vertex(0.9f, 0.1f, 0.8f), d = s.vertex(-0.9f, 0.1f, -0.8f);
         s.triangle(a, b, c);
         s.triangle(a, c, d);
-        const uint32_t e = s.vertex(0.6f, -0.9f, 0.3f), f = s.vertex(0.8f, -0.9f, 0.3f),
-                       g = s.vertex(0.8f, 0.9f, 0.3f), h = s.vertex(0.6f, 0.9f, 0.3f);
+        const uint32_t e = s.vertex(0.6f, -0.9f, 0.3f), f = s.vertex(0.8f, -0.9f, 0.3f), g = s.vertex(0.8f, 0.9f, 0.3f),
+                       h = s.vertex(0.6f, 0.9f, 0.3f);
         s.triangle(e, f, g);
         s.triangle(e, g, h);
     }
@@ -306,8 +307,10 @@ std::vector<Arc> random_graph(std::mt19937& rng, size_t n) {
         for (uint32_t b = a + 1; b < n; ++b) {
             if (rng() % 3 == 0) continue;
             const uint64_t w = 1 + rng() % 20;
-            if (rng() % 2) arcs.push_back({a, b, w});
-            else arcs.push_back({b, a, w});
+            if (rng() % 2)
+                arcs.push_back({a, b, w});
+            else
+                arcs.push_back({b, a, w});
         }
     return arcs;
 }

@@ -73,9 +73,9 @@ Soup cube(float dx = 0) {
 
 // Σ over nodes of the fragments passing when `order` is drawn, for the triangles `order` lists
 // (a sub-buffer), framed as `framing` says (the whole mesh's framing).
-uint64_t passed_sum(const Soup& s, const std::vector<uint32_t>& triangles_drawn, const std::vector<uint32_t>& order_in_sub,
-                    const Framing& framing, const std::vector<OverdrawNode>& nodes, unsigned resolution,
-                    const float* keyframes_positions) {
+uint64_t passed_sum(const Soup& s, const std::vector<uint32_t>& triangles_drawn,
+                    const std::vector<uint32_t>& order_in_sub, const Framing& framing,
+                    const std::vector<OverdrawNode>& nodes, unsigned resolution, const float* keyframes_positions) {
     std::vector<uint32_t> sub;
     for (uint32_t t : triangles_drawn) sub.insert(sub.end(), s.indices.begin() + 3 * t, s.indices.begin() + 3 * t + 3);
     const std::vector<uint32_t> ranks = make_rank_table({order_in_sub.data()}, triangles_drawn.size());
@@ -177,8 +177,8 @@ TEST(FeedbackArcSet, BadInputThrows) {
 
 TEST(PlanarClusters, CubeFacesAreTheSixClusters) {
     const Soup s = cube();
-    const std::vector<uint32_t> c = cluster_by_normals(s.indices.data(), s.indices.size(), s.positions.data(),
-                                                       s.vertex_count(), 6);
+    const std::vector<uint32_t> c =
+        cluster_by_normals(s.indices.data(), s.indices.size(), s.positions.data(), s.vertex_count(), 6);
     ASSERT_EQ(c.size(), 12u);
     for (size_t face = 0; face < 6; ++face) EXPECT_EQ(c[2 * face], c[2 * face + 1]) << "face " << face;
     EXPECT_EQ(std::set<uint32_t>(c.begin(), c.end()).size(), 6u);
@@ -187,8 +187,8 @@ TEST(PlanarClusters, CubeFacesAreTheSixClusters) {
 
 TEST(PlanarClusters, OneClusterPerTriangleAtMostAndOneCluster) {
     const Soup s = cube();
-    std::vector<uint32_t> c = cluster_by_normals(s.indices.data(), s.indices.size(), s.positions.data(),
-                                                 s.vertex_count(), 100);
+    std::vector<uint32_t> c =
+        cluster_by_normals(s.indices.data(), s.indices.size(), s.positions.data(), s.vertex_count(), 100);
     EXPECT_EQ(std::set<uint32_t>(c.begin(), c.end()).size(), 12u);
     c = cluster_by_normals(s.indices.data(), s.indices.size(), s.positions.data(), s.vertex_count(), 1);
     EXPECT_EQ(c, std::vector<uint32_t>(12, 0));
@@ -200,8 +200,8 @@ TEST(PlanarClusters, EveryComponentGetsASeedWhileSeedsLast) {
     const uint32_t base = uint32_t(s.vertex_count());
     s.positions.insert(s.positions.end(), second.positions.begin(), second.positions.end());
     for (uint32_t i : second.indices) s.indices.push_back(base + i);
-    const std::vector<uint32_t> c = cluster_by_normals(s.indices.data(), s.indices.size(), s.positions.data(),
-                                                       s.vertex_count(), 2);
+    const std::vector<uint32_t> c =
+        cluster_by_normals(s.indices.data(), s.indices.size(), s.positions.data(), s.vertex_count(), 2);
     for (size_t t = 0; t < 12; ++t) {
         EXPECT_EQ(c[t], c[0]);
         EXPECT_EQ(c[12 + t], c[12]);
@@ -234,8 +234,8 @@ TEST(PlanarClusters, SeamsDoNotCutAndTheLargestComponentIsSeededFirst) {
     small(4);
     // Without update steps the seeding alone must get it right; with them it must stay right.
     for (unsigned iterations : {0u, 8u}) {
-        const std::vector<uint32_t> c = cluster_by_normals(s.indices.data(), s.indices.size(), s.positions.data(),
-                                                           s.vertex_count(), 2, iterations);
+        const std::vector<uint32_t> c =
+            cluster_by_normals(s.indices.data(), s.indices.size(), s.positions.data(), s.vertex_count(), 2, iterations);
         for (uint32_t t = box; t < box_end; ++t) EXPECT_EQ(c[t], c[box]) << t << " after " << iterations;
         EXPECT_EQ(c[1], c[0]) << iterations;
         EXPECT_EQ(c[box_end], c[0]) << iterations;
@@ -252,7 +252,8 @@ TEST(PlanarClusters, ClustersAreFlatterThanChanceOnATorusKnot) {
             cluster_by_normals(knot.indices.data(), knot.indices.size(), knot.keyframe(0), knot.vertex_count, k);
         std::vector<std::array<double, 3>> sum(k, {0, 0, 0}), normal(knot.triangle_count());
         for (size_t t = 0; t < knot.triangle_count(); ++t) {
-            const float *a = knot.keyframe(0) + 3 * knot.indices[3 * t], *b = knot.keyframe(0) + 3 * knot.indices[3 * t + 1],
+            const float *a = knot.keyframe(0) + 3 * knot.indices[3 * t],
+                        *b = knot.keyframe(0) + 3 * knot.indices[3 * t + 1],
                         *d = knot.keyframe(0) + 3 * knot.indices[3 * t + 2];
             const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
             std::array<double, 3> n = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
@@ -310,9 +311,9 @@ TEST(PlanarClusters, BadInputThrows) {
     EXPECT_THROW(cluster_by_normals(s.indices.data(), s.indices.size(), nan.data(), s.vertex_count(), 2), InvalidInput);
     const std::vector<uint32_t> bad_cluster(12, 3);
     std::vector<uint32_t> order(12);
-    EXPECT_THROW(tipsify_clusters(order.data(), s.indices.data(), s.indices.size(), s.vertex_count(),
-                                  bad_cluster.data(), 3),
-                 InvalidInput);
+    EXPECT_THROW(
+        tipsify_clusters(order.data(), s.indices.data(), s.indices.size(), s.vertex_count(), bad_cluster.data(), 3),
+        InvalidInput);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -419,8 +420,9 @@ TEST(StaticNehab06, NestedShellsDrawTheOuterShellFirst) {
     OverdrawGraphSettings graph;
     graph.views = 42;
     graph.resolution = 128;
-    const std::vector<Arc> arcs = build_overdraw_graph(s.indices.data(), s.indices.size(), s.positions.data(), 1,
-                                                       s.vertex_count(), nullptr, 0, shell.data(), 2, grouped.data(), graph);
+    const std::vector<Arc> arcs =
+        build_overdraw_graph(s.indices.data(), s.indices.size(), s.positions.data(), 1, s.vertex_count(), nullptr, 0,
+                             shell.data(), 2, grouped.data(), graph);
     ASSERT_EQ(arcs.size(), 1u);
     EXPECT_EQ(arcs[0].from, 1u);  // outer before inner
     EXPECT_EQ(arcs[0].to, 0u);
@@ -438,7 +440,8 @@ TEST(StaticNehab06, NestedShellsDrawTheOuterShellFirst) {
     EXPECT_EQ(r.feedback_arc_count, 0u);
     for (size_t i = 0; i < n; ++i) EXPECT_EQ(order[i] >= inner, i < n - inner) << "position " << i;
 
-    const Framing framing = frame_keyframes(s.positions.data(), 1, s.vertex_count(), s.indices.data(), s.indices.size());
+    const Framing framing =
+        frame_keyframes(s.positions.data(), 1, s.vertex_count(), s.indices.data(), s.indices.size());
     const std::vector<OverdrawNode> nodes = icosphere_nodes({0}, 2);
     const std::vector<uint32_t> ranks = make_rank_table({order.data()}, n);
     std::vector<uint64_t> visible(nodes.size()), passed(nodes.size());
@@ -466,9 +469,9 @@ TEST(StaticNehab06, RowOfOccludersIsDrawnFrontToBackAlongTheRow) {
     tipsify_clusters(grouped.data(), s.indices.data(), s.indices.size(), s.vertex_count(), square.data(), squares);
     OverdrawGraphSettings graph;
     graph.resolution = 128;
-    const std::vector<Arc> arcs = build_overdraw_graph(s.indices.data(), s.indices.size(), s.positions.data(), 1,
-                                                       s.vertex_count(), nullptr, 0, square.data(), squares,
-                                                       grouped.data(), graph);
+    const std::vector<Arc> arcs =
+        build_overdraw_graph(s.indices.data(), s.indices.size(), s.positions.data(), 1, s.vertex_count(), nullptr, 0,
+                             square.data(), squares, grouped.data(), graph);
     EXPECT_EQ(arcs.size(), squares * (squares - 1) / 2);  // every pair overlaps from some view
     for (const Arc& arc : arcs) EXPECT_GT(arc.from, arc.to);
     const std::vector<uint32_t> order = fas(squares, arcs);
@@ -518,8 +521,9 @@ TEST(StaticNehab06, CyclicOverlapKeepsTheHeavierArcs) {
     tipsify_clusters(grouped.data(), s.indices.data(), s.indices.size(), s.vertex_count(), stick.data(), 3);
     OverdrawGraphSettings graph;
     graph.resolution = 128;
-    const std::vector<Arc> arcs = build_overdraw_graph(s.indices.data(), s.indices.size(), s.positions.data(), 1,
-                                                       s.vertex_count(), nullptr, 0, stick.data(), 3, grouped.data(), graph);
+    const std::vector<Arc> arcs =
+        build_overdraw_graph(s.indices.data(), s.indices.size(), s.positions.data(), 1, s.vertex_count(), nullptr, 0,
+                             stick.data(), 3, grouped.data(), graph);
     ASSERT_EQ(arcs.size(), 3u);
     uint64_t lightest = std::numeric_limits<uint64_t>::max();
     for (const Arc& arc : arcs) {
@@ -544,11 +548,13 @@ TEST(StaticNehab06, IdenticalWithOneOrTwoThreadsAndAutomaticClusters) {
     settings.resolution = 128;
     std::vector<uint32_t> a(knot.triangle_count()), b(knot.triangle_count());
     settings.threads = 1;
-    const Nehab06Result ra = order_static_nehab06(a.data(), knot.indices.data(), knot.indices.size(),
-                                                  knot.keyframe_positions.data(), 1, knot.vertex_count, nullptr, 0, settings);
+    const Nehab06Result ra =
+        order_static_nehab06(a.data(), knot.indices.data(), knot.indices.size(), knot.keyframe_positions.data(), 1,
+                             knot.vertex_count, nullptr, 0, settings);
     settings.threads = 2;
-    const Nehab06Result rb = order_static_nehab06(b.data(), knot.indices.data(), knot.indices.size(),
-                                                  knot.keyframe_positions.data(), 1, knot.vertex_count, nullptr, 0, settings);
+    const Nehab06Result rb =
+        order_static_nehab06(b.data(), knot.indices.data(), knot.indices.size(), knot.keyframe_positions.data(), 1,
+                             knot.vertex_count, nullptr, 0, settings);
     EXPECT_TRUE(test::is_permutation_of_iota(a));
     EXPECT_EQ(a, b);
     EXPECT_EQ(ra.cluster_count, rb.cluster_count);
@@ -600,18 +606,18 @@ TEST(StaticNehab06, BeatsSander07AndTipsifyOnTheBundledCharacter) {
         b.orders.push_back(order);
         return b;
     };
-    const auto r = evaluate_methods(mesh, {fixed(original.order), fixed(sander.order), fixed(nehab.order),
-                                           fixed(nehab_all.order)},
-                                    evaluation);
+    const auto r = evaluate_methods(
+        mesh, {fixed(original.order), fixed(sander.order), fixed(nehab.order), fixed(nehab_all.order)}, evaluation);
     const double acmr_original = analyze_mesh_vertex_cache(mesh, original.indices).acmr;
     const double acmr_sander = analyze_mesh_vertex_cache(mesh, sander.indices).acmr;
     const double acmr_nehab = analyze_mesh_vertex_cache(mesh, nehab.indices).acmr;
     const double acmr_nehab_all = analyze_mesh_vertex_cache(mesh, nehab_all.indices).acmr;
-    std::printf("character, 40 random views × every keyframe, 256²: mean OVR / ACMR\n"
-                "  original        %.4f / %.3f\n  static-sander07 %.4f / %.3f\n"
-                "  static-nehab06  %.4f / %.3f (%zu clusters)\n  nehab06 all kf  %.4f / %.3f (%zu clusters)\n",
-                r[0].overall.ovr_mean, acmr_original, r[1].overall.ovr_mean, acmr_sander, r[2].overall.ovr_mean,
-                acmr_nehab, nehab.patch_count, r[3].overall.ovr_mean, acmr_nehab_all, nehab_all.patch_count);
+    std::printf(
+        "character, 40 random views × every keyframe, 256²: mean OVR / ACMR\n"
+        "  original        %.4f / %.3f\n  static-sander07 %.4f / %.3f\n"
+        "  static-nehab06  %.4f / %.3f (%zu clusters)\n  nehab06 all kf  %.4f / %.3f (%zu clusters)\n",
+        r[0].overall.ovr_mean, acmr_original, r[1].overall.ovr_mean, acmr_sander, r[2].overall.ovr_mean, acmr_nehab,
+        nehab.patch_count, r[3].overall.ovr_mean, acmr_nehab_all, nehab_all.patch_count);
     EXPECT_LT(r[2].overall.ovr_mean, r[1].overall.ovr_mean);
     EXPECT_LT(r[2].overall.ovr_mean, r[0].overall.ovr_mean);
     EXPECT_LT(r[3].overall.ovr_mean, r[1].overall.ovr_mean);
@@ -649,9 +655,9 @@ TEST(StaticNehab06, BadInputThrows) {
     std::vector<float> nan = s.positions;
     nan[5] = std::numeric_limits<float>::infinity();
     EXPECT_THROW(run(settings, nullptr, 0, nan.data()), InvalidInput);
-    EXPECT_THROW(order_static_nehab06(order.data(), s.indices.data(), s.indices.size(), nullptr, 0, 8, nullptr, 0,
-                                      settings),
-                 InvalidInput);
+    EXPECT_THROW(
+        order_static_nehab06(order.data(), s.indices.data(), s.indices.size(), nullptr, 0, 8, nullptr, 0, settings),
+        InvalidInput);
     EXPECT_THROW(parse_static_method("static-nehab"), InvalidInput);
     EXPECT_EQ(parse_static_method("static-nehab06"), StaticMethod::StaticNehab06);
     EXPECT_STREQ(method_name(StaticMethod::StaticNehab06), "static-nehab06");

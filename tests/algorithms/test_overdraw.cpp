@@ -66,7 +66,8 @@ TEST(ScoreNodes, IdenticalWithOneOrTwoThreads) {
 
 TEST(ScoreNodes, RejectsAKeyframeOutOfRange) {
     const AnimatedMesh mesh = make_uv_sphere(500);
-    const Framing framing = frame_keyframes(mesh.keyframe(0), 1, mesh.vertex_count, mesh.indices.data(), mesh.indices.size());
+    const Framing framing =
+        frame_keyframes(mesh.keyframe(0), 1, mesh.vertex_count, mesh.indices.data(), mesh.indices.size());
     std::vector<uint32_t> order(mesh.triangle_count());
     for (size_t i = 0; i < order.size(); ++i) order[i] = uint32_t(i);
     const std::vector<uint32_t> ranks = make_rank_table({order.data()}, order.size());

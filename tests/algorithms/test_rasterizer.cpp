@@ -39,8 +39,10 @@ struct Scene {
         auto ndc = [&](float p) { return 2.0f * p / float(resolution) - 1.0f; };
         const uint32_t a = vertex(ndc(x0), ndc(y0), z), b = vertex(ndc(x1), ndc(y0), z),
                        c = vertex(ndc(x1), ndc(y1), z), d = vertex(ndc(x0), ndc(y1), z);
-        if (counter_clockwise) ib.insert(ib.end(), {a, b, c, a, c, d});
-        else ib.insert(ib.end(), {a, c, b, a, d, c});
+        if (counter_clockwise)
+            ib.insert(ib.end(), {a, b, c, a, c, d});
+        else
+            ib.insert(ib.end(), {a, c, b, a, d, c});
     }
     size_t triangles() const { return ib.size() / 3; }
     NodeRasterizer rasterize() const {
@@ -172,8 +174,8 @@ TEST(Rasterizer, SphereFillsTheInscribedDisc) {
     // Framing and camera: the bounding sphere of radius R exactly fits the viewport, so a fine
     // sphere's silhouette covers π(N/2)² pixels (a little less: the mesh is inscribed).
     const AnimatedMesh sphere = make_uv_sphere(40000);
-    const Framing framing = frame_keyframes(sphere.keyframe(0), 1, sphere.vertex_count, sphere.indices.data(),
-                                            sphere.indices.size());
+    const Framing framing =
+        frame_keyframes(sphere.keyframe(0), 1, sphere.vertex_count, sphere.indices.data(), sphere.indices.size());
     const std::vector<float> dirs = icosphere_directions(1);
     for (size_t v = 0; v < 42; v += 7) {
         std::vector<float> clip(sphere.vertex_count * 4);
@@ -233,7 +235,8 @@ TEST(Rasterizer, ScoringManyOrdersEqualsDrawingEachOrderWithAZBuffer) {
             std::vector<uint64_t> passed(orders.size());
             r.score(passed.data(), ranks.data(), orders.size());
             for (size_t o = 0; o < orders.size(); ++o) {
-                EXPECT_EQ(passed[o], brute_force_passed(r, orders[o])) << "view " << v << " keyframe " << k << " order " << o;
+                EXPECT_EQ(passed[o], brute_force_passed(r, orders[o]))
+                    << "view " << v << " keyframe " << k << " order " << o;
                 EXPECT_GE(passed[o], r.visible_pixels());
                 EXPECT_LE(passed[o], r.fragments());
             }
@@ -281,7 +284,7 @@ TEST(Rasterizer, DoubleSidedBackFaceOccludesLikeAFrontFace) {
     const std::vector<uint32_t> ranks = make_rank_table({near_first.data(), far_first.data()}, 4);
     uint64_t passed[2];
     r.score(passed, ranks.data(), 2);
-    EXPECT_EQ(passed[0], 256u);       // near first: the far quad is hidden where the near one lies
+    EXPECT_EQ(passed[0], 256u);        // near first: the far quad is hidden where the near one lies
     EXPECT_EQ(passed[1], 256u + 64u);  // far first: the 64 near fragments pass again
 }
 
@@ -296,7 +299,8 @@ TEST(Rasterizer, DoubleSidedBackFacesCoverTheSamePixelsAsTheirFrontFaces) {
         for (auto& p : v) p[0] = coordinate(rng), p[1] = coordinate(rng), p[2] = depth(rng);
         const uint32_t a = front.vertex(v[0][0], v[0][1], v[0][2]), b = front.vertex(v[1][0], v[1][1], v[1][2]),
                        c = front.vertex(v[2][0], v[2][1], v[2][2]);
-        back.vertex(v[0][0], v[0][1], v[0][2]), back.vertex(v[1][0], v[1][1], v[1][2]), back.vertex(v[2][0], v[2][1], v[2][2]);
+        back.vertex(v[0][0], v[0][1], v[0][2]), back.vertex(v[1][0], v[1][1], v[1][2]),
+            back.vertex(v[2][0], v[2][1], v[2][2]);
         front.ib.insert(front.ib.end(), {a, b, c});
         back.ib.insert(back.ib.end(), {a, c, b});
     }
@@ -354,16 +358,16 @@ TEST(BlendError, HiddenBlendedFragmentsDoNotCount) {
     // An opaque quad at z = 0 over [0,16]²; a blended shell in front (z = −0.5, over [2,6]×[2,6])
     // and behind it (z = −0.2 and z = +0.5 over [8,12]²: one layer hidden by the opaque quad).
     Scene s(16);
-    s.rect(0, 0, 16, 16, 0.0f);    // opaque: 0, 1
-    s.rect(2, 2, 6, 6, -0.5f);     // blended, in front: 2, 3
-    s.rect(8, 8, 12, 12, -0.2f);   // blended, in front: 4, 5
-    s.rect(8, 8, 12, 12, 0.5f);    // blended, hidden: 6, 7
-    s.rect(2, 2, 6, 6, -0.1f);     // blended, in front, behind 2/3: 8, 9
+    s.rect(0, 0, 16, 16, 0.0f);   // opaque: 0, 1
+    s.rect(2, 2, 6, 6, -0.5f);    // blended, in front: 2, 3
+    s.rect(8, 8, 12, 12, -0.2f);  // blended, in front: 4, 5
+    s.rect(8, 8, 12, 12, 0.5f);   // blended, hidden: 6, 7
+    s.rect(2, 2, 6, 6, -0.1f);    // blended, in front, behind 2/3: 8, 9
     const std::vector<uint8_t> blended = {0, 0, 1, 1, 1, 1, 1, 1, 1, 1};
     const BlendCounts c = blend_counts(s, blended, {0, 1, 2, 3, 4, 5, 6, 7, 8, 9});
-    EXPECT_EQ(c.covered, 16u + 16u);        // both 4 × 4 squares; the hidden layer adds nothing
-    EXPECT_EQ(c.pairs, 16u);                // only [2,6]² has two counted layers
-    EXPECT_EQ(c.missorted_pairs, 16u);      // 2/3 (nearer) drawn before 8/9
+    EXPECT_EQ(c.covered, 16u + 16u);    // both 4 × 4 squares; the hidden layer adds nothing
+    EXPECT_EQ(c.pairs, 16u);            // only [2,6]² has two counted layers
+    EXPECT_EQ(c.missorted_pairs, 16u);  // 2/3 (nearer) drawn before 8/9
     EXPECT_EQ(c.missorted_pixels, 16u);
     const BlendCounts back_to_front = blend_counts(s, blended, {0, 1, 8, 9, 6, 7, 4, 5, 2, 3});
     EXPECT_EQ(back_to_front.missorted_pairs, 0u);

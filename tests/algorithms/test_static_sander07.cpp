@@ -19,16 +19,18 @@ void add_triangle(std::vector<float>& positions, std::vector<uint32_t>& ib, floa
     const uint32_t base = uint32_t(positions.size() / 3);
     const float corners[3][3] = {{x, 0, h}, {x + size, 0, h}, {x, size, h}};
     for (const auto& c : corners) positions.insert(positions.end(), c, c + 3);
-    if (up) ib.insert(ib.end(), {base, base + 1, base + 2});
-    else ib.insert(ib.end(), {base, base + 2, base + 1});
+    if (up)
+        ib.insert(ib.end(), {base, base + 1, base + 2});
+    else
+        ib.insert(ib.end(), {base, base + 2, base + 1});
 }
 
 std::vector<uint32_t> sort_each_triangle_a_patch(const std::vector<float>& positions, const std::vector<uint32_t>& ib) {
     const size_t n = ib.size() / 3;
     std::vector<uint32_t> starts(n + 1), order(n);
     for (size_t i = 0; i <= n; ++i) starts[i] = uint32_t(i);
-    sort_patches_sander07(order.data(), ib.data(), ib.size(), positions.data(), positions.size() / 3, 12,
-                          starts.data(), n);
+    sort_patches_sander07(order.data(), ib.data(), ib.size(), positions.data(), positions.size() / 3, 12, starts.data(),
+                          n);
     return order;
 }
 }  // namespace
@@ -72,8 +74,8 @@ TEST(StaticSander07, PatchNormalIsTheAreaWeightedAverageNotTheSum) {
     add_triangle(positions, ib, 10, -1, false, 2);
     const std::vector<uint32_t> starts{0, 2, 3};
     std::vector<uint32_t> order(2);
-    sort_patches_sander07(order.data(), ib.data(), ib.size(), positions.data(), positions.size() / 3, 12,
-                          starts.data(), 2);
+    sort_patches_sander07(order.data(), ib.data(), ib.size(), positions.data(), positions.size() / 3, 12, starts.data(),
+                          2);
     EXPECT_EQ(order, (std::vector<uint32_t>{1, 0}));
 }
 

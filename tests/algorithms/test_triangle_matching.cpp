@@ -59,7 +59,7 @@ TEST(MatchTriangles, FindsShuffledRotatedAndSlightlyMovedCopies) {
 
 TEST(MatchTriangles, LeavesAMirroredMovedOrExtraTriangleUnmatched) {
     const std::vector<float> from = strip(2);
-    std::vector<float> to = {0, 0, 0, 0, 1, 0, 1, 0, 0};             // triangle 0 mirrored (winding flipped)
+    std::vector<float> to = {0, 0, 0, 0, 1, 0, 1, 0, 0};  // triangle 0 mirrored (winding flipped)
     for (float c : {10.f, 0.f, 0.f, 11.f, 0.f, 0.f, 10.f, 1.5f, 0.f}) to.push_back(c);  // a corner moved 0.5
     for (float c : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) to.push_back(c);      // triangle 0 itself
     for (float c : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) to.push_back(c);      // and again: no second match

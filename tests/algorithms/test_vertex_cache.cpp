@@ -52,9 +52,7 @@ TEST(VertexCache, IsFifoNotLru) {
     EXPECT_EQ(stats({0, 1, 2, 0, 3, 4, 0, 2, 5}, 6, 3).misses, 8u);
 }
 
-TEST(VertexCache, DegenerateTriangleLooksUpCornersInTurn) {
-    EXPECT_EQ(stats({0, 0, 1}, 2, 16).misses, 2u);
-}
+TEST(VertexCache, DegenerateTriangleLooksUpCornersInTurn) { EXPECT_EQ(stats({0, 0, 1}, 2, 16).misses, 2u); }
 
 TEST(VertexCache, UnreferencedVerticesDoNotCountInAtvr) {
     const VertexCacheStats s = stats({5, 6, 7}, 100, 16);

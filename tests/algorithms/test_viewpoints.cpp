@@ -33,9 +33,9 @@ TEST(Viewpoints, IcosphereCountsAreUnitAndEvenlySpread) {
             min_angle = std::min(min_angle, nearest);
             max_nearest = std::max(max_nearest, nearest);
         }
-        EXPECT_GT(min_angle, 0.0);                  // no duplicates
-        EXPECT_LT(max_nearest / min_angle, 1.3);    // nearly uniform spacing
-        EXPECT_NEAR(sx, 0.0, 1e-4);                 // symmetric: centroid at the origin
+        EXPECT_GT(min_angle, 0.0);                // no duplicates
+        EXPECT_LT(max_nearest / min_angle, 1.3);  // nearly uniform spacing
+        EXPECT_NEAR(sx, 0.0, 1e-4);               // symmetric: centroid at the origin
         EXPECT_NEAR(sy, 0.0, 1e-4);
         EXPECT_NEAR(sz, 0.0, 1e-4);
     }
@@ -64,8 +64,8 @@ TEST(Viewpoints, RandomDirectionsAreUniformAndSeeded) {
 TEST(Framing, CentresEachKeyframeOnItsBoxAndTakesTheLargestRadius) {
     // Two keyframes of 4 vertices; vertex 3 is unreferenced and far away: it must not count.
     const std::vector<float> keyframes = {
-        0, 0, 0,  2, 0, 0,  0, 4, 0,  100, 100, 100,   // box centre (1, 2, 0), farthest 2.236
-        10, 0, 0, 10, 6, 0, 10, 0, 2, -100, 0, 0};      // box centre (10, 3, 1), farthest 3.162
+        0,  0, 0, 2,  0, 0, 0,  4, 0, 100,  100, 100,  // box centre (1, 2, 0), farthest 2.236
+        10, 0, 0, 10, 6, 0, 10, 0, 2, -100, 0,   0};   // box centre (10, 3, 1), farthest 3.162
     const std::vector<uint32_t> ib{0, 1, 2};
     const Framing f = frame_keyframes(keyframes.data(), 2, 4, ib.data(), ib.size());
     EXPECT_EQ(f.centres, (std::vector<float>{1, 2, 0, 10, 3, 1}));

@@ -95,7 +95,8 @@ TEST(ProceduralCharacter, EveryKeyframeIsClosedAndOutward) {
             const float *a = p + 3 * m.indices[t], *b = p + 3 * m.indices[t + 1], *c = p + 3 * m.indices[t + 2];
             volume += (double(a[0]) * (double(b[1]) * c[2] - double(b[2]) * c[1]) -
                        double(a[1]) * (double(b[0]) * c[2] - double(b[2]) * c[0]) +
-                       double(a[2]) * (double(b[0]) * c[1] - double(b[1]) * c[0])) / 6.0;
+                       double(a[2]) * (double(b[0]) * c[1] - double(b[1]) * c[0])) /
+                      6.0;
         }
         EXPECT_GT(volume, 0.05) << "keyframe " << k;  // a body of tens of litres, outward
         EXPECT_LT(volume, 0.2) << "keyframe " << k;
@@ -113,7 +114,8 @@ TEST(ProceduralCharacter, EveryPartIsOutwardInEveryKeyframe) {
             const float *a = p + 3 * m.indices[t], *b = p + 3 * m.indices[t + 1], *c = p + 3 * m.indices[t + 2];
             volume[component[m.indices[t]]] += (double(a[0]) * (double(b[1]) * c[2] - double(b[2]) * c[1]) -
                                                 double(a[1]) * (double(b[0]) * c[2] - double(b[2]) * c[0]) +
-                                                double(a[2]) * (double(b[0]) * c[1] - double(b[1]) * c[0])) / 6.0;
+                                                double(a[2]) * (double(b[0]) * c[1] - double(b[1]) * c[0])) /
+                                               6.0;
         }
         ASSERT_GE(volume.size(), 7u);  // torso, head, two arms, two legs, shield at least
         for (const auto& [part, v] : volume) EXPECT_GT(v, 1e-4) << "keyframe " << k << ", part of vertex " << part;

@@ -17,7 +17,8 @@ double signed_volume(const AnimatedMesh& m, size_t keyframe) {
         const float *a = p + 3 * m.indices[t], *b = p + 3 * m.indices[t + 1], *c = p + 3 * m.indices[t + 2];
         v += (double(a[0]) * (double(b[1]) * c[2] - double(b[2]) * c[1]) -
               double(a[1]) * (double(b[0]) * c[2] - double(b[2]) * c[0]) +
-              double(a[2]) * (double(b[0]) * c[1] - double(b[1]) * c[0])) / 6.0;
+              double(a[2]) * (double(b[0]) * c[1] - double(b[1]) * c[0])) /
+             6.0;
     }
     return v;
 }

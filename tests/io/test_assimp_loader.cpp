@@ -91,7 +91,8 @@ TEST(Md2, EveryFrameIsAKeyframeAndFrontsFaceOut) {
             const float *a = p + 3 * m.indices[t], *b = p + 3 * m.indices[t + 1], *c = p + 3 * m.indices[t + 2];
             volume += (double(a[0]) * (double(b[1]) * c[2] - double(b[2]) * c[1]) -
                        double(a[1]) * (double(b[0]) * c[2] - double(b[2]) * c[0]) +
-                       double(a[2]) * (double(b[0]) * c[1] - double(b[1]) * c[0])) / 6.0;
+                       double(a[2]) * (double(b[0]) * c[1] - double(b[1]) * c[0])) /
+                      6.0;
         }
         EXPECT_GT(volume, 0.0) << "keyframe " << k;
     }
@@ -125,7 +126,8 @@ TEST(Iqm, SkeletalAnimationMovesAndFrontsFaceOut) {
         const float *a = p + 3 * m.indices[t], *b = p + 3 * m.indices[t + 1], *d = p + 3 * m.indices[t + 2];
         volume += (double(a[0]) * (double(b[1]) * d[2] - double(b[2]) * d[1]) -
                    double(a[1]) * (double(b[0]) * d[2] - double(b[2]) * d[0]) +
-                   double(a[2]) * (double(b[0]) * d[1] - double(b[1]) * d[0])) / 6.0;
+                   double(a[2]) * (double(b[0]) * d[1] - double(b[1]) * d[0])) /
+                  6.0;
     }
     EXPECT_GT(volume, 0.0);
 }
@@ -187,9 +189,11 @@ std::string x_normals(const std::string& index) {
 
 // An MD5 mesh of one triangle over one joint; `tri` is its face, `extra_tris` lines after it.
 std::string md5_mesh(const std::string& tri, const std::string& extra_tris = "") {
-    return "MD5Version 10\ncommandline \"\"\n\nnumJoints 1\nnumMeshes 1\n\njoints {\n\t\"root\"\t-1 ( 0 0 0 ) ( 0 0 0 )\n}\n\n"
+    return "MD5Version 10\ncommandline \"\"\n\nnumJoints 1\nnumMeshes 1\n\njoints {\n\t\"root\"\t-1 ( 0 0 0 ) ( 0 0 0 "
+           ")\n}\n\n"
            "mesh {\n\tshader \"x\"\n\tnumverts 3\n\tvert 0 ( 0 0 ) 0 1\n\tvert 1 ( 1 0 ) 1 1\n\tvert 2 ( 0 1 ) 2 1\n"
-           "\tnumtris 1\n\ttri 0 " + tri + "\n" + extra_tris +
+           "\tnumtris 1\n\ttri 0 " +
+           tri + "\n" + extra_tris +
            "\tnumweights 3\n\tweight 0 0 1.0 ( 0 0 0 )\n\tweight 1 0 1.0 ( 1 0 0 )\n\tweight 2 0 1.0 ( 0 1 0 )\n}\n";
 }
 
@@ -198,11 +202,14 @@ std::string md5_mesh(const std::string& tri, const std::string& extra_tris = "")
 // ticks per second.
 std::string x_skinned(const std::string& bone2, long last_tick = 40) {
     auto frame = [](const std::string& ty) {
-        return std::string("FrameTransformMatrix { 1.0,0.0,0.0,0.0,0.0,1.0,0.0,0.0,0.0,0.0,1.0,0.0,0.0,") + ty + ",0.0,1.0;; }\n";
+        return std::string("FrameTransformMatrix { 1.0,0.0,0.0,0.0,0.0,1.0,0.0,0.0,0.0,0.0,1.0,0.0,0.0,") + ty +
+               ",0.0,1.0;; }\n";
     };
     std::ostringstream s;
-    s << "xof 0303txt 0032\nAnimTicksPerSecond { 25; }\nFrame Root {\n" << frame("0.0") << "Frame Bone1 {\n" << frame("1.0")
-      << "Frame Bone2 {\n" << frame(bone2) << "}\n}\n"
+    s << "xof 0303txt 0032\nAnimTicksPerSecond { 25; }\nFrame Root {\n"
+      << frame("0.0") << "Frame Bone1 {\n"
+      << frame("1.0") << "Frame Bone2 {\n"
+      << frame(bone2) << "}\n}\n"
       << x_mesh("3;0,1,2;;", std::string(" SkinWeights {\n \"Bone1\";\n 1;\n 0;\n 1.0;\n ") + kIdentity + "\n }\n" +
                                  " SkinWeights {\n \"Bone2\";\n 2;\n 1,2;\n 1.0,1.0;\n " + kIdentity + "\n }\n")
       << "}\nAnimationSet walk {\n Animation {\n  { Bone2 }\n  AnimationKey {\n   2;\n   2;\n   0;3;0.0," << bone2
@@ -211,7 +218,8 @@ std::string x_skinned(const std::string& bone2, long last_tick = 40) {
 }
 
 // The LoadError of loading `file` (with `clips`), or "" with a test failure when none.
-std::string load_error(const std::string& file, const std::vector<std::string>& clips = {}, const LoadOptions& options = {}) {
+std::string load_error(const std::string& file, const std::vector<std::string>& clips = {},
+                       const LoadOptions& options = {}) {
     try {
         load_character(file, clips, options);
     } catch (const LoadError& e) {
@@ -228,7 +236,8 @@ TEST_F(AssimpHostile, CraftedFilesThatCrashAssimpGiveOneLineErrors) {
     for (int i = 0; i < 60000; ++i) nested += "Frame f {\n";
     nested += x_mesh();
     for (int i = 0; i < 60000; ++i) nested += "}\n";
-    const std::string skin_weight = std::string(" SkinWeights {\n \"Root\";\n 1;\n -2147483648;\n 1.0;\n ") + kIdentity + "\n }\n";
+    const std::string skin_weight =
+        std::string(" SkinWeights {\n \"Root\";\n 1;\n -2147483648;\n 1.0;\n ") + kIdentity + "\n }\n";
     // Each of these killed the process inside libassimp 5.2.5 (SIGSEGV) before loads were isolated.
     const std::vector<std::string> crashers = {
         write("normal-index-2e31.x", x_file(x_mesh("3;0,1,2;;", x_normals("2147483647")))),
@@ -265,7 +274,8 @@ TEST_F(AssimpHostile, CraftedFilesThatCrashAssimpGiveOneLineErrors) {
 
 TEST_F(AssimpHostile, ACrashInAClipFileNamesTheClipFile) {
     const std::string character = write("character.x", x_skinned("1.0"));
-    const std::string skin_weight = std::string(" SkinWeights {\n \"Root\";\n 1;\n -2147483648;\n 1.0;\n ") + kIdentity + "\n }\n";
+    const std::string skin_weight =
+        std::string(" SkinWeights {\n \"Root\";\n 1;\n -2147483648;\n 1.0;\n ") + kIdentity + "\n }\n";
     const std::string clip = write("clip.x", x_file(x_mesh("3;0,1,2;;", skin_weight)));
     const std::string what = load_error(character, {clip});
     EXPECT_EQ(what.rfind(clip + ": assimp crashed reading it (", 0), 0u) << what;
@@ -281,7 +291,8 @@ TEST_F(AssimpHostile, AGoodFileComesBackFromTheChildWhole) {
     // The triangle's corners, whatever order assimp keeps them in, with z up to a sign (.X is
     // left-handed).
     std::set<std::array<float, 3>> corners;
-    for (size_t v = 0; v < 3; ++v) corners.insert({m.keyframe(0)[3 * v], m.keyframe(0)[3 * v + 1], std::fabs(m.keyframe(0)[3 * v + 2])});
+    for (size_t v = 0; v < 3; ++v)
+        corners.insert({m.keyframe(0)[3 * v], m.keyframe(0)[3 * v + 1], std::fabs(m.keyframe(0)[3 * v + 2])});
     EXPECT_EQ(corners, (std::set<std::array<float, 3>>{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}));
     // The skinned one: Bone2 held at rest, so every keyframe is the bind pose.
     const AnimatedMesh s = load_character(write("skinned.x", x_skinned("1.0")));
@@ -326,7 +337,8 @@ TEST(AssimpCharacters, AnotherCharactersMixamoClipIsRefused) {
     ANIMORDER_REQUIRE_DATA(walk);
     const std::string what = load_error(witch, {walk});
     // The barbarian's forearm is 27.36 cm, the witch's 38.89 cm, her size 236 cm.
-    EXPECT_EQ(what.rfind(walk + ": made for another skeleton than " + witch + "'s: joint 'mixamorig:LeftForeArm'", 0), 0u)
+    EXPECT_EQ(what.rfind(walk + ": made for another skeleton than " + witch + "'s: joint 'mixamorig:LeftForeArm'", 0),
+              0u)
         << what;
     EXPECT_EQ(what.find('\n'), std::string::npos);
     // Her own clips pass (the same rule, the same joints).

@@ -11,9 +11,9 @@
 
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
 #include "support/files.h"
 #include "support/require.h"
-#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <cstdlib>
@@ -38,7 +38,8 @@ AnimatedMesh small_mesh() {
     m.primitives[1].alpha_mode = AlphaMode::Blend;
     const float rest[] = {1, 1, 1, 1, -1, -1, -1, 1, -1, -1, -1, 1, 9, 9, 9, 2, 0, 0, 3, 0, 0, 2, 1, 0};
     for (int k = 0; k < 3; ++k)
-        for (size_t i = 0; i < 24; ++i) m.keyframe_positions.push_back(rest[i] + 0.25f * float(k) * float(i % 3 == 1) + 0.1f * float(k * (i % 5)));
+        for (size_t i = 0; i < 24; ++i)
+            m.keyframe_positions.push_back(rest[i] + 0.25f * float(k) * float(i % 3 == 1) + 0.1f * float(k * (i % 5)));
     m.clips = {{"walk", 1.0 / 30, 30, 0, 2}, {"pose", 0, 24, 2, 1}};
     return m;
 }
@@ -116,8 +117,8 @@ TEST_F(GltfAnimatedWriter, SmallMeshReadsBackExactlyInBothForms) {
             const AnimatedMesh& back = k < 2 ? back30 : back24;
             for (size_t i = 0; i < m.indices.size(); ++i)
                 for (int c = 0; c < 3; ++c)
-                    EXPECT_NEAR(back.keyframe(k)[3 * back.indices[i] + size_t(c)], m.keyframe(k)[3 * m.indices[i] + size_t(c)],
-                                1e-5 * radius(m))
+                    EXPECT_NEAR(back.keyframe(k)[3 * back.indices[i] + size_t(c)],
+                                m.keyframe(k)[3 * m.indices[i] + size_t(c)], 1e-5 * radius(m))
                         << "keyframe " << k << " index " << i;
         }
     }

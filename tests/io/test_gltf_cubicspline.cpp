@@ -42,7 +42,8 @@ protected:
             while (bin.size() % 4) bin.push_back('\0');
             views.push_back({{"buffer", 0}, {"byteOffset", bin.size()}, {"byteLength", bytes}});
             bin.append(static_cast<const char*>(data), bytes);
-            accessors.push_back({{"bufferView", views.size() - 1}, {"componentType", component}, {"count", count}, {"type", type}});
+            accessors.push_back(
+                {{"bufferView", views.size() - 1}, {"componentType", component}, {"count", count}, {"type", type}});
             return accessors.size() - 1;
         };
         const std::vector<uint16_t> indices = {0, 1, 2};
@@ -55,20 +56,23 @@ protected:
         const size_t t = add(times.data(), times.size() * 4, 2, "SCALAR", 5126);
         accessors[t]["min"] = {0.0};
         accessors[t]["max"] = {times[1]};
-        const size_t v = add(keys.data(), keys.size() * 4, keys.size() / components, components == 4 ? "VEC4" : "VEC3", 5126);
+        const size_t v =
+            add(keys.data(), keys.size() * 4, keys.size() / components, components == 4 ? "VEC4" : "VEC3", 5126);
         const json doc = {
             {"asset", {{"version", "2.0"}}},
             {"buffers", json::array({{{"byteLength", bin.size()}, {"uri", "cubic.bin"}}})},
             {"bufferViews", views},
             {"accessors", accessors},
-            {"meshes", json::array({{{"primitives", json::array({{{"attributes", {{"POSITION", p}}}, {"indices", i}}})}}})},
+            {"meshes",
+             json::array({{{"primitives", json::array({{{"attributes", {{"POSITION", p}}}, {"indices", i}}})}}})},
             {"nodes", json::array({{{"name", "moving"}, {"mesh", 0}}})},
             {"scenes", json::array({{{"nodes", {0}}}})},
             {"scene", 0},
             {"animations",
-             json::array({{{"name", "move"},
-                           {"samplers", json::array({{{"input", t}, {"output", v}, {"interpolation", "CUBICSPLINE"}}})},
-                           {"channels", json::array({{{"sampler", 0}, {"target", {{"node", 0}, {"path", target}}}}})}}})}};
+             json::array(
+                 {{{"name", "move"},
+                   {"samplers", json::array({{{"input", t}, {"output", v}, {"interpolation", "CUBICSPLINE"}}})},
+                   {"channels", json::array({{{"sampler", 0}, {"target", {{"node", 0}, {"path", target}}}}})}}})}};
         std::ofstream(path("cubic.bin"), std::ios::binary) << bin;
         std::ofstream(path("cubic.gltf"), std::ios::binary) << doc.dump();
         return path("cubic.gltf").string();
@@ -85,8 +89,8 @@ TEST_F(GltfCubicSpline, TranslationFollowsTheHermiteCurveOffCentre) {
     // p0 = (0,0,0), p1 = (1,2,3); out-tangent of key 0 (10,0,−5) and in-tangent of key 1 (−20,10,5)
     // per second, so over the 0.1 s interval m0 = (1,0,−0.5), m1 = (−2,1,0.5). The other two
     // tangents lie outside the interval and must not matter: they are set to junk.
-    const std::vector<float> keys = {99, 99, 99, 0, 0, 0, 10, 0, -5,  // key 0: in, value, out
-                                     -20, 10, 5, 1, 2, 3, 77, 77, 77};  // key 1
+    const std::vector<float> keys = {99,  99, 99, 0, 0, 0, 10, 0,  -5,   // key 0: in, value, out
+                                     -20, 10, 5,  1, 2, 3, 77, 77, 77};  // key 1
     const AnimatedMesh m = load_gltf(write("translation", keys));
     ASSERT_EQ(m.clips.size(), 1u);
     ASSERT_EQ(m.clips[0].keyframe_count, 4u);  // 0.1 s at 30/s: 0, 1/30, 2/30, 3/30
@@ -115,7 +119,7 @@ TEST_F(GltfCubicSpline, RotationIsTheNormalisedHermiteQuaternion) {
     // Normalised, that is a turn by θ about Z with cos θ = (w² − z²)/(w² + z²) and
     // sin θ = 2zw/(w² + z²): θ ≈ 29.986° and 66.394° (linear slerp would give 30° and 60°).
     const float s = float(std::sqrt(0.5));
-    const std::vector<float> keys = {9, 9, 9, 9, 0, 0, 0, 1, 0, 0, 5, 0,    // key 0: in, value, out
+    const std::vector<float> keys = {9, 9, 9, 9,  0, 0, 0, 1, 0, 0, 5, 0,   // key 0: in, value, out
                                      0, 0, 0, -5, 0, 0, s, s, 9, 9, 9, 9};  // key 1
     const AnimatedMesh m = load_gltf(write("rotation", keys));
     ASSERT_EQ(m.clips.size(), 1u);
@@ -128,9 +132,9 @@ TEST_F(GltfCubicSpline, RotationIsTheNormalisedHermiteQuaternion) {
         const double n = w[k - 1] * w[k - 1] + z[k - 1] * z[k - 1];
         const double c = (w[k - 1] * w[k - 1] - z[k - 1] * z[k - 1]) / n, sn = 2 * z[k - 1] * w[k - 1] / n;
         EXPECT_NEAR(std::atan2(sn, c) * 180 / M_PI, degrees[k - 1], 1e-3);  // the derivation's figure
-        expect_vertex(m, k, 0, 0, 0, 0);    // the origin stays
-        expect_vertex(m, k, 1, c, sn, 0);   // (1,0,0) turned by θ
-        expect_vertex(m, k, 2, -sn, c, 0);  // (0,1,0) turned by θ
+        expect_vertex(m, k, 0, 0, 0, 0);                                    // the origin stays
+        expect_vertex(m, k, 1, c, sn, 0);                                   // (1,0,0) turned by θ
+        expect_vertex(m, k, 2, -sn, c, 0);                                  // (0,1,0) turned by θ
     }
     expect_vertex(m, 3, 1, 0, 1, 0);  // 90° at the last key
 }

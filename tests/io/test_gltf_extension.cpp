@@ -61,8 +61,8 @@ protected:
 
 TEST_F(GltfExtension, TheExampleReadsAsTheReadmeDescribesIt) {
     // The shipped example itself (embedded buffer) and the rebuilt one agree.
-    for (const std::string& file : {(fs::path(ANIMORDER_SOURCE_DIR) / "docs" / "extension" / "example.gltf").string(),
-                                    variant(nullptr)}) {
+    for (const std::string& file :
+         {(fs::path(ANIMORDER_SOURCE_DIR) / "docs" / "extension" / "example.gltf").string(), variant(nullptr)}) {
         const OrdersExtensionCheck r = check_orders_extension(file);
         ASSERT_TRUE(r.errors.empty()) << r.errors.front();
         EXPECT_TRUE(r.present);
@@ -100,23 +100,38 @@ TEST_F(GltfExtension, EveryCorruptionIsReportedOnOneLine) {
         const char* expected;
     };
     const std::vector<Case> cases = {
-        {"no extension", [](json& g) { g.erase("extensions"); g.erase("extensionsUsed"); }, buffer_bytes(),
-         "no ANIMORDER_animated_triangle_orders extension"},
-        {"required", [](json& g) { g["extensionsRequired"] = {kExt}; }, buffer_bytes(), "must not be listed in extensionsRequired"},
-        {"not used", [](json& g) { g["extensionsUsed"] = json::array(); }, buffer_bytes(), "not listed in extensionsUsed"},
+        {"no extension",
+         [](json& g) {
+             g.erase("extensions");
+             g.erase("extensionsUsed");
+         },
+         buffer_bytes(), "no ANIMORDER_animated_triangle_orders extension"},
+        {"required", [](json& g) { g["extensionsRequired"] = {kExt}; }, buffer_bytes(),
+         "must not be listed in extensionsRequired"},
+        {"not used", [](json& g) { g["extensionsUsed"] = json::array(); }, buffer_bytes(),
+         "not listed in extensionsUsed"},
         {"orders out of range", [&](json& g) { prim(g)["orders"] = 99; }, buffer_bytes(), "accessor 99 does not exist"},
         {"orders negative", [&](json& g) { prim(g)["orders"] = -1; }, buffer_bytes(), "orders = -1 is out of range"},
         {"orders of the wrong type", [&](json& g) { prim(g)["orders"] = 0; }, buffer_bytes(), "has the wrong type"},
         {"orders of bytes", [&](json& g) { prim(g)["orders"] = 3; }, buffer_bytes(), "UNSIGNED_BYTE"},
-        {"orders past their view", [](json& g) { g["accessors"][2]["count"] = 14; }, buffer_bytes(), "more than its buffer view holds"},
-        {"orderCount", [&](json& g) { prim(g)["orderCount"] = 3; }, buffer_bytes(), "orderCount 3 differs from bufferCount 2"},
-        {"bufferCount", [&](json& g) { root(g)["bufferCount"] = 3; prim(g)["orderCount"] = 3; }, buffer_bytes(),
-         "orders has 12 elements; orderCount x indices = 18"},
-        {"fallback out of range", [&](json& g) { root(g)["fallback"] = 2; }, buffer_bytes(), "fallback = 2 is out of range"},
-        {"indices not the fallback", [&](json& g) { root(g)["fallback"] = 1; }, buffer_bytes(), "indices differs from order 1"},
+        {"orders past their view", [](json& g) { g["accessors"][2]["count"] = 14; }, buffer_bytes(),
+         "more than its buffer view holds"},
+        {"orderCount", [&](json& g) { prim(g)["orderCount"] = 3; }, buffer_bytes(),
+         "orderCount 3 differs from bufferCount 2"},
+        {"bufferCount",
+         [&](json& g) {
+             root(g)["bufferCount"] = 3;
+             prim(g)["orderCount"] = 3;
+         },
+         buffer_bytes(), "orders has 12 elements; orderCount x indices = 18"},
+        {"fallback out of range", [&](json& g) { root(g)["fallback"] = 2; }, buffer_bytes(),
+         "fallback = 2 is out of range"},
+        {"indices not the fallback", [&](json& g) { root(g)["fallback"] = 1; }, buffer_bytes(),
+         "indices differs from order 1"},
         {"flipped winding", nullptr, buffer_bytes([](std::vector<uint16_t>& o) { std::swap(o[7], o[8]); }),
          "order 1 is not a permutation"},
-        {"other triangle", nullptr, buffer_bytes([](std::vector<uint16_t>& o) { o[11] = 3; }), "order 1 is not a permutation"},
+        {"other triangle", nullptr, buffer_bytes([](std::vector<uint16_t>& o) { o[11] = 3; }),
+         "order 1 is not a permutation"},
         {"table of the wrong size", [&](json& g) { root(g)["clips"][0]["thetaSteps"] = 3; }, buffer_bytes(),
          "table has 4 cells; keyframes x thetaSteps x phiSteps = 6"},
         {"table accessor out of range", [&](json& g) { root(g)["clips"][0]["table"] = 1000; }, buffer_bytes(),
@@ -124,14 +139,24 @@ TEST_F(GltfExtension, EveryCorruptionIsReportedOnOneLine) {
         {"table of shorts", [&](json& g) { root(g)["clips"][0]["table"] = 1; }, buffer_bytes(), "component type 5123"},
         {"cell past bufferCount", [&](json& g) { root(g)["clips"][0]["bufferBase"] = 1; }, buffer_bytes(),
          "names order 2, not below bufferCount 2"},
-        {"thetaSteps 1", [&](json& g) { root(g)["clips"][0]["thetaSteps"] = 1; }, buffer_bytes(), "thetaSteps = 1 is out of range"},
-        {"sampleRate", [&](json& g) { root(g)["clips"][0]["sampleRate"] = 0; }, buffer_bytes(), "sampleRate is missing or not a positive"},
-        {"centers of the wrong type", [&](json& g) { root(g)["clips"][0]["centers"] = 3; }, buffer_bytes(), "centers (accessor 3) has the wrong type"},
-        {"animation out of range", [&](json& g) { root(g)["clips"][0]["animation"] = 5; }, buffer_bytes(), "animation = 5 is out of range"},
+        {"thetaSteps 1", [&](json& g) { root(g)["clips"][0]["thetaSteps"] = 1; }, buffer_bytes(),
+         "thetaSteps = 1 is out of range"},
+        {"sampleRate", [&](json& g) { root(g)["clips"][0]["sampleRate"] = 0; }, buffer_bytes(),
+         "sampleRate is missing or not a positive"},
+        {"centers of the wrong type", [&](json& g) { root(g)["clips"][0]["centers"] = 3; }, buffer_bytes(),
+         "centers (accessor 3) has the wrong type"},
+        {"animation out of range", [&](json& g) { root(g)["clips"][0]["animation"] = 5; }, buffer_bytes(),
+         "animation = 5 is out of range"},
         {"no clips", [&](json& g) { root(g)["clips"] = json::array(); }, buffer_bytes(), "clips is missing or empty"},
-        {"sparse orders", [](json& g) { g["accessors"][2]["sparse"] = {{"count", 1}, {"indices", {{"bufferView", 3}, {"componentType", 5121}}}, {"values", {{"bufferView", 1}}}}; },
+        {"sparse orders",
+         [](json& g) {
+             g["accessors"][2]["sparse"] = {{"count", 1},
+                                            {"indices", {{"bufferView", 3}, {"componentType", 5121}}},
+                                            {"values", {{"bufferView", 1}}}};
+         },
          buffer_bytes(), "is sparse"},
-        {"view outside the buffer", [](json& g) { g["bufferViews"][2]["byteOffset"] = 1000; }, buffer_bytes(), "lies outside its buffer"},
+        {"view outside the buffer", [](json& g) { g["bufferViews"][2]["byteOffset"] = 1000; }, buffer_bytes(),
+         "lies outside its buffer"},
     };
     for (const Case& c : cases) {
         SCOPED_TRACE(c.what);
@@ -165,7 +190,8 @@ TEST_F(GltfExtension, WritingIntoAnotherFileReadsBackTheSame) {
         g.erase("extensionsUsed");
         g["meshes"][0]["primitives"][0].erase("extensions");
     });
-    OrdersExtensionCheck root = read_orders_extension((fs::path(ANIMORDER_SOURCE_DIR) / "docs" / "extension" / "example.gltf").string());
+    OrdersExtensionCheck root =
+        read_orders_extension((fs::path(ANIMORDER_SOURCE_DIR) / "docs" / "extension" / "example.gltf").string());
     root.fallback = 1;
     PrimitiveOrders po;
     po.mesh = 0, po.primitive = 0;

@@ -53,15 +53,22 @@ struct Gltf {
         while (bin.size() % 4) bin.push_back('\0');
         doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", bin.size()}, {"byteLength", bytes}});
         bin.append(static_cast<const char*>(data), bytes);
-        doc["accessors"].push_back(
-            {{"bufferView", doc["bufferViews"].size() - 1}, {"componentType", component}, {"count", count}, {"type", type}});
+        doc["accessors"].push_back({{"bufferView", doc["bufferViews"].size() - 1},
+                                    {"componentType", component},
+                                    {"count", count},
+                                    {"type", type}});
         return int(doc["accessors"].size() - 1);
     }
-    int floats(const std::vector<float>& v, const char* type, size_t per) { return add(v.data(), v.size() * 4, v.size() / per, type, 5126); }
-    int u16(const std::vector<uint16_t>& v, const char* type, size_t per) { return add(v.data(), v.size() * 2, v.size() / per, type, 5123); }
+    int floats(const std::vector<float>& v, const char* type, size_t per) {
+        return add(v.data(), v.size() * 4, v.size() / per, type, 5126);
+    }
+    int u16(const std::vector<uint16_t>& v, const char* type, size_t per) {
+        return add(v.data(), v.size() * 2, v.size() / per, type, 5123);
+    }
     std::string text() {
         json d = doc;
-        d["buffers"] = json::array({{{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + base64(bin)}}});
+        d["buffers"] =
+            json::array({{{"byteLength", bin.size()}, {"uri", "data:application/octet-stream;base64," + base64(bin)}}});
         return d.dump();
     }
 };
@@ -96,20 +103,21 @@ Gltf skinned_bar(const std::string& interpolation = "LINEAR") {
     const std::vector<uint16_t> idx = {0, 1, 2, 0, 2, 3};
     const std::vector<uint16_t> joints = {0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
     const std::vector<float> weights = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
-    const std::vector<float> ibm = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1,    // root at the origin
+    const std::vector<float> ibm = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0,  0, 1,   // root at the origin
                                     1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, -1, 0, 1};  // child at y = 1
     const int p = g.floats(pos, "VEC3", 3), i = g.u16(idx, "SCALAR", 1), j = g.u16(joints, "VEC4", 4),
               w = g.floats(weights, "VEC4", 4), m = g.floats(ibm, "MAT4", 16);
     const double s = std::sqrt(0.5);
     std::vector<float> times = {0, 1}, rot = {0, 0, 0, 1, 0, 0, float(s), float(s)};
-    if (interpolation == "CUBICSPLINE") rot = {0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, float(s), float(s), 0, 0, 0, 0};
+    if (interpolation == "CUBICSPLINE")
+        rot = {0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, float(s), float(s), 0, 0, 0, 0};
     const int t = g.floats(times, "SCALAR", 1), r = g.floats(rot, "VEC4", 4);
     json primitive = {{"attributes", {{"POSITION", p}, {"JOINTS_0", j}, {"WEIGHTS_0", w}}}, {"indices", i}};
     g.doc["meshes"] = json::array({json{{"name", "bar"}, {"primitives", json::array({primitive})}}});
-    g.doc["nodes"] = json::array({json{{"name", "root"}, {"children", {1}}},
-                                  json{{"name", "child"}, {"translation", {0, 1, 0}}},
-                                  // The skinned node's own transform must be ignored (glTF §3.7.3).
-                                  json{{"name", "skinned"}, {"mesh", 0}, {"skin", 0}, {"translation", {100, 0, 0}}}});
+    g.doc["nodes"] =
+        json::array({json{{"name", "root"}, {"children", {1}}}, json{{"name", "child"}, {"translation", {0, 1, 0}}},
+                     // The skinned node's own transform must be ignored (glTF §3.7.3).
+                     json{{"name", "skinned"}, {"mesh", 0}, {"skin", 0}, {"translation", {100, 0, 0}}}});
     g.doc["skins"] = json::array({json{{"joints", {0, 1}}, {"inverseBindMatrices", m}}});
     g.doc["scenes"] = json::array({json{{"nodes", {0, 2}}}});
     g.doc["scene"] = 0;
@@ -141,7 +149,7 @@ TEST_F(GltfLoader, SkinnedBarBendsAsWorkedOutByHand) {
 
 TEST_F(GltfLoader, StepAndCubicSplineInterpolation) {
     const AnimatedMesh step = load_gltf(write("step.gltf", skinned_bar("STEP").text()));
-    expect_position(step, 29, 2, 1, 2, 0);   // holds the first key until t = 1
+    expect_position(step, 29, 2, 1, 2, 0);  // holds the first key until t = 1
     expect_position(step, 30, 2, -1, 2, 0);
     // Zero tangents: Hermite gives 3u² − 2u³ of the way; at u = 0.5 exactly halfway (then normalised).
     const AnimatedMesh cubic = load_gltf(write("cubic.gltf", skinned_bar("CUBICSPLINE").text()));
@@ -162,21 +170,21 @@ TEST_F(GltfLoader, SparseMorphTargetWithAnimatedWeights) {
     const std::vector<float> sparse_value = {0, 0, 2};
     g.u16(sparse_index, "SCALAR", 1);
     g.floats(sparse_value, "VEC3", 3);
-    json sparse = {{"count", 1},
-                   {"indices", {{"bufferView", 2}, {"componentType", 5123}}},
-                   {"values", {{"bufferView", 3}}}};
+    json sparse = {
+        {"count", 1}, {"indices", {{"bufferView", 2}, {"componentType", 5123}}}, {"values", {{"bufferView", 3}}}};
     g.doc["accessors"].push_back({{"componentType", 5126}, {"count", 3}, {"type", "VEC3"}, {"sparse", sparse}});
     const int target = int(g.doc["accessors"].size() - 1);
     const std::vector<float> times = {0, 2}, weights = {0, 1};
     const int t = g.floats(times, "SCALAR", 1), w = g.floats(weights, "SCALAR", 1);
-    json primitive = {{"attributes", {{"POSITION", p}}}, {"indices", i},
-                      {"targets", json::array({json{{"POSITION", target}}})}};
+    json primitive = {
+        {"attributes", {{"POSITION", p}}}, {"indices", i}, {"targets", json::array({json{{"POSITION", target}}})}};
     g.doc["meshes"] = json::array({json{{"primitives", json::array({primitive})}, {"weights", json::array({0.0})}}});
     g.doc["nodes"] = json::array({json{{"mesh", 0}, {"translation", {0, 0, 5}}}});
     g.doc["scenes"] = json::array({json{{"nodes", json::array({0})}}});
     json sampler = {{"input", t}, {"output", w}};
     json channel = {{"sampler", 0}, {"target", {{"node", 0}, {"path", "weights"}}}};
-    g.doc["animations"] = json::array({json{{"samplers", json::array({sampler})}, {"channels", json::array({channel})}}});
+    g.doc["animations"] =
+        json::array({json{{"samplers", json::array({sampler})}, {"channels", json::array({channel})}}});
     const AnimatedMesh m = load_gltf(write("morph.gltf", g.text()));
     EXPECT_EQ(m.morph_target_count, 1u);
     EXPECT_EQ(m.clips[0].keyframe_count, 61u);
@@ -271,22 +279,21 @@ TEST_F(GltfLoader, HostileAccessorsGiveOneLineErrors) {
     }
     {
         Gltf g = skinned_bar();
-        g.doc["accessors"][0]["sparse"] = {{"count", -1},
-                                           {"indices", {{"bufferView", 1}, {"componentType", 5123}}},
-                                           {"values", {{"bufferView", 0}}}};
+        g.doc["accessors"][0]["sparse"] = {
+            {"count", -1}, {"indices", {{"bufferView", 1}, {"componentType", 5123}}}, {"values", {{"bufferView", 0}}}};
         expect_load_error("sparse-count.gltf", g.text(), "substitutes -1 of 4 elements");
     }
     {
         Gltf g = skinned_bar();
-        g.doc["accessors"][0]["sparse"] = {{"count", 1},
-                                           {"indices", {{"bufferView", 0}, {"componentType", 5126}}},
-                                           {"values", {{"bufferView", 0}}}};
+        g.doc["accessors"][0]["sparse"] = {
+            {"count", 1}, {"indices", {{"bufferView", 0}, {"componentType", 5126}}}, {"values", {{"bufferView", 0}}}};
         expect_load_error("sparse-type.gltf", g.text(), "not unsigned integers");
     }
     {
         Gltf g = skinned_bar();  // no buffer view: a billion zeros, 24 GB of doubles
         g.doc["accessors"].push_back({{"componentType", 5126}, {"count", 1000000000}, {"type", "VEC3"}});
-        g.doc["meshes"][0]["primitives"][0]["targets"] = json::array({json{{"POSITION", g.doc["accessors"].size() - 1}}});
+        g.doc["meshes"][0]["primitives"][0]["targets"] =
+            json::array({json{{"POSITION", g.doc["accessors"].size() - 1}}});
         expect_load_error("zeros.gltf", g.text(), "more than the loading budget");
     }
     {
@@ -298,7 +305,8 @@ TEST_F(GltfLoader, HostileAccessorsGiveOneLineErrors) {
     {
         Gltf g = skinned_bar();
         const std::vector<int8_t> joints = {0, 0, 0, 0, 0, 0, 0, 0, -1, 0, 0, 0, 1, 0, 0, 0};
-        g.doc["meshes"][0]["primitives"][0]["attributes"]["JOINTS_0"] = g.add(joints.data(), joints.size(), 4, "VEC4", 5120);
+        g.doc["meshes"][0]["primitives"][0]["attributes"]["JOINTS_0"] =
+            g.add(joints.data(), joints.size(), 4, "VEC4", 5120);
         expect_load_error("negative-joint.gltf", g.text(), "names joint -1");
     }
     {
@@ -329,15 +337,14 @@ TEST_F(GltfLoader, HostileAccessorsGiveOneLineErrors) {
 // scripts/test-sanitized.sh: no memory error, no undefined behaviour).
 TEST_F(GltfLoader, HostileNumbersLoadOrFailCleanly) {
     Gltf bar = skinned_bar();
-    bar.doc["accessors"][0]["sparse"] = {{"count", 1},
-                                         {"indices", {{"bufferView", 1}, {"componentType", 5123}}},
-                                         {"values", {{"bufferView", 0}}}};
-    const json values = json::array({-1, 0, 1, 3, 4, 255, 2147483647LL, 4294967296LL, 9223372036854775807LL,
-                                     18446744073709551615ULL});
+    bar.doc["accessors"][0]["sparse"] = {
+        {"count", 1}, {"indices", {{"bufferView", 1}, {"componentType", 5123}}}, {"values", {{"bufferView", 0}}}};
+    const json values =
+        json::array({-1, 0, 1, 3, 4, 255, 2147483647LL, 4294967296LL, 9223372036854775807LL, 18446744073709551615ULL});
     const std::vector<std::pair<std::string, std::vector<std::string>>> fields = {
-        {"accessors", {"/bufferView", "/byteOffset", "/count", "/componentType", "/sparse/count",
-                       "/sparse/indices/bufferView", "/sparse/indices/byteOffset", "/sparse/values/bufferView",
-                       "/sparse/values/byteOffset"}},
+        {"accessors",
+         {"/bufferView", "/byteOffset", "/count", "/componentType", "/sparse/count", "/sparse/indices/bufferView",
+          "/sparse/indices/byteOffset", "/sparse/values/bufferView", "/sparse/values/byteOffset"}},
         {"bufferViews", {"/buffer", "/byteOffset", "/byteLength", "/byteStride"}}};
     size_t loaded = 0, refused = 0;
     for (const auto& [array, keys] : fields)
@@ -403,10 +410,14 @@ std::string shared_data(const std::string& relative) {
 }  // namespace
 
 TEST(GltfCharacters, EveryGltfInSharedDataLoads) {
-    const char* files[] = {"mixamo-ganfaul/Ganfaul.gltf",     "glb-xbot/Xbot.glb",
-                           "gltf-cesiumman/CesiumMan.glb",     "gltf-fox/Fox.glb",
-                           "glb-robot-expressive/RobotExpressive.glb", "gltf-morph-stress-test/MorphStressTest.gltf",
-                           "gltf-animated-morph-sphere/AnimatedMorphSphere.gltf", "glb-horse-morph/Horse.glb",
+    const char* files[] = {"mixamo-ganfaul/Ganfaul.gltf",
+                           "glb-xbot/Xbot.glb",
+                           "gltf-cesiumman/CesiumMan.glb",
+                           "gltf-fox/Fox.glb",
+                           "glb-robot-expressive/RobotExpressive.glb",
+                           "gltf-morph-stress-test/MorphStressTest.gltf",
+                           "gltf-animated-morph-sphere/AnimatedMorphSphere.gltf",
+                           "glb-horse-morph/Horse.glb",
                            "glb-flamingo-morph/Flamingo.glb"};
     ANIMORDER_REQUIRE_DATA(shared_data(""));
     for (const char* f : files) {
@@ -417,7 +428,8 @@ TEST(GltfCharacters, EveryGltfInSharedDataLoads) {
         EXPECT_GE(m.clips.size(), 1u);
         EXPECT_NO_THROW(validate_animated_mesh(m));
         std::printf("%-52s %6zu triangles %6zu vertices %3zu joints %2zu morph targets %2zu clips %5zu keyframes\n", f,
-                    m.triangle_count(), m.vertex_count, m.joint_count, m.morph_target_count, m.clips.size(), m.keyframe_count());
+                    m.triangle_count(), m.vertex_count, m.joint_count, m.morph_target_count, m.clips.size(),
+                    m.keyframe_count());
     }
 }
 
@@ -449,8 +461,7 @@ TEST_F(GltfLoader, PrimitivesCarryTheirMaterialFlags) {
         if (material >= 0) prim["material"] = material;
         prims.push_back(prim);
     }
-    g.doc["materials"] = json::array({json{{"doubleSided", true}},
-                                      json{{"alphaMode", "BLEND"}},
+    g.doc["materials"] = json::array({json{{"doubleSided", true}}, json{{"alphaMode", "BLEND"}},
                                       json{{"alphaMode", "MASK"}, {"doubleSided", true}},
                                       json{{"alphaMode", "OPAQUE"}, {"doubleSided", false}}});
     g.doc["meshes"] = json::array({json{{"name", "m"}, {"primitives", prims}}});
@@ -459,7 +470,8 @@ TEST_F(GltfLoader, PrimitivesCarryTheirMaterialFlags) {
     const AnimatedMesh m = load_gltf(write("materials.gltf", g.text()));
     ASSERT_EQ(m.primitives.size(), 5u);
     const bool sided[] = {false, true, false, true, false};
-    const AlphaMode mode[] = {AlphaMode::Opaque, AlphaMode::Opaque, AlphaMode::Blend, AlphaMode::Mask, AlphaMode::Opaque};
+    const AlphaMode mode[] = {AlphaMode::Opaque, AlphaMode::Opaque, AlphaMode::Blend, AlphaMode::Mask,
+                              AlphaMode::Opaque};
     for (size_t i = 0; i < 5; ++i) {
         EXPECT_EQ(m.primitives[i].double_sided, sided[i]) << i;
         EXPECT_EQ(m.primitives[i].alpha_mode, mode[i]) << i;

@@ -20,9 +20,9 @@
 
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
 #include "support/files.h"
 #include "support/require.h"
-#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -55,9 +55,8 @@ Written optimise_and_write(const std::string& input, const fs::path& output) {
     s.max_iterations = 3;
     w.method = run_han_sander(w.mesh, false, 0.85, 16, s);
     w.path = output;
-    std::ofstream(output, std::ios::binary)
-        << gltf_with_orders(input, output.string(), w.mesh, w.method.buffers, 1, w.method.framing, "single",
-                            output.extension() == ".glb");
+    std::ofstream(output, std::ios::binary) << gltf_with_orders(
+        input, output.string(), w.mesh, w.method.buffers, 1, w.method.framing, "single", output.extension() == ".glb");
     return w;
 }
 
@@ -100,7 +99,8 @@ TEST_F(GltfWriter, OutputValidatesAndReadsBackWithEveryOrder) {
         EXPECT_EQ(back.vertex_count, w.mesh.vertex_count);
         EXPECT_EQ(back.keyframe_positions, w.mesh.keyframe_positions);
         std::vector<uint32_t> fallback(w.mesh.indices.size());
-        apply_triangle_order(fallback.data(), w.mesh.indices.data(), w.method.buffers.orders[1].data(), w.mesh.triangle_count());
+        apply_triangle_order(fallback.data(), w.mesh.indices.data(), w.method.buffers.orders[1].data(),
+                             w.mesh.triangle_count());
         EXPECT_EQ(back.indices, fallback);
         EXPECT_TRUE(test::same_triangles_same_winding(w.mesh.indices, back.indices));
     }
@@ -114,7 +114,8 @@ TEST_F(GltfWriter, DeterministicAndLeavesTheRestAlone) {
     const std::string text = test::slurp(a.path);
     EXPECT_EQ(text, test::slurp(b.path));
     // Materials, skins, animations and images are still there, and the extension describes the orders.
-    for (const char* key : {"\"materials\"", "\"skins\"", "\"animations\"", "\"images\"", "\"ANIMORDER_animated_triangle_orders\"", "\"orders\"", "\"extensionsUsed\""})
+    for (const char* key : {"\"materials\"", "\"skins\"", "\"animations\"", "\"images\"",
+                            "\"ANIMORDER_animated_triangle_orders\"", "\"orders\"", "\"extensionsUsed\""})
         EXPECT_NE(text.find(key), std::string::npos) << key;
 }
 
@@ -148,7 +149,8 @@ TEST_F(GltfWriter, TheExtensionHoldsEveryOrderAsOneIndexRangeAndTheTables) {
         // Order b is indices [b·n, (b+1)·n): the method's order b of this primitive, local.
         for (size_t b = 0; b < buffers.orders.size(); ++b) {
             std::vector<uint32_t> global(w.mesh.indices.size());
-            apply_triangle_order(global.data(), w.mesh.indices.data(), buffers.orders[b].data(), w.mesh.triangle_count());
+            apply_triangle_order(global.data(), w.mesh.indices.data(), buffers.orders[b].data(),
+                                 w.mesh.triangle_count());
             for (size_t k = 0; k < p.index_count; ++k)
                 ASSERT_EQ(e.orders[b * p.index_count + k], global[p.first_index + k] - p.vertex_base) << b << " " << k;
         }
@@ -159,9 +161,10 @@ TEST_F(GltfWriter, TheExtensionHoldsEveryOrderAsOneIndexRangeAndTheTables) {
         EXPECT_EQ(r.clips[c].buffer_base, buffers.table_base[c]);
         EXPECT_EQ(r.clips[c].keyframes, w.mesh.clips[c].keyframe_count);
         EXPECT_EQ(r.clips[c].animation, int(c));
-        const std::vector<float> centres(w.method.framing.centres.begin() + ptrdiff_t(3 * w.mesh.clips[c].first_keyframe),
-                                         w.method.framing.centres.begin() +
-                                             ptrdiff_t(3 * (w.mesh.clips[c].first_keyframe + w.mesh.clips[c].keyframe_count)));
+        const std::vector<float> centres(
+            w.method.framing.centres.begin() + ptrdiff_t(3 * w.mesh.clips[c].first_keyframe),
+            w.method.framing.centres.begin() +
+                ptrdiff_t(3 * (w.mesh.clips[c].first_keyframe + w.mesh.clips[c].keyframe_count)));
         EXPECT_EQ(r.clips[c].centers, centres);
     }
 }
@@ -172,7 +175,7 @@ TEST_F(GltfWriter, TheExtensionHoldsEveryOrderAsOneIndexRangeAndTheTables) {
 namespace {
 
 int extension_lookup(const ExtensionClip& c, double seconds_since_start, const float camera[3]) {
-    double k = (seconds_since_start) * c.sample_rate;
+    double k = (seconds_since_start)*c.sample_rate;
     k = k != k ? 0.0 : std::floor(k + 0.5);
     const size_t f = k <= 0 ? 0 : (k >= double(c.keyframes - 1) ? c.keyframes - 1 : size_t(k));
     const double d[3] = {double(camera[0]) - c.centers[3 * f], double(camera[1]) - c.centers[3 * f + 1],
@@ -206,7 +209,8 @@ TEST_F(GltfWriter, TheExtensionAndTheSidecarAnswerAlike) {
         for (size_t p = 0; p < w.mesh.primitives.size(); ++p) {
             const Primitive& prim = w.mesh.primitives[p];
             for (size_t k = 0; k < prim.index_count; ++k)
-                ASSERT_EQ(indices[prim.first_index + k], r.primitives[p].orders[b * prim.index_count + k] + prim.vertex_base);
+                ASSERT_EQ(indices[prim.first_index + k],
+                          r.primitives[p].orders[b * prim.index_count + k] + prim.vertex_base);
         }
     }
     size_t probes = 0;

@@ -24,14 +24,35 @@ namespace {
 
 // Header fields (Lee Salzman's iqm.h) by byte offset.
 enum : size_t {
-    kNumText = 28, kOfsText = 32, kNumArrays = 44, kNumVertexes = 48, kOfsArrays = 52, kNumTriangles = 56,
-    kOfsTriangles = 60, kNumJoints = 68, kOfsJoints = 72, kNumPoses = 76, kOfsPoses = 80, kNumAnims = 84,
-    kOfsAnims = 88, kNumFrames = 92, kNumChannels = 96, kOfsFrames = 100
+    kNumText = 28,
+    kOfsText = 32,
+    kNumArrays = 44,
+    kNumVertexes = 48,
+    kOfsArrays = 52,
+    kNumTriangles = 56,
+    kOfsTriangles = 60,
+    kNumJoints = 68,
+    kOfsJoints = 72,
+    kNumPoses = 76,
+    kOfsPoses = 80,
+    kNumAnims = 84,
+    kOfsAnims = 88,
+    kNumFrames = 92,
+    kNumChannels = 96,
+    kOfsFrames = 100
 };
 // Where tiny_iqm() puts its sections.
 enum : size_t {
-    kText = 124, kArrays = 132, kPositions = 192, kBlendIndices = 228, kBlendWeights = 240, kTriangles = 252,
-    kJoints = 264, kPoses = 312, kAnims = 400, kFrames = 420
+    kText = 124,
+    kArrays = 132,
+    kPositions = 192,
+    kBlendIndices = 228,
+    kBlendWeights = 240,
+    kTriangles = 252,
+    kJoints = 264,
+    kPoses = 312,
+    kAnims = 400,
+    kFrames = 420
 };
 
 // Three vertices (0,0,0), (1,0,0), (0,1,0), one triangle, one joint at the origin that carries
@@ -63,19 +84,19 @@ test::ByteImage tiny_iqm() {
     for (size_t i = 0; i < 3; ++i) m.put<uint32_t>(kTriangles + 4 * i, uint32_t(i));
     m.put<uint32_t>(kNumJoints, 1);
     m.put<uint32_t>(kOfsJoints, kJoints);
-    m.put<int32_t>(kJoints + 4, -1);                            // no parent
-    m.put<float>(kJoints + 32, 1.0f);                           // rotation w
+    m.put<int32_t>(kJoints + 4, -1);                                          // no parent
+    m.put<float>(kJoints + 32, 1.0f);                                         // rotation w
     for (size_t c = 0; c < 3; ++c) m.put<float>(kJoints + 36 + 4 * c, 1.0f);  // scale
     m.put<uint32_t>(kNumPoses, 1);
     m.put<uint32_t>(kOfsPoses, kPoses);
     m.put<int32_t>(kPoses, -1);
-    m.put<uint32_t>(kPoses + 4, 1);                              // channel mask: translate x only
-    m.put<float>(kPoses + 8 + 4 * 6, 1.0f);                      // offset of rotation w
+    m.put<uint32_t>(kPoses + 4, 1);                                          // channel mask: translate x only
+    m.put<float>(kPoses + 8 + 4 * 6, 1.0f);                                  // offset of rotation w
     for (size_t c = 7; c < 10; ++c) m.put<float>(kPoses + 8 + 4 * c, 1.0f);  // offsets of scale
-    m.put<float>(kPoses + 48, 1.0f);                             // scale of translate x
+    m.put<float>(kPoses + 48, 1.0f);                                         // scale of translate x
     m.put<uint32_t>(kNumAnims, 1);
     m.put<uint32_t>(kOfsAnims, kAnims);
-    m.put<uint32_t>(kAnims, 1);                                  // name "slide"
+    m.put<uint32_t>(kAnims, 1);  // name "slide"
     m.put<uint32_t>(kAnims + 4, 0);
     m.put<uint32_t>(kAnims + 8, 2);
     m.put<float>(kAnims + 12, 10.0f);
@@ -89,7 +110,9 @@ test::ByteImage tiny_iqm() {
 
 class IqmLoader : public test::BinaryLoaderTest {
 protected:
-    IqmLoader() : BinaryLoaderTest("animorder-iqm", [](const std::string& f, const LoadOptions& o) { return load_iqm(f, o); }) {}
+    IqmLoader()
+        : BinaryLoaderTest("animorder-iqm", [](const std::string& f, const LoadOptions& o) { return load_iqm(f, o); }) {
+    }
 };
 
 }  // namespace
@@ -105,7 +128,8 @@ TEST_F(IqmLoader, TinyModelSlidesAsWorkedOutByHand) {
     const float rest[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
     for (size_t k = 0; k < 4; ++k)
         for (size_t i = 0; i < 9; ++i)
-            EXPECT_NEAR(m.keyframe(k)[i], rest[i] + (i % 3 == 0 ? double(k) : 0.0), 1e-5) << "keyframe " << k << " float " << i;
+            EXPECT_NEAR(m.keyframe(k)[i], rest[i] + (i % 3 == 0 ? double(k) : 0.0), 1e-5)
+                << "keyframe " << k << " float " << i;
 }
 
 TEST_F(IqmLoader, HostileFilesGiveOneLineErrors) {
@@ -117,7 +141,8 @@ TEST_F(IqmLoader, HostileFilesGiveOneLineErrors) {
         m.put<uint32_t>(kAnims + 8, 0x7FFFFFFF);
         expect_error("frames.iqm", m, "loading budget");
     }
-    expect_field_error(tiny_iqm(), "slow.iqm", kAnims + 12, float(1e-30f), "absurdly long"); // 10^30 s at 30 keyframes per second
+    expect_field_error(tiny_iqm(), "slow.iqm", kAnims + 12, float(1e-30f),
+                       "absurdly long");  // 10^30 s at 30 keyframes per second
     expect_field_error(tiny_iqm(), "fast.iqm", kAnims + 12, float(INFINITY), "frame rate");
     {
         test::ByteImage m = tiny_iqm();
@@ -126,7 +151,8 @@ TEST_F(IqmLoader, HostileFilesGiveOneLineErrors) {
         expect_error("channels.iqm", m, "frames past its end");
     }
     expect_field_error(tiny_iqm(), "offset.iqm", kOfsTriangles, uint32_t(0xFFFFFFF0), "triangles past its end");
-    expect_field_error(tiny_iqm(), "positions.iqm", kArrays + 16, uint32_t(0xFFFFFFF0), "positions past its end"); // positions far past the end
+    expect_field_error(tiny_iqm(), "positions.iqm", kArrays + 16, uint32_t(0xFFFFFFF0),
+                       "positions past its end");  // positions far past the end
     {
         test::ByteImage m = tiny_iqm();
         m.put<uint32_t>(kArrays + 20, 0);  // the blend indices array is a second POSITION array
@@ -136,8 +162,9 @@ TEST_F(IqmLoader, HostileFilesGiveOneLineErrors) {
     }
     expect_field_error(tiny_iqm(), "index.iqm", kTriangles + 4, uint32_t(3), "names a vertex past 3");
     expect_field_error(tiny_iqm(), "joint.iqm", kBlendIndices, uint32_t(1), "names joint 1");
-    expect_field_error(tiny_iqm(), "parent.iqm", kJoints + 4, int32_t(0), "parent"); // its own parent
-    expect_field_error(tiny_iqm(), "missing.iqm", kAnims + 4, uint32_t(1), "names missing frames"); // frames 1 and 2 of two
+    expect_field_error(tiny_iqm(), "parent.iqm", kJoints + 4, int32_t(0), "parent");  // its own parent
+    expect_field_error(tiny_iqm(), "missing.iqm", kAnims + 4, uint32_t(1),
+                       "names missing frames");  // frames 1 and 2 of two
     test::ByteImage m = tiny_iqm();
     m.bytes.resize(100);
     expect_error("short.iqm", m, "no IQM header");

@@ -23,7 +23,16 @@ namespace fs = std::filesystem;
 namespace {
 
 // Header fields (id Software's md2.h) by byte offset.
-enum : size_t { kFrameSize = 16, kVertices = 24, kTexCoords = 28, kTriangles = 32, kFrames = 40, kOfsTris = 52, kOfsFrames = 56, kOfsEnd = 64 };
+enum : size_t {
+    kFrameSize = 16,
+    kVertices = 24,
+    kTexCoords = 28,
+    kTriangles = 32,
+    kFrames = 40,
+    kOfsTris = 52,
+    kOfsFrames = 56,
+    kOfsEnd = 64
+};
 
 // Three vertices, one triangle (0, 1, 2), two frames "wave1" and "wave2": frame f has scale
 // (1, 1, 1), translate (0, 0, 10·f) and vertex bytes v0 = (0, 0, 0), v1 = (4, 0, 0), v2 = (0, 8 + 2·f, 0).
@@ -59,7 +68,9 @@ test::ByteImage tiny_md2() {
 
 class Md2Loader : public test::BinaryLoaderTest {
 protected:
-    Md2Loader() : BinaryLoaderTest("animorder-md2", [](const std::string& f, const LoadOptions& o) { return load_md2(f, o); }) {}
+    Md2Loader()
+        : BinaryLoaderTest("animorder-md2", [](const std::string& f, const LoadOptions& o) { return load_md2(f, o); }) {
+    }
 };
 
 }  // namespace
@@ -68,7 +79,7 @@ TEST_F(Md2Loader, TinyModelResamplesAsWorkedOutByHand) {
     const AnimatedMesh m = load_md2(write("tiny.md2", tiny_md2()));
     ASSERT_EQ(m.clips.size(), 1u);
     EXPECT_EQ(m.clips[0].name, "wave");
-    EXPECT_EQ(m.clips[0].keyframe_count, 4u);  // 0.1 s (two frames at 10/s) at 30/s, both ends
+    EXPECT_EQ(m.clips[0].keyframe_count, 4u);                // 0.1 s (two frames at 10/s) at 30/s, both ends
     EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 2, 1}));  // clockwise → counter-clockwise
     // Keyframe k is 1/3·k of the way from frame 0 to frame 1: v2 = (0, 8 + 2k/3, 10k/3).
     for (size_t k = 0; k < 4; ++k) {
@@ -80,7 +91,8 @@ TEST_F(Md2Loader, TinyModelResamplesAsWorkedOutByHand) {
 }
 
 TEST_F(Md2Loader, HostileHeadersGiveOneLineErrors) {
-    expect_field_error(tiny_md2(), "overflow.md2", kVertices, int32_t(0x40000000), "header counts are invalid"); // 40 + 4 · vertices overflows a 32-bit int
+    expect_field_error(tiny_md2(), "overflow.md2", kVertices, int32_t(0x40000000),
+                       "header counts are invalid");  // 40 + 4 · vertices overflows a 32-bit int
     {
         test::ByteImage m = tiny_md2();
         m.put<int32_t>(kVertices, 0x7FFFFFFF);

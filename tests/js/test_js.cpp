@@ -49,9 +49,8 @@ TEST_F(JsTest, RuntimeAnswersExactlyAsTheCRuntime) {
     optimise_character();
     if (HasFatalFailure()) return;
     // The same tables read from the sidecar and from the glb's ANIMORDER_animated_triangle_orders.
-    const test::Outcome o = run("node " + sh(source_dir + "/js/test/equivalence.mjs") + " " +
-                                sh(RUNTIME_ANSWERS_EXE) + " " + sh(path("out.animorder.bin")) + " " +
-                                sh(dir_) + " " + sh(path("out.glb")));
+    const test::Outcome o = run("node " + sh(source_dir + "/js/test/equivalence.mjs") + " " + sh(RUNTIME_ANSWERS_EXE) +
+                                " " + sh(path("out.animorder.bin")) + " " + sh(dir_) + " " + sh(path("out.glb")));
     EXPECT_EQ(o.exit_code, 0) << o.out << o.err;
     // Every answer identical (the script prints one line per source).
     EXPECT_NE(o.out.find("sidecar: 120000 of 120000 answers identical"), std::string::npos) << o.out << o.err;
@@ -77,11 +76,11 @@ bool have_browser(std::string& why) {
 // lines starting "ok" and none "FAIL".
 void run_browser_test(JsTest& t, const fs::path& dir, const std::string& files, const fs::path& shot, size_t checks) {
     fs::create_directories(shot.parent_path());
-    const test::Outcome o = test::run_captured(
-        "node " + sh(source_dir + "/viewer/test/browser.mjs") + " --animorder " + sh(ANIMORDER_EXE) + " --answers " +
-            sh(RUNTIME_ANSWERS_EXE) + " --node-counts " + sh(NODE_COUNTS_EXE) + " --scratch " + sh(dir) + " --screenshot " +
-            sh(shot) + files,
-        dir);
+    const test::Outcome o =
+        test::run_captured("node " + sh(source_dir + "/viewer/test/browser.mjs") + " --animorder " + sh(ANIMORDER_EXE) +
+                               " --answers " + sh(RUNTIME_ANSWERS_EXE) + " --node-counts " + sh(NODE_COUNTS_EXE) +
+                               " --scratch " + sh(dir) + " --screenshot " + sh(shot) + files,
+                           dir);
     (void)t;
     std::cout << o.out;
     EXPECT_EQ(o.exit_code, 0) << o.out << o.err;
@@ -121,10 +120,12 @@ TEST_F(JsTest, ViewServesOnlyTheViewer) {
     std::string why;
     ANIMORDER_REQUIRE_OR_SKIP("node", have_node(why), why);
     const fs::path three = fs::path(source_dir) / "viewer" / "node_modules" / "three";
-    ANIMORDER_REQUIRE_OR_SKIP("browser", fs::exists(three), three.string() + " is absent (run scripts/install-deps.sh)");
+    ANIMORDER_REQUIRE_OR_SKIP("browser", fs::exists(three),
+                              three.string() + " is absent (run scripts/install-deps.sh)");
     const test::Outcome a = run(std::string(ANIMORDER_EXE) + " subdivide -q --levels 0 -o " + sh(path("char.glb")));
     ASSERT_EQ(a.exit_code, 0) << a.err;
-    const test::Outcome o = run("node " + sh(source_dir + "/viewer/test/server.mjs") + " " + sh(ANIMORDER_EXE) + " " + sh(path("char.glb")));
+    const test::Outcome o = run("node " + sh(source_dir + "/viewer/test/server.mjs") + " " + sh(ANIMORDER_EXE) + " " +
+                                sh(path("char.glb")));
     EXPECT_EQ(o.exit_code, 0) << o.out << o.err;
     EXPECT_EQ(test::line_count(o.out), 17u) << o.out;
     EXPECT_EQ(o.out.find("FAIL"), std::string::npos) << o.out;

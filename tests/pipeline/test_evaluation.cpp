@@ -66,7 +66,8 @@ OverdrawSummary direct(const AnimatedMesh& mesh, size_t clip, const std::vector<
                        const EvaluationSettings& settings) {
     const Framing all = frame_animated_mesh(mesh);
     std::vector<uint32_t> keyframes;
-    for (size_t f = 0; f < mesh.clips[clip].keyframe_count; ++f) keyframes.push_back(uint32_t(mesh.clips[clip].first_keyframe + f));
+    for (size_t f = 0; f < mesh.clips[clip].keyframe_count; ++f)
+        keyframes.push_back(uint32_t(mesh.clips[clip].first_keyframe + f));
     const Framing framing = frame_subset(all, keyframes);
     const std::vector<float> directions = random_sphere_directions(settings.views, settings.seed);
     std::vector<OverdrawNode> nodes;
@@ -169,7 +170,8 @@ TEST(Evaluation, OracleShadesEveryPixelOnceWhereFrontToBackIsExact) {
     EvaluationSettings settings;
     settings.views = 80;
     settings.resolution = 128;
-    const auto r = evaluate_methods(mesh, {oracle, fixed(iota_order(mesh.triangle_count())), fixed(plus_x_first)}, settings);
+    const auto r =
+        evaluate_methods(mesh, {oracle, fixed(iota_order(mesh.triangle_count())), fixed(plus_x_first)}, settings);
     EXPECT_DOUBLE_EQ(r[0].overall.ovr_mean, 1.0);
     EXPECT_DOUBLE_EQ(r[0].overall.ovr_pooled, 1.0);
     EXPECT_GT(r[1].overall.ovr_mean, 1.001);  // each fixed order is back to front from half the views

@@ -36,7 +36,8 @@ TEST(StaticMethods, MeshoptIsExactlyMeshoptimizersBuffer) {
     const AnimatedMesh mesh = make_torus_knot(6000);
     std::vector<uint32_t> cache(mesh.indices.size()), expected(mesh.indices.size());
     meshopt_optimizeVertexCache(cache.data(), mesh.indices.data(), mesh.indices.size(), mesh.vertex_count);
-    meshopt_optimizeOverdraw(expected.data(), cache.data(), cache.size(), mesh.keyframe(0), mesh.vertex_count, 12, 1.05f);
+    meshopt_optimizeOverdraw(expected.data(), cache.data(), cache.size(), mesh.keyframe(0), mesh.vertex_count, 12,
+                             1.05f);
     const std::vector<uint32_t> order =
         meshopt_order(mesh.indices.data(), mesh.indices.size(), mesh.keyframe(0), mesh.vertex_count, 16);
     EXPECT_EQ(test::applied(mesh.indices, order), expected);

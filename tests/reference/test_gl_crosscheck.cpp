@@ -63,7 +63,8 @@ AnimatedMesh opaque_character() {
     m.vertex_count = *std::max_element(m.indices.begin(), m.indices.end()) + 1;
     m.keyframe_positions.clear();
     for (size_t k = 0; k < full.keyframe_count(); ++k)
-        m.keyframe_positions.insert(m.keyframe_positions.end(), full.keyframe(k), full.keyframe(k) + 3 * m.vertex_count);
+        m.keyframe_positions.insert(m.keyframe_positions.end(), full.keyframe(k),
+                                    full.keyframe(k) + 3 * m.vertex_count);
     return m;
 }
 
@@ -72,8 +73,8 @@ struct Totals {
     double worst = 0;
 };
 
-void compare_mesh(GlOverdrawReference& gl, const AnimatedMesh& mesh, size_t keyframe, unsigned resolution, Totals& totals,
-                  bool double_sided = false) {
+void compare_mesh(GlOverdrawReference& gl, const AnimatedMesh& mesh, size_t keyframe, unsigned resolution,
+                  Totals& totals, bool double_sided = false) {
     SCOPED_TRACE(mesh.name + " keyframe " + std::to_string(keyframe));
     const Framing framing = frame_animated_mesh(mesh);
     const size_t n = mesh.triangle_count();
@@ -99,7 +100,9 @@ void compare_mesh(GlOverdrawReference& gl, const AnimatedMesh& mesh, size_t keyf
             double d2 = 0;
             for (int d = 0; d < 3; ++d) {
                 const double centroid = (double(p[3 * mesh.indices[3 * t] + d]) + p[3 * mesh.indices[3 * t + 1] + d] +
-                                         p[3 * mesh.indices[3 * t + 2] + d]) / 3.0 - c[d];
+                                         p[3 * mesh.indices[3 * t + 2] + d]) /
+                                            3.0 -
+                                        c[d];
                 d2 += (centroid - eye[d]) * (centroid - eye[d]);
             }
             distance[t] = d2;
@@ -132,7 +135,8 @@ void compare_mesh(GlOverdrawReference& gl, const AnimatedMesh& mesh, size_t keyf
             EXPECT_LE(relative, kTolerance) << what << " view " << v << ": ours " << a << ", OpenGL " << b;
         };
         check(ours.visible_pixels(), reference.visible, "visible");
-        for (size_t o = 0; o < 3; ++o) check(passed[o], reference.passed[o], o == 0 ? "tipsify" : o == 1 ? "random" : "front-to-back");
+        for (size_t o = 0; o < 3; ++o)
+            check(passed[o], reference.passed[o], o == 0 ? "tipsify" : o == 1 ? "random" : "front-to-back");
     }
 }
 

@@ -6,7 +6,8 @@
 #include <gtest/gtest.h>
 
 TEST(GlReference, OpenGLWasFoundAtConfigureTime) {
-    ANIMORDER_REQUIRE_OR_SKIP("gl", false,
-                              "OpenGL/EGL was not found at configure time: the OpenGL cross-check and the rendering-time "
-                              "check were not built (install libegl-dev and libopengl-dev, then reconfigure)");
+    ANIMORDER_REQUIRE_OR_SKIP(
+        "gl", false,
+        "OpenGL/EGL was not found at configure time: the OpenGL cross-check and the rendering-time "
+        "check were not built (install libegl-dev and libopengl-dev, then reconfigure)");
 }

@@ -79,7 +79,8 @@ TEST(Runtime, BuffersAreTheOrdersAppliedToTheMesh) {
     ASSERT_EQ(rt.index_count, f.mesh.indices.size());
     std::vector<uint32_t> expected(f.mesh.indices.size());
     for (size_t b = 0; b < rt.buffer_count; ++b) {
-        apply_triangle_order(expected.data(), f.mesh.indices.data(), f.result.buffers.orders[b].data(), f.mesh.triangle_count());
+        apply_triangle_order(expected.data(), f.mesh.indices.data(), f.result.buffers.orders[b].data(),
+                             f.mesh.triangle_count());
         const uint32_t* got = animorder_buffer(&rt, int(b));
         ASSERT_NE(got, nullptr);
         EXPECT_TRUE(std::equal(expected.begin(), expected.end(), got)) << "buffer " << b;
@@ -139,7 +140,7 @@ constexpr size_t kClip = 20, kBuffers = 52, kCells = 100, kCentres = 124, kTinyS
 std::string tiny_sidecar() {
     std::string out = header(4, 3, 1);
     for (uint32_t v : {2u, 3u, 4u}) put_u32(out, v);  // keyframes, theta_steps, phi_steps
-    put_f32(out, 10.0f);                               // sample rate
+    put_f32(out, 10.0f);                              // sample rate
     for (uint32_t v : {0u, uint32_t(kCells), uint32_t(kCentres), 0u}) put_u32(out, v);
     for (uint32_t b = 0; b < 4; ++b)
         for (uint32_t i = 0; i < 3; ++i) put_u32(out, 10 * b + i);
@@ -169,10 +170,10 @@ TEST(RuntimeHostile, TinyHandBuiltSidecarAnswersTheHandWorkedCells) {
     EXPECT_EQ(rt.index_count, 3u);
     EXPECT_EQ(rt.clip_count, 1u);
     const float up[3] = {0, 5, 0}, right[3] = {5, 0, 0}, back[3] = {0, 0, -5};
-    const float almost_front[3] = {-0.001f, 0, 5};  // φ just under 2π rounds to cell j = 0
-    EXPECT_EQ(animorder_select_keyframe(&rt, 0, 0, up, nullptr), 0);          // θ 0 → i 0, j 0
-    EXPECT_EQ(animorder_select_keyframe(&rt, 0, 0, right, nullptr), 1);       // θ π/2, φ π/2 → (1, 1)
-    EXPECT_EQ(animorder_select_keyframe(&rt, 0, 0, back, nullptr), 2);        // θ π/2, φ π → (1, 2)
+    const float almost_front[3] = {-0.001f, 0, 5};                       // φ just under 2π rounds to cell j = 0
+    EXPECT_EQ(animorder_select_keyframe(&rt, 0, 0, up, nullptr), 0);     // θ 0 → i 0, j 0
+    EXPECT_EQ(animorder_select_keyframe(&rt, 0, 0, right, nullptr), 1);  // θ π/2, φ π/2 → (1, 1)
+    EXPECT_EQ(animorder_select_keyframe(&rt, 0, 0, back, nullptr), 2);   // θ π/2, φ π → (1, 2)
     EXPECT_EQ(animorder_select_keyframe(&rt, 0, 0, almost_front, nullptr), 3);  // (1, 0)
     // Keyframe 1, its stored centre (10, 0, 0): straight below → θ π → i 2, j 0.
     const float below_second[3] = {10, -5, 0};

@@ -50,9 +50,9 @@ class ScratchFolderTest : public ::testing::Test {
 protected:
     explicit ScratchFolderTest(std::string prefix) : prefix_(std::move(prefix)) {}
     void SetUp() override {
-        dir_ = std::filesystem::temp_directory_path() /
-               (prefix_ + "-" + std::to_string(::getpid()) + "-" +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        dir_ =
+            std::filesystem::temp_directory_path() / (prefix_ + "-" + std::to_string(::getpid()) + "-" +
+                                                      ::testing::UnitTest::GetInstance()->current_test_info()->name());
         std::filesystem::remove_all(dir_);
         std::filesystem::create_directories(dir_);
     }
@@ -85,7 +85,8 @@ inline bool validator_available(std::string& why) {
 // Runs the validator on `file`: true when it reports no error; `report` gets its output. The
 // output is captured in `scratch` (the test's own folder), never next to `file`, which may be
 // read-only data.
-inline bool validate_gltf(const std::filesystem::path& file, std::string& report, const std::filesystem::path& scratch) {
+inline bool validate_gltf(const std::filesystem::path& file, std::string& report,
+                          const std::filesystem::path& scratch) {
     const std::filesystem::path script =
         std::filesystem::path(ANIMORDER_SOURCE_DIR) / "tools" / "validate" / "validate_gltf.js";
     std::string why;

@@ -40,7 +40,8 @@ inline bool requires_component(const char* requirement, const std::string& compo
         const size_t first = item.find_first_not_of(" \t"), last = item.find_last_not_of(" \t");
         item = first == std::string::npos ? "" : item.substr(first, last - first + 1);
         if (item.empty()) continue;
-        if (item == "all" || item == component) found = true;
+        if (item == "all" || item == component)
+            found = true;
         else if (!known_component(item))
             ADD_FAILURE() << "ANIMORDER_REQUIRE names an unknown component '" << item
                           << "' (known: gl, validator, data, results, gltf-tools, node, browser, all)";
@@ -65,19 +66,19 @@ inline std::filesystem::path shared_data_path(const std::string& relative = "") 
 
 // Skips the test with `reason` when `condition` is false, or fails it when ANIMORDER_REQUIRE
 // requires `component`.
-#define ANIMORDER_REQUIRE_OR_SKIP(component, condition, reason)                                            \
-    do {                                                                                                   \
-        /* read first, so a typo in ANIMORDER_REQUIRE fails even where everything is present */           \
-        const bool animorder_required_ = ::animorder::test::required(component);                          \
-        if (!(condition)) {                                                                                \
-            if (animorder_required_)                                                                       \
-                FAIL() << "required " << (component) << " (ANIMORDER_REQUIRE) is missing: " << reason;     \
-            else                                                                                           \
-                GTEST_SKIP() << (component) << " missing: " << reason;                                     \
-        }                                                                                                  \
+#define ANIMORDER_REQUIRE_OR_SKIP(component, condition, reason)                                        \
+    do {                                                                                               \
+        /* read first, so a typo in ANIMORDER_REQUIRE fails even where everything is present */        \
+        const bool animorder_required_ = ::animorder::test::required(component);                       \
+        if (!(condition)) {                                                                            \
+            if (animorder_required_)                                                                   \
+                FAIL() << "required " << (component) << " (ANIMORDER_REQUIRE) is missing: " << reason; \
+            else                                                                                       \
+                GTEST_SKIP() << (component) << " missing: " << reason;                                 \
+        }                                                                                              \
     } while (0)
 
 // Skips (or fails, when data is required) unless the file or folder DATA_PATH of ../shared/data exists.
-#define ANIMORDER_REQUIRE_DATA(data_path)                                                                   \
-    ANIMORDER_REQUIRE_OR_SKIP("data", std::filesystem::exists(data_path),                                   \
+#define ANIMORDER_REQUIRE_DATA(data_path)                                 \
+    ANIMORDER_REQUIRE_OR_SKIP("data", std::filesystem::exists(data_path), \
                               std::filesystem::path(data_path).string() + " is absent (../shared/data)")

@@ -49,7 +49,9 @@ TEST(Require, RequiredAndMissingFailsWithTheReason) {
     ::setenv("ANIMORDER_REQUIRE", "all", 1);
     EXPECT_FATAL_FAILURE(missing_gl(), "required gl (ANIMORDER_REQUIRE) is missing");
     EXPECT_NO_FATAL_FAILURE(present_gl());  // present: neither a failure nor a skip
-    if (before) ::setenv("ANIMORDER_REQUIRE", saved.c_str(), 1);
-    else ::unsetenv("ANIMORDER_REQUIRE");
+    if (before)
+        ::setenv("ANIMORDER_REQUIRE", saved.c_str(), 1);
+    else
+        ::unsetenv("ANIMORDER_REQUIRE");
     EXPECT_FALSE(::testing::Test::IsSkipped());
 }

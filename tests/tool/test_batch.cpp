@@ -10,6 +10,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <sys/wait.h>
+#include <unistd.h>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -17,9 +19,7 @@
 #include <fstream>
 #include <map>
 #include <string>
-#include <sys/wait.h>
 #include <thread>
-#include <unistd.h>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -38,14 +38,19 @@ protected:
         ScratchFolderTest::SetUp();
         fs::create_directories(path("out"));
     }
-    test::Outcome run(const std::string& args) { return test::run_captured(std::string(ANIMORDER_EXE) + " " + args, dir_); }
+    test::Outcome run(const std::string& args) {
+        return test::run_captured(std::string(ANIMORDER_EXE) + " " + args, dir_);
+    }
     std::string manifest() const { return path("m.json").string(); }
-    void write(const std::string& name, const std::string& text) { std::ofstream(path(name), std::ios::binary) << text; }
+    void write(const std::string& name, const std::string& text) {
+        std::ofstream(path(name), std::ios::binary) << text;
+    }
 
     // Every regular file under out/ (name → bytes), temporaries included.
     std::map<std::string, std::string> outputs() const {
         std::map<std::string, std::string> files;
-        for (const auto& e : fs::directory_iterator(path("out"))) files[e.path().filename().string()] = test::slurp(e.path());
+        for (const auto& e : fs::directory_iterator(path("out")))
+            files[e.path().filename().string()] = test::slurp(e.path());
         return files;
     }
 };
@@ -66,7 +71,8 @@ TEST_F(Batch, ThreeParallelShardsGiveTheFilesAndSummaryOfOneRun) {
     const test::Outcome one = run("batch -q --no-timings" + kEval + " " + manifest());
     ASSERT_EQ(one.exit_code, 0) << one.err;
     const std::map<std::string, std::string> single_run = outputs();
-    const std::string summary_json = test::slurp(path("m.summary.json")), summary_md = test::slurp(path("m.summary.md"));
+    const std::string summary_json = test::slurp(path("m.summary.json")),
+                      summary_md = test::slurp(path("m.summary.md"));
     ASSERT_EQ(single_run.size(), 5u * 3u);  // sidecar, its description and the item report each
     for (const auto& [name, bytes] : single_run) EXPECT_NE(name[0], '.') << name << ": a temporary was left";
 
@@ -121,18 +127,24 @@ TEST_F(Batch, ThreeParallelShardsGiveTheFilesAndSummaryOfOneRun) {
 
     // The shard index from a farm's environment.
     const test::Outcome k8s = test::run_captured("env JOB_COMPLETION_INDEX=1 " + std::string(ANIMORDER_EXE) +
-                                  " batch -q --no-timings" + kEval + " --shard env/3 " + manifest(), dir_);
+                                                     " batch -q --no-timings" + kEval + " --shard env/3 " + manifest(),
+                                                 dir_);
     EXPECT_EQ(k8s.exit_code, 0) << k8s.err;
     EXPECT_NE(k8s.out.find("shard 1/3: 2 items: 0 done, 2 up to date"), std::string::npos) << k8s.out;
-    const test::Outcome slurm = test::run_captured("env -u JOB_COMPLETION_INDEX SLURM_ARRAY_TASK_ID=2 " +
-                                                   std::string(ANIMORDER_EXE) + " batch -q --no-timings" + kEval +
-                                                   " --shard env/3 " + manifest(), dir_);
+    const test::Outcome slurm =
+        test::run_captured("env -u JOB_COMPLETION_INDEX SLURM_ARRAY_TASK_ID=2 " + std::string(ANIMORDER_EXE) +
+                               " batch -q --no-timings" + kEval + " --shard env/3 " + manifest(),
+                           dir_);
     EXPECT_NE(slurm.out.find("shard 2/3: 1 items"), std::string::npos) << slurm.out;
 }
 
 TEST_F(Batch, CsvManifestIsTheJsonManifest) {
-    write("m.json", R"({"items": [{"clips": ["walk", "wave"], "options": "-k 2 --views 12 --resolution 32 --max-iterations 2", "output": "out/a"}]})");
-    write("m.csv", "input,clips,method,options,output\n,walk;wave,single,\"-k 2 --views 12 --resolution 32 --max-iterations 2\",out/b\n");
+    write(
+        "m.json",
+        R"({"items": [{"clips": ["walk", "wave"], "options": "-k 2 --views 12 --resolution 32 --max-iterations 2", "output": "out/a"}]})");
+    write("m.csv",
+          "input,clips,method,options,output\n,walk;wave,single,\"-k 2 --views 12 --resolution 32 --max-iterations "
+          "2\",out/b\n");
     ASSERT_EQ(run("batch -q --eval-views 0 " + manifest()).exit_code, 0);
     const test::Outcome csv = run("batch -q --eval-views 0 " + path("m.csv").string());
     ASSERT_EQ(csv.exit_code, 0) << csv.err;
@@ -145,8 +157,9 @@ TEST_F(Batch, KilledRunResumesWithoutRedoingFinishedItems) {
     // Items slow enough (about a second each) that the kill lands while one is being made.
     std::string items;
     for (int i = 0; i < 4; ++i)
-        items += std::string(i ? "," : "") + R"({"options": "-k 3 --views 42 --resolution 48 --max-iterations 2 --seed )" +
-                 std::to_string(i + 1) + R"(", "output": "out/item)" + std::to_string(i) + "\"}";
+        items += std::string(i ? "," : "") +
+                 R"({"options": "-k 3 --views 42 --resolution 48 --max-iterations 2 --seed )" + std::to_string(i + 1) +
+                 R"(", "output": "out/item)" + std::to_string(i) + "\"}";
     write("m.json", "{\"items\": [" + items + "]}");
     const pid_t child = fork();
     ASSERT_GE(child, 0);
@@ -187,13 +200,15 @@ TEST_F(Batch, KilledRunResumesWithoutRedoingFinishedItems) {
         << again.out;
     for (const auto& [stem, bytes] : reports)  // wall times included: a redone item would differ
         EXPECT_EQ(test::slurp(stem + ".animorder.report.json"), bytes) << stem;
-    for (const auto& [name, bytes] : outputs()) EXPECT_NE(name[0], '.') << name << ": the killed run's temporary remains";
+    for (const auto& [name, bytes] : outputs())
+        EXPECT_NE(name[0], '.') << name << ": the killed run's temporary remains";
     const nlohmann::json s = nlohmann::json::parse(test::slurp(path("m.summary.json")));
     EXPECT_EQ(s["ok"], 4);
 }
 
 TEST_F(Batch, ABrokenItemFailsAloneAndTheExitCodeSaysSo) {
-    write("broken.gltf", "{\"asset\": {\"version\": \"2.0\"}, \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 7}}]}]}");
+    write("broken.gltf",
+          "{\"asset\": {\"version\": \"2.0\"}, \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 7}}]}]}");
     write("m.json", R"({"items": [
       {"name": "good", "method": "static-sander07", "output": "out/good"},
       {"name": "broken", "input": "broken.gltf", "method": "static-sander07", "output": "out/broken"},
@@ -237,7 +252,8 @@ TEST_F(Batch, AChangedOptionRerunsOnlyTheItemsItAffects) {
     auto manifest_with = [&](const std::string& k_of_b) {
         write("m.json", R"({"items": [
           {"name": "a", "clips": ["walk"], "options": "-k 2 --views 12 --resolution 32 --max-iterations 2", "output": "out/a"},
-          {"name": "b", "clips": ["wave"], "options": "-k )" + k_of_b + R"( --views 12 --resolution 32 --max-iterations 2", "output": "out/b"},
+          {"name": "b", "clips": ["wave"], "options": "-k )" +
+                            k_of_b + R"( --views 12 --resolution 32 --max-iterations 2", "output": "out/b"},
           {"name": "c", "method": "static-sander07", "output": "out/c"}
         ]})");
     };
@@ -255,7 +271,8 @@ TEST_F(Batch, AChangedOptionRerunsOnlyTheItemsItAffects) {
     ASSERT_EQ(changed.exit_code, 0) << changed.err;
     EXPECT_NE(changed.out.find("1 done, 2 up to date"), std::string::npos) << changed.out;
     const std::map<std::string, std::string> second = outputs();
-    for (const char* name : {"a.animorder.bin", "a.animorder.report.json", "c.animorder.bin", "c.animorder.report.json"})
+    for (const char* name :
+         {"a.animorder.bin", "a.animorder.report.json", "c.animorder.bin", "c.animorder.report.json"})
         EXPECT_EQ(second.at(name), first.at(name)) << name;
     EXPECT_NE(second.at("b.animorder.bin"), first.at("b.animorder.bin"));
     EXPECT_EQ(nlohmann::json::parse(second.at("b.animorder.report.json"))["settings"]["clusters"], 3);
@@ -279,13 +296,14 @@ TEST_F(Batch, EveryOutputIsCheckedBeforeAnyWork) {
     EXPECT_TRUE(outputs().empty());  // the first item did not run either
 
     write("prev.animorder.bin", "an input that an output would replace");
-    for (const char* bad : {
-             R"({"items": [{"input": "prev.animorder.bin", "output": "out/x"}, {"method": "original", "output": "prev"}]})",
-             R"({"items": [{"method": "original", "output": "out/x"}, {"method": "original", "output": "out/x"}]})",
-             R"({"items": [{"method": "original", "output": "out/x", "colour": "red"}]})",
-             R"({"items": [{"method": "nonsense", "output": "out/x"}]})",
-             R"({"items": [{"method": "original", "options": "-o elsewhere", "output": "out/x"}]})",
-             R"({"items": [{"method": "original"}]})", "not json"}) {
+    for (
+        const char* bad :
+        {R"({"items": [{"input": "prev.animorder.bin", "output": "out/x"}, {"method": "original", "output": "prev"}]})",
+         R"({"items": [{"method": "original", "output": "out/x"}, {"method": "original", "output": "out/x"}]})",
+         R"({"items": [{"method": "original", "output": "out/x", "colour": "red"}]})",
+         R"({"items": [{"method": "nonsense", "output": "out/x"}]})",
+         R"({"items": [{"method": "original", "options": "-o elsewhere", "output": "out/x"}]})",
+         R"({"items": [{"method": "original"}]})", "not json"}) {
         write("m.json", bad);  // NOLINT
         const test::Outcome e = run("batch -q " + manifest());
         EXPECT_EQ(e.exit_code, 1) << bad;

@@ -2,10 +2,11 @@
 // report's schema, atomic and deterministic output.
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
 #include "support/files.h"
 #include "support/require.h"
-#include <nlohmann/json.hpp>
 
+#include <sys/wait.h>
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -13,7 +14,6 @@
 #include <fstream>
 #include <sstream>
 #include <string>
-#include <sys/wait.h>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -24,7 +24,9 @@ namespace {
 class Cli : public test::ScratchFolderTest {
 protected:
     Cli() : ScratchFolderTest("animorder-cli") {}
-    test::Outcome run(const std::string& args) { return test::run_captured(std::string(ANIMORDER_EXE) + " " + args, dir_); }
+    test::Outcome run(const std::string& args) {
+        return test::run_captured(std::string(ANIMORDER_EXE) + " " + args, dir_);
+    }
 };
 
 }  // namespace
@@ -49,8 +51,9 @@ TEST_F(Cli, MaterialsBlendReportAndHeatmap) {
     EXPECT_EQ(j["primitives"][2]["name"], "hair");
     EXPECT_EQ(j["primitives"][2]["alpha_mode"], "BLEND");
     EXPECT_EQ(j["primitives"][3]["double_sided"], true);
-    const test::Outcome e = run("evaluate -q --methods original,static-sander07 --eval-views 2 --eval-resolution 64 -r " +
-                                path("b.json").string());
+    const test::Outcome e =
+        run("evaluate -q --methods original,static-sander07 --eval-views 2 --eval-resolution 64 -r " +
+            path("b.json").string());
     ASSERT_EQ(e.exit_code, 0) << e.err;
     EXPECT_NE(e.out.find("back-to-front per node (bound)"), std::string::npos) << e.out;
     const nlohmann::json r = nlohmann::json::parse(test::slurp(path("b.json")));
@@ -77,7 +80,7 @@ TEST_F(Cli, QuietSilencesStderr) {
 
 TEST_F(Cli, OptimizeWritesIndicesAndReport) {
     const test::Outcome o = run("optimize -q --method static-sander07 --lambda 0.85 -o " + path("ib").string() +
-                          " --report " + path("report.json").string());
+                                " --report " + path("report.json").string());
     ASSERT_EQ(o.exit_code, 0) << o.err;
     const nlohmann::json j = nlohmann::json::parse(test::slurp(path("report.json")));
     for (const char* key : {"tool", "version", "input", "triangles", "vertices", "settings", "methods", "timings_s"})
@@ -111,9 +114,12 @@ TEST_F(Cli, SingleWritesKBuffersPerClipAndReportsIterations) {
     // Small settings so the test stays quick; the full defaults run in the benchmarks.
     const std::string fast = " -q -k 3 --views 12 --resolution 48 --max-iterations 4";
     ASSERT_EQ(run("optimize --method single" + fast + " --threads 1 -o " + path("s1").string() + " --report " +
-                  path("r.json").string()).exit_code, 0);
+                  path("r.json").string())
+                  .exit_code,
+              0);
     ASSERT_EQ(run("optimize --method single" + fast + " --threads 2 -o " + path("s2").string()).exit_code, 0);
-    EXPECT_EQ(test::slurp(path("s1.animorder.bin")), test::slurp(path("s2.animorder.bin")));  // thread count changes nothing
+    EXPECT_EQ(test::slurp(path("s1.animorder.bin")),
+              test::slurp(path("s2.animorder.bin")));  // thread count changes nothing
     const nlohmann::json j = nlohmann::json::parse(test::slurp(path("r.json")));
     const nlohmann::json& m = j["methods"][0];
     EXPECT_EQ(m["name"], "single");
@@ -133,7 +139,9 @@ TEST_F(Cli, SingleWritesKBuffersPerClipAndReportsIterations) {
 TEST_F(Cli, MeasuredOptimizesJointAndEvaluates) {
     const std::string fast = " -q -k 3 --views 12 --resolution 48 --max-iterations 4";
     ASSERT_EQ(run("optimize --method measured" + fast + " --threads 1 -o " + path("m1").string() + " --report " +
-                  path("r.json").string()).exit_code, 0);
+                  path("r.json").string())
+                  .exit_code,
+              0);
     ASSERT_EQ(run("optimize --method measured" + fast + " --threads 2 -o " + path("m2").string()).exit_code, 0);
     EXPECT_EQ(test::slurp(path("m1.animorder.bin")), test::slurp(path("m2.animorder.bin")));
     const nlohmann::json j = nlohmann::json::parse(test::slurp(path("r.json")));
@@ -143,8 +151,8 @@ TEST_F(Cli, MeasuredOptimizesJointAndEvaluates) {
     const nlohmann::json joint = nlohmann::json::parse(test::slurp(path("j.json")));
     EXPECT_EQ(joint["methods"][0]["name"], "measured-joint");
     EXPECT_EQ(joint["methods"][0]["buffers"], 3);
-    const test::Outcome e = run("evaluate --methods single,measured" + fast + " --eval-views 4 --eval-resolution 64 --csv " +
-                                path("e.csv").string());
+    const test::Outcome e = run("evaluate --methods single,measured" + fast +
+                                " --eval-views 4 --eval-resolution 64 --csv " + path("e.csv").string());
     ASSERT_EQ(e.exit_code, 0) << e.err;
     const std::string csv = test::slurp(path("e.csv"));
     EXPECT_NE(csv.find("\nsingle,"), std::string::npos);
@@ -156,7 +164,9 @@ TEST_F(Cli, GltfInGltfOut) {
     ANIMORDER_REQUIRE_DATA(fox);
     const std::string fast = " -q -k 2 --views 12 --resolution 32 --max-iterations 2";
     ASSERT_EQ(run("optimize " + fox + " --method single" + fast + " -o " + path("fox.glb").string() + " --report " +
-                  path("r.json").string()).exit_code, 0);
+                  path("r.json").string())
+                  .exit_code,
+              0);
     EXPECT_TRUE(fs::exists(path("fox.glb")));
     EXPECT_TRUE(fs::exists(path("fox.animorder.bin")));
     const nlohmann::json j = nlohmann::json::parse(test::slurp(path("r.json")));
@@ -235,9 +245,10 @@ TEST_F(Cli, BadInputAndOptionsGiveOneLineErrors) {
 }
 
 TEST_F(Cli, EvaluateReportHasARowPerMethodAndSweptValue) {
-    const test::Outcome o = run("evaluate -q --methods original,tipsify-per-frame,single,oracle --lambda 0.85,3 -k 2 "
-                          "--views 12 --resolution 64 --max-iterations 2 --eval-views 2 --eval-resolution 64 -r " +
-                          path("e.json").string() + " --csv " + path("e.csv").string());
+    const test::Outcome o =
+        run("evaluate -q --methods original,tipsify-per-frame,single,oracle --lambda 0.85,3 -k 2 "
+            "--views 12 --resolution 64 --max-iterations 2 --eval-views 2 --eval-resolution 64 -r " +
+            path("e.json").string() + " --csv " + path("e.csv").string());
     ASSERT_EQ(o.exit_code, 0) << o.err;
     const nlohmann::json report = nlohmann::json::parse(test::slurp(path("e.json")));
     const nlohmann::json& methods = report["methods"];
@@ -266,15 +277,18 @@ TEST_F(Cli, EvaluateReportHasARowPerMethodAndSweptValue) {
 TEST_F(Cli, Nehab06RunsInOptimizeAndEvaluateAndBeatsTheOriginalOrder) {
     const std::string fast = " -q --nehab-views 42 --resolution 96 --nehab-clusters 16";
     ASSERT_EQ(run("optimize --method static-nehab06" + fast + " --threads 1 -o " + path("n1").string() + " -r " +
-                  path("r.json").string()).exit_code, 0);
+                  path("r.json").string())
+                  .exit_code,
+              0);
     ASSERT_EQ(run("optimize --method static-nehab06" + fast + " --threads 2 -o " + path("n2").string()).exit_code, 0);
-    EXPECT_EQ(test::slurp(path("n1.animorder.bin")), test::slurp(path("n2.animorder.bin")));  // thread count changes nothing
+    EXPECT_EQ(test::slurp(path("n1.animorder.bin")),
+              test::slurp(path("n2.animorder.bin")));  // thread count changes nothing
     const nlohmann::json j = nlohmann::json::parse(test::slurp(path("r.json")));
     EXPECT_EQ(j["methods"][0]["name"], "static-nehab06");
     EXPECT_EQ(j["methods"][0]["planar_clusters"], 16 * 4);  // 16 per primitive; the character has 4
     EXPECT_EQ(j["settings"]["nehab_views"], 42);
-    const test::Outcome e = run("evaluate --methods original,static-nehab06" + fast + " --eval-views 2 --eval-resolution 96 -r " +
-                          path("e.json").string());
+    const test::Outcome e = run("evaluate --methods original,static-nehab06" + fast +
+                                " --eval-views 2 --eval-resolution 96 -r " + path("e.json").string());
     ASSERT_EQ(e.exit_code, 0) << e.err;
     const nlohmann::json report = nlohmann::json::parse(test::slurp(path("e.json")));
     const nlohmann::json& methods = report["methods"];
@@ -311,9 +325,10 @@ TEST_F(Cli, FailedWriteLeavesNoFileBehind) {
     ASSERT_TRUE(fs::exists("/dev/full"));
     const fs::path out = path("out");
     fs::create_directories(out);
-    const test::Outcome o = test::run_captured("ln -s /dev/full '" + (out / ".o.animorder.bin.tmp").string() + "'$$ && exec " +
-                                                   std::string(ANIMORDER_EXE) + " optimize -q -o '" + (out / "o").string() + "'",
-                                               dir_);
+    const test::Outcome o =
+        test::run_captured("ln -s /dev/full '" + (out / ".o.animorder.bin.tmp").string() + "'$$ && exec " +
+                               std::string(ANIMORDER_EXE) + " optimize -q -o '" + (out / "o").string() + "'",
+                           dir_);
     EXPECT_NE(o.exit_code, 0);
     EXPECT_NE(o.err.find("o.animorder.bin: write failed"), std::string::npos) << o.err;
     EXPECT_EQ(entries_of(out), "");
@@ -372,9 +387,9 @@ TEST_F(CliOutputs, ReportOnTheInputIsRefused) {
 }
 
 TEST_F(CliOutputs, TwoOutputsOnOneFileAreRefusedBeforeAnyWrite) {
-    expect_refused("optimize " + path("in.glb").string() + " -o " + path("out.glb").string() + " -r " +
-                       path("out.glb").string(),
-                   "named twice");
+    expect_refused(
+        "optimize " + path("in.glb").string() + " -o " + path("out.glb").string() + " -r " + path("out.glb").string(),
+        "named twice");
     expect_refused("optimize " + path("in.glb").string() + " -o " + path("out").string() + " -r " +
                        path("out.animorder.json").string(),
                    "named twice");
@@ -401,11 +416,15 @@ TEST_F(Cli, OptionRangeErrorsAreOneLineWithExitCodeOne) {
 }
 
 TEST_F(CliOutputs, ReapplyOntoEitherInputIsRefused) {
-    ASSERT_EQ(run("optimize -q --method original " + path("in.glb").string() + " -o " + path("opt.glb").string()).exit_code, 0);
+    ASSERT_EQ(
+        run("optimize -q --method original " + path("in.glb").string() + " -o " + path("opt.glb").string()).exit_code,
+        0);
     const std::string optimised = test::slurp(path("opt.glb"));
-    expect_refused("reapply " + path("opt.glb").string() + " " + path("in.glb").string() + " -o " + path("in.glb").string(),
-                   "in.glb");
-    expect_refused("reapply " + path("opt.glb").string() + " " + path("in.glb").string() + " -o " + path("opt.glb").string(),
-                   "opt.glb");
+    expect_refused(
+        "reapply " + path("opt.glb").string() + " " + path("in.glb").string() + " -o " + path("in.glb").string(),
+        "in.glb");
+    expect_refused(
+        "reapply " + path("opt.glb").string() + " " + path("in.glb").string() + " -o " + path("opt.glb").string(),
+        "opt.glb");
     EXPECT_EQ(test::slurp(path("opt.glb")), optimised);
 }

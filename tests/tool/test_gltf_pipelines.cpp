@@ -74,8 +74,9 @@ protected:
 
     double stored_ovr(const fs::path& file) {
         const fs::path report = path(file.stem().string() + ".evaluate.json");
-        const test::Outcome o = run(exe() + " evaluate -q --methods original --stored --eval-views 12 --eval-resolution 64 " +
-                                    q(file) + " --report " + q(report));
+        const test::Outcome o =
+            run(exe() + " evaluate -q --methods original --stored --eval-views 12 --eval-resolution 64 " + q(file) +
+                " --report " + q(report));
         EXPECT_EQ(o.exit_code, 0) << o.err;
         if (o.exit_code != 0) return -1;
         const json j = json::parse(test::slurp(report));
@@ -86,8 +87,9 @@ protected:
     void round_trip(const fs::path& input, const std::string& name) {
         SCOPED_TRACE(name);
         const fs::path optimised = path(name + ".glb");
-        test::Outcome o = run(exe() + " optimize -q --method single -k 3 --views 12 --resolution 64 --max-iterations 3 " +
-                              q(input) + " -o " + q(optimised));
+        test::Outcome o =
+            run(exe() + " optimize -q --method single -k 3 --views 12 --resolution 64 --max-iterations 3 " + q(input) +
+                " -o " + q(optimised));
         ASSERT_EQ(o.exit_code, 0) << o.err;
         ASSERT_EQ(check(optimised), 0);
         expect_valid(optimised);
@@ -98,7 +100,8 @@ protected:
         const std::string gt = q(kTools / "gltf-transform");
         for (const std::string& step :
              {std::string("prune"), std::string("dedup"), std::string("resample"), std::string("reorder"),
-              std::string("weld"), std::string("optimize --compress false --texture-compress false --simplify false")}) {
+              std::string("weld"),
+              std::string("optimize --compress false --texture-compress false --simplify false")}) {
             SCOPED_TRACE(step);
             const fs::path out = path(name + "-gt-" + step.substr(0, step.find(' ')) + ".glb");
             const std::string verb = step.substr(0, step.find(' '));

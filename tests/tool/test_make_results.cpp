@@ -245,11 +245,14 @@ protected:
     }
 };
 
-const char* const kSections[] = {
-    "Table 1: Ganfaul against the paper", "Every skinned character",
-    "Clustering viewpoints (Fig. 3)",     "Patch threshold lambda (Fig. 6)",
-    "Number of clusters k (Fig. 7)",      "Per clip: overdraw (Fig. 8) and preprocessing time (Fig. 5)",
-    "Rendering time in OpenGL",           "Nehab et al. 2006: against the other one-buffer orders, and its preprocessing"};
+const char* const kSections[] = {"Table 1: Ganfaul against the paper",
+                                 "Every skinned character",
+                                 "Clustering viewpoints (Fig. 3)",
+                                 "Patch threshold lambda (Fig. 6)",
+                                 "Number of clusters k (Fig. 7)",
+                                 "Per clip: overdraw (Fig. 8) and preprocessing time (Fig. 5)",
+                                 "Rendering time in OpenGL",
+                                 "Nehab et al. 2006: against the other one-buffer orders, and its preprocessing"};
 
 }  // namespace
 
@@ -477,7 +480,8 @@ TEST_F(MakeResults, OutputIsByteIdenticalAcrossRuns) {
     EXPECT_EQ(test::slurp(dir_ / "a" / "RESULTS.md"), test::slurp(dir_ / "b" / "RESULTS.md"));
     size_t compared = 0;
     for (const auto& entry : fs::directory_iterator(dir_ / "a" / "results")) {
-        EXPECT_EQ(test::slurp(entry.path()), test::slurp(dir_ / "b" / "results" / entry.path().filename())) << entry.path();
+        EXPECT_EQ(test::slurp(entry.path()), test::slurp(dir_ / "b" / "results" / entry.path().filename()))
+            << entry.path();
         ++compared;
     }
     EXPECT_GT(compared, 0u);
@@ -765,11 +769,11 @@ TEST_F(CommittedResults, RegenerateToTheCommittedFiles) {
 // A new figure must be a placeholder (templates.h).
 TEST(CommittedNotes, CarryNoHandTypedMeasurements) {
     const std::set<std::string> allowed = {
-        "0.654", "1.377", "1.302", "1.211", "1.153", "1.065", "1.166", "1.088",  // JCGT 2017 Table 1, Ganfaul
-        "1.48",                                                                  // its Fig. 7 axis
+        "0.654",  "1.377",  "1.302",   "1.211", "1.153", "1.065", "1.166", "1.088",  // JCGT 2017 Table 1, Ganfaul
+        "1.48",                                                                      // its Fig. 7 axis
         "13,795", "55,180", "220,720", "2,500",  // its triangle counts, its joint-set seconds
-        "0.7", "3.3",                            // Tootle's published 0.7–3.3 s (and λ = 0.7)
-        "0.85", "1.25"};                         // λ, kAcmrBudget
+        "0.7",    "3.3",                         // Tootle's published 0.7–3.3 s (and λ = 0.7)
+        "0.85",   "1.25"};                       // λ, kAcmrBudget
     const std::regex number(R"((?:^|[^\w.])(\d+\.\d+|\d+%|\d{1,3}(?:,\d{3})+))");
     const fs::path notes = fs::path(ANIMORDER_SOURCE_DIR) / "docs" / "results-notes";
     size_t files = 0;
@@ -791,7 +795,8 @@ TEST(CommittedNotes, CarryNoHandTypedMeasurements) {
 
     // README.md's "Results" and "Performance" sections, outside the generated block, likewise.
     const std::string readme = test::slurp(fs::path(ANIMORDER_SOURCE_DIR) / "README.md");
-    const size_t start = readme.find("\n## Results\n"), end = readme.find("\n## ", readme.find("\n## Performance\n") + 4);
+    const size_t start = readme.find("\n## Results\n"),
+                 end = readme.find("\n## ", readme.find("\n## Performance\n") + 4);
     ASSERT_NE(start, std::string::npos);
     std::string sections = readme.substr(start, end == std::string::npos ? std::string::npos : end - start);
     const size_t begin = sections.find(kBlockBegin), stop = sections.find(kBlockEnd);

@@ -8,12 +8,12 @@
 
 #include "support/files.h"
 
+#include <sys/wait.h>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
-#include <sys/wait.h>
 
 namespace fs = std::filesystem;
 namespace test = animorder::test;
@@ -23,7 +23,9 @@ namespace {
 class SubdivideCli : public test::ScratchFolderTest {
 protected:
     SubdivideCli() : ScratchFolderTest("animorder-subdivide-cli") {}
-    test::Outcome run(const std::string& args) { return test::run_captured(std::string(ANIMORDER_EXE) + " " + args, dir_); }
+    test::Outcome run(const std::string& args) {
+        return test::run_captured(std::string(ANIMORDER_EXE) + " " + args, dir_);
+    }
 };
 
 }  // namespace
@@ -50,7 +52,8 @@ TEST_F(SubdivideCli, BundledCharacterOneLevelWritesTheCounts) {
 TEST_F(SubdivideCli, TwoLevelsOfAGltfInputAndQuiet) {
     // A subdivided file is itself an input: subdivide it once more.
     ASSERT_EQ(run("subdivide -q --levels 1 --clip wave -o " + path("c1.gltf").string()).exit_code, 0);
-    const test::Outcome o = run("subdivide --quiet " + path("c1.gltf").string() + " --levels 1 -o " + path("c2.glb").string());
+    const test::Outcome o =
+        run("subdivide --quiet " + path("c1.gltf").string() + " --levels 1 -o " + path("c2.glb").string());
     ASSERT_EQ(o.exit_code, 0) << o.err;
     EXPECT_EQ(o.err, "");
     EXPECT_NE(o.out.find("triangles 47040 -> 188160"), std::string::npos) << o.out;
@@ -68,7 +71,8 @@ TEST_F(SubdivideCli, TooManyLevelsIsAClearError) {
 TEST_F(SubdivideCli, RefusesToOverwriteTheInputAndOtherExtensions) {
     ASSERT_EQ(run("subdivide -q --levels 1 --clip wave -o " + path("in.glb").string()).exit_code, 0);
     const std::string before = test::slurp(path("in.glb"));
-    const test::Outcome same = run("subdivide -q " + path("in.glb").string() + " --levels 1 -o " + path("in.glb").string());
+    const test::Outcome same =
+        run("subdivide -q " + path("in.glb").string() + " --levels 1 -o " + path("in.glb").string());
     EXPECT_NE(same.exit_code, 0);
     EXPECT_NE(same.err.find("refusing to overwrite the input"), std::string::npos) << same.err;
     EXPECT_EQ(test::slurp(path("in.glb")), before);

@@ -20,8 +20,8 @@
 #include "animorder/evaluation.h"
 
 #include <nettle/sha2.h>
-#include <nlohmann/json.hpp>
 #include <signal.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cctype>
@@ -45,8 +45,8 @@ using json = nlohmann::ordered_json;
 using Clock = std::chrono::steady_clock;
 
 // Exit codes beyond 0 (all done) and 1 (an error before any work).
-constexpr int kExitItemsFailed = 3;      // at least one item failed (each has its error line)
-constexpr int kExitItemsMissing = 4;     // merge: some items have no up-to-date result yet
+constexpr int kExitItemsFailed = 3;   // at least one item failed (each has its error line)
+constexpr int kExitItemsMissing = 4;  // merge: some items have no up-to-date result yet
 
 // ---------------------------------------------------------------------------------------------
 // The manifest
@@ -57,7 +57,7 @@ struct ManifestItem {
     std::vector<std::string> clips;  // names, or clip files/folders (resolved when they exist)
     std::string method;              // empty: optimize's default
     std::vector<std::string> options;
-    std::string output;              // resolved against the manifest's folder
+    std::string output;  // resolved against the manifest's folder
 };
 
 // Items' relative paths are relative to the manifest's folder, so a manifest moves with its data.
@@ -146,13 +146,15 @@ std::vector<ManifestItem> parse_json_manifest(const std::string& text, const std
         item.output = text_of("output");
         if (e.contains("clips")) {
             const json& c = e["clips"];
-            if (c.is_string()) item.clips = {c.get<std::string>()};
+            if (c.is_string())
+                item.clips = {c.get<std::string>()};
             else if (c.is_array())
                 for (const json& v : c) {
                     if (!v.is_string()) throw std::runtime_error(where + ": \"clips\" entries must be strings");
                     item.clips.push_back(v.get<std::string>());
                 }
-            else if (!c.is_null()) throw std::runtime_error(where + ": \"clips\" must be a string or a list");
+            else if (!c.is_null())
+                throw std::runtime_error(where + ": \"clips\" must be a string or a list");
         }
         item.options = options_from_json(e.contains("options") ? e["options"] : json(), where);
         items.push_back(item);
@@ -167,9 +169,12 @@ std::vector<std::string> csv_record(const std::string& text, size_t& pos, const 
     for (; pos < text.size(); ++pos) {
         const char c = text[pos];
         if (quoted) {
-            if (c == '"' && pos + 1 < text.size() && text[pos + 1] == '"') fields.back() += '"', ++pos;
-            else if (c == '"') quoted = false;
-            else fields.back() += c;
+            if (c == '"' && pos + 1 < text.size() && text[pos + 1] == '"')
+                fields.back() += '"', ++pos;
+            else if (c == '"')
+                quoted = false;
+            else
+                fields.back() += c;
         } else if (c == '"') {
             quoted = true;
         } else if (c == ',') {
@@ -207,11 +212,16 @@ std::vector<ManifestItem> parse_csv_manifest(const std::string& text, const std:
         ManifestItem item;
         for (size_t f = 0; f < header.size(); ++f) {
             const std::string& v = fields[f];
-            if (header[f] == "name") item.name = v;
-            else if (header[f] == "input") item.input = v;
-            else if (header[f] == "method") item.method = v;
-            else if (header[f] == "output") item.output = v;
-            else if (header[f] == "options") item.options = split_words(v);
+            if (header[f] == "name")
+                item.name = v;
+            else if (header[f] == "input")
+                item.input = v;
+            else if (header[f] == "method")
+                item.method = v;
+            else if (header[f] == "output")
+                item.output = v;
+            else if (header[f] == "options")
+                item.options = split_words(v);
             else if (header[f] == "clips") {
                 std::stringstream list(v);
                 for (std::string c; std::getline(list, c, ';');)
@@ -227,7 +237,8 @@ std::vector<ManifestItem> read_manifest(const std::string& path) {
     const std::string text = read_text(path);
     const std::string ext = fs::path(path).extension().string();
     std::vector<ManifestItem> items;
-    if (ext == ".csv") items = parse_csv_manifest(text, path);
+    if (ext == ".csv")
+        items = parse_csv_manifest(text, path);
     else {
         const size_t first = text.find_first_not_of(" \t\r\n");
         if (ext != ".json" && (first == std::string::npos || (text[first] != '{' && text[first] != '[')))
@@ -333,8 +344,8 @@ void hash_input(Sha256& hash, const std::string& path) {
     std::error_code error;
     if (fs::is_directory(path, error)) {
         std::vector<fs::path> files;
-        for (auto it = fs::recursive_directory_iterator(path, error); !error && it != fs::recursive_directory_iterator();
-             it.increment(error))
+        for (auto it = fs::recursive_directory_iterator(path, error);
+             !error && it != fs::recursive_directory_iterator(); it.increment(error))
             if (it->is_regular_file(error)) files.push_back(it->path());
         std::sort(files.begin(), files.end());
         hash.add("folder:" + std::to_string(files.size()));
@@ -410,8 +421,10 @@ void drop_timings(json& value) {
     if (!value.is_object()) return;
     for (auto it = value.begin(); it != value.end(); ++it) {
         const std::string& k = it.key();
-        if (k == "time_s" || k == "timings_s" || k == "stages_s" || k.rfind("seconds", 0) == 0) it.value() = nullptr;
-        else drop_timings(it.value());
+        if (k == "time_s" || k == "timings_s" || k == "stages_s" || k.rfind("seconds", 0) == 0)
+            it.value() = nullptr;
+        else
+            drop_timings(it.value());
     }
 }
 
@@ -423,14 +436,16 @@ void remove_stale_temporaries(const std::vector<std::string>& outputs) {
         const fs::path target(out);
         const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
         const std::string prefix = "." + target.filename().string() + ".";
-        for (auto it = fs::directory_iterator(folder, error); !error && it != fs::directory_iterator(); it.increment(error)) {
+        for (auto it = fs::directory_iterator(folder, error); !error && it != fs::directory_iterator();
+             it.increment(error)) {
             const std::string name = it->path().filename().string();
             if (name.size() <= prefix.size() + 3 || name.compare(0, prefix.size(), prefix) != 0) continue;
             const std::string kind = name.substr(prefix.size(), 3), pid = name.substr(prefix.size() + 3);
             if ((kind != "tmp" && kind != "old") || pid.empty() || pid.size() > 9 ||
                 !std::all_of(pid.begin(), pid.end(), [](char c) { return std::isdigit(uint8_t(c)); }))
                 continue;
-            if (::kill(pid_t(std::stol(pid)), 0) == 0 || errno != ESRCH) continue;  // still running (or not ours to judge)
+            if (::kill(pid_t(std::stol(pid)), 0) == 0 || errno != ESRCH)
+                continue;  // still running (or not ours to judge)
             std::error_code ignored;
             fs::remove(it->path(), ignored);
         }
@@ -491,8 +506,10 @@ void run_item(const PlannedItem& p, const std::string& stamp, const BatchOptions
 // The summary, merged from the items' files in manifest order
 
 json summary_row(const PlannedItem& p, const std::string& stamp) {
-    json row = {{"name", p.item.name}, {"input", p.options.common.input.empty() ? "(bundled)" : p.options.common.input},
-                {"output", p.item.output}, {"method", method_name(p.plan.method)}};
+    json row = {{"name", p.item.name},
+                {"input", p.options.common.input.empty() ? "(bundled)" : p.options.common.input},
+                {"output", p.item.output},
+                {"method", method_name(p.plan.method)}};
     const json report = current_report(p, stamp);
     if (report.is_object()) {
         const json& b = report["batch"];
@@ -509,7 +526,8 @@ json summary_row(const PlannedItem& p, const std::string& stamp) {
                             "index_bytes_added", "time_s"})
         row[key] = nullptr;
     row["status"] = failed ? "failed" : "missing";
-    row["error"] = failed ? failure.value("error", "") : "no up-to-date result (not run yet, or its inputs or options changed)";
+    row["error"] =
+        failed ? failure.value("error", "") : "no up-to-date result (not run yet, or its inputs or options changed)";
     return row;
 }
 
@@ -534,8 +552,9 @@ std::string summary_markdown(const json& summary) {
     md += std::to_string(summary["items"].size()) + " items: " + summary["ok"].dump() + " ok, " +
           summary["failed"].dump() + " failed, " + summary["missing"].dump() + " missing (animorder " +
           summary["version"].get<std::string>() + ").\n\n";
-    md += "| item | method | triangles | clips | OVR before | OVR after | ACMR before | ACMR after | index bytes added | "
-          "time (s) | status |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
+    md +=
+        "| item | method | triangles | clips | OVR before | OVR after | ACMR before | ACMR after | index bytes added | "
+        "time (s) | status |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const json& r : summary["items"]) {
         std::string status = r["status"].get<std::string>();
         if (!r["error"].is_null()) status += ": " + cell(r["error"], 0);
@@ -550,8 +569,8 @@ std::string summary_markdown(const json& summary) {
 // Builds and writes the summary; returns the exit code it implies.
 int write_summary(const std::vector<PlannedItem>& items, const std::vector<std::string>& stamps,
                   const std::string& stem, const std::string& manifest, const BatchOptions& batch) {
-    json summary = {{"tool", "animorder"}, {"version", ANIMORDER_VERSION},
-                    {"manifest", fs::path(manifest).filename().string()}};
+    json summary = {
+        {"tool", "animorder"}, {"version", ANIMORDER_VERSION}, {"manifest", fs::path(manifest).filename().string()}};
     json rows = json::array();
     size_t ok = 0, failed = 0, missing = 0;
     for (size_t i = 0; i < items.size(); ++i) {
@@ -577,7 +596,8 @@ int write_summary(const std::vector<PlannedItem>& items, const std::vector<std::
 std::pair<size_t, size_t> parse_shard(const std::string& text) {
     const size_t slash = text.find('/');
     auto number = [&](const std::string& s, const char* what) {
-        if (s.empty() || s.size() > 9 || !std::all_of(s.begin(), s.end(), [](char c) { return std::isdigit(uint8_t(c)); }))
+        if (s.empty() || s.size() > 9 ||
+            !std::all_of(s.begin(), s.end(), [](char c) { return std::isdigit(uint8_t(c)); }))
             throw std::runtime_error("--shard " + text + ": " + what + " must be a number (I/N, or env/N)");
         return size_t(std::stoul(s));
     };
@@ -587,9 +607,12 @@ std::pair<size_t, size_t> parse_shard(const std::string& text) {
     if (index == "env") {
         const char* k8s = std::getenv("JOB_COMPLETION_INDEX");
         const char* slurm = std::getenv("SLURM_ARRAY_TASK_ID");
-        if (k8s && *k8s) index = k8s;
-        else if (slurm && *slurm) index = slurm;
-        else throw std::runtime_error("--shard env/N: neither JOB_COMPLETION_INDEX nor SLURM_ARRAY_TASK_ID is set");
+        if (k8s && *k8s)
+            index = k8s;
+        else if (slurm && *slurm)
+            index = slurm;
+        else
+            throw std::runtime_error("--shard env/N: neither JOB_COMPLETION_INDEX nor SLURM_ARRAY_TASK_ID is set");
     }
     const size_t i = number(index, "I");
     if (count == 0 || i >= count)
@@ -603,7 +626,8 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
     const std::vector<ManifestItem> manifest = read_manifest(batch.manifest);
     std::pair<size_t, size_t> shard = {0, 1};
     if (!batch.shard.empty()) shard = parse_shard(batch.shard);
-    if (batch.merge && !batch.shard.empty()) throw std::runtime_error("--merge builds the summary of every shard: drop --shard");
+    if (batch.merge && !batch.shard.empty())
+        throw std::runtime_error("--merge builds the summary of every shard: drop --shard");
 
     // Every item planned and every output of every item checked before any work: folders exist
     // and are writable, no output is any item's input or the manifest, no file is named twice.
@@ -633,7 +657,8 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
     for (size_t i = 0; i < items.size(); ++i) {
         if (i % shard.second != shard.first) continue;
         const PlannedItem& p = items[i];
-        const std::string label = "batch [" + std::to_string(++position) + "/" + std::to_string(mine) + "] " + p.item.name;
+        const std::string label =
+            "batch [" + std::to_string(++position) + "/" + std::to_string(mine) + "] " + p.item.name;
         if (!batch.force && current_report(p, stamps[i]).is_object()) {
             ++skipped;
             note(p.options.common, label + ": up to date, skipped");
@@ -651,8 +676,10 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
                 if (c == '\n' || c == '\r') c = ' ';
             std::fprintf(stderr, "animorder: %s: failed: %s\n", label.c_str(), message.c_str());
             try {
-                write_file_atomically(p.error, report_text(json{{"stamp", stamps[i]}, {"item", p.item.name},
-                                                                {"status", "failed"}, {"error", message}}));
+                write_file_atomically(
+                    p.error,
+                    report_text(
+                        json{{"stamp", stamps[i]}, {"item", p.item.name}, {"status", "failed"}, {"error", message}}));
             } catch (const std::exception& again) {
                 std::fprintf(stderr, "animorder: %s: cannot record the failure: %s\n", label.c_str(), again.what());
             }

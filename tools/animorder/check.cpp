@@ -50,8 +50,9 @@ int run_check(const CheckOptions& options) {
     std::printf("%s\n", j.dump(2).c_str());
     if (r.errors.empty()) return 0;
     if (options.quiet) return 1;
-    std::fprintf(stderr, "animorder: error: %s: %s%s\n", options.file.c_str(), r.errors.front().c_str(),
-                 r.errors.size() > 1 ? (" (and " + std::to_string(r.errors.size() - 1) + " more problems)").c_str() : "");
+    std::fprintf(
+        stderr, "animorder: error: %s: %s%s\n", options.file.c_str(), r.errors.front().c_str(),
+        r.errors.size() > 1 ? (" (and " + std::to_string(r.errors.size() - 1) + " more problems)").c_str() : "");
     return 1;
 }
 

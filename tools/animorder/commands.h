@@ -16,8 +16,8 @@
 namespace animorder::tool {
 
 struct CommonOptions {
-    std::string input;   // empty: the bundled procedural character
-    bool quiet = false;  // no progress on stderr
+    std::string input;               // empty: the bundled procedural character
+    bool quiet = false;              // no progress on stderr
     std::vector<std::string> clips;  // --clip: only these clips (all when empty), or clip files
     unsigned cache_size = kDefaultCacheSize;
     size_t max_memory = LoadOptions{}.max_keyframe_bytes;  // --max-memory: the loading budget in bytes
@@ -42,7 +42,7 @@ struct InspectOptions {
 struct OptimizeOptions {
     CommonOptions common;
     std::string method = method_name(kDefaultMethod);
-    bool joint = false;       // --joint: the same as --method joint
+    bool joint = false;  // --joint: the same as --method joint
     MethodOptions methods;
     std::string output;       // OUT → OUT.animorder.bin and OUT.animorder.json (+ OUT.glb/.gltf)
     std::string report_path;  // JSON report, optional
@@ -85,7 +85,7 @@ struct ViewOptions {
 };
 
 struct CheckOptions {
-    std::string file;  // a glTF/GLB file with (or without) ANIMORDER_animated_triangle_orders
+    std::string file;    // a glTF/GLB file with (or without) ANIMORDER_animated_triangle_orders
     bool quiet = false;  // no error line on stderr (the JSON report still says it)
 };
 
@@ -115,13 +115,13 @@ namespace animorder::tool {
 struct BatchOptions {
     std::string manifest;
     bool quiet = false;
-    std::string shard;           // "I/N", "env/N" (JOB_COMPLETION_INDEX or SLURM_ARRAY_TASK_ID), empty: all
-    bool merge = false;          // only build the summary from the items' reports
-    std::string summary;         // SUMMARY → SUMMARY.json and SUMMARY.md (default: beside the manifest)
-    size_t eval_views = 10;      // OVR before/after per item: random views per keyframe (0: no OVR)
+    std::string shard;       // "I/N", "env/N" (JOB_COMPLETION_INDEX or SLURM_ARRAY_TASK_ID), empty: all
+    bool merge = false;      // only build the summary from the items' reports
+    std::string summary;     // SUMMARY → SUMMARY.json and SUMMARY.md (default: beside the manifest)
+    size_t eval_views = 10;  // OVR before/after per item: random views per keyframe (0: no OVR)
     unsigned eval_resolution = 256;
-    bool no_timings = false;     // wall times left out: identical work gives byte-identical files
-    bool force = false;          // redo items even when up to date
+    bool no_timings = false;  // wall times left out: identical work gives byte-identical files
+    bool force = false;       // redo items even when up to date
     unsigned threads = 0;
 };
 using ItemParser = std::function<OptimizeOptions(const std::vector<std::string>& args)>;

@@ -39,7 +39,8 @@ struct Row {
 
 // Every combination of the swept settings, for the methods that use them.
 std::vector<std::pair<Method, MethodOptions>> plan_rows(const std::vector<Method>& methods, const MethodOptions& base,
-                                                        const std::vector<double>& lambdas, const std::vector<size_t>& ks,
+                                                        const std::vector<double>& lambdas,
+                                                        const std::vector<size_t>& ks,
                                                         const std::vector<size_t>& views) {
     std::vector<std::pair<Method, MethodOptions>> plan;
     for (Method n : methods)
@@ -68,7 +69,8 @@ nlohmann::ordered_json blend_json(const BlendSummary& s) {
 // is (original − method) / (original − bound) of the mis-sorted pixel fraction. Adds "blend" to
 // the report's method entries and "blend_input_order", "blend_bound" to the report. Returns seconds.
 double evaluate_blend_rows(const AnimatedMesh& mesh, const std::vector<Row>& rows, std::vector<MethodBuffers> buffers,
-                           const EvaluationSettings& eval, const EvaluateOptions& options, nlohmann::ordered_json& report) {
+                           const EvaluationSettings& eval, const EvaluateOptions& options,
+                           nlohmann::ordered_json& report) {
     const Clock::time_point start = Clock::now();
     MethodBuffers input;
     input.orders.emplace_back(mesh.triangle_count());
@@ -81,16 +83,18 @@ double evaluate_blend_rows(const AnimatedMesh& mesh, const std::vector<Row>& row
     double original = -1;
     for (size_t m = 0; m < rows.size(); ++m)
         if (rows[m].result.method == Method::Original) original = blend[m].overall.missorted_pixel_fraction;
-    std::string table = "\n| blended primitives | k | buffers | mis-sorted pairs | mis-sorted pixels | of the way to the bound |\n"
-                        "|---|---|---|---|---|---|\n";
+    std::string table =
+        "\n| blended primitives | k | buffers | mis-sorted pairs | mis-sorted pixels | of the way to the bound |\n"
+        "|---|---|---|---|---|---|\n";
     auto add_row = [&](const std::string& name, const std::string& k, const std::string& count, const BlendSummary& s) {
         char cells[256];
         const double span = original - bound.missorted_pixel_fraction;
-        const std::string way = original >= 0 && span > 0
-                                    ? format_number(std::round(1000 * (original - s.missorted_pixel_fraction) / span) / 10) + "%"
-                                    : "";
-        std::snprintf(cells, sizeof cells, "| %s | %s | %s | %.4f | %.4f | %s |\n", name.c_str(), k.c_str(), count.c_str(),
-                      s.missorted_pair_fraction, s.missorted_pixel_fraction, way.c_str());
+        const std::string way =
+            original >= 0 && span > 0
+                ? format_number(std::round(1000 * (original - s.missorted_pixel_fraction) / span) / 10) + "%"
+                : "";
+        std::snprintf(cells, sizeof cells, "| %s | %s | %s | %.4f | %.4f | %s |\n", name.c_str(), k.c_str(),
+                      count.c_str(), s.missorted_pair_fraction, s.missorted_pixel_fraction, way.c_str());
         table += cells;
     };
     add_row("input order", "", "1", blend[rows.size()].overall);
@@ -132,7 +136,8 @@ MethodBuffers stored_buffers(const AnimatedMesh& mesh, const std::string& path) 
         for (uint32_t b = 0; b < ext.buffer_count; ++b) {
             std::vector<uint32_t> perm;
             if (e) {
-                if (e->indices.size() != p.index_count) throw std::runtime_error(path + ": primitive " + p.name + " reads back with another index count");
+                if (e->indices.size() != p.index_count)
+                    throw std::runtime_error(path + ": primitive " + p.name + " reads back with another index count");
                 perm = triangle_permutation(e->indices.data(), e->orders.data() + b * p.index_count, count);
             } else {
                 perm.resize(count);
@@ -145,16 +150,20 @@ MethodBuffers stored_buffers(const AnimatedMesh& mesh, const std::string& path) 
         const ExtensionClip* e = nullptr;
         for (const ExtensionClip& x : ext.clips)
             if (x.name == c.name) e = &x;
-        if (!e) throw std::runtime_error(path + ": clip '" + c.name + "' has no stored table (keep the stored clips with --clip NAME)");
+        if (!e)
+            throw std::runtime_error(path + ": clip '" + c.name +
+                                     "' has no stored table (keep the stored clips with --clip NAME)");
         SelectionTable t;
         t.keyframes = uint32_t(c.keyframe_count);
         t.theta_steps = e->theta_steps;
         t.phi_steps = e->phi_steps;
         const size_t cells = size_t(e->theta_steps) * e->phi_steps;
         for (size_t f = 0; f < c.keyframe_count; ++f) {
-            const double k = std::floor((c.start_time_s + double(f) / c.sample_rate - e->start_time) * e->sample_rate + 0.5);
+            const double k =
+                std::floor((c.start_time_s + double(f) / c.sample_rate - e->start_time) * e->sample_rate + 0.5);
             const size_t g = k <= 0 ? 0 : (k >= double(e->keyframes - 1) ? e->keyframes - 1 : size_t(k));
-            t.cells.insert(t.cells.end(), e->cells.begin() + ptrdiff_t(g * cells), e->cells.begin() + ptrdiff_t((g + 1) * cells));
+            t.cells.insert(t.cells.end(), e->cells.begin() + ptrdiff_t(g * cells),
+                           e->cells.begin() + ptrdiff_t((g + 1) * cells));
         }
         m.tables.push_back(std::move(t));
         m.table_base.push_back(e->buffer_base);
@@ -174,7 +183,8 @@ int run_evaluate(const EvaluateOptions& options) {
     for (const std::string& n : names) methods.push_back(parse_method(n));
     const MethodSettings& b = base.settings;
     const std::vector<double> lambdas = base.lambdas.empty() ? std::vector<double>{b.lambda} : base.lambdas;
-    const std::vector<size_t> ks = base.cluster_list.empty() ? std::vector<size_t>{b.clustering.clusters} : base.cluster_list;
+    const std::vector<size_t> ks =
+        base.cluster_list.empty() ? std::vector<size_t>{b.clustering.clusters} : base.cluster_list;
     const std::vector<size_t> views = base.view_list.empty() ? std::vector<size_t>{b.clustering.views} : base.view_list;
     std::vector<std::pair<Method, MethodSettings>> plan;
     for (const auto& [n, m] : plan_rows(methods, base, lambdas, ks, views)) {
@@ -257,7 +267,8 @@ int run_evaluate(const EvaluateOptions& options) {
                                          {"ovr_mean", r.per_clip[c].ovr_mean},
                                          {"ovr_pooled", r.per_clip[c].ovr_pooled},
                                          {"nodes", r.per_clip[c].nodes},
-                                         {"time_s", (run.method == Method::Single || run.method == Method::Measured) && c < run.run_seconds.size()
+                                         {"time_s", (run.method == Method::Single || run.method == Method::Measured) &&
+                                                            c < run.run_seconds.size()
                                                         ? json(run.run_seconds[c])
                                                         : json(nullptr)}});
         const std::string lambda = method_uses_lambda(run.method) ? format_number(s.lambda) : "";
@@ -283,11 +294,14 @@ int run_evaluate(const EvaluateOptions& options) {
     if (options.stored) {
         const OrderEvaluation& r = results.back();
         char cells[256];
-        std::snprintf(cells, sizeof cells, "| stored |  |  |  | %zu |  |  | %.3f | %.3f |  |", buffers.back().orders.size(),
-                      r.overall.ovr_mean, r.overall.ovr_pooled);
+        std::snprintf(cells, sizeof cells, "| stored |  |  |  | %zu |  |  | %.3f | %.3f |  |",
+                      buffers.back().orders.size(), r.overall.ovr_mean, r.overall.ovr_pooled);
         table += cells;
-        json entry = {{"name", "stored"}, {"buffers", buffers.back().orders.size()}, {"ovr_mean", r.overall.ovr_mean},
-                      {"ovr_pooled", r.overall.ovr_pooled}, {"per_clip", json::array()}};
+        json entry = {{"name", "stored"},
+                      {"buffers", buffers.back().orders.size()},
+                      {"ovr_mean", r.overall.ovr_mean},
+                      {"ovr_pooled", r.overall.ovr_pooled},
+                      {"per_clip", json::array()}};
         for (size_t c = 0; c < mesh.clips.size(); ++c) {
             std::snprintf(cells, sizeof cells, " %.3f |", r.per_clip[c].ovr_mean);
             table += cells;
@@ -308,13 +322,14 @@ int run_evaluate(const EvaluateOptions& options) {
     report["nodes"] = nodes;
     report["timings_s"] = {{"methods", methods_s}, {"evaluation", eval_s}, {"total", seconds_since(start)}};
     if (blend_s > 0) report["timings_s"]["blend_evaluation"] = blend_s;
-    report["machine"] = {{"threads", b.clustering.threads ? b.clustering.threads : std::thread::hardware_concurrency()}};
+    report["machine"] = {
+        {"threads", b.clustering.threads ? b.clustering.threads : std::thread::hardware_concurrency()}};
     OutputSet files;
     if (!options.report_path.empty()) files.add(options.report_path, report_text(report));
     if (!options.csv_path.empty()) files.add(options.csv_path, csv);
     files.commit();
-    note(options.common, "evaluation took " + format_number(eval_s) + " s (" + format_number(seconds_since(start)) +
-                             " s in all)");
+    note(options.common,
+         "evaluation took " + format_number(eval_s) + " s (" + format_number(seconds_since(start)) + " s in all)");
     return 0;
 }
 

@@ -23,10 +23,12 @@ namespace {
 // blended primitives reversed, as run_method ships them, except for original).
 int draw_blend_heatmap(const HeatmapOptions& options, const AnimatedMesh& mesh, Method method,
                        std::vector<uint32_t> order) {
-    if (!has_blended_primitives(mesh)) throw std::runtime_error("--blend: the input has no blended primitive (alphaMode BLEND)");
+    if (!has_blended_primitives(mesh))
+        throw std::runtime_error("--blend: the input has no blended primitive (alphaMode BLEND)");
     if (method != Method::Original) reverse_blended_primitives(mesh, order);
-    const double length = std::sqrt(double(options.view[0]) * options.view[0] + double(options.view[1]) * options.view[1] +
-                                    double(options.view[2]) * options.view[2]);
+    const double length =
+        std::sqrt(double(options.view[0]) * options.view[0] + double(options.view[1]) * options.view[1] +
+                  double(options.view[2]) * options.view[2]);
     const float direction[3] = {float(options.view[0] / length), float(options.view[1] / length),
                                 float(options.view[2] / length)};
     const Framing framing = frame_animated_mesh(mesh);
@@ -64,9 +66,11 @@ int draw_blend_heatmap(const HeatmapOptions& options, const AnimatedMesh& mesh, 
 int run_heatmap(const HeatmapOptions& options) {
     if (!std::isfinite(options.lambda)) throw std::runtime_error("--lambda must be a finite number");
     if (options.view.size() != 3) throw std::runtime_error("--view takes three numbers: x,y,z");
-    const double length = std::sqrt(double(options.view[0]) * options.view[0] + double(options.view[1]) * options.view[1] +
-                                    double(options.view[2]) * options.view[2]);
-    if (!(length > 1e-9) || !std::isfinite(length)) throw std::runtime_error("--view must be a non-zero finite direction");
+    const double length =
+        std::sqrt(double(options.view[0]) * options.view[0] + double(options.view[1]) * options.view[1] +
+                  double(options.view[2]) * options.view[2]);
+    if (!(length > 1e-9) || !std::isfinite(length))
+        throw std::runtime_error("--view must be a non-zero finite direction");
     if (options.output.empty()) throw std::runtime_error("heatmap needs an output file (-o out.png)");
     const Method method = parse_static_method(options.method);
     check_output_paths({options.output}, {options.common.input});

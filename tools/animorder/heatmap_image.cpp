@@ -15,7 +15,8 @@ using Rgb = std::array<uint8_t, 3>;
 
 // A perceptually ordered scale (dark blue → teal → yellow → red) sampled at 6 stops.
 Rgb scale_colour(double t) {
-    static const double stops[6][3] = {{48, 18, 59}, {40, 120, 230}, {30, 200, 160}, {160, 230, 60}, {250, 170, 30}, {200, 30, 10}};
+    static const double stops[6][3] = {{48, 18, 59},   {40, 120, 230}, {30, 200, 160},
+                                       {160, 230, 60}, {250, 170, 30}, {200, 30, 10}};
     t = std::clamp(t, 0.0, 1.0) * 5.0;
     const int i = std::min(4, int(t));
     const double f = t - i;
@@ -87,7 +88,8 @@ std::string heatmap_png(const std::vector<uint32_t>& counts, unsigned resolution
     const uint32_t steps = std::min<uint32_t>(max_count, 12);
     const int swatch = std::max(12, std::min(28, (r - 30) / int(steps)));
     for (uint32_t i = 0; i < steps; ++i) {
-        const uint32_t value = 1 + uint32_t(std::lround(double(i) * (max_count - 1) / double(std::max<uint32_t>(1, steps - 1))));
+        const uint32_t value =
+            1 + uint32_t(std::lround(double(i) * (max_count - 1) / double(std::max<uint32_t>(1, steps - 1))));
         const int y = top + 24 + int(i) * swatch;
         canvas.rect(x0, y, x0 + 20, y + swatch - 2, scale_colour(double(value - 1) / double(max_count - 1)));
         canvas.text(x0 + 26, y + swatch / 2 - 6, std::to_string(value), {0, 0, 0});

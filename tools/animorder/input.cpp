@@ -61,7 +61,8 @@ AnimatedMesh load_drawable_input(const CommonOptions& common, std::string& input
     for (size_t t = 0; p && t < mesh.indices.size() && area == 0; t += 3) {
         const float *a = p + 3 * mesh.indices[t], *b = p + 3 * mesh.indices[t + 1], *c = p + 3 * mesh.indices[t + 2];
         const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-        area += std::fabs(u[1] * v[2] - u[2] * v[1]) + std::fabs(u[2] * v[0] - u[0] * v[2]) + std::fabs(u[0] * v[1] - u[1] * v[0]);
+        area += std::fabs(u[1] * v[2] - u[2] * v[1]) + std::fabs(u[2] * v[0] - u[0] * v[2]) +
+                std::fabs(u[0] * v[1] - u[1] * v[0]);
     }
     if (area == 0) throw std::runtime_error(input_name + ": every triangle has zero area: nothing to reorder");
     return mesh;
@@ -71,7 +72,8 @@ MethodSettings method_settings(const MethodOptions& options, const CommonOptions
     MethodSettings settings = options.settings;
     settings.cache_size = common.cache_size;
     // Errors name the option the user typed; the library checks the same again in run_method.
-    if (options.distance != distance_name(DistanceVariant::Jcgt) && options.distance != distance_name(DistanceVariant::I3d))
+    if (options.distance != distance_name(DistanceVariant::Jcgt) &&
+        options.distance != distance_name(DistanceVariant::I3d))
         throw std::runtime_error("--distance must be jcgt or i3d, not '" + options.distance + "'");
     if (options.update != update_name(UpdateRule::Monotone) && options.update != update_name(UpdateRule::Paper))
         throw std::runtime_error("--update must be monotone or paper, not '" + options.update + "'");

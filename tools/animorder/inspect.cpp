@@ -27,9 +27,8 @@ std::vector<float> clip_radii(const AnimatedMesh& mesh) {
 void print_inspect_text(const AnimatedMesh& mesh, const std::string& input_name, const VertexCacheStats& cache,
                         unsigned cache_size) {
     std::printf("%s\n", input_name.c_str());
-    std::printf("  triangles %zu  vertices %zu  joints %zu  morph targets %zu  keyframes %zu\n",
-                mesh.triangle_count(), mesh.vertex_count, mesh.joint_count, mesh.morph_target_count,
-                mesh.keyframe_count());
+    std::printf("  triangles %zu  vertices %zu  joints %zu  morph targets %zu  keyframes %zu\n", mesh.triangle_count(),
+                mesh.vertex_count, mesh.joint_count, mesh.morph_target_count, mesh.keyframe_count());
     std::printf("  ACMR %.4f  ATVR %.4f  (FIFO cache of %u, current order)\n", cache.acmr, cache.atvr, cache_size);
     for (const Primitive& p : mesh.primitives)
         std::printf("  primitive %-12s triangles %zu  %s  %s\n", p.name.c_str(), p.index_count / 3,
@@ -63,7 +62,9 @@ int run_inspect(const InspectOptions& options) {
         size_t vertices = 0;
         for (size_t i = p.first_index; i < p.first_index + p.index_count; ++i)
             vertices += used[mesh.indices[i]] ? 0 : (used[mesh.indices[i]] = 1);
-        report["primitives"].push_back({{"name", p.name}, {"triangles", p.index_count / 3}, {"vertices", vertices},
+        report["primitives"].push_back({{"name", p.name},
+                                        {"triangles", p.index_count / 3},
+                                        {"vertices", vertices},
                                         {"double_sided", p.double_sided},
                                         {"alpha_mode", alpha_mode_name(p.alpha_mode)}});
     }

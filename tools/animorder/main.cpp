@@ -16,12 +16,14 @@ namespace {
 void add_common(CLI::App& command, animorder::tool::CommonOptions& common) {
     command.add_option("input", common.input, "Input mesh (default: the bundled procedural character)");
     command.add_flag("-q,--quiet", common.quiet, "No progress or notes on stderr");
-    command.add_option("--clip", common.clips,
-                       "A clip to keep (by name), or a clip file / folder of clip files to add (Mixamo style); repeatable");
+    command.add_option(
+        "--clip", common.clips,
+        "A clip to keep (by name), or a clip file / folder of clip files to add (Mixamo style); repeatable");
     command.add_option("--cache-size", common.cache_size, "FIFO vertex cache entries for ACMR and Tipsify")
         ->check(CLI::Range(3u, 1024u));
-    command.add_option("--max-memory", common.max_memory,
-                       "Loading budget in bytes for the sampled animation (keyframes x vertices x 12)")
+    command
+        .add_option("--max-memory", common.max_memory,
+                    "Loading budget in bytes for the sampled animation (keyframes x vertices x 12)")
         ->capture_default_str()
         ->check(CLI::Range(size_t(1) << 20, std::numeric_limits<size_t>::max()));
 }
@@ -30,8 +32,9 @@ void add_common(CLI::App& command, animorder::tool::CommonOptions& common) {
 void add_method_options(CLI::App& command, animorder::tool::MethodOptions& options, bool sweep = false) {
     animorder::MethodSettings& m = options.settings;
     animorder::ClusteringSettings& c = m.clustering;
-    const char* lambda_help = "Patch threshold: soft boundary when a patch's local ACMR < lambda "
-                              "(<0.5: hard boundaries only, >=3: single triangles)";
+    const char* lambda_help =
+        "Patch threshold: soft boundary when a patch's local ACMR < lambda "
+        "(<0.5: hard boundaries only, >=3: single triangles)";
     if (sweep) {
         options.lambdas = {m.lambda};
         options.cluster_list = {c.clusters};
@@ -40,12 +43,15 @@ void add_method_options(CLI::App& command, animorder::tool::MethodOptions& optio
             ->delimiter(',')
             ->capture_default_str()
             ->check(CLI::Range(0.0, 1000.0));
-        command.add_option("-k,--clusters", options.cluster_list, "single/joint: number of buffers k; a list runs each value")
+        command
+            .add_option("-k,--clusters", options.cluster_list,
+                        "single/joint: number of buffers k; a list runs each value")
             ->delimiter(',')
             ->capture_default_str()
             ->check(CLI::Range(size_t(1), size_t(255)));
-        command.add_option("--views", options.view_list,
-                           "single/joint: clustering viewpoints (12, 42, 162, 642); a list runs each value")
+        command
+            .add_option("--views", options.view_list,
+                        "single/joint: clustering viewpoints (12, 42, 162, 642); a list runs each value")
             ->delimiter(',')
             ->capture_default_str();
     } else {
@@ -69,11 +75,13 @@ void add_method_options(CLI::App& command, animorder::tool::MethodOptions& optio
         ->check(CLI::Range(size_t(1), size_t(1000)));
     command.add_option("--distance", options.distance, "single/joint: jcgt (sum) or i3d (visible-only mean)")
         ->capture_default_str();
-    command.add_option("--update", options.update,
-                       "single/joint: monotone (keep a cluster's new order only if its nodes' OVR falls) or paper")
+    command
+        .add_option("--update", options.update,
+                    "single/joint: monotone (keep a cluster's new order only if its nodes' OVR falls) or paper")
         ->capture_default_str();
-    command.add_flag("--blend-clusters", m.blend_clusters,
-                     "single/joint: blended primitives get their own k clusters (buffers: the cluster pairs, up to k^2 per clip)");
+    command.add_flag(
+        "--blend-clusters", m.blend_clusters,
+        "single/joint: blended primitives get their own k clusters (buffers: the cluster pairs, up to k^2 per clip)");
     command.add_option("--nehab-clusters", m.nehab_clusters, "static-nehab06: planar clusters (0: automatic)")
         ->capture_default_str()
         ->check(CLI::Range(size_t(0), size_t(1) << 20));
@@ -99,8 +107,7 @@ std::string method_list(bool shippable_only) {
 
 void add_optimize_options(CLI::App& command, animorder::tool::OptimizeOptions& optimize) {
     add_common(command, optimize.common);
-    command.add_option("-m,--method", optimize.method, "One of: " + method_list(true))
-        ->capture_default_str();
+    command.add_option("-m,--method", optimize.method, "One of: " + method_list(true))->capture_default_str();
     command.add_flag("--joint", optimize.joint, "One set of buffers for all clips (same as --method joint)");
     add_method_options(command, optimize.methods);
     command.add_option("-o,--output", optimize.output,
@@ -127,27 +134,28 @@ animorder::tool::OptimizeOptions parse_batch_item(const std::vector<std::string>
 
 int main(int argc, char** argv) {
     using namespace animorder::tool;
-    CLI::App app{"animorder: triangle orders for animated meshes with low overdraw and a good vertex cache\n"
-                 "(Han & Sander 2017; Sander, Nehab & Barczak 2007)"};
+    CLI::App app{
+        "animorder: triangle orders for animated meshes with low overdraw and a good vertex cache\n"
+        "(Han & Sander 2017; Sander, Nehab & Barczak 2007)"};
     app.set_version_flag("--version", std::string("animorder ") + ANIMORDER_VERSION);
     app.require_subcommand(1);
 
     InspectOptions inspect;
-    CLI::App* inspect_cmd = app.add_subcommand("inspect", "Print triangles, vertices, clips and the ACMR of the current order");
+    CLI::App* inspect_cmd =
+        app.add_subcommand("inspect", "Print triangles, vertices, clips and the ACMR of the current order");
     add_common(*inspect_cmd, inspect.common);
     inspect_cmd->add_flag("--json", inspect.json, "Print JSON instead of text");
 
     OptimizeOptions optimize;
-    CLI::App* optimize_cmd = app.add_subcommand("optimize", "Reorder triangles with a method; write buffers, table, report");
+    CLI::App* optimize_cmd =
+        app.add_subcommand("optimize", "Reorder triangles with a method; write buffers, table, report");
     add_optimize_options(*optimize_cmd, optimize);
 
     EvaluateOptions evaluate;
     CLI::App* evaluate_cmd =
         app.add_subcommand("evaluate", "Score methods' overdraw (OVR) and ACMR over the evaluation nodes (DESIGN.md)");
     add_common(*evaluate_cmd, evaluate.common);
-    evaluate_cmd
-        ->add_option("--methods", evaluate.methods,
-                     "Comma-separated, of: " + method_list(false))
+    evaluate_cmd->add_option("--methods", evaluate.methods, "Comma-separated, of: " + method_list(false))
         ->capture_default_str();
     add_method_options(*evaluate_cmd, evaluate.method_options, true);
     evaluate_cmd->add_option("--eval-views", evaluate.evaluation.views, "Random viewpoints per keyframe")
@@ -156,16 +164,19 @@ int main(int argc, char** argv) {
     evaluate_cmd->add_option("--eval-resolution", evaluate.evaluation.resolution, "Viewport size in pixels")
         ->capture_default_str()
         ->check(CLI::Range(1u, 8192u));
-    evaluate_cmd->add_option("--eval-seed", evaluate.evaluation.seed, "Seed of the evaluation viewpoints")->capture_default_str();
+    evaluate_cmd->add_option("--eval-seed", evaluate.evaluation.seed, "Seed of the evaluation viewpoints")
+        ->capture_default_str();
     evaluate_cmd->add_option("-r,--report", evaluate.report_path, "Write the JSON report to this file");
     evaluate_cmd->add_option("--csv", evaluate.csv_path, "Write the table as CSV to this file");
-    evaluate_cmd->add_flag("--stored", evaluate.stored,
-                           "Also evaluate the orders stored in INPUT (ANIMORDER_animated_triangle_orders): row 'stored'");
+    evaluate_cmd->add_flag(
+        "--stored", evaluate.stored,
+        "Also evaluate the orders stored in INPUT (ANIMORDER_animated_triangle_orders): row 'stored'");
 
     HeatmapOptions heatmap;
     CLI::App* heatmap_cmd = app.add_subcommand("heatmap", "Draw a per-pixel overdraw image of one node as PNG");
     add_common(*heatmap_cmd, heatmap.common);
-    heatmap_cmd->add_option("--order", heatmap.method, "A single-buffer method: original, static-sander07, ...")->capture_default_str();
+    heatmap_cmd->add_option("--order", heatmap.method, "A single-buffer method: original, static-sander07, ...")
+        ->capture_default_str();
     heatmap_cmd->add_option("-l,--lambda", heatmap.lambda, "Patch threshold for static-sander07")
         ->capture_default_str()
         ->check(CLI::Range(0.0, 1000.0));
@@ -201,7 +212,8 @@ int main(int argc, char** argv) {
     batch_cmd->add_option("--shard", batch.shard,
                           "I/N: only items i with i % N == I (0-based); env/N: I from JOB_COMPLETION_INDEX or "
                           "SLURM_ARRAY_TASK_ID");
-    batch_cmd->add_flag("--merge", batch.merge, "Run nothing: build the summary from the items' reports (after the shards)");
+    batch_cmd->add_flag("--merge", batch.merge,
+                        "Run nothing: build the summary from the items' reports (after the shards)");
     batch_cmd->add_option("--summary", batch.summary,
                           "Write SUMMARY.json and SUMMARY.md (default: the manifest's name + .summary)");
     batch_cmd->add_option("--eval-views", batch.eval_views, "OVR before/after: random views per keyframe (0: no OVR)")
@@ -220,28 +232,36 @@ int main(int argc, char** argv) {
     ViewOptions view;
     CLI::App* view_cmd = app.add_subcommand(
         "view", "Serve the viewer page and a glb on 127.0.0.1 (the bundled character, optimised, by default)");
-    view_cmd->add_option("input", view.common.input, "The optimised glb to show (default: the bundled character, optimised)");
+    view_cmd->add_option("input", view.common.input,
+                         "The optimised glb to show (default: the bundled character, optimised)");
     view_cmd->add_flag("-q,--quiet", view.common.quiet, "No progress or notes on stderr");
     view_cmd->add_option("--original", view.original, "The un-optimised file, to compare its order in the page");
-    view_cmd->add_option("--port", view.port, "Port on 127.0.0.1 (0: any free one)")->capture_default_str()->check(CLI::Range(0u, 65535u));
+    view_cmd->add_option("--port", view.port, "Port on 127.0.0.1 (0: any free one)")
+        ->capture_default_str()
+        ->check(CLI::Range(0u, 65535u));
     view_cmd->add_flag("!--no-open", view.open, "Do not start a browser; just print the address");
     view_cmd->add_option("--seconds", view.seconds, "Stop serving after this many seconds (0: until interrupted)");
-    view_cmd->add_option("--viewer-root", view.viewer_root, "The folder holding viewer/ and js/ (default: the source tree)");
+    view_cmd->add_option("--viewer-root", view.viewer_root,
+                         "The folder holding viewer/ and js/ (default: the source tree)");
 
     CheckOptions check;
     CLI::App* check_cmd = app.add_subcommand(
-        "check", "Check the ANIMORDER_animated_triangle_orders orders of a glTF file (JSON report; exit 1 when unusable)");
+        "check",
+        "Check the ANIMORDER_animated_triangle_orders orders of a glTF file (JSON report; exit 1 when unusable)");
     check_cmd->add_option("file", check.file, "glTF/GLB file")->required();
     check_cmd->add_flag("-q,--quiet", check.quiet, "No error line on stderr (the JSON report still has it)");
 
     ReapplyOptions reapply;
-    CLI::App* reapply_cmd = app.add_subcommand(
-        "reapply", "Map an optimised file's orders onto a processed copy of it (gltfpack, gltf-pipeline...) by matching triangles");
+    CLI::App* reapply_cmd = app.add_subcommand("reapply",
+                                               "Map an optimised file's orders onto a processed copy of it (gltfpack, "
+                                               "gltf-pipeline...) by matching triangles");
     reapply_cmd->add_option("optimized", reapply.optimized, "The file animorder optimize wrote")->required();
     reapply_cmd->add_option("processed", reapply.processed, "The same file after another tool")->required();
-    reapply_cmd->add_option("-o,--output", reapply.output, "OUT.glb or OUT.gltf: PROCESSED with the orders")->required();
-    reapply_cmd->add_option("--tolerance", reapply.tolerance,
-                            "Corner distance allowed, as a fraction of the bounding-box diagonal")
+    reapply_cmd->add_option("-o,--output", reapply.output, "OUT.glb or OUT.gltf: PROCESSED with the orders")
+        ->required();
+    reapply_cmd
+        ->add_option("--tolerance", reapply.tolerance,
+                     "Corner distance allowed, as a fraction of the bounding-box diagonal")
         ->capture_default_str()
         ->check(CLI::Range(0.0, 0.1));
     reapply_cmd->add_option("--max-memory", reapply.max_memory, "Loading budget in bytes for the sampled animation")

@@ -30,7 +30,8 @@ void output_paths(const OptimizeOptions& options, OptimizePlan& paths) {
     if (extension == ".glb" || extension == ".gltf") {
         const std::string in_ext = std::filesystem::path(options.common.input).extension().string();
         if (in_ext != ".glb" && in_ext != ".gltf")
-            throw std::runtime_error(options.output + ": glTF output needs a glTF input (the sidecar works for any input)");
+            throw std::runtime_error(options.output +
+                                     ": glTF output needs a glTF input (the sidecar works for any input)");
         paths.gltf = options.output;
         stem = options.output.substr(0, options.output.size() - extension.size());
     }
@@ -53,37 +54,39 @@ nlohmann::ordered_json optimize_settings_json(const OptimizeOptions& options, co
                                               bool with_threads) {
     const MethodSettings& m = plan.settings;
     nlohmann::ordered_json settings = {{"method", method_name(plan.method)},
-            {"lambda", m.lambda},
-            {"cache_size", m.cache_size},
-            {"keyframe", m.keyframe},
-            {"clusters", m.clustering.clusters},
-            {"views", m.clustering.views},
-            {"resolution", m.clustering.resolution},
-            {"seed", m.clustering.seed},
-            {"min_separation_deg", m.clustering.min_separation_deg},
-            {"max_iterations", m.clustering.max_iterations},
-            {"distance", options.methods.distance},
-            {"update", options.methods.update},
-            {"nehab_clusters", m.nehab_clusters},
-            {"nehab_views", m.nehab_views},
-            {"nehab_all_keyframes", m.nehab_all_keyframes},
-            {"blend_clusters", m.blend_clusters}};
+                                       {"lambda", m.lambda},
+                                       {"cache_size", m.cache_size},
+                                       {"keyframe", m.keyframe},
+                                       {"clusters", m.clustering.clusters},
+                                       {"views", m.clustering.views},
+                                       {"resolution", m.clustering.resolution},
+                                       {"seed", m.clustering.seed},
+                                       {"min_separation_deg", m.clustering.min_separation_deg},
+                                       {"max_iterations", m.clustering.max_iterations},
+                                       {"distance", options.methods.distance},
+                                       {"update", options.methods.update},
+                                       {"nehab_clusters", m.nehab_clusters},
+                                       {"nehab_views", m.nehab_views},
+                                       {"nehab_all_keyframes", m.nehab_all_keyframes},
+                                       {"blend_clusters", m.blend_clusters}};
     if (with_threads) settings["threads"] = m.clustering.threads;
     return settings;
 }
 
 OptimizePlan plan_optimize(const OptimizeOptions& options) {
     OptimizePlan plan;
-    const bool measured = options.method == method_name(Method::Measured) ||
-                          options.method == method_name(Method::MeasuredJoint);
-    const Method method = options.joint ? (measured ? Method::MeasuredJoint : Method::Joint) : parse_method(options.method);
-    if (options.joint && options.method != method_name(Method::Single) && options.method != method_name(Method::Joint) &&
-        options.method != method_name(kDefaultMethod) && !measured)
+    const bool measured =
+        options.method == method_name(Method::Measured) || options.method == method_name(Method::MeasuredJoint);
+    const Method method =
+        options.joint ? (measured ? Method::MeasuredJoint : Method::Joint) : parse_method(options.method);
+    if (options.joint && options.method != method_name(Method::Single) &&
+        options.method != method_name(Method::Joint) && options.method != method_name(kDefaultMethod) && !measured)
         throw std::runtime_error("--joint applies to the single and measured methods, not " + options.method);
     if (!method_has_buffers(method))
-        throw std::runtime_error(std::string(method_name(method)) +
-                                 " is a bound (a new order at every node), not an order to ship; use evaluate --methods " +
-                                 method_name(method));
+        throw std::runtime_error(
+            std::string(method_name(method)) +
+            " is a bound (a new order at every node), not an order to ship; use evaluate --methods " +
+            method_name(method));
     plan.method = method;
     plan.settings = method_settings(options.methods, options.common, method);
     validate_method_settings(plan.settings);
@@ -156,8 +159,8 @@ int run_optimize(const OptimizeOptions& options) {
     const std::string input_name = product.report["input"].get<std::string>();
 
     std::printf("%s on %s: %zu triangles, %zu buffers, ACMR %.4f -> %.4f, ATVR %.4f -> %.4f, %.3f s\n",
-                method_name(plan.method), input_name.c_str(), product.mesh.triangle_count(), run.buffers.orders.size(), before.acmr,
-                run.acmr_mean, before.atvr, run.atvr_mean, run.seconds);
+                method_name(plan.method), input_name.c_str(), product.mesh.triangle_count(), run.buffers.orders.size(),
+                before.acmr, run.acmr_mean, before.atvr, run.atvr_mean, run.seconds);
     return 0;
 }
 

@@ -25,7 +25,8 @@ namespace {
 
 // Per triangle of the listed primitives of `mesh` (or all when `only` is empty), its three
 // corners, each with xyz at every keyframe in `keyframes`.
-std::vector<float> corners(const AnimatedMesh& mesh, const std::vector<size_t>& triangles, const std::vector<size_t>& keyframes) {
+std::vector<float> corners(const AnimatedMesh& mesh, const std::vector<size_t>& triangles,
+                           const std::vector<size_t>& keyframes) {
     const size_t dims = 3 * keyframes.size();
     std::vector<float> out(triangles.size() * 3 * dims);
     for (size_t i = 0; i < triangles.size(); ++i)
@@ -91,8 +92,10 @@ int run_reapply(const ReapplyOptions& options) {
     float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (size_t v = 0; v < a.vertex_count; ++v)
         for (int c = 0; c < 3; ++c)
-            lo[c] = std::min(lo[c], a.keyframe(ka[0])[3 * v + size_t(c)]), hi[c] = std::max(hi[c], a.keyframe(ka[0])[3 * v + size_t(c)]);
-    const float diagonal = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
+            lo[c] = std::min(lo[c], a.keyframe(ka[0])[3 * v + size_t(c)]),
+            hi[c] = std::max(hi[c], a.keyframe(ka[0])[3 * v + size_t(c)]);
+    const float diagonal = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                                     (hi[2] - lo[2]) * (hi[2] - lo[2]));
     const TriangleMatch m = match_triangles(corners(a, a_triangles, ka), corners(b, b_triangles, kb), 3 * ka.size(),
                                             float(options.tolerance) * diagonal);
     // Per triangle of OPTIMIZED (global index): its triangle of PROCESSED.
@@ -100,11 +103,12 @@ int run_reapply(const ReapplyOptions& options) {
     for (size_t t = 0; t < m.from_of_to.size(); ++t)
         if (m.from_of_to[t] >= 0) b_of_a[a_triangles[size_t(m.from_of_to[t])]] = int64_t(t);
     if (!options.quiet)
-        std::fprintf(stderr, "animorder: matched %zu of %zu optimised triangles to %zu processed triangles\n", m.matched,
-                 a_triangles.size(), b.triangle_count());
+        std::fprintf(stderr, "animorder: matched %zu of %zu optimised triangles to %zu processed triangles\n",
+                     m.matched, a_triangles.size(), b.triangle_count());
     if (m.matched != a_triangles.size())
         throw std::runtime_error(options.processed + ": only " + std::to_string(m.matched) + " of " +
-                                 std::to_string(a_triangles.size()) + " optimised triangles found (simplified or changed mesh?); nothing written");
+                                 std::to_string(a_triangles.size()) +
+                                 " optimised triangles found (simplified or changed mesh?); nothing written");
 
     std::vector<PrimitiveOrders> out;
     std::map<std::pair<int, int>, size_t> seen;
@@ -127,11 +131,13 @@ int run_reapply(const ReapplyOptions& options) {
                 for (uint32_t q : s.order_triangles[o]) {
                     const int64_t t = b_of_a[s.first_triangle + q];
                     if (t < int64_t(first) || t >= int64_t(last)) continue;
-                    for (size_t c = 0; c < 3; ++c) po.orders.push_back(uint32_t(b.indices[3 * size_t(t) + c] - p.vertex_base));
+                    for (size_t c = 0; c < 3; ++c)
+                        po.orders.push_back(uint32_t(b.indices[3 * size_t(t) + c] - p.vertex_base));
                 }
         out.push_back(std::move(po));
     }
-    const std::string bytes = gltf_with_extension_orders(options.processed, options.output, orders, out, extension == ".glb");
+    const std::string bytes =
+        gltf_with_extension_orders(options.processed, options.output, orders, out, extension == ".glb");
     write_file_atomically(options.output, bytes);
     std::printf("reapplied %u orders: %zu of %zu triangles matched, %zu primitive(s); wrote %s\n", orders.buffer_count,
                 m.matched, a_triangles.size(), out.size(), options.output.c_str());

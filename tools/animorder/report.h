@@ -22,7 +22,8 @@ nlohmann::ordered_json cache_stats_json(const VertexCacheStats& stats);
 // A method's entry of "methods": name, the settings it used (null where it uses none), buffers,
 // ACMR/ATVR, OVR (null until evaluate fills it), time, and what the method reports of itself
 // (patches; single/joint: runs, iterations, stages).
-nlohmann::ordered_json method_entry(const AnimatedMesh& mesh, const MethodResult& result, const MethodSettings& settings);
+nlohmann::ordered_json method_entry(const AnimatedMesh& mesh, const MethodResult& result,
+                                    const MethodSettings& settings);
 
 // Serialised with two-space indentation and a final newline.
 std::string report_text(const nlohmann::ordered_json& report);

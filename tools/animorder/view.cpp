@@ -54,8 +54,8 @@ void send_all(int fd, const std::string& bytes) {
     }
 }
 
-void respond(int fd, int code, const std::string& status, const std::string& type, const std::string& body,
-             bool head, const std::string& extra = "") {
+void respond(int fd, int code, const std::string& status, const std::string& type, const std::string& body, bool head,
+             const std::string& extra = "") {
     std::string header = "HTTP/1.1 " + std::to_string(code) + " " + status + "\r\nContent-Type: " + type +
                          "\r\nContent-Length: " + std::to_string(body.size()) +
                          "\r\nCache-Control: no-store\r\nConnection: close\r\n" + extra + "\r\n";
@@ -72,7 +72,8 @@ struct Site {
 fs::path resolve(const Site& site, const std::string& url) {
     if (url == "/model.glb") return site.model;
     if (url == "/original.glb") return site.original;
-    if (url.find("..") != std::string::npos || url.find('%') != std::string::npos || url.find('\\') != std::string::npos)
+    if (url.find("..") != std::string::npos || url.find('%') != std::string::npos ||
+        url.find('\\') != std::string::npos)
         return {};
     for (const char* prefix : {"/viewer/", "/js/"}) {
         if (url.rfind(prefix, 0) != 0) continue;
@@ -80,7 +81,8 @@ fs::path resolve(const Site& site, const std::string& url) {
         if (!url.empty() && url.back() == '/') path /= "index.html";
         std::error_code ec;
         const fs::path real = fs::canonical(path, ec);
-        const fs::path base = fs::canonical(site.root / std::string(prefix).substr(1, std::string(prefix).size() - 2), ec);
+        const fs::path base =
+            fs::canonical(site.root / std::string(prefix).substr(1, std::string(prefix).size() - 2), ec);
         if (ec || !fs::is_regular_file(real)) return {};
         // The real path must stay below its folder (a link inside the viewer may not lead out of it),
         // except for viewer/node_modules, which npm may link.
@@ -118,7 +120,8 @@ void serve_one(int fd, const Site& site, bool quiet) {
     }
     if (url == "/") {
         respond(fd, 302, "Found", "text/plain", "", head,
-                "Location: /viewer/?file=/model.glb" + std::string(site.original.empty() ? "" : "&original=/original.glb") + "\r\n");
+                "Location: /viewer/?file=/model.glb" +
+                    std::string(site.original.empty() ? "" : "&original=/original.glb") + "\r\n");
         return;
     }
     const fs::path path = resolve(site, url);
@@ -199,8 +202,8 @@ int run_view(const ViewOptions& options) {
     const auto start = std::chrono::steady_clock::now();
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);
-    while (!interrupted && (options.seconds == 0 ||
-                            std::chrono::steady_clock::now() - start < std::chrono::seconds(options.seconds))) {
+    while (!interrupted &&
+           (options.seconds == 0 || std::chrono::steady_clock::now() - start < std::chrono::seconds(options.seconds))) {
         timeval wait{1, 0};  // wake up now and then to honour --seconds and signals
         fd_set ready;
         FD_ZERO(&ready);

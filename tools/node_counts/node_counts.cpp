@@ -48,7 +48,8 @@ std::vector<uint32_t> face_order(const std::vector<uint32_t>& indices, const uin
     std::vector<uint32_t> order(indices.size() / 3);
     for (size_t i = 0; i < order.size(); ++i) {
         auto it = where.find(key(buffer[3 * i], buffer[3 * i + 1], buffer[3 * i + 2]));
-        if (it == where.end() || it->second.empty()) throw std::runtime_error("the sidecar's buffer is not a permutation of the input's triangles");
+        if (it == where.end() || it->second.empty())
+            throw std::runtime_error("the sidecar's buffer is not a permutation of the input's triangles");
         order[i] = it->second.back();
         it->second.pop_back();
     }
@@ -68,16 +69,21 @@ int main(int argc, char** argv) try {
     for (int a = 3; a + 1 < argc; a += 2) {
         const std::string name = argv[a];
         const unsigned long long value = std::strtoull(argv[a + 1], nullptr, 10);
-        if (name == "--nodes-per-clip") per_clip = value;
-        else if (name == "--resolution") resolution = unsigned(value);
-        else if (name == "--seed") seed = value;
-        else throw std::runtime_error("unknown option " + name);
+        if (name == "--nodes-per-clip")
+            per_clip = value;
+        else if (name == "--resolution")
+            resolution = unsigned(value);
+        else if (name == "--seed")
+            seed = value;
+        else
+            throw std::runtime_error("unknown option " + name);
     }
     const AnimatedMesh mesh = load_character(argv[1]);
     std::ifstream in(argv[2], std::ios::binary);
     const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     animorder_runtime rt;
-    if (animorder_runtime_open(&rt, bytes.data(), bytes.size()) != 0) throw std::runtime_error("the sidecar does not open");
+    if (animorder_runtime_open(&rt, bytes.data(), bytes.size()) != 0)
+        throw std::runtime_error("the sidecar does not open");
     if (rt.index_count != mesh.indices.size() || rt.clip_count != mesh.clips.size())
         throw std::runtime_error("the sidecar does not belong to this input");
 
@@ -86,7 +92,8 @@ int main(int argc, char** argv) try {
     std::vector<std::vector<uint32_t>> orders;
     orders.emplace_back(triangles);
     std::iota(orders[0].begin(), orders[0].end(), 0u);
-    for (uint32_t b = 0; b < rt.buffer_count; ++b) orders.push_back(face_order(mesh.indices, animorder_buffer(&rt, int(b))));
+    for (uint32_t b = 0; b < rt.buffer_count; ++b)
+        orders.push_back(face_order(mesh.indices, animorder_buffer(&rt, int(b))));
     std::vector<const uint32_t*> pointers;
     for (const auto& o : orders) pointers.push_back(o.data());
     const std::vector<uint32_t> ranks = make_rank_table(pointers, triangles);
@@ -121,11 +128,16 @@ int main(int argc, char** argv) try {
             score_nodes(&visible, passed.data(), mesh.keyframe_positions.data(), mesh.vertex_count, framing,
                         mesh.indices.data(), mesh.indices.size(), &node, 1, ranks.data(), orders.size(), settings);
             const Mat4d vp = node_view_projection(node.direction, framing.radius);
-            out["nodes"].push_back({{"clip", c}, {"keyframe", f}, {"direction", {node.direction[0], node.direction[1], node.direction[2]}},
-                                    {"radius", framing.radius}, {"centre", {centre[0], centre[1], centre[2]}},
+            out["nodes"].push_back({{"clip", c},
+                                    {"keyframe", f},
+                                    {"direction", {node.direction[0], node.direction[1], node.direction[2]}},
+                                    {"radius", framing.radius},
+                                    {"centre", {centre[0], centre[1], centre[2]}},
                                     {"view_projection", std::vector<double>(vp.begin(), vp.end())},
-                                    {"buffer", buffer}, {"visible", visible},
-                                    {"original_passed", passed[0]}, {"optimised_passed", passed[1 + size_t(buffer)]}});
+                                    {"buffer", buffer},
+                                    {"visible", visible},
+                                    {"original_passed", passed[0]},
+                                    {"optimised_passed", passed[1 + size_t(buffer)]}});
         }
     }
     std::cout << out.dump() << "\n";

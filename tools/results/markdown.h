@@ -9,8 +9,8 @@ namespace animorder::results {
 
 extern const char* const kDash;  // a missing value: "—"
 
-std::string f3(double v);       // 3 decimals, or — when not finite
-std::string f1(double v);       // 1 decimal, or — when not finite
+std::string f3(double v);        // 3 decimals, or — when not finite
+std::string f1(double v);        // 1 decimal, or — when not finite
 std::string count(long long v);  // the integer, or — when negative
 
 // λ as written in the reports' settings: 0.85, 3, 1.5 (— when not finite).

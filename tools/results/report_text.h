@@ -31,9 +31,9 @@ const Method* find_method(const Report& r, const std::string& name, double lambd
 // The same, falling back to the entry without λ.
 const Method* find_method_any(const Report& r, const std::string& name, double lambda);
 
-std::string keyframes_total(const Report& r);             // all clips' keyframes
-std::string clip_list(const Report& r);                   // "Idle (60), Walk (24)"
-std::string joined(const std::vector<long long>& v);      // "5, 7"
+std::string keyframes_total(const Report& r);              // all clips' keyframes
+std::string clip_list(const Report& r);                    // "Idle (60), Walk (24)"
+std::string joined(const std::vector<long long>& v);       // "5, 7"
 std::string lambdas_joined(const std::vector<double>& v);  // "0.85, 3"
 
 // One sentence of a report's protocol, from its own settings.

@@ -20,8 +20,8 @@ std::string nehab06_comparison(const Inputs& in) {
     std::vector<std::string> files = {"ganfaul-idle.json", "ganfaul-idle-sub1.json", "ganfaul-idle-sub2.json",
                                       "ganfaul-clips.json"};
     files.insert(files.end(), in.characters.begin(), in.characters.end());
-    const std::vector<std::string> header = {"input", "triangles", "original",         "meshopt",
-                                             "static-sander07 λ=0.85", "static-nehab06", "nehab06 s"};
+    const std::vector<std::string> header = {
+        "input", "triangles", "original", "meshopt", "static-sander07 λ=0.85", "static-nehab06", "nehab06 s"};
     std::vector<std::vector<std::string>> rows;
     size_t inputs = 0, beats_sander = 0, beats_original = 0, lower_acmr = 0;
     auto cell = [](const Method* m) { return m ? f3(m->ovr_mean) + " (" + f3(m->acmr) + ")" : std::string(kDash); };

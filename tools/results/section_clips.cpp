@@ -63,7 +63,7 @@ Section clips_section(const Inputs& in, Charts& charts) {
         const std::string file =
             "fig8-clips-ovr" + (std::isfinite(lambda) ? "-lambda-" + lambda_text(lambda) : "") + ".svg";
         b += charts.chart(file, chart,
-                       "OVR per clip and method" + (std::isfinite(lambda) ? ", lambda " + lambda_text(lambda) : ""));
+                          "OVR per clip and method" + (std::isfinite(lambda) ? ", lambda " + lambda_text(lambda) : ""));
     }
     b += "\n";
     std::vector<std::string> header = {"clip", "keyframes"};

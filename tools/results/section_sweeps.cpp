@@ -25,8 +25,7 @@ struct Axis {
 
 // Horizontal dashed reference lines over [x0, x1] for the methods that do not vary with the swept
 // parameter, e.g. original and static-nehab06 in the λ sweep.
-void add_references(LineChart& chart, const Report& r, double x0, double x1, const Axis& axis,
-                    double Method::*value) {
+void add_references(LineChart& chart, const Report& r, double x0, double x1, const Axis& axis, double Method::*value) {
     for (const std::string& name : method_names({&r}))
         for (const Method& m : r.methods)
             if (m.name == name && !axis.is_swept(m)) {
@@ -72,9 +71,9 @@ std::string lambda_key(const Method& m) { return std::isfinite(m.lambda) ? " λ=
 
 const Axis kViews = {[](const Method& m) { return m.views >= 0; }, [](const Method& m) { return double(m.views); },
                      [](const Method& m) { return m.name + lambda_key(m) + " k=" + std::to_string(m.clusters); }};
-const Axis kClusters = {
-    [](const Method& m) { return m.clusters >= 0; }, [](const Method& m) { return double(m.clusters); },
-    [](const Method& m) { return m.name + lambda_key(m) + " views=" + std::to_string(m.views); }};
+const Axis kClusters = {[](const Method& m) { return m.clusters >= 0; },
+                        [](const Method& m) { return double(m.clusters); },
+                        [](const Method& m) { return m.name + lambda_key(m) + " views=" + std::to_string(m.views); }};
 const Axis kLambda = {[](const Method& m) { return std::isfinite(m.lambda); }, [](const Method& m) { return m.lambda; },
                       [](const Method& m) {
                           std::string s = m.name;
@@ -157,8 +156,12 @@ Section views_section(const Inputs& in, Charts& charts) {
 
 Section lambda_section(const Inputs& in, Charts& charts) {
     const Plot ovr{"fig6-lambda-ovr.svg", "OVR against lambda", "Overdraw against λ (Fig. 6)"};
-    const Plot acmr{"fig6-lambda-acmr.svg", "ACMR against lambda", "Vertex cache: ACMR against λ (Fig. 6)", "ACMR",
-                    &Method::acmr, true};
+    const Plot acmr{"fig6-lambda-acmr.svg",
+                    "ACMR against lambda",
+                    "Vertex cache: ACMR against λ (Fig. 6)",
+                    "ACMR",
+                    &Method::acmr,
+                    true};
     return sweep_section(
         in, charts,
         {"lambda", "Patch threshold lambda (Fig. 6)", "sweep-lambda.json",

@@ -95,8 +95,7 @@ Section table1_section(const Inputs& in) {
         if (const Report* r = in.get(files[level])) {
             rows.push_back(our_table1_row(
                 p.model,
-                "ours, " + (r->clips.size() == 1 ? r->clips[0].name : std::to_string(r->clips.size()) + " clips"),
-                *r));
+                "ours, " + (r->clips.size() == 1 ? r->clips[0].name : std::to_string(r->clips.size()) + " clips"), *r));
         } else {
             missing += not_run(files[level]);
         }

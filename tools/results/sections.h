@@ -51,6 +51,6 @@ Section clips_section(const Inputs& in, Charts& charts);
 Section render_time_section(const Inputs& in);
 Section nehab06_section(const Inputs& in);
 Section performance_section(const Inputs& in);  // its figures: notes-performance.md (templates.h)
-Section other_section(const Inputs& in);  // empty body when there is no other *.txt
+Section other_section(const Inputs& in);        // empty body when there is no other *.txt
 
 }  // namespace animorder::results

@@ -9,6 +9,8 @@
 // the same pixels and a method with many buffers costs no more than one with a single buffer.
 #include "animorder/evaluation.h"
 
+#include "evaluation_nodes.h"
+
 #include "animorder/animated_mesh.h"
 #include "animorder/camera.h"
 #include "animorder/invalid_input.h"
@@ -53,37 +55,6 @@ struct Accumulator {
     }
 };
 
-void check_method(const AnimatedMesh& mesh, const MethodBuffers& m) {
-    const size_t triangles = mesh.triangle_count();
-    if (m.front_to_back) {
-        const MeshPatches& p = *m.front_to_back;
-        if (p.cache_order.size() != triangles || p.patch_starts.size() != p.patch_count() + 1 ||
-            p.patch_starts.back() != triangles)
-            throw InvalidInput("the oracle's patches do not cover the mesh's " + std::to_string(triangles) +
-                               " triangles");
-        validate_triangle_order(p.cache_order.data(), triangles);
-        return;
-    }
-    if (m.orders.empty()) throw InvalidInput("a method has no buffer");
-    for (const auto& order : m.orders) {
-        if (order.size() != triangles)
-            throw InvalidInput("an order has " + std::to_string(order.size()) + " triangles, the mesh " +
-                               std::to_string(triangles));
-        validate_triangle_order(order.data(), triangles);
-    }
-    if (!m.keyframe_buffer.empty()) {
-        if (m.keyframe_buffer.size() != mesh.keyframe_count())
-            throw InvalidInput("a per-keyframe method needs one buffer per keyframe (" +
-                               std::to_string(mesh.keyframe_count()) + "), it names " +
-                               std::to_string(m.keyframe_buffer.size()));
-        for (uint32_t b : m.keyframe_buffer)
-            if (b >= m.orders.size()) throw InvalidInput("a per-keyframe method names a missing buffer");
-        return;
-    }
-    if (!m.tables.empty() && (m.tables.size() != mesh.clips.size() || m.table_base.size() != mesh.clips.size()))
-        throw InvalidInput("a method with lookup tables needs one table per clip");
-}
-
 }  // namespace
 
 std::vector<uint32_t> front_to_back_patch_order(const float* centroids, size_t patch_count, const float eye[3]) {
@@ -102,26 +73,15 @@ std::vector<uint32_t> front_to_back_patch_order(const float* centroids, size_t p
 
 std::vector<OrderEvaluation> evaluate_methods(const AnimatedMesh& mesh, const std::vector<MethodBuffers>& methods,
                                               const EvaluationSettings& settings) {
+    using namespace evaluation_detail;
     validate_animated_mesh(mesh);
     if (settings.views == 0) throw InvalidInput("evaluation needs at least one viewpoint");
     if (settings.resolution == 0) throw InvalidInput("evaluation needs a resolution of at least one pixel");
     for (const MethodBuffers& m : methods) check_method(mesh, m);
     const size_t triangles = mesh.triangle_count(), method_count = methods.size();
-
-    // rank_of[m][b][t]: the position at which buffer b of method m draws triangle t.
-    std::vector<std::vector<std::vector<uint32_t>>> rank_of(method_count);
-    for (size_t m = 0; m < method_count; ++m)
-        for (const auto& order : methods[m].orders) {
-            std::vector<uint32_t> rank(triangles);
-            for (size_t i = 0; i < triangles; ++i) rank[order[i]] = uint32_t(i);
-            rank_of[m].push_back(std::move(rank));
-        }
-
+    const RankTables rank_of = rank_tables(methods, triangles);
     const std::vector<uint8_t> modes = opaque_pass_modes(mesh);
     const Framing all = frame_animated_mesh(mesh);
-    const std::vector<float> directions = random_sphere_directions(settings.views, settings.seed);
-    size_t total_nodes = 0, done_before = 0;
-    for (const Clip& c : mesh.clips) total_nodes += c.keyframe_count * settings.views;
 
     std::vector<Accumulator> overall(method_count);
     std::vector<std::vector<Accumulator>> per_clip(method_count, std::vector<Accumulator>(mesh.clips.size()));
@@ -131,76 +91,50 @@ std::vector<OrderEvaluation> evaluate_methods(const AnimatedMesh& mesh, const st
         std::vector<uint32_t> ranks;  // this node's table: triangles × methods
     };
     tbb::enumerable_thread_specific<Worker> workers;
-    const int threads = settings.threads ? int(settings.threads) : tbb::this_task_arena::max_concurrency();
-    tbb::task_arena arena(threads);
-    std::mutex progress_mutex;
-
-    for (size_t c = 0; c < mesh.clips.size(); ++c) {
-        const Clip& clip = mesh.clips[c];
-        std::vector<uint32_t> keyframes(clip.keyframe_count);
-        std::iota(keyframes.begin(), keyframes.end(), uint32_t(clip.first_keyframe));
-        const Framing framing = frame_subset(all, keyframes);  // R of this animation
-        // The oracles' patch centroids at every keyframe of the clip.
-        std::vector<std::vector<float>> centroids(method_count);
+    std::vector<std::vector<float>> centroids(method_count);  // the oracles' patch centroids in the clip
+    std::vector<uint64_t> visible, passed;
+    auto begin = [&](size_t, const std::vector<uint32_t>& keyframes, const Framing&, size_t node_count) {
         for (size_t m = 0; m < method_count; ++m)
             if (methods[m].front_to_back)
                 centroids[m] = patch_centroids(mesh, *methods[m].front_to_back, all, keyframes);
-
-        const size_t node_count = keyframes.size() * settings.views;
-        std::vector<uint64_t> visible(node_count), passed(node_count * method_count);
-        std::atomic<size_t> done{0};
-        const size_t report_every = std::max<size_t>(1, total_nodes / 200);
-        auto body = [&](const tbb::blocked_range<size_t>& range) {
-            Worker& w = workers.local();
-            w.clip.resize(mesh.vertex_count * 4);
-            w.ranks.resize(triangles * method_count);
-            for (size_t n = range.begin(); n != range.end(); ++n) {
-                const size_t f = n / settings.views, keyframe = keyframes[f];
-                const float* direction = &directions[3 * (n % settings.views)];
-                for (size_t m = 0; m < method_count; ++m) {
-                    const MethodBuffers& method = methods[m];
-                    if (method.front_to_back) {
-                        const MeshPatches& patches = *method.front_to_back;
-                        const float eye[3] = {3 * framing.radius * direction[0], 3 * framing.radius * direction[1],
-                                              3 * framing.radius * direction[2]};
-                        const std::vector<uint32_t> order = patch_order_to_triangle_order(
-                            patches, front_to_back_patch_order(&centroids[m][f * patches.patch_count() * 3],
-                                                               patches.patch_count(), eye));
-                        for (size_t i = 0; i < triangles; ++i)
-                            w.ranks[size_t(order[i]) * method_count + m] = uint32_t(i);
-                        continue;
-                    }
-                    size_t buffer = 0;
-                    if (!method.keyframe_buffer.empty())
-                        buffer = method.keyframe_buffer[keyframe];
-                    else if (!method.tables.empty())
-                        buffer = method.table_base[c] + select_buffer(method.tables[c], f, direction);
-                    if (buffer >= rank_of[m].size()) throw InvalidInput("a lookup table names a missing buffer");
-                    const uint32_t* rank = rank_of[m][buffer].data();
-                    for (size_t t = 0; t < triangles; ++t) w.ranks[t * method_count + m] = rank[t];
-                }
-                transform_to_clip(w.clip.data(), mesh.keyframe(keyframe), mesh.vertex_count, &all.centres[3 * keyframe],
-                                  node_view_projection(direction, framing.radius));
-                w.rasterizer.rasterize(w.clip.data(), mesh.vertex_count, mesh.indices.data(), mesh.indices.size(),
-                                       settings.resolution, modes.empty() ? nullptr : modes.data());
-                visible[n] = w.rasterizer.visible_pixels();
-                w.rasterizer.score(&passed[n * method_count], w.ranks.data(), method_count);
-                const size_t finished = ++done;
-                if (settings.progress && (finished % report_every == 0 || finished == node_count)) {
-                    std::lock_guard<std::mutex> lock(progress_mutex);
-                    settings.progress(done_before + finished, total_nodes);
-                }
+        visible.assign(node_count, 0);
+        passed.assign(node_count * method_count, 0);
+    };
+    auto visit = [&](const Node& node) {
+        Worker& w = workers.local();
+        w.clip.resize(mesh.vertex_count * 4);
+        w.ranks.resize(triangles * method_count);
+        const Framing& framing = *node.framing;
+        for (size_t m = 0; m < method_count; ++m) {
+            const MethodBuffers& method = methods[m];
+            if (method.front_to_back) {
+                const MeshPatches& patches = *method.front_to_back;
+                const float eye[3] = {3 * framing.radius * node.direction[0], 3 * framing.radius * node.direction[1],
+                                      3 * framing.radius * node.direction[2]};
+                const std::vector<uint32_t> order = patch_order_to_triangle_order(
+                    patches, front_to_back_patch_order(&centroids[m][node.f * patches.patch_count() * 3],
+                                                       patches.patch_count(), eye));
+                for (size_t i = 0; i < triangles; ++i) w.ranks[size_t(order[i]) * method_count + m] = uint32_t(i);
+                continue;
             }
-        };
-        arena.execute([&] { tbb::parallel_for(tbb::blocked_range<size_t>(0, node_count, 1), body); });
-        done_before += node_count;
-
+            const uint32_t* rank = node_ranks(method, rank_of[m], node.clip, node.f, node.keyframe, node.direction);
+            for (size_t t = 0; t < triangles; ++t) w.ranks[t * method_count + m] = rank[t];
+        }
+        transform_to_clip(w.clip.data(), mesh.keyframe(node.keyframe), mesh.vertex_count,
+                          &all.centres[3 * node.keyframe], node_view_projection(node.direction, framing.radius));
+        w.rasterizer.rasterize(w.clip.data(), mesh.vertex_count, mesh.indices.data(), mesh.indices.size(),
+                               settings.resolution, modes.empty() ? nullptr : modes.data());
+        visible[node.index] = w.rasterizer.visible_pixels();
+        w.rasterizer.score(&passed[node.index * method_count], w.ranks.data(), method_count);
+    };
+    auto end = [&](size_t c, size_t node_count) {
         for (size_t n = 0; n < node_count; ++n)  // in node order: sums independent of the schedule
             for (size_t m = 0; m < method_count; ++m) {
                 overall[m].add(passed[n * method_count + m], visible[n]);
                 per_clip[m][c].add(passed[n * method_count + m], visible[n]);
             }
-    }
+    };
+    for_each_evaluation_node(mesh, all, settings, begin, visit, end);
     std::vector<OrderEvaluation> result(method_count);
     for (size_t m = 0; m < method_count; ++m) {
         result[m].overall = overall[m].summary();

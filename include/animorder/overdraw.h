@@ -31,6 +31,8 @@ std::vector<uint8_t> opaque_pass_modes(const AnimatedMesh& mesh);
 // The transparent pass: every triangle drawn (the opaque ones for their depth), double-sided
 // ones without culling. Empty when none is double-sided.
 std::vector<uint8_t> full_pass_modes(const AnimatedMesh& mesh);
+// 1 for every triangle of a blended primitive (AlphaMode::Blend), else 0: one entry per triangle.
+std::vector<uint8_t> blended_triangles(const AnimatedMesh& mesh);
 
 // One (keyframe, viewpoint): keyframe indexes the keyframe arrays, direction is a unit vector
 // from the frame's centre towards the camera.

@@ -73,11 +73,7 @@ BlendClustering cluster_blend_nodes(const AnimatedMesh& mesh, const Framing& fra
     const size_t k = run.triangle_orders.size(), triangles = mesh.triangle_count();
     if (views == 0 || node_count != views * run.keyframes.size() || k == 0)
         throw InvalidInput("a clustering run's assignment does not cover its nodes");
-    std::vector<uint8_t> blended(triangles, 0);
-    for (const Primitive& p : mesh.primitives)
-        if (p.alpha_mode == AlphaMode::Blend)
-            std::fill(blended.begin() + ptrdiff_t(p.first_index / 3),
-                      blended.begin() + ptrdiff_t((p.first_index + p.index_count) / 3), 1);
+    const std::vector<uint8_t> blended = blended_triangles(mesh);
     const std::vector<uint8_t> modes = full_pass_modes(mesh);
 
     // Every node's transparent pass, once.

@@ -7,6 +7,7 @@
 // the nodes.
 #include "animorder/overdraw.h"
 
+#include "animorder/animated_mesh.h"
 #include "animorder/camera.h"
 #include "animorder/invalid_input.h"
 #include "animorder/rasterizer.h"
@@ -18,6 +19,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <atomic>
 #include <mutex>
 #include <string>
@@ -39,6 +41,15 @@ std::vector<uint8_t> opaque_pass_modes(const AnimatedMesh& mesh) {
 }
 
 std::vector<uint8_t> full_pass_modes(const AnimatedMesh& mesh) { return double_sided_triangles(mesh); }
+
+std::vector<uint8_t> blended_triangles(const AnimatedMesh& mesh) {
+    std::vector<uint8_t> blended(mesh.triangle_count(), 0);
+    for (const Primitive& p : mesh.primitives)
+        if (p.alpha_mode == AlphaMode::Blend)
+            std::fill(blended.begin() + ptrdiff_t(p.first_index / 3),
+                      blended.begin() + ptrdiff_t((p.first_index + p.index_count) / 3), 1);
+    return blended;
+}
 
 std::vector<uint32_t> make_rank_table(const std::vector<const uint32_t*>& orders, size_t triangle_count) {
     const size_t k = orders.size();

@@ -163,27 +163,9 @@ std::string gltf_with_orders(const std::string& input_path, const std::string& o
     root["clips"] = tinygltf::Value(clips);
     model.extensions[kOrdersExtension] = tinygltf::Value(root);
     add_extension_used(model, kOrdersExtension);
-    model.buffers[0].uri.clear();  // embedded: the output stands alone
-    // Image files stay where they are: a relative URI is re-expressed from the output's folder.
-    namespace fs = std::filesystem;
-    const fs::path from = fs::absolute(fs::path(input_path)).parent_path();
-    const fs::path to = fs::absolute(fs::path(output_path)).parent_path();
-    for (tinygltf::Image& image : model.images)
-        if (!image.uri.empty() && image.uri.rfind("data:", 0) != 0 && image.uri.find("://") == std::string::npos &&
-            fs::path(image.uri).is_relative() && from != to)
-            image.uri = fs::relative(from / image.uri, to).generic_string();
-
-    tinygltf::TinyGLTF writer;
-    writer.SetImageWriter(
-        [](const std::string*, const std::string*, const tinygltf::Image* image, bool, std::string* uri, void*) {
-            *uri = image->uri;  // never decoded, never rewritten: external images keep their URIs
-            return true;
-        },
-        nullptr);
-    std::ostringstream out;
-    if (!writer.WriteGltfSceneToStream(&model, out, !binary, binary))
-        throw LoadError(input_path + ": writing the glTF output failed");
-    return out.str();
+    // Buffers embedded (the output stands alone); image files stay where they are, a relative URI
+    // re-expressed from the output's folder (gltf_buffer.h).
+    return io::write_model(model, input_path, output_path, binary);
 }
 
 }  // namespace animorder

@@ -92,11 +92,7 @@ std::vector<BlendEvaluation> evaluate_blend(const AnimatedMesh& mesh, const std:
     for (const MethodBuffers& m : methods)
         if (!m.front_to_back) check_method(mesh, m);  // the oracle has no buffers: it is left out here
     const RankTables rank_of = rank_tables(methods, triangles);
-    std::vector<uint8_t> blended(triangles, 0);
-    for (const Primitive& p : mesh.primitives)
-        if (p.alpha_mode == AlphaMode::Blend)
-            std::fill(blended.begin() + ptrdiff_t(p.first_index / 3),
-                      blended.begin() + ptrdiff_t((p.first_index + p.index_count) / 3), 1);
+    const std::vector<uint8_t> blended = blended_triangles(mesh);
     const std::vector<uint8_t> modes = full_pass_modes(mesh);
     const Framing all = frame_animated_mesh(mesh);
 

@@ -32,23 +32,6 @@ namespace {
 
 const char* const kOrdersExtension = "ANIMORDER_animated_triangle_orders";
 
-tinygltf::Model read_model(const std::string& path) {
-    tinygltf::Model model;
-    tinygltf::TinyGLTF loader;
-    loader.SetImageLoader([](tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*,
-                             int, void*) { return true; },
-                          nullptr);
-    std::string error, warning;
-    std::string magic(4, '\0');
-    if (FILE* f = std::fopen(path.c_str(), "rb")) {
-        if (std::fread(magic.data(), 1, 4, f) != 4) magic.clear();
-        std::fclose(f);
-    }
-    const bool ok = magic == "glTF" ? loader.LoadBinaryFromFile(&model, &error, &warning, path)
-                                    : loader.LoadASCIIFromFile(&model, &error, &warning, path);
-    if (!ok) throw LoadError(path + ": not a readable glTF 2.0 file: " + error);
-    return model;
-}
 
 int append_accessor(tinygltf::Model& model, int view, int component, int type, size_t count, const std::string& name) {
     tinygltf::Accessor a;
@@ -98,7 +81,7 @@ std::string gltf_with_orders(const std::string& input_path, const std::string& o
                              const MethodBuffers& buffers, uint32_t fallback, const Framing& framing,
                              const std::string& method, bool binary) {
     if (fallback >= buffers.orders.size()) throw LoadError(input_path + ": no buffer " + std::to_string(fallback));
-    tinygltf::Model model = read_model(input_path);
+    tinygltf::Model model = io::read_model(input_path);
     std::map<std::pair<int, int>, size_t> seen;
     for (size_t i = 0; i < mesh.primitives.size(); ++i) {
         const Primitive& p = mesh.primitives[i];

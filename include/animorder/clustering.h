@@ -48,8 +48,9 @@ struct ClusteringSettings {
     UpdateRule update = UpdateRule::Monotone;
     OrderSource order = OrderSource::Distance;
     unsigned threads = 0;
-    // Nodes' fragments are kept between iterations (orders change, fragments do not) while they
-    // fit in this many bytes; beyond, every iteration rasterises again (slower, same result).
+    // Nodes' fragments are kept between iterations (orders change, fragments do not), compactly
+    // (kept_fragments.h), in node order while they fit in this many bytes; the nodes beyond are
+    // rasterised again whenever they are scored (slower, same result).
     size_t max_cache_bytes = size_t(6) << 30;
     std::function<void(const std::string&)> log;   // one line per event (re-seeding, …)
     std::function<void(size_t, size_t)> progress;  // nodes scored, total, per iteration
@@ -76,6 +77,8 @@ struct ClusteringResult {
     std::string stop_reason;           // "converged", "stalled" (patience ran out) or "iteration cap"
     size_t best_iteration = 0;         // 0-based: the iteration whose buffers and assignment these are
     double seconds_rasterization = 0;  // rasterising every node once (kept for all iterations)
+    size_t kept_nodes = 0;             // nodes whose fragments fit the cache budget (the first ones)
+    size_t kept_bytes = 0;             // their compact fragments (KeptNode)
 };
 
 // Han & Sander 2017, Algorithm 1, over the nodes keyframes × icosphere viewpoints.

@@ -5,6 +5,7 @@
 // (nehab06.h), here measured per cluster from the fragments k-means already keeps. No file I/O.
 #pragma once
 
+#include "animorder/kept_fragments.h"
 #include "animorder/nehab06.h"
 #include "animorder/rasterizer.h"
 
@@ -48,6 +49,8 @@ public:
 
     // Adds (sign +1) or removes (sign −1, nodes added before) the nodes' pixels.
     void add(const NodeFragments* const* nodes, size_t node_count, int sign, unsigned threads = 0);
+    // The same from kept nodes (kept_fragments.h) over the same units: the same counts.
+    void add(const KeptNode* const* nodes, size_t node_count, int sign, unsigned threads = 0);
     // The netted arcs, as measured_overdraw_graph returns them.
     std::vector<Arc> arcs() const;
 

@@ -9,12 +9,14 @@
 #pragma once
 
 #include "animorder/animated_mesh.h"
+#include "animorder/kept_fragments.h"
 #include "animorder/rasterizer.h"
 #include "animorder/viewpoints.h"
 
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <vector>
 
 namespace animorder {
@@ -68,5 +70,54 @@ std::vector<NodeFragments> rasterize_nodes(const float* keyframe_positions, size
 // score_nodes' results from kept fragments: no rasterisation at all.
 void score_kept_nodes(uint64_t* visible, uint64_t* passed, const std::vector<NodeFragments>& nodes,
                       const uint32_t* ranks, size_t order_count, const ScoreSettings& settings);
+
+// The nodes of a k-means run, rasterised once and kept compactly (KeptNode) for any number of
+// unit orders. Nodes are kept in node order while their total stays within max_bytes; the rest
+// are rasterised again whenever they are scored. Either way a node's counts are the same, so the
+// budget trades time for memory and never changes a result. The arrays must outlive the cache.
+class NodeCache {
+public:
+    NodeCache(const float* keyframe_positions, size_t vertex_count, const Framing& framing, const uint32_t* indices,
+              size_t index_count, const OverdrawNode* nodes, size_t node_count, UnitPartition partition,
+              const ScoreSettings& settings, size_t max_bytes);
+    ~NodeCache();
+    NodeCache(const NodeCache&) = delete;
+    NodeCache& operator=(const NodeCache&) = delete;
+
+    size_t node_count() const { return node_count_; }
+    size_t kept_count() const { return kept_.size(); }  // nodes [0, kept_count()) are kept
+    size_t kept_bytes() const { return kept_bytes_; }
+    const UnitPartition& partition() const { return partition_; }
+
+    // visible[n] and passed[n · order_count + o] for every node and every order of the rank table
+    // (make_rank_table over unit orders; InvalidInput for an order that splits a unit).
+    void score(uint64_t* visible, uint64_t* passed, const uint32_t* ranks, size_t order_count) const;
+    // passed[n · stride + order_of_node[n]]: each node scored with one order only, ranks[c] the
+    // one-order rank table of order c; nodes whose order_of_node is UINT32_MAX are skipped.
+    void score_one(uint64_t* passed, size_t stride, const uint32_t* order_of_node,
+                   const std::vector<const uint32_t*>& ranks) const;
+    // Node n's KeptNode, or nullptr when it is not kept (n >= kept_count()).
+    const KeptNode* kept(size_t n) const { return n < kept_.size() ? &kept_[n] : nullptr; }
+    // KeptNodes of the nodes which[0..count), rasterised again (in parallel).
+    std::vector<KeptNode> rasterize_again(const uint32_t* which, size_t count) const;
+
+private:
+    struct Worker;
+    template <typename Body>
+    void for_nodes(size_t count, size_t grain, Body&& body) const;
+    void rasterize_node(Worker& w, size_t n) const;
+
+    const float* positions_;
+    size_t vertex_count_;
+    const Framing& framing_;
+    const uint32_t* indices_;
+    size_t index_count_;
+    const OverdrawNode* nodes_;
+    size_t node_count_;
+    UnitPartition partition_;
+    ScoreSettings settings_;
+    std::vector<KeptNode> kept_;
+    size_t kept_bytes_ = 0;
+};
 
 }  // namespace animorder

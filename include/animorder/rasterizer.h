@@ -55,6 +55,16 @@ public:
     // The node's fragments in the compact form scoring needs (see NodeFragments).
     struct NodeFragments export_fragments() const;
 
+    // The same lists without a copy: starts has pixels + 1 offsets into fragments. Valid until the
+    // next rasterize.
+    struct FragmentLists {
+        uint64_t visible = 0, single = 0;
+        const uint32_t* starts = nullptr;
+        size_t pixels = 0;
+        const uint32_t* fragments = nullptr;
+    };
+    FragmentLists fragment_lists() const;
+
     // The node's transparent pass (see BlendFragments): blended[t] non-zero marks the triangles
     // of blended primitives; every other triangle is opaque and writes depth.
     struct BlendFragments export_blend_fragments(const uint8_t* blended) const;

@@ -31,6 +31,7 @@
 #include "animorder/viewpoints.h"
 
 #include <algorithm>
+#include <memory>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -168,14 +169,16 @@ struct Nodes {
     std::vector<float> average;          // per patch: its centroid averaged over the keyframes
     std::vector<uint8_t> patch_visible;  // I3D only: [n · patch_count + p], some triangle faces n
     ScoreSettings score;
-    std::vector<uint8_t> modes;       // per triangle (opaque_pass_modes): score's triangle_modes
-    std::vector<NodeFragments> kept;  // every node's fragments, or empty when over budget
+    std::vector<uint8_t> modes;        // per triangle (opaque_pass_modes): score's triangle_modes
+    std::unique_ptr<NodeCache> cache;  // every node rasterised once, kept compactly within the budget
 };
 
 // Measured overdraw at every node: visible[n], the pixels covered (what drawing front-to-back
 // would pass), and passed[n · k + c], the fragments passing the depth test with buffer c.
+// scored[c] is the patch order that column c holds (empty before the first scoring).
 struct NodeScores {
     std::vector<uint64_t> visible, passed;
+    std::vector<std::vector<uint32_t>> scored;
 };
 
 // The best state met so far (its orders produced its assignment): what cluster_nodes returns.
@@ -192,19 +195,31 @@ std::vector<std::vector<uint32_t>> triangle_orders_of(const MeshPatches& patches
     return out;
 }
 
-// Every node scored with every one of the face orders: a replay of the kept fragments, or a new
-// rasterisation when they did not fit.
-void score_orders(const Nodes& nodes, const std::vector<std::vector<uint32_t>>& triangle_orders, NodeScores& out) {
+// Every node scored with the patch orders that changed since the last scoring (all of them the
+// first time): the other columns already hold their counts, which depend on nothing else.
+void score_orders(const Nodes& nodes, const std::vector<std::vector<uint32_t>>& patch_orders, NodeScores& out) {
+    const size_t k = patch_orders.size();
+    out.scored.resize(k);
+    std::vector<uint32_t> changed;
+    std::vector<std::vector<uint32_t>> triangle_orders;
+    for (uint32_t c = 0; c < k; ++c)
+        if (out.scored[c].empty() || out.scored[c] != patch_orders[c]) {
+            changed.push_back(c);
+            triangle_orders.push_back(patch_order_to_triangle_order(nodes.patches, patch_orders[c]));
+        }
+    if (changed.empty()) return;
     std::vector<const uint32_t*> pointers;
     for (const auto& o : triangle_orders) pointers.push_back(o.data());
-    const AnimatedMesh& mesh = nodes.mesh;
-    const std::vector<uint32_t> ranks = make_rank_table(pointers, mesh.triangle_count());
-    if (nodes.kept.empty())
-        score_nodes(out.visible.data(), out.passed.data(), mesh.keyframe_positions.data(), mesh.vertex_count,
-                    nodes.framing, mesh.indices.data(), mesh.indices.size(), nodes.cameras.data(), nodes.count,
-                    ranks.data(), pointers.size(), nodes.score);
-    else
-        score_kept_nodes(out.visible.data(), out.passed.data(), nodes.kept, ranks.data(), pointers.size(), nodes.score);
+    const std::vector<uint32_t> ranks = make_rank_table(pointers, nodes.mesh.triangle_count());
+    if (changed.size() == k) {
+        nodes.cache->score(out.visible.data(), out.passed.data(), ranks.data(), k);
+    } else {
+        std::vector<uint64_t> passed(nodes.count * changed.size());
+        nodes.cache->score(out.visible.data(), passed.data(), ranks.data(), changed.size());
+        for (size_t n = 0; n < nodes.count; ++n)
+            for (size_t j = 0; j < changed.size(); ++j) out.passed[n * k + changed[j]] = passed[n * changed.size() + j];
+    }
+    for (const uint32_t c : changed) out.scored[c] = patch_orders[c];
 }
 
 // Bootstrapping (lines 9–14): k viewpoints at least min_separation apart (line 10), and for each
@@ -226,7 +241,7 @@ std::vector<std::vector<uint32_t>> bootstrap_orders(const Nodes& nodes, const Cl
 // buffer (0 for a node that sees nothing), and the iteration's reassigned count and mean OVR.
 void assign_nodes(const Nodes& nodes, const std::vector<std::vector<uint32_t>>& patch_orders, NodeScores& scores,
                   std::vector<uint32_t>& assignment, std::vector<double>& node_ovr, ClusteringIteration& log) {
-    score_orders(nodes, triangle_orders_of(nodes.patches, patch_orders), scores);
+    score_orders(nodes, patch_orders, scores);
     const size_t k = nodes.k;
     node_ovr.assign(nodes.count, 0.0);
     double ovr_sum = 0;
@@ -289,17 +304,36 @@ struct MeasuredGraphs {
     std::vector<std::vector<uint32_t>> start;  // per cluster: the buffer that order started from
 };
 
+// Nodes into (sign +1) or out of (−1) a cluster's graph: the kept ones as kept, the others
+// rasterised again, a chunk at a time.
+void add_to_graph(const NodeCache& cache, const std::vector<uint32_t>& which, int sign, unsigned threads,
+                  MeasuredPairCounts& graph) {
+    std::vector<const KeptNode*> kept;
+    std::vector<uint32_t> again;
+    for (const uint32_t n : which) {
+        if (const KeptNode* node = cache.kept(n))
+            kept.push_back(node);
+        else
+            again.push_back(n);
+    }
+    graph.add(kept.data(), kept.size(), sign, threads);
+    const size_t chunk = 1024;
+    for (size_t begin = 0; begin < again.size(); begin += chunk) {
+        const size_t count = std::min(chunk, again.size() - begin);
+        const std::vector<KeptNode> nodes = cache.rasterize_again(again.data() + begin, count);
+        std::vector<const KeptNode*> pointers;
+        for (const KeptNode& node : nodes) pointers.push_back(&node);
+        graph.add(pointers.data(), pointers.size(), sign, threads);
+    }
+}
+
 // OrderSource::Measured, not in the paper (measured_order.cpp): each non-empty cluster's patches
-// ordered by the overdraw graph measured over its own nodes' kept fragments, starting from the
-// better of the greedy order and its current one. Without kept fragments (over the memory budget)
-// the distance order is used, and said. Returns the number of nodes of each cluster.
+// ordered by the overdraw graph measured over its own nodes' kept fragments (rasterised again for
+// nodes beyond the memory budget), starting from the better of the greedy order and its current
+// one. Returns the number of nodes of each cluster.
 std::vector<size_t> measured_update_orders(const Nodes& nodes, const ClusteringSettings& settings,
                                            const std::vector<uint32_t>& assignment, MeasuredGraphs& state,
                                            std::vector<std::vector<uint32_t>>& patch_orders) {
-    if (nodes.kept.empty()) {
-        say(settings, "measured orders need the kept fragments: this iteration sorts by distance");
-        return update_orders(nodes, settings.distance, assignment, patch_orders);
-    }
     const MeshPatches& patches = nodes.patches;
     const uint32_t* group = patches.patch_primitive.data();
     if (state.graphs.empty()) {
@@ -316,13 +350,13 @@ std::vector<size_t> measured_update_orders(const Nodes& nodes, const ClusteringS
     }
     // Only the nodes that changed cluster since the last update are counted again.
     const Clock::time_point graph_start = Clock::now();
-    std::vector<std::vector<const NodeFragments*>> leaving(nodes.k), arriving(nodes.k);
+    std::vector<std::vector<uint32_t>> leaving(nodes.k), arriving(nodes.k);
     std::vector<size_t> sizes(nodes.k, 0);
     for (size_t n = 0; n < nodes.count; ++n) {
         ++sizes[assignment[n]];
         if (state.counted[n] == assignment[n]) continue;
-        if (state.counted[n] != UINT32_MAX) leaving[state.counted[n]].push_back(&nodes.kept[n]);
-        arriving[assignment[n]].push_back(&nodes.kept[n]);
+        if (state.counted[n] != UINT32_MAX) leaving[state.counted[n]].push_back(uint32_t(n));
+        arriving[assignment[n]].push_back(uint32_t(n));
         state.counted[n] = assignment[n];
     }
     size_t moved = 0;
@@ -330,8 +364,8 @@ std::vector<size_t> measured_update_orders(const Nodes& nodes, const ClusteringS
     for (size_t c = 0; c < nodes.k; ++c) {
         moved += arriving[c].size();
         changed[c] = !leaving[c].empty() || !arriving[c].empty();
-        state.graphs[c].add(leaving[c].data(), leaving[c].size(), -1, settings.threads);
-        state.graphs[c].add(arriving[c].data(), arriving[c].size(), +1, settings.threads);
+        add_to_graph(*nodes.cache, leaving[c], -1, settings.threads, state.graphs[c]);
+        add_to_graph(*nodes.cache, arriving[c], +1, settings.threads, state.graphs[c]);
     }
     const double graph_seconds = seconds_since(graph_start);
     const Clock::time_point order_start = Clock::now();
@@ -395,38 +429,35 @@ size_t reseed_empty_clusters(const Nodes& nodes, const std::vector<size_t>& memb
 // clusters whose new order was kept.
 size_t keep_improved_orders(const Nodes& nodes, const std::vector<uint32_t>& assignment, const NodeScores& scores,
                             const std::vector<std::vector<uint32_t>>& previous, const std::vector<uint8_t>& reseeded,
-                            unsigned threads, std::vector<std::vector<uint32_t>>& patch_orders) {
+                            std::vector<std::vector<uint32_t>>& patch_orders) {
     const size_t k = nodes.k;
-    const std::vector<std::vector<uint32_t>> candidate = triangle_orders_of(nodes.patches, patch_orders);
-    NodeScores after_scores{std::vector<uint64_t>(nodes.count), std::vector<uint64_t>(nodes.count * k)};
-    if (nodes.kept.empty()) {
-        score_orders(nodes, candidate, after_scores);
-    } else {
-        // Each node only needs its own cluster's candidate: one order per node, not k.
-        std::vector<std::vector<uint32_t>> single_ranks;
-        for (const auto& o : candidate)
-            single_ranks.push_back(make_rank_table({o.data()}, nodes.mesh.triangle_count()));
-        tbb::task_arena arena(threads ? int(threads) : tbb::this_task_arena::max_concurrency());
-        arena.execute([&] {
-            tbb::parallel_for(tbb::blocked_range<size_t>(0, nodes.count, 64), [&](const tbb::blocked_range<size_t>& r) {
-                for (size_t n = r.begin(); n != r.end(); ++n) {
-                    const uint32_t c = assignment[n];
-                    score_fragments(&after_scores.passed[n * k + c], nodes.kept[n], single_ranks[c].data(), 1);
-                }
-            });
-        });
+    // Each node only needs its own cluster's candidate, and only where the candidate is new: a
+    // cluster whose order did not change keeps it (the same order cannot score lower).
+    std::vector<std::vector<uint32_t>> candidate(k);
+    std::vector<const uint32_t*> ranks(k, nullptr);
+    std::vector<std::vector<uint32_t>> rank_tables(k);
+    for (size_t c = 0; c < k; ++c) {
+        if (patch_orders[c] == previous[c]) continue;
+        candidate[c] = patch_order_to_triangle_order(nodes.patches, patch_orders[c]);
+        rank_tables[c] = make_rank_table({candidate[c].data()}, nodes.mesh.triangle_count());
+        ranks[c] = rank_tables[c].data();
     }
+    std::vector<uint32_t> order_of_node(nodes.count);
+    for (size_t n = 0; n < nodes.count; ++n) order_of_node[n] = ranks[assignment[n]] ? assignment[n] : UINT32_MAX;
+    NodeScores after_scores{{}, std::vector<uint64_t>(nodes.count * k), {}};
+    nodes.cache->score_one(after_scores.passed.data(), k, order_of_node.data(), ranks);
     std::vector<double> before(k, 0.0), after(k, 0.0);
     for (size_t n = 0; n < nodes.count; ++n) {
         if (scores.visible[n] == 0) continue;
         const uint32_t c = assignment[n];
+        if (!ranks[c]) continue;
         before[c] += double(scores.passed[n * k + c]) / double(scores.visible[n]);
         after[c] += double(after_scores.passed[n * k + c]) / double(scores.visible[n]);
     }
     size_t accepted = 0;
     for (size_t c = 0; c < k; ++c) {
         if (reseeded[c]) continue;
-        if (after[c] < before[c])
+        if (ranks[c] && after[c] < before[c])
             ++accepted;
         else
             patch_orders[c] = previous[c];  // no better: keep the old buffer
@@ -530,13 +561,22 @@ ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patc
 
     // Rasterise every node once; later iterations only replay the kept fragments in new orders.
     const Clock::time_point raster_start = Clock::now();
-    nodes.kept =
-        rasterize_nodes(mesh.keyframe_positions.data(), mesh.vertex_count, framing, mesh.indices.data(),
-                        mesh.indices.size(), nodes.cameras.data(), nodes.count, nodes.score, settings.max_cache_bytes);
+    nodes.cache =
+        std::make_unique<NodeCache>(mesh.keyframe_positions.data(), mesh.vertex_count, framing, mesh.indices.data(),
+                                    mesh.indices.size(), nodes.cameras.data(), nodes.count,
+                                    make_unit_partition(patches.patch_starts.data(), patches.patch_count(),
+                                                        patches.cache_order.data(), mesh.triangle_count()),
+                                    nodes.score, settings.max_cache_bytes);
     result.seconds_rasterization = seconds_since(raster_start);
-    if (nodes.kept.empty()) say(settings, "node fragments exceed the cache budget: rasterising again every iteration");
+    result.kept_nodes = nodes.cache->kept_count();
+    result.kept_bytes = nodes.cache->kept_bytes();
+    if (nodes.cache->kept_count() < nodes.count)
+        say(settings, "node fragments exceed the cache budget: " + std::to_string(nodes.cache->kept_count()) + " of " +
+                          std::to_string(nodes.count) + " nodes kept (" +
+                          std::to_string(nodes.cache->kept_bytes() >> 20) +
+                          " MiB), the others rasterised again when scored");
 
-    NodeScores scores{std::vector<uint64_t>(nodes.count), std::vector<uint64_t>(nodes.count * nodes.k)};
+    NodeScores scores{std::vector<uint64_t>(nodes.count), std::vector<uint64_t>(nodes.count * nodes.k), {}};
     std::vector<double> node_ovr;
     result.assignment.assign(nodes.count, UINT32_MAX);
     BestState best;
@@ -574,8 +614,8 @@ ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patc
         std::vector<uint8_t> reseeded;
         log.reseeded = reseed_empty_clusters(nodes, members, node_ovr, settings, result.patch_orders, reseeded);
         if (settings.update == UpdateRule::Monotone)
-            log.accepted = keep_improved_orders(nodes, result.assignment, scores, previous_orders, reseeded,
-                                                settings.threads, result.patch_orders);
+            log.accepted =
+                keep_improved_orders(nodes, result.assignment, scores, previous_orders, reseeded, result.patch_orders);
         log.seconds_update = seconds_since(update_start);
         result.iterations.push_back(log);
         say(settings, "iteration " + std::to_string(iteration + 1) + ": mean OVR " + std::to_string(log.mean_ovr) +

@@ -1,15 +1,58 @@
-// Private to src/algorithms: how NodeFragments::fragments (overdraw.h) packs one fragment into a
-// uint32_t. The low 31 bits are the triangle index; the top bit is set when the fragment's depth
-// equals the previous fragment's of the same pixel (fragments run nearest first), so the two are
-// one depth group of which only the one drawn first can pass. rasterizer.cpp writes it;
-// rasterizer.cpp and nehab06.cpp read it.
+// Private to src/algorithms: how a pixel's fragment list is encoded and replayed.
+//
+// NodeFragments::fragments (rasterizer.h) packs one fragment into a uint32_t: the low 31 bits are
+// the triangle index; the top bit is set when the fragment's depth equals the previous fragment's
+// of the same pixel (fragments run nearest first), so the two are one depth group of which only
+// the one drawn first can pass. rasterizer.cpp writes it; rasterizer.cpp, kept_fragments.cpp and
+// nehab06.cpp read it. KeptNode's unit lists use the same scheme in 16 bits (kUnitTieBit).
 #pragma once
 
+#include <algorithm>
+#include <cstddef>
 #include <cstdint>
+#include <limits>
 
 namespace animorder {
 
 constexpr uint32_t kTieBit = 0x80000000u;
 constexpr uint32_t kTriangleMask = 0x7fffffffu;
+constexpr uint16_t kUnitTieBit = 0x8000u;
+
+// Replays one pixel's list nearest first for every order, keeping the lowest rank seen so far
+// (`running`) and the lowest before the current group of equal depths (`before`). An entry passes
+// LESS iff its rank beats every entry at smaller or equal depth; of a group of equal depths only
+// the first drawn can pass, hence at most one emit(o) per group. ranks[id · order_count + o].
+template <typename Entry, typename Rank, typename Emit>
+void replay_list(const Entry* entries, uint32_t count, Entry tie_bit, const Rank* ranks, size_t order_count,
+                 Rank* running, Rank* before, Emit&& emit) {
+    std::fill(running, running + order_count, std::numeric_limits<Rank>::max());
+    for (uint32_t j = 0; j < count; ++j) {
+        const Entry f = entries[j];
+        const Rank* r = ranks + size_t(f & Entry(~tie_bit)) * order_count;
+        const bool same_group = (f & tie_bit) != 0;
+        for (size_t o = 0; o < order_count; ++o) {
+            if (!same_group) before[o] = running[o];
+            if (r[o] < running[o]) {
+                if (running[o] == before[o]) emit(o);
+                running[o] = r[o];
+            }
+        }
+    }
+}
+
+// The same for a list without equal depths (nearly all), branch-free and vectorised across the K
+// orders: an entry passes under order o iff its rank is below the running minimum.
+template <size_t K, typename Entry, typename Rank>
+void replay_untied_list(const Entry* entries, uint32_t count, const Rank* ranks, uint32_t (&passes)[K]) {
+    Rank running[K];
+    for (size_t o = 0; o < K; ++o) running[o] = std::numeric_limits<Rank>::max();
+    for (uint32_t j = 0; j < count; ++j) {
+        const Rank* r = ranks + size_t(entries[j]) * K;
+        for (size_t o = 0; o < K; ++o) {
+            passes[o] += r[o] < running[o];
+            running[o] = std::min(running[o], r[o]);
+        }
+    }
+}
 
 }  // namespace animorder

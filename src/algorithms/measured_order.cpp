@@ -14,6 +14,8 @@
 // λ patches of the k-means, so the vertex cache cost stays the patches' (Tipsify-level).
 #include "animorder/measured_order.h"
 
+#include "fragment_encoding.h"
+
 #include "animorder/invalid_input.h"
 #include "animorder/nehab06.h"
 
@@ -28,8 +30,6 @@
 
 namespace animorder {
 namespace {
-
-constexpr uint32_t kTieBit = 0x80000000u;
 
 // Open-addressing table: key (min unit << 32 | max unit) → pixels with min in front, with max
 // in front (signed: nodes are also removed). Linear probing, grown at half load.
@@ -93,31 +93,42 @@ struct PairCounts {
     }
 };
 
-// One node's pixels into the counts.
+// One list of units nearest first (unit | kTieBit at the previous entry's depth) into the counts,
+// `amount` times: each unit by its nearest entry, one count per pair at different depths.
+void accumulate_list(PairCounts& table, const uint32_t* units, uint32_t n, size_t unit_count, const uint32_t* group,
+                     int64_t amount, std::vector<std::pair<uint32_t, uint32_t>>& seen) {
+    seen.clear();  // (unit, depth level) of each unit's nearest entry, nearest first
+    uint32_t level = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+        if (i != 0 && !(units[i] & kTieBit)) ++level;
+        const uint32_t unit = units[i] & ~kTieBit;
+        if (unit >= unit_count)
+            throw InvalidInput("measured graph: unit " + std::to_string(unit) + ", but there are " +
+                               std::to_string(unit_count));
+        bool known = false;
+        for (const auto& s : seen) known |= s.first == unit;
+        if (known) continue;
+        for (const auto& s : seen)
+            if (s.second < level && (!group || group[s.first] == group[unit])) table.add(s.first, unit, amount);
+        seen.emplace_back(unit, level);
+    }
+}
+
+// One node's pixels into the counts, each pixel's triangles mapped to their units.
 void accumulate_node(PairCounts& table, const NodeFragments& node, const uint32_t* unit_of_triangle,
                      size_t triangle_count, size_t unit_count, const uint32_t* group, int64_t sign,
-                     std::vector<std::pair<uint32_t, uint32_t>>& seen) {
+                     std::vector<std::pair<uint32_t, uint32_t>>& seen, std::vector<uint32_t>& units) {
     for (size_t p = 0; p + 1 < node.starts.size(); ++p) {
-        seen.clear();  // (unit, depth level) of each unit's nearest fragment, nearest first
-        uint32_t level = 0;
+        units.clear();
         for (uint32_t i = node.starts[p]; i < node.starts[p + 1]; ++i) {
             const uint32_t f = node.fragments[i];
             const uint32_t triangle = f & ~kTieBit;
             if (triangle >= triangle_count)
                 throw InvalidInput("measured graph: fragment of triangle " + std::to_string(triangle) +
                                    ", but there are " + std::to_string(triangle_count));
-            if (i != node.starts[p] && !(f & kTieBit)) ++level;
-            const uint32_t unit = unit_of_triangle[triangle];
-            if (unit >= unit_count)
-                throw InvalidInput("measured graph: unit " + std::to_string(unit) + " of triangle " +
-                                   std::to_string(triangle) + ", but there are " + std::to_string(unit_count));
-            bool known = false;
-            for (const auto& s : seen) known |= s.first == unit;
-            if (known) continue;
-            for (const auto& s : seen)
-                if (s.second < level && (!group || group[s.first] == group[unit])) table.add(s.first, unit, sign);
-            seen.emplace_back(unit, level);
+            units.push_back(unit_of_triangle[triangle] | (f & kTieBit));
         }
+        accumulate_list(table, units.data(), uint32_t(units.size()), unit_count, group, sign, seen);
     }
 }
 
@@ -127,6 +138,13 @@ struct MeasuredPairCounts::State {
     std::vector<uint32_t> unit_of_triangle, group;
     PairCounts counts;
     explicit State(size_t units) : counts(units) {}
+    struct Scratch {
+        std::vector<std::pair<uint32_t, uint32_t>> seen;
+        std::vector<uint32_t> units;
+    };
+    // Every node into per-worker tables (accumulate(table, node, scratch)), then summed.
+    template <typename Node, typename Accumulate>
+    void add_nodes(const Node* const* nodes, size_t node_count, unsigned threads, Accumulate&& accumulate);
 };
 
 MeasuredPairCounts::MeasuredPairCounts(size_t unit_count, const uint32_t* unit_of_triangle, size_t triangle_count,
@@ -140,24 +158,43 @@ MeasuredPairCounts::~MeasuredPairCounts() = default;
 MeasuredPairCounts::MeasuredPairCounts(MeasuredPairCounts&&) noexcept = default;
 MeasuredPairCounts& MeasuredPairCounts::operator=(MeasuredPairCounts&&) noexcept = default;
 
-void MeasuredPairCounts::add(const NodeFragments* const* nodes, size_t node_count, int sign, unsigned threads) {
-    State& s = *state_;
-    const size_t units = s.counts.units;
-    const uint32_t* group = s.group.empty() ? nullptr : s.group.data();
+template <typename Node, typename Accumulate>
+void MeasuredPairCounts::State::add_nodes(const Node* const* nodes, size_t node_count, unsigned threads,
+                                          Accumulate&& accumulate) {
+    const size_t units = counts.units;
     tbb::enumerable_thread_specific<PairCounts> tables([units] { return PairCounts(units); });
-    tbb::enumerable_thread_specific<std::vector<std::pair<uint32_t, uint32_t>>> scratch;
+    tbb::enumerable_thread_specific<Scratch> scratch;
     tbb::task_arena arena(threads ? int(threads) : tbb::this_task_arena::max_concurrency());
     arena.execute([&] {
         tbb::parallel_for(tbb::blocked_range<size_t>(0, node_count, 4), [&](const tbb::blocked_range<size_t>& r) {
             PairCounts& table = tables.local();
-            auto& seen = scratch.local();
-            for (size_t n = r.begin(); n != r.end(); ++n)
-                accumulate_node(table, *nodes[n], s.unit_of_triangle.data(), s.unit_of_triangle.size(), units, group,
-                                sign < 0 ? -1 : 1, seen);
+            Scratch& s = scratch.local();
+            for (size_t n = r.begin(); n != r.end(); ++n) accumulate(table, *nodes[n], s);
         });
     });
     // Integer sums: the same whatever the worker that counted a node.
-    for (const PairCounts& t : tables) s.counts.merge(t);
+    for (const PairCounts& t : tables) counts.merge(t);
+}
+
+void MeasuredPairCounts::add(const NodeFragments* const* nodes, size_t node_count, int sign, unsigned threads) {
+    State& s = *state_;
+    const uint32_t* group = s.group.empty() ? nullptr : s.group.data();
+    s.add_nodes(nodes, node_count, threads, [&](PairCounts& table, const NodeFragments& node, State::Scratch& w) {
+        accumulate_node(table, node, s.unit_of_triangle.data(), s.unit_of_triangle.size(), s.counts.units, group,
+                        sign < 0 ? -1 : 1, w.seen, w.units);
+    });
+}
+
+void MeasuredPairCounts::add(const KeptNode* const* nodes, size_t node_count, int sign, unsigned threads) {
+    State& s = *state_;
+    const uint32_t* group = s.group.empty() ? nullptr : s.group.data();
+    s.add_nodes(nodes, node_count, threads, [&](PairCounts& table, const KeptNode& node, State::Scratch& w) {
+        for_each_unit_list(node, s.unit_of_triangle.data(), s.unit_of_triangle.size(), w.units,
+                           [&](const uint32_t* units, uint32_t n, uint32_t weight) {
+                               accumulate_list(table, units, n, s.counts.units, group,
+                                               (sign < 0 ? -1 : 1) * int64_t(weight), w.seen);
+                           });
+    });
 }
 
 std::vector<Arc> MeasuredPairCounts::arcs() const {

@@ -167,4 +167,133 @@ void score_kept_nodes(uint64_t* visible, uint64_t* passed, const std::vector<Nod
     if (settings.progress) settings.progress(nodes.size(), nodes.size());
 }
 
+struct NodeCache::Worker {
+    NodeRasterizer rasterizer;
+    std::vector<float> clip;
+    KeepScratch scratch;
+};
+
+template <typename Body>
+void NodeCache::for_nodes(size_t count, size_t grain, Body&& body) const {
+    tbb::enumerable_thread_specific<Worker> workers;
+    const int threads = settings_.threads ? int(settings_.threads) : tbb::this_task_arena::max_concurrency();
+    tbb::task_arena arena(threads);
+    arena.execute([&] {
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, count, grain), [&](const tbb::blocked_range<size_t>& range) {
+            Worker& w = workers.local();
+            for (size_t i = range.begin(); i != range.end(); ++i) body(w, i);
+        });
+    });
+}
+
+void NodeCache::rasterize_node(Worker& w, size_t n) const {
+    const OverdrawNode& node = nodes_[n];
+    w.clip.resize(vertex_count_ * 4);
+    transform_to_clip(w.clip.data(), positions_ + size_t(node.keyframe) * vertex_count_ * 3, vertex_count_,
+                      framing_.centres.data() + 3 * size_t(node.keyframe),
+                      node_view_projection(node.direction, framing_.radius));
+    w.rasterizer.rasterize(w.clip.data(), vertex_count_, indices_, index_count_, settings_.resolution,
+                           settings_.triangle_modes);
+}
+
+NodeCache::NodeCache(const float* keyframe_positions, size_t vertex_count, const Framing& framing,
+                     const uint32_t* indices, size_t index_count, const OverdrawNode* nodes, size_t node_count,
+                     UnitPartition partition, const ScoreSettings& settings, size_t max_bytes)
+    : positions_(keyframe_positions),
+      vertex_count_(vertex_count),
+      framing_(framing),
+      indices_(indices),
+      index_count_(index_count),
+      nodes_(nodes),
+      node_count_(node_count),
+      partition_(std::move(partition)),
+      settings_(settings) {
+    validate_indices(indices, index_count, vertex_count);
+    if (partition_.unit_of_triangle.size() != index_count / 3)
+        throw InvalidInput("node cache: the unit partition covers " +
+                           std::to_string(partition_.unit_of_triangle.size()) + " triangles, the mesh has " +
+                           std::to_string(index_count / 3));
+    const size_t keyframes = framing.centres.size() / 3;
+    for (size_t n = 0; n < node_count; ++n)
+        if (nodes[n].keyframe >= keyframes)
+            throw InvalidInput("node " + std::to_string(n) + " names a missing keyframe");
+    // In chunks, so that memory never holds more than the budget and one chunk; which nodes are
+    // kept depends on their sizes in node order only, never on the schedule.
+    const size_t chunk = 2048;
+    std::vector<KeptNode> batch;
+    bool full = false;
+    for (size_t begin = 0; begin < node_count && !full; begin += chunk) {
+        const size_t end = std::min(node_count, begin + chunk);
+        batch.assign(end - begin, KeptNode{});
+        for_nodes(end - begin, 1, [&](Worker& w, size_t i) {
+            rasterize_node(w, begin + i);
+            const NodeRasterizer::FragmentLists l = w.rasterizer.fragment_lists();
+            batch[i] = keep_fragments(l.visible, l.single, l.starts, l.pixels, l.fragments, partition_, w.scratch);
+        });
+        for (KeptNode& node : batch) {
+            if (kept_bytes_ + node.bytes() > max_bytes) {
+                full = true;
+                break;
+            }
+            kept_bytes_ += node.bytes();
+            kept_.push_back(std::move(node));
+        }
+        if (settings.progress) settings.progress(full ? node_count : end, node_count);
+    }
+}
+
+NodeCache::~NodeCache() = default;
+
+void NodeCache::score(uint64_t* visible, uint64_t* passed, const uint32_t* ranks, size_t order_count) const {
+    const std::vector<uint16_t> unit_ranks = make_unit_rank_table(ranks, order_count, partition_);
+    std::atomic<size_t> done{0};
+    std::mutex progress_mutex;
+    const size_t report_every = std::max<size_t>(1, node_count_ / 100);
+    for_nodes(node_count_, 64, [&](Worker& w, size_t n) {
+        if (const KeptNode* k = kept(n)) {
+            visible[n] = k->visible;
+            score_kept(passed + n * order_count, *k, unit_ranks.data(), ranks, order_count);
+        } else {
+            rasterize_node(w, n);
+            visible[n] = w.rasterizer.visible_pixels();
+            w.rasterizer.score(passed + n * order_count, ranks, order_count);
+        }
+        const size_t finished = ++done;
+        if (settings_.progress && (finished % report_every == 0 || finished == node_count_)) {
+            std::lock_guard<std::mutex> lock(progress_mutex);
+            settings_.progress(finished, node_count_);
+        }
+    });
+}
+
+void NodeCache::score_one(uint64_t* passed, size_t stride, const uint32_t* order_of_node,
+                          const std::vector<const uint32_t*>& ranks) const {
+    std::vector<std::vector<uint16_t>> unit_ranks;
+    for (const uint32_t* r : ranks)
+        unit_ranks.push_back(r ? make_unit_rank_table(r, 1, partition_) : std::vector<uint16_t>());
+    for_nodes(node_count_, 64, [&](Worker& w, size_t n) {
+        const uint32_t c = order_of_node[n];
+        if (c == UINT32_MAX) return;
+        if (c >= ranks.size() || !ranks[c])
+            throw InvalidInput("node cache: node " + std::to_string(n) + " names no order");
+        if (const KeptNode* k = kept(n)) {
+            score_kept(passed + n * stride + c, *k, unit_ranks[c].data(), ranks[c], 1);
+        } else {
+            rasterize_node(w, n);
+            w.rasterizer.score(passed + n * stride + c, ranks[c], 1);
+        }
+    });
+}
+
+std::vector<KeptNode> NodeCache::rasterize_again(const uint32_t* which, size_t count) const {
+    std::vector<KeptNode> out(count);
+    for_nodes(count, 1, [&](Worker& w, size_t i) {
+        if (which[i] >= node_count_) throw InvalidInput("node cache: no node " + std::to_string(which[i]));
+        rasterize_node(w, which[i]);
+        const NodeRasterizer::FragmentLists l = w.rasterizer.fragment_lists();
+        out[i] = keep_fragments(l.visible, l.single, l.starts, l.pixels, l.fragments, partition_, w.scratch);
+    });
+    return out;
+}
+
 }  // namespace animorder

@@ -63,7 +63,8 @@ struct NodeRasterizer::State {
     uint64_t visible = 0, single = 0;
     // Per-vertex setup, done once per node rather than once per triangle corner.
     std::vector<WindowVertex> window;
-    std::vector<uint8_t> unclipped;  // inside the near, far and guard-band planes
+    std::vector<uint8_t> unclipped;   // inside the near, far and guard-band planes
+    std::vector<uint32_t> histogram;  // counting sort of the fragments by pixel
 };
 
 namespace {
@@ -212,8 +213,8 @@ void rasterize_clipped_triangle(const ClipVertex (&v)[3], uint32_t triangle, uns
         rasterize_window_triangle(w[0], w[i], w[i + 1], triangle, resolution, sink, two_sided);
 }
 
-// Groups the node's fragments by pixel with an LSD radix sort on the pixel index (two passes of
-// 11 bits up to 2048² pixels): linear in the fragments, never a loop over every pixel of the
+// Groups the node's fragments by pixel with an LSD radix sort on the pixel index (one counting
+// pass up to 256² pixels, passes of 11 bits beyond): linear in the fragments, never a loop over every pixel of the
 // viewport. Each pixel with two or more fragments is then sorted by depth into the compact list
 // that scoring walks; a single-fragment pixel only counts, its fragment passes under every order.
 void group_fragments(NodeRasterizer::State& s) {
@@ -224,11 +225,16 @@ void group_fragments(NodeRasterizer::State& s) {
     while ((uint64_t(1) << bits) < pixels) ++bits;
     Fragment* from = s.raw.data();
     Fragment* to = s.sorted.data();
-    for (int shift = 0; shift < bits; shift += 11) {
-        uint32_t histogram[2049] = {};
-        for (size_t f = 0; f < n; ++f) ++histogram[((from[f].pixel >> shift) & 2047) + 1];
-        for (int d = 0; d < 2048; ++d) histogram[d + 1] += histogram[d];
-        for (size_t f = 0; f < n; ++f) to[histogram[(from[f].pixel >> shift) & 2047]++] = from[f];
+    // Up to 2^16 pixels (256²) one counting pass; beyond, passes of 11 bits.
+    const int digit_bits = bits <= 16 ? 16 : 11;
+    const uint32_t digits = uint32_t(1) << digit_bits;
+    s.histogram.resize(digits + 1);
+    for (int shift = 0; shift < bits; shift += digit_bits) {
+        uint32_t* histogram = s.histogram.data();
+        std::fill(histogram, histogram + digits + 1, 0u);
+        for (size_t f = 0; f < n; ++f) ++histogram[((from[f].pixel >> shift) & (digits - 1)) + 1];
+        for (uint32_t d = 0; d < digits; ++d) histogram[d + 1] += histogram[d];
+        for (size_t f = 0; f < n; ++f) to[histogram[(from[f].pixel >> shift) & (digits - 1)]++] = from[f];
         std::swap(from, to);
     }
     // `from` now holds the fragments by pixel (rasterisation order kept within a pixel).
@@ -321,28 +327,6 @@ void NodeRasterizer::rasterize(const float* clip_xyzw, size_t vertex_count, cons
 
 namespace {
 
-// Walks one pixel's fragments nearest first for every order, keeping the lowest rank seen so
-// far (`running`) and the lowest before the current group of equal depths (`before`). A
-// fragment passes LESS iff its rank beats every fragment at smaller or equal depth; of a group
-// of equal depths only the first drawn can pass, hence at most one increment per group.
-template <typename Emit>
-void replay_pixel(const uint32_t* fragments, uint32_t count, const uint32_t* ranks, size_t order_count,
-                  uint32_t* running, uint32_t* before, Emit&& emit) {
-    std::fill(running, running + order_count, UINT32_MAX);
-    for (uint32_t j = 0; j < count; ++j) {
-        const uint32_t f = fragments[j];
-        const uint32_t* r = ranks + size_t(f & kTriangleMask) * order_count;
-        const bool same_group = (f & kTieBit) != 0;
-        for (size_t o = 0; o < order_count; ++o) {
-            if (!same_group) before[o] = running[o];
-            if (r[o] < running[o]) {
-                if (running[o] == before[o]) emit(o);
-                running[o] = r[o];
-            }
-        }
-    }
-}
-
 // The hot loop of k-means: all multi-fragment pixels of a node for K orders at once. Pixels
 // without equal depths (nearly all) take a branch-free path the compiler vectorises across the K
 // orders: a fragment passes under order o iff its rank is below the running minimum.
@@ -357,18 +341,12 @@ void replay_all(uint64_t* passed, const uint32_t* starts, size_t pixels, const u
         uint32_t ties = 0;
         for (uint32_t j = 0; j < n; ++j) ties |= f[j];
         if (ties & kTieBit) {
-            replay_pixel(f, n, ranks, K, scratch, scratch + K, [&](size_t o) { ++count[o]; });
+            replay_list(f, n, kTieBit, ranks, K, scratch, scratch + K, [&](size_t o) { ++count[o]; });
             continue;
         }
-        uint32_t running[K];
-        for (size_t o = 0; o < K; ++o) running[o] = UINT32_MAX;
-        for (uint32_t j = 0; j < n; ++j) {
-            const uint32_t* r = ranks + size_t(f[j]) * K;
-            for (size_t o = 0; o < K; ++o) {
-                count[o] += r[o] < running[o];
-                running[o] = std::min(running[o], r[o]);
-            }
-        }
+        uint32_t passes[K] = {};
+        replay_untied_list(f, n, ranks, passes);
+        for (size_t o = 0; o < K; ++o) count[o] += passes[o];
     }
     for (size_t o = 0; o < K; ++o) passed[o] += count[o];
 }
@@ -388,8 +366,8 @@ void replay_all_any(uint64_t* passed, const uint32_t* starts, size_t pixels, con
     }
     std::vector<uint32_t> scratch(2 * order_count);
     for (size_t m = 0; m < pixels; ++m)
-        replay_pixel(fragments + starts[m], starts[m + 1] - starts[m], ranks, order_count, scratch.data(),
-                     scratch.data() + order_count, [&](size_t o) { ++passed[o]; });
+        replay_list(fragments + starts[m], starts[m + 1] - starts[m], kTieBit, ranks, order_count, scratch.data(),
+                    scratch.data() + order_count, [&](size_t o) { ++passed[o]; });
 }
 
 }  // namespace
@@ -404,6 +382,11 @@ NodeFragments NodeRasterizer::export_fragments() const {
     for (uint32_t& start : out.starts) start -= first;
     out.fragments.assign(s.multi_fragment.begin() + first, s.multi_fragment.begin() + first + out.starts.back());
     return out;
+}
+
+NodeRasterizer::FragmentLists NodeRasterizer::fragment_lists() const {
+    const State& s = *state_;
+    return {s.visible, s.single, s.multi_start.data(), s.multi_count, s.multi_fragment.data()};
 }
 
 void score_fragments(uint64_t* passed, const NodeFragments& node, const uint32_t* ranks, size_t order_count) {
@@ -428,8 +411,8 @@ std::vector<uint32_t> NodeRasterizer::passed_per_pixel(const uint32_t* ranks, si
     for (size_t m = 0; m < s.multi_count; ++m) {
         const uint32_t begin = s.multi_start[m];
         uint32_t& pixel = image[s.multi_pixel[m]];
-        replay_pixel(s.multi_fragment.data() + begin, s.multi_start[m + 1] - begin, ranks, order_count, scratch.data(),
-                     scratch.data() + order_count, [&](size_t o) { pixel += o == order_index; });
+        replay_list(s.multi_fragment.data() + begin, s.multi_start[m + 1] - begin, kTieBit, ranks, order_count,
+                    scratch.data(), scratch.data() + order_count, [&](size_t o) { pixel += o == order_index; });
     }
     return image;
 }

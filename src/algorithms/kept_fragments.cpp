@@ -1,0 +1,324 @@
+// A node's fragments kept compactly between k-means iterations (issue 19: memory-lean scoring),
+// giving exactly the counts of the per-triangle lists (rasterizer.cpp) for unit orders.
+//
+// Scoring follows Han & Sander, "Triangle Reordering for Efficient Rendering in Complex Scenes",
+// JCGT 2017, §3: the fragments passing a LESS depth test at a node when the mesh is drawn in a
+// given order; the orders k-means scores are its patch orders, each patch a contiguous block
+// drawn in its Tipsify order. Three reductions, each exact for such orders:
+//   1. A fragment with a nearer (or equally near) fragment of its own unit that the unit draws
+//      first never passes, and every fragment it could stop is stopped by that one already:
+//      dropped (the tie bits are rejoined so equal depths stay groups).
+//   2. Between fragments of different units only the units' positions in the order matter: a
+//      list whose units are all different becomes a list of unit ids (16 bits each).
+//   3. Pixels with equal unit lists are kept once, with a weight.
+// A pixel left with one fragment passes one under every order (it joins `single`). The rare list
+// that still holds a unit twice keeps its triangles (their inner order decides).
+#include "animorder/kept_fragments.h"
+#include "fragment_encoding.h"
+
+#include "animorder/invalid_input.h"
+
+#include <algorithm>
+#include <cstring>
+#include <numeric>
+#include <string>
+
+namespace animorder {
+namespace {
+
+constexpr uint32_t kMaxWeight = UINT16_MAX;
+
+uint64_t hash_list(const uint16_t* e, size_t n) {
+    uint64_t h = 0x9e3779b97f4a7c15ULL ^ n;
+    for (size_t i = 0; i < n; ++i) {
+        h ^= e[i];
+        h *= 0xff51afd7ed558ccdULL;
+        h ^= h >> 29;
+    }
+    return h;
+}
+
+// Drops the fragments of reduction 1 from one pixel's list into `out` (tie bits recomputed: an
+// entry is tied when its depth equals the previous kept entry's). Sets `repeated` when a unit
+// still appears twice.
+void reduce_pixel(const uint32_t* f, uint32_t n, const UnitPartition& partition, std::vector<uint32_t>& out,
+                  bool& repeated) {
+    out.clear();
+    repeated = false;
+    const size_t triangles = partition.unit_of_triangle.size();
+    bool previous_at_kept_depth = true;  // the previous fragment's depth equals the last kept one's
+    for (uint32_t j = 0; j < n; ++j) {
+        const uint32_t t = f[j] & kTriangleMask;
+        if (t >= triangles)
+            throw InvalidInput("kept fragments: triangle " + std::to_string(t) + ", but the partition has " +
+                               std::to_string(triangles));
+        const bool tied = j > 0 && (f[j] & kTieBit) && previous_at_kept_depth;
+        const uint32_t unit = partition.unit_of_triangle[t];
+        bool dominated = false, same_unit = false;
+        for (const uint32_t kept : out) {
+            const uint32_t k = kept & kTriangleMask;
+            if (partition.unit_of_triangle[k] != unit) continue;
+            same_unit = true;
+            dominated |= partition.position[k] < partition.position[t];
+        }
+        if (dominated) {
+            previous_at_kept_depth = tied;
+            continue;
+        }
+        repeated |= same_unit;
+        out.push_back(t | (tied ? kTieBit : 0));
+        previous_at_kept_depth = true;
+    }
+}
+
+// The deduplicated unit lists of one node, in order of first appearance.
+struct ListTable {
+    KeepScratch& s;
+    size_t mask = 0;
+
+    explicit ListTable(KeepScratch& scratch) : s(scratch) {
+        s.entries.clear();
+        s.weights.clear();
+        s.lengths.clear();
+        s.list_offset.clear();
+        s.slots.assign(1024, 0);
+        mask = s.slots.size() - 1;
+    }
+    bool equal(uint32_t list, const uint16_t* e, size_t n) const {
+        return s.lengths[list] == n && std::memcmp(&s.entries[s.list_offset[list]], e, n * sizeof(uint16_t)) == 0;
+    }
+    void grow() {
+        s.slots.assign(s.slots.size() * 2, 0);
+        mask = s.slots.size() - 1;
+        for (uint32_t list = 0; list < s.weights.size(); ++list) {
+            size_t i = hash_list(&s.entries[s.list_offset[list]], s.lengths[list]) & mask;
+            while (s.slots[i] != 0) i = (i + 1) & mask;
+            s.slots[i] = list + 1;
+        }
+    }
+    // One more pixel with this list. A full weight starts a second copy (later pixels count there).
+    void add(const uint16_t* e, size_t n) {
+        size_t i = hash_list(e, n) & mask;
+        for (; s.slots[i] != 0; i = (i + 1) & mask) {
+            const uint32_t list = s.slots[i] - 1;
+            if (!equal(list, e, n)) continue;
+            if (s.weights[list] < kMaxWeight) {
+                ++s.weights[list];
+                return;
+            }
+            break;  // this slot now names the new copy
+        }
+        const uint32_t list = uint32_t(s.weights.size());
+        s.list_offset.push_back(uint32_t(s.entries.size()));
+        s.entries.insert(s.entries.end(), e, e + n);
+        s.lengths.push_back(uint8_t(n));
+        s.weights.push_back(1);
+        s.slots[i] = list + 1;
+        if (2 * s.weights.size() > s.slots.size()) grow();
+    }
+};
+
+struct Layout {
+    size_t weights, entries, lengths, triangles, total;
+};
+
+Layout layout_of(const KeptNode& n) {
+    Layout l;
+    l.weights = 0;
+    l.entries = l.weights + 2 * size_t(n.unit_lists);
+    l.lengths = l.entries + 2 * size_t(n.unit_entries);
+    l.triangles = (l.lengths + n.unit_lists + 3) & ~size_t(3);
+    l.total = l.triangles + 4 * (size_t(n.triangle_lists) + n.triangle_entries);
+    return l;
+}
+
+template <typename T>
+const T* at(const KeptNode& n, size_t offset) {
+    return reinterpret_cast<const T*>(n.data.data() + offset);
+}
+
+template <size_t K>
+void score_kept_k(uint64_t* passed, const KeptNode& node, const uint16_t* unit_ranks) {
+    const Layout l = layout_of(node);
+    const uint16_t* weights = at<uint16_t>(node, l.weights);
+    const uint16_t* e = at<uint16_t>(node, l.entries);
+    const uint8_t* lengths = at<uint8_t>(node, l.lengths);
+    uint64_t count[K] = {};
+    uint16_t scratch[2 * K] = {};
+    for (uint32_t list = 0; list < node.unit_lists; ++list) {
+        const uint32_t n = lengths[list];
+        uint16_t ties = 0;
+        for (uint32_t j = 0; j < n; ++j) ties |= e[j];
+        uint32_t passes[K] = {};
+        if (ties & kUnitTieBit)
+            replay_list(e, n, kUnitTieBit, unit_ranks, K, scratch, scratch + K, [&](size_t o) { ++passes[o]; });
+        else
+            replay_untied_list(e, n, unit_ranks, passes);
+        for (size_t o = 0; o < K; ++o) count[o] += uint64_t(passes[o]) * weights[list];
+        e += n;
+    }
+    for (size_t o = 0; o < K; ++o) passed[o] += count[o];
+}
+
+void score_unit_lists_any(uint64_t* passed, const KeptNode& node, const uint16_t* unit_ranks, size_t order_count) {
+    switch (order_count) {
+        case 1: return score_kept_k<1>(passed, node, unit_ranks);
+        case 2: return score_kept_k<2>(passed, node, unit_ranks);
+        case 3: return score_kept_k<3>(passed, node, unit_ranks);
+        case 4: return score_kept_k<4>(passed, node, unit_ranks);
+        case 5: return score_kept_k<5>(passed, node, unit_ranks);
+        case 6: return score_kept_k<6>(passed, node, unit_ranks);
+        case 7: return score_kept_k<7>(passed, node, unit_ranks);
+        case 8: return score_kept_k<8>(passed, node, unit_ranks);
+        default: break;
+    }
+    const Layout l = layout_of(node);
+    const uint16_t* weights = at<uint16_t>(node, l.weights);
+    const uint16_t* e = at<uint16_t>(node, l.entries);
+    const uint8_t* lengths = at<uint8_t>(node, l.lengths);
+    std::vector<uint16_t> scratch(2 * order_count);
+    for (uint32_t list = 0; list < node.unit_lists; ++list) {
+        replay_list(e, lengths[list], kUnitTieBit, unit_ranks, order_count, scratch.data(),
+                    scratch.data() + order_count, [&](size_t o) { passed[o] += weights[list]; });
+        e += lengths[list];
+    }
+}
+
+}  // namespace
+
+UnitPartition make_unit_partition(const uint32_t* unit_starts, size_t unit_count, const uint32_t* inner_order,
+                                  size_t triangle_count) {
+    if (unit_count == 0 ? triangle_count != 0 : unit_starts[0] != 0 || unit_starts[unit_count] != triangle_count)
+        throw InvalidInput("unit partition: the units do not cover the " + std::to_string(triangle_count) +
+                           " triangles");
+    UnitPartition p;
+    p.unit_count = unit_count;
+    p.unit_of_triangle.assign(triangle_count, UINT32_MAX);
+    p.position.assign(triangle_count, 0);
+    for (size_t u = 0; u < unit_count; ++u) {
+        if (unit_starts[u + 1] < unit_starts[u]) throw InvalidInput("unit partition: unit starts go backwards");
+        for (uint32_t j = unit_starts[u]; j < unit_starts[u + 1]; ++j) {
+            const uint32_t t = inner_order[j];
+            if (t >= triangle_count || p.unit_of_triangle[t] != UINT32_MAX)
+                throw InvalidInput("unit partition: triangle " + std::to_string(t) +
+                                   " is out of range or listed twice");
+            p.unit_of_triangle[t] = uint32_t(u);
+            p.position[t] = j;
+        }
+    }
+    return p;
+}
+
+KeptNode keep_fragments(uint64_t visible, uint64_t single, const uint32_t* starts, size_t pixel_count,
+                        const uint32_t* fragments, const UnitPartition& partition, KeepScratch& s) {
+    KeptNode node;
+    node.visible = visible;
+    node.single = single;
+    const bool unit_lists = partition.unit_count <= kMaxListedUnits;
+    ListTable table(s);
+    s.triangle_lists.clear();
+    uint16_t units[kMaxListLength];
+    bool repeated = false;
+    for (size_t p = 0; p < pixel_count; ++p) {
+        reduce_pixel(fragments + starts[p], starts[p + 1] - starts[p], partition, s.reduced, repeated);
+        if (s.reduced.size() < 2) {
+            ++node.single;  // only the nearest is left: it passes under every order, nothing else does
+            continue;
+        }
+        if (!unit_lists || repeated || s.reduced.size() > kMaxListLength) {
+            s.triangle_lists.push_back(uint32_t(s.reduced.size()));
+            s.triangle_lists.insert(s.triangle_lists.end(), s.reduced.begin(), s.reduced.end());
+            ++node.triangle_lists;
+            node.triangle_entries += uint32_t(s.reduced.size());
+            continue;
+        }
+        for (size_t j = 0; j < s.reduced.size(); ++j)
+            units[j] = uint16_t(partition.unit_of_triangle[s.reduced[j] & kTriangleMask] |
+                                (s.reduced[j] & kTieBit ? kUnitTieBit : 0));
+        table.add(units, s.reduced.size());
+    }
+    node.unit_lists = uint32_t(s.weights.size());
+    node.unit_entries = uint32_t(s.entries.size());
+    const Layout l = layout_of(node);
+    node.data = std::vector<uint8_t>(l.total, 0);  // exactly its size: bytes() is deterministic
+    uint8_t* d = node.data.data();
+    std::memcpy(d + l.weights, s.weights.data(), 2 * s.weights.size());
+    std::memcpy(d + l.entries, s.entries.data(), 2 * s.entries.size());
+    std::memcpy(d + l.lengths, s.lengths.data(), s.lengths.size());
+    std::memcpy(d + l.triangles, s.triangle_lists.data(), 4 * s.triangle_lists.size());
+    return node;
+}
+
+std::vector<uint16_t> make_unit_rank_table(const uint32_t* triangle_ranks, size_t order_count,
+                                           const UnitPartition& partition) {
+    const size_t units = partition.unit_count, triangles = partition.unit_of_triangle.size();
+    if (units > kMaxListedUnits) return {};  // every list is kept per triangle
+    std::vector<uint16_t> table(units * order_count);
+    std::vector<uint32_t> low(units), high(units), size(units), by_position(units);
+    for (size_t o = 0; o < order_count; ++o) {
+        std::fill(low.begin(), low.end(), UINT32_MAX);
+        std::fill(high.begin(), high.end(), 0);
+        std::fill(size.begin(), size.end(), 0);
+        for (size_t t = 0; t < triangles; ++t) {
+            const uint32_t u = partition.unit_of_triangle[t], r = triangle_ranks[t * order_count + o];
+            low[u] = std::min(low[u], r);
+            high[u] = std::max(high[u], r);
+            ++size[u];
+        }
+        for (size_t u = 0; u < units; ++u)
+            if (size[u] > 0 && high[u] - low[u] + 1 != size[u])
+                throw InvalidInput("order " + std::to_string(o) + " splits unit " + std::to_string(u) +
+                                   ": kept fragments score unit orders only");
+        std::iota(by_position.begin(), by_position.end(), 0u);
+        std::sort(by_position.begin(), by_position.end(), [&](uint32_t a, uint32_t b) { return low[a] < low[b]; });
+        for (size_t i = 0; i < units; ++i) table[size_t(by_position[i]) * order_count + o] = uint16_t(i);
+    }
+    return table;
+}
+
+void score_kept(uint64_t* passed, const KeptNode& node, const uint16_t* unit_ranks, const uint32_t* triangle_ranks,
+                size_t order_count) {
+    for (size_t o = 0; o < order_count; ++o) passed[o] = node.single;
+    if (node.unit_lists) score_unit_lists_any(passed, node, unit_ranks, order_count);
+    if (node.triangle_lists == 0) return;
+    const uint32_t* t = at<uint32_t>(node, layout_of(node).triangles);
+    std::vector<uint32_t> scratch(2 * order_count);
+    for (uint32_t list = 0; list < node.triangle_lists; ++list) {
+        const uint32_t n = *t++;
+        replay_list(t, n, kTieBit, triangle_ranks, order_count, scratch.data(), scratch.data() + order_count,
+                    [&](size_t o) { ++passed[o]; });
+        t += n;
+    }
+}
+
+void for_each_unit_list(const KeptNode& node, const uint32_t* unit_of_triangle, size_t triangle_count,
+                        std::vector<uint32_t>& scratch,
+                        const std::function<void(const uint32_t* units, uint32_t count, uint32_t weight)>& visit) {
+    const Layout l = layout_of(node);
+    const uint16_t* weights = at<uint16_t>(node, l.weights);
+    const uint16_t* e = at<uint16_t>(node, l.entries);
+    const uint8_t* lengths = at<uint8_t>(node, l.lengths);
+    for (uint32_t list = 0; list < node.unit_lists; ++list) {
+        scratch.clear();
+        for (uint32_t j = 0; j < lengths[list]; ++j)
+            scratch.push_back(uint32_t(e[j] & ~kUnitTieBit) | (e[j] & kUnitTieBit ? kTieBit : 0));
+        visit(scratch.data(), lengths[list], weights[list]);
+        e += lengths[list];
+    }
+    const uint32_t* t = at<uint32_t>(node, l.triangles);
+    for (uint32_t list = 0; list < node.triangle_lists; ++list) {
+        const uint32_t n = *t++;
+        scratch.clear();
+        for (uint32_t j = 0; j < n; ++j) {
+            const uint32_t triangle = t[j] & kTriangleMask;
+            if (triangle >= triangle_count)
+                throw InvalidInput("kept fragments: triangle " + std::to_string(triangle) + ", but there are " +
+                                   std::to_string(triangle_count));
+            scratch.push_back(unit_of_triangle[triangle] | (t[j] & kTieBit));
+        }
+        visit(scratch.data(), n, 1);
+        t += n;
+    }
+}
+
+}  // namespace animorder

@@ -1,0 +1,322 @@
+// Kept fragments (kept_fragments.cpp, NodeCache in overdraw.cpp): the compact form gives exactly
+// the per-triangle lists' counts for unit orders — hand-worked pixels, every unit order of small
+// random scenes against the per-triangle replay, real nodes of the bundled character — and the
+// memory budget changes time only: k-means returns the same buffers with everything, part or
+// nothing kept (bundled character, and a clip set of Ganfaul when ../shared/data is there).
+#include "animorder/clustering.h"
+#include "animorder/invalid_input.h"
+#include "animorder/kept_fragments.h"
+#include "animorder/load.h"
+#include "animorder/measured_order.h"
+#include "animorder/mesh_patches.h"
+#include "animorder/overdraw.h"
+#include "animorder/procedural_character.h"
+#include "animorder/rasterizer.h"
+#include "animorder/viewpoints.h"
+#include "support/require.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <numeric>
+#include <random>
+#include <vector>
+
+using namespace animorder;
+
+namespace {
+
+constexpr uint32_t kTie = 0x80000000u;
+
+struct Lists {
+    std::vector<uint32_t> starts{0}, fragments;
+    void pixel(const std::vector<uint32_t>& triangles) {
+        fragments.insert(fragments.end(), triangles.begin(), triangles.end());
+        starts.push_back(uint32_t(fragments.size()));
+    }
+    size_t pixels() const { return starts.size() - 1; }
+    NodeFragments node(uint64_t single) const {
+        NodeFragments n;
+        n.single = single;
+        n.visible = single + pixels();
+        n.starts = starts;
+        n.fragments = fragments;
+        return n;
+    }
+};
+
+// Units as contiguous runs of triangle ids: units {0,1}, {2}, {3,4,5} for sizes {2,1,3}; each
+// unit's inner order is its ids ascending.
+UnitPartition runs(const std::vector<uint32_t>& sizes) {
+    std::vector<uint32_t> starts{0};
+    for (uint32_t s : sizes) starts.push_back(starts.back() + s);
+    std::vector<uint32_t> inner(starts.back());
+    std::iota(inner.begin(), inner.end(), 0u);
+    return make_unit_partition(starts.data(), sizes.size(), inner.data(), inner.size());
+}
+
+// The face order of a unit order: each unit's triangles in its inner order.
+std::vector<uint32_t> face_order(const UnitPartition& p, const std::vector<uint32_t>& unit_order) {
+    std::vector<uint32_t> faces;
+    for (uint32_t u : unit_order) {
+        std::vector<uint32_t> mine;
+        for (uint32_t t = 0; t < p.unit_of_triangle.size(); ++t)
+            if (p.unit_of_triangle[t] == u) mine.push_back(t);
+        std::sort(mine.begin(), mine.end(), [&](uint32_t a, uint32_t b) { return p.position[a] < p.position[b]; });
+        faces.insert(faces.end(), mine.begin(), mine.end());
+    }
+    return faces;
+}
+
+// Both forms scored with the same orders must agree.
+void expect_same_counts(const NodeFragments& full, const KeptNode& kept, const UnitPartition& p,
+                        const std::vector<std::vector<uint32_t>>& unit_orders) {
+    std::vector<std::vector<uint32_t>> faces;
+    std::vector<const uint32_t*> pointers;
+    for (const auto& o : unit_orders) faces.push_back(face_order(p, o));
+    for (const auto& f : faces) pointers.push_back(f.data());
+    const std::vector<uint32_t> ranks = make_rank_table(pointers, p.unit_of_triangle.size());
+    const std::vector<uint16_t> unit_ranks = make_unit_rank_table(ranks.data(), faces.size(), p);
+    std::vector<uint64_t> expected(faces.size()), got(faces.size());
+    score_fragments(expected.data(), full, ranks.data(), faces.size());
+    score_kept(got.data(), kept, unit_ranks.data(), ranks.data(), faces.size());
+    EXPECT_EQ(got, expected);
+    EXPECT_EQ(kept.visible, full.visible);
+}
+
+KeptNode keep(const NodeFragments& n, const UnitPartition& p) {
+    KeepScratch scratch;
+    return keep_fragments(n.visible, n.single, n.starts.data(), n.starts.size() - 1, n.fragments.data(), p, scratch);
+}
+
+}  // namespace
+
+TEST(KeptFragments, HandWorkedPixelsAreReducedAndShared) {
+    const UnitPartition p = runs({2, 1, 3});  // units 0 {0,1}, 1 {2}, 2 {3,4,5}
+    Lists l;
+    l.pixel({1, 0});            // unit 0 twice, the nearer (1) drawn after 0: a list kept per triangle
+    l.pixel({0, 1});            // 1 behind 0, which unit 0 draws first: dropped, one fragment left
+    l.pixel({2, 3});            // units 1, 2
+    l.pixel({2, 4});            // units 1, 2 again: the same unit list, weight 2
+    l.pixel({3, 2, 5});         // units 2, 1; 5 behind 3 of its unit (3 drawn first): dropped
+    l.pixel({2, 0, 1});         // units 1, 0; 1 behind 0: dropped
+    l.pixel({3, 4 | kTie, 2});  // 4 at 3's depth, drawn after 3: dropped; the tie goes with it
+    const KeptNode k = keep(l.node(5), p);
+    EXPECT_EQ(k.single, 5u + 1u);  // the five lone pixels and the {0, 1} pixel
+    EXPECT_EQ(k.triangle_lists, 1u);
+    EXPECT_EQ(k.triangle_entries, 2u);
+    // Unit lists in order of first appearance: {1,2} (pixels 3, 4), {2,1} (pixels 5, 7), {1,0};
+    // then the triangle list, as units.
+    EXPECT_EQ(k.unit_lists, 3u);
+    std::vector<std::vector<uint32_t>> lists;
+    std::vector<uint32_t> weights, scratch;
+    for_each_unit_list(k, p.unit_of_triangle.data(), p.unit_of_triangle.size(), scratch,
+                       [&](const uint32_t* u, uint32_t n, uint32_t w) {
+                           lists.emplace_back(u, u + n);
+                           weights.push_back(w);
+                       });
+    const std::vector<std::vector<uint32_t>> want_lists = {{1, 2}, {2, 1}, {1, 0}, {0, 0}};
+    EXPECT_EQ(lists, want_lists);
+    EXPECT_EQ(weights, (std::vector<uint32_t>{2, 2, 1, 1}));
+    // Every unit order scores as the per-triangle lists do.
+    std::vector<uint32_t> order = {0, 1, 2};
+    std::vector<std::vector<uint32_t>> all;
+    do all.push_back(order);
+    while (std::next_permutation(order.begin(), order.end()));
+    expect_same_counts(l.node(5), k, p, all);
+}
+
+TEST(KeptFragments, TiesStayGroupsWhenAFragmentBetweenIsDropped) {
+    const UnitPartition p = runs({2, 1});  // unit 0 {0,1}, unit 1 {2}
+    Lists l;
+    // 0 nearest; 1 at 0's depth (same unit, drawn after: dropped); 2 at the same depth again.
+    l.pixel({0, 1 | kTie, 2 | kTie});
+    // 0 nearest; 1 farther (dropped); 2 at 1's depth, farther than 0: no tie with 0.
+    l.pixel({0, 1, 2 | kTie});
+    const KeptNode k = keep(l.node(0), p);
+    std::vector<std::vector<uint32_t>> lists;
+    std::vector<uint32_t> scratch;
+    for_each_unit_list(k, p.unit_of_triangle.data(), p.unit_of_triangle.size(), scratch,
+                       [&](const uint32_t* u, uint32_t n, uint32_t) { lists.emplace_back(u, u + n); });
+    EXPECT_EQ(lists, (std::vector<std::vector<uint32_t>>{{0, 1 | kTie}, {0, 1}}));
+    // Drawn 1 then 0: the tied pixel passes one fragment (the first of the group), the other two.
+    expect_same_counts(l.node(0), k, p, {{0, 1}, {1, 0}});
+    uint64_t passed[1];
+    const std::vector<uint32_t> faces = face_order(p, {1, 0});
+    const std::vector<uint32_t> ranks = make_rank_table({faces.data()}, 3);
+    score_kept(passed, k, make_unit_rank_table(ranks.data(), 1, p).data(), ranks.data(), 1);
+    EXPECT_EQ(passed[0], 1u + 2u);
+}
+
+TEST(KeptFragments, RandomListsScoreAsThePerTriangleListsForEveryUnitOrder) {
+    std::mt19937 rng(3);
+    auto pick = [&rng](uint32_t n) { return uint32_t(rng() % n); };
+    for (int scene = 0; scene < 40; ++scene) {
+        const std::vector<uint32_t> sizes = {1 + pick(3), 1 + pick(3), 1 + pick(3), 1 + pick(3)};
+        // Inner orders shuffled, so positions are not the ids.
+        std::vector<uint32_t> starts{0};
+        for (uint32_t s : sizes) starts.push_back(starts.back() + s);
+        std::vector<uint32_t> inner(starts.back());
+        std::iota(inner.begin(), inner.end(), 0u);
+        std::shuffle(inner.begin(), inner.end(), rng);
+        const UnitPartition p = make_unit_partition(starts.data(), sizes.size(), inner.data(), inner.size());
+        Lists l;
+        for (int px = 0; px < 60; ++px) {
+            std::vector<uint32_t> t(inner.size());
+            std::iota(t.begin(), t.end(), 0u);
+            std::shuffle(t.begin(), t.end(), rng);
+            t.resize(2 + rng() % std::min<size_t>(5, t.size() - 1));
+            for (size_t j = 1; j < t.size(); ++j)
+                if (rng() % 4 == 0) t[j] |= kTie;
+            l.pixel(t);
+        }
+        std::vector<uint32_t> order = {0, 1, 2, 3};
+        std::vector<std::vector<uint32_t>> all;
+        do all.push_back(order);
+        while (std::next_permutation(order.begin(), order.end()));
+        const NodeFragments full = l.node(7);
+        const KeptNode k = keep(full, p);
+        for (size_t i = 0; i < all.size(); i += 8)
+            expect_same_counts(full, k, p, std::vector<std::vector<uint32_t>>(all.begin() + i, all.begin() + i + 8));
+        expect_same_counts(full, k, p, {all[3], all[17], all[22]});  // an odd count: the generic path
+        // The measured graph reads the same pairs from both forms.
+        std::vector<uint32_t> unit(p.unit_of_triangle);
+        MeasuredPairCounts a(sizes.size(), unit.data(), unit.size(), nullptr),
+            b(sizes.size(), unit.data(), unit.size(), nullptr);
+        const NodeFragments* fp = &full;
+        const KeptNode* kp = &k;
+        a.add(&fp, 1, +1, 1);
+        b.add(&kp, 1, +1, 1);
+        const std::vector<Arc> arcs_a = a.arcs(), arcs_b = b.arcs();
+        ASSERT_EQ(arcs_a.size(), arcs_b.size());
+        for (size_t i = 0; i < arcs_a.size(); ++i) {
+            EXPECT_EQ(arcs_a[i].from, arcs_b[i].from);
+            EXPECT_EQ(arcs_a[i].to, arcs_b[i].to);
+            EXPECT_EQ(arcs_a[i].weight, arcs_b[i].weight);
+        }
+    }
+}
+
+TEST(KeptFragments, AnOrderThatSplitsAUnitIsRefused) {
+    const UnitPartition p = runs({2, 1});
+    const std::vector<uint32_t> faces = {0, 2, 1};  // unit 0 split by unit 1
+    const std::vector<uint32_t> ranks = make_rank_table({faces.data()}, 3);
+    EXPECT_THROW(make_unit_rank_table(ranks.data(), 1, p), InvalidInput);
+    const std::vector<uint32_t> starts = {0, 2, 3}, twice = {0, 0, 1};
+    EXPECT_THROW(make_unit_partition(starts.data(), 2, twice.data(), 3), InvalidInput);
+}
+
+namespace {
+
+// Every node of a clip subset scored by NodeCache under three budgets and by the engine without
+// any cache (score_nodes): the same counts; the kept form is several times smaller.
+void check_cache_budgets(const AnimatedMesh& mesh, const std::vector<uint32_t>& keyframes, size_t views,
+                         unsigned resolution) {
+    const Framing framing = frame_animated_mesh(mesh);
+    const MeshPatches patches = build_mesh_patches(mesh, 0.85);
+    const std::vector<float> dirs = icosphere_directions(icosphere_subdivisions_for(views));
+    std::vector<OverdrawNode> nodes;
+    for (uint32_t k : keyframes)
+        for (size_t v = 0; v < dirs.size() / 3; ++v) {
+            OverdrawNode n;
+            n.keyframe = k;
+            std::copy(&dirs[3 * v], &dirs[3 * v] + 3, n.direction);
+            nodes.push_back(n);
+        }
+    std::mt19937 rng(5);
+    std::vector<std::vector<uint32_t>> faces;
+    for (int o = 0; o < 5; ++o) {
+        std::vector<uint32_t> patch_order(patches.patch_count());
+        std::iota(patch_order.begin(), patch_order.end(), 0u);
+        std::shuffle(patch_order.begin(), patch_order.end(), rng);
+        faces.push_back(patch_order_to_triangle_order(patches, patch_order));
+    }
+    std::vector<const uint32_t*> pointers;
+    for (const auto& f : faces) pointers.push_back(f.data());
+    const std::vector<uint32_t> ranks = make_rank_table(pointers, mesh.triangle_count());
+    ScoreSettings settings;
+    settings.resolution = resolution;
+    const std::vector<uint8_t> modes = opaque_pass_modes(mesh);
+    settings.triangle_modes = modes.empty() ? nullptr : modes.data();
+    std::vector<uint64_t> visible(nodes.size()), passed(nodes.size() * 5);
+    score_nodes(visible.data(), passed.data(), mesh.keyframe_positions.data(), mesh.vertex_count, framing,
+                mesh.indices.data(), mesh.indices.size(), nodes.data(), nodes.size(), ranks.data(), 5, settings);
+    const UnitPartition partition = make_unit_partition(patches.patch_starts.data(), patches.patch_count(),
+                                                        patches.cache_order.data(), mesh.triangle_count());
+    size_t all_bytes = 0;
+    for (size_t budget : {SIZE_MAX, size_t(0), size_t(1)}) {
+        if (budget == 1) budget = all_bytes / 2;
+        const NodeCache cache(mesh.keyframe_positions.data(), mesh.vertex_count, framing, mesh.indices.data(),
+                              mesh.indices.size(), nodes.data(), nodes.size(), partition, settings, budget);
+        if (budget == SIZE_MAX) {
+            EXPECT_EQ(cache.kept_count(), nodes.size());
+            all_bytes = cache.kept_bytes();
+        } else {
+            EXPECT_LT(cache.kept_count(), nodes.size()) << budget;
+            EXPECT_LE(cache.kept_bytes(), budget);
+        }
+        std::vector<uint64_t> v(nodes.size()), p(nodes.size() * 5);
+        cache.score(v.data(), p.data(), ranks.data(), 5);
+        EXPECT_EQ(v, visible) << "budget " << budget;
+        EXPECT_EQ(p, passed) << "budget " << budget;
+    }
+    // The per-triangle form of the same nodes, for the size comparison.
+    const std::vector<NodeFragments> full =
+        rasterize_nodes(mesh.keyframe_positions.data(), mesh.vertex_count, framing, mesh.indices.data(),
+                        mesh.indices.size(), nodes.data(), nodes.size(), settings, SIZE_MAX);
+    size_t full_bytes = 0;
+    for (const NodeFragments& n : full) full_bytes += n.bytes();
+    EXPECT_LT(3 * all_bytes, full_bytes) << "kept " << all_bytes << " bytes, per triangle " << full_bytes;
+}
+
+// cluster_nodes with everything, half and nothing kept: the same buffers and assignment.
+void check_clustering_budgets(const AnimatedMesh& mesh, const std::vector<uint32_t>& keyframes, OrderSource source) {
+    const Framing framing = frame_animated_mesh(mesh);
+    const MeshPatches patches = build_mesh_patches(mesh, 0.85);
+    ClusteringSettings s;
+    s.clusters = 3;
+    s.views = 42;
+    s.resolution = 64;
+    s.max_iterations = 6;
+    s.order = source;
+    const ClusteringResult all = cluster_nodes(mesh, patches, framing, keyframes, s);
+    EXPECT_EQ(all.kept_nodes, all.assignment.size());
+    for (size_t budget : {all.kept_bytes / 2, size_t(0)}) {
+        s.max_cache_bytes = budget;
+        const ClusteringResult r = cluster_nodes(mesh, patches, framing, keyframes, s);
+        EXPECT_LT(r.kept_nodes, all.kept_nodes);
+        EXPECT_EQ(r.patch_orders, all.patch_orders) << "budget " << budget;
+        EXPECT_EQ(r.assignment, all.assignment) << "budget " << budget;
+        EXPECT_EQ(r.iterations.size(), all.iterations.size());
+    }
+}
+
+std::vector<uint32_t> every(size_t step, size_t first, size_t count) {
+    std::vector<uint32_t> k;
+    for (size_t f = 0; f < count; f += step) k.push_back(uint32_t(first + f));
+    return k;
+}
+
+}  // namespace
+
+TEST(NodeCache, BundledCharacterScoresTheSameWhateverTheBudget) {
+    const AnimatedMesh mesh = make_procedural_character();
+    check_cache_budgets(mesh, every(4, 0, mesh.keyframe_count()), 42, 128);
+}
+
+TEST(NodeCache, BundledCharacterClustersTheSameWhateverTheBudget) {
+    const AnimatedMesh mesh = make_procedural_character();
+    check_clustering_budgets(mesh, every(3, 0, mesh.keyframe_count()), OrderSource::Distance);
+    check_clustering_budgets(mesh, every(3, 0, mesh.keyframe_count()), OrderSource::Measured);
+}
+
+TEST(NodeCache, GanfaulClipSetClustersTheSameWhateverTheBudget) {
+    const std::filesystem::path path = test::shared_data_path("mixamo-ganfaul/Ganfaul.gltf");
+    ANIMORDER_REQUIRE_DATA(path);
+    AnimatedMesh mesh = load_character(path.string());
+    mesh = select_clips(mesh, {mesh.clips[0].name, mesh.clips[1].name});
+    const std::vector<uint32_t> keyframes = every(6, 0, mesh.keyframe_count());
+    check_cache_budgets(mesh, keyframes, 12, 256);
+    check_clustering_budgets(mesh, keyframes, OrderSource::Distance);
+    check_clustering_budgets(mesh, keyframes, OrderSource::Measured);
+}

@@ -502,20 +502,25 @@ std::vector<uint32_t> integrated_distance_order(const float* centroids, size_t k
                                                 size_t node_count, DistanceVariant variant, const uint8_t* node_visible,
                                                 const uint32_t* patch_primitive) {
     const bool i3d = variant == DistanceVariant::I3d;
-    std::vector<double> d(patch_count, 0.0), seen(patch_count, 0.0);
-    for (size_t n = 0; n < node_count; ++n) {
+    for (size_t n = 0; n < node_count; ++n)
         if (node_keyframes[n] >= keyframe_count)
             throw InvalidInput("integrated distance: node " + std::to_string(n) + " names keyframe row " +
                                std::to_string(node_keyframes[n]) + ", but there are " + std::to_string(keyframe_count));
-        const float* eye = &node_eyes[3 * n];
-        const float* cent = &centroids[size_t(node_keyframes[n]) * patch_count * 3];
-        const uint8_t* vis = i3d && node_visible ? &node_visible[n * patch_count] : nullptr;
-        for (size_t p = 0; p < patch_count; ++p) {
-            if (vis && !vis[p]) continue;  // I3D: wholly back-facing at this node
-            d[p] += distance(eye, cent + 3 * p);
-            seen[p] += 1.0;
+    std::vector<double> d(patch_count, 0.0), seen(patch_count, 0.0);
+    // Blocks of patches in parallel, each patch's sum in node order: the same sums for any thread
+    // count (the caller's task arena decides it).
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, patch_count, 64), [&](const tbb::blocked_range<size_t>& block) {
+        for (size_t n = 0; n < node_count; ++n) {
+            const float* eye = &node_eyes[3 * n];
+            const float* cent = &centroids[size_t(node_keyframes[n]) * patch_count * 3];
+            const uint8_t* vis = i3d && node_visible ? &node_visible[n * patch_count] : nullptr;
+            for (size_t p = block.begin(); p != block.end(); ++p) {
+                if (vis && !vis[p]) continue;  // I3D: wholly back-facing at this node
+                d[p] += distance(eye, cent + 3 * p);
+                seen[p] += 1.0;
+            }
         }
-    }
+    });
     if (i3d)
         for (size_t p = 0; p < patch_count; ++p)
             // A patch no node of the cluster sees goes last (it is never visible there).
@@ -581,6 +586,7 @@ ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patc
     result.assignment.assign(nodes.count, UINT32_MAX);
     BestState best;
     MeasuredGraphs measured;
+    tbb::task_arena update_arena(settings.threads ? int(settings.threads) : tbb::this_task_arena::max_concurrency());
     for (size_t iteration = 0;; ++iteration) {
         ClusteringIteration log;
         const Clock::time_point assignment_start = Clock::now();
@@ -607,10 +613,12 @@ ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patc
 
         const Clock::time_point update_start = Clock::now();
         const std::vector<std::vector<uint32_t>> previous_orders = result.patch_orders;
-        const std::vector<size_t> members =
-            settings.order == OrderSource::Measured
-                ? measured_update_orders(nodes, settings, result.assignment, measured, result.patch_orders)
-                : update_orders(nodes, settings.distance, result.assignment, result.patch_orders);
+        std::vector<size_t> members;
+        update_arena.execute([&] {
+            members = settings.order == OrderSource::Measured
+                          ? measured_update_orders(nodes, settings, result.assignment, measured, result.patch_orders)
+                          : update_orders(nodes, settings.distance, result.assignment, result.patch_orders);
+        });
         std::vector<uint8_t> reseeded;
         log.reseeded = reseed_empty_clusters(nodes, members, node_ovr, settings, result.patch_orders, reseeded);
         if (settings.update == UpdateRule::Monotone)

@@ -80,8 +80,9 @@ struct ClipVertex {
 // llvmpipe's util_iround: round half away from zero.
 int64_t round_half_away(float v) { return int64_t(v >= 0.0f ? v + 0.5f : v - 0.5f); }
 
-int64_t floor_div(int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
-int64_t ceil_div(int64_t a, int64_t b) { return -floor_div(-a, b); }
+// Floor and ceiling of a / kSubpixel: an arithmetic shift rounds towards minus infinity.
+int64_t floor_subpixel(int64_t a) { return a >> kSubpixelBits; }
+int64_t ceil_subpixel(int64_t a) { return -((-a) >> kSubpixelBits); }
 
 // Where the rasteriser puts fragments: three parallel arrays (pixel, triangle, depth).
 // Capacity is ensured once per triangle (its bounding box bounds its fragments), so adding a
@@ -124,10 +125,10 @@ void rasterize_window_triangle(const WindowVertex& v0, const WindowVertex& v1, c
 
     const int64_t min_x = std::min({c[0]->X, c[1]->X, c[2]->X}), max_x = std::max({c[0]->X, c[1]->X, c[2]->X});
     const int64_t min_y = std::min({c[0]->Y, c[1]->Y, c[2]->Y}), max_y = std::max({c[0]->Y, c[1]->Y, c[2]->Y});
-    const int64_t px0 = std::max<int64_t>(0, ceil_div(min_x, kSubpixel));
-    const int64_t px1 = std::min<int64_t>(resolution - 1, floor_div(max_x, kSubpixel));
-    const int64_t py0 = std::max<int64_t>(0, ceil_div(min_y, kSubpixel));
-    const int64_t py1 = std::min<int64_t>(resolution - 1, floor_div(max_y, kSubpixel));
+    const int64_t px0 = std::max<int64_t>(0, ceil_subpixel(min_x));
+    const int64_t px1 = std::min<int64_t>(resolution - 1, floor_subpixel(max_x));
+    const int64_t py0 = std::max<int64_t>(0, ceil_subpixel(min_y));
+    const int64_t py1 = std::min<int64_t>(resolution - 1, floor_subpixel(max_y));
     if (px0 > px1 || py0 > py1) return;
 
     // Edge a→b: E(P) = (Xb−Xa)(Py−Ya) − (Yb−Ya)(Px−Xa). Top edge: horizontal going right; left
@@ -157,9 +158,10 @@ void rasterize_window_triangle(const WindowVertex& v0, const WindowVertex& v1, c
         int64_t e0 = e_row[0], e1 = e_row[1], e2 = e_row[2];
         const double z_row = z_origin + dzdy * double(py);
         const uint32_t row = uint32_t(py * resolution);
-        for (int64_t px = px0; px <= px1; ++px) {
+        double x = double(px0);  // double(px), exactly
+        for (int64_t px = px0; px <= px1; ++px, x += 1.0) {
             if ((e0 | e1 | e2) >= 0) {
-                const float depth = float(z_row + dzdx * double(px));
+                const float depth = float(z_row + dzdx * x);
                 if (depth < 1.0f && depth >= 0.0f) sink.add(row + uint32_t(px), triangle, depth);
             }
             e0 += step_x[0];

@@ -91,6 +91,11 @@ void add_method_options(CLI::App& command, animorder::tool::MethodOptions& optio
                      "static-nehab06: measure also at 8 keyframes spread over the clips (default: --frame only)");
     command.add_flag("--planar-units", m.measured_planar_units,
                      "measured: Nehab 2006 planar clusters as units (as many as lambda's patches), not patches");
+    command
+        .add_option("--fragment-memory", c.max_cache_bytes,
+                    "single/joint/measured: bytes for the nodes' kept fragments; nodes beyond are rasterised again "
+                    "each iteration (same result, slower)")
+        ->capture_default_str();
     command.add_option("--threads", c.threads, "Worker threads (0: all cores)")
         ->capture_default_str()
         ->check(CLI::Range(0u, 1024u));

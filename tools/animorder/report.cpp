@@ -47,6 +47,8 @@ nlohmann::ordered_json clustering_details(const AnimatedMesh& mesh, const Method
                         {"converged", r.runs[i].converged},
                         {"stop", r.runs[i].stop_reason},
                         {"best_iteration", r.runs[i].best_iteration + 1},
+                        {"kept_nodes", r.runs[i].kept_nodes},
+                        {"kept_bytes", r.runs[i].kept_bytes},
                         {"iterations", iterations}});
     }
     return {{"clusters", m.clustering.clusters},

@@ -199,6 +199,11 @@ fi
 if [ -x "$BIN/bench/bench_overdraw" ]; then
   step_stdout bench-overdraw.txt "$BIN/bench/bench_overdraw"
 fi
+# Issue 19's production scale: whole sets with their peak memory, each case in a process of its own
+# (the engine-ratio case is bench-overdraw.txt above).
+if [ -x "$BIN/bench/bench_scale" ]; then
+  step_stdout bench-scale.txt "$BIN/bench/bench_scale" ganfaul-joint xbot-single clip60-single
+fi
 mkdir -p "$OUT/out"
 step optimize-ganfaul-idle.json $A optimize --method single "$GANFAUL" --clip Idle -q \
   -o "$OUT/out/ganfaul-idle" --report "$OUT/optimize-ganfaul-idle.json"

@@ -13,6 +13,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <utility>
 #include <vector>
 
 namespace animorder {
@@ -22,6 +23,7 @@ namespace animorder {
 struct UnitPartition {
     std::vector<uint32_t> unit_of_triangle;
     std::vector<uint32_t> position;
+    std::vector<std::pair<uint32_t, uint32_t>> unit_position;  // both, side by side (one cache line)
     size_t unit_count = 0;
 };
 
@@ -51,6 +53,7 @@ struct KeptNode {
 // Working memory of keep_fragments, reused between nodes.
 struct KeepScratch {
     std::vector<uint32_t> reduced, slots, list_offset;
+    std::vector<std::pair<uint32_t, uint32_t>> kept;
     std::vector<uint16_t> entries, weights;
     std::vector<uint8_t> lengths;
     std::vector<uint32_t> triangle_lists;

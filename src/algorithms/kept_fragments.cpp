@@ -40,12 +40,14 @@ uint64_t hash_list(const uint16_t* e, size_t n) {
 
 // Drops the fragments of reduction 1 from one pixel's list into `out` (tie bits recomputed: an
 // entry is tied when its depth equals the previous kept entry's). Sets `repeated` when a unit
-// still appears twice.
+// still appears twice. `kept` holds the kept entries' (unit, position).
 void reduce_pixel(const uint32_t* f, uint32_t n, const UnitPartition& partition, std::vector<uint32_t>& out,
-                  bool& repeated) {
+                  std::vector<std::pair<uint32_t, uint32_t>>& kept, bool& repeated) {
     out.clear();
+    kept.clear();
     repeated = false;
     const size_t triangles = partition.unit_of_triangle.size();
+    const std::pair<uint32_t, uint32_t>* unit_position = partition.unit_position.data();
     bool previous_at_kept_depth = true;  // the previous fragment's depth equals the last kept one's
     for (uint32_t j = 0; j < n; ++j) {
         const uint32_t t = f[j] & kTriangleMask;
@@ -53,13 +55,12 @@ void reduce_pixel(const uint32_t* f, uint32_t n, const UnitPartition& partition,
             throw InvalidInput("kept fragments: triangle " + std::to_string(t) + ", but the partition has " +
                                std::to_string(triangles));
         const bool tied = j > 0 && (f[j] & kTieBit) && previous_at_kept_depth;
-        const uint32_t unit = partition.unit_of_triangle[t];
+        const auto [unit, position] = unit_position[t];
         bool dominated = false, same_unit = false;
-        for (const uint32_t kept : out) {
-            const uint32_t k = kept & kTriangleMask;
-            if (partition.unit_of_triangle[k] != unit) continue;
+        for (const auto& [u, p] : kept) {
+            if (u != unit) continue;
             same_unit = true;
-            dominated |= partition.position[k] < partition.position[t];
+            dominated |= p < position;
         }
         if (dominated) {
             previous_at_kept_depth = tied;
@@ -67,6 +68,7 @@ void reduce_pixel(const uint32_t* f, uint32_t n, const UnitPartition& partition,
         }
         repeated |= same_unit;
         out.push_back(t | (tied ? kTieBit : 0));
+        kept.emplace_back(unit, position);
         previous_at_kept_depth = true;
     }
 }
@@ -81,7 +83,8 @@ struct ListTable {
         s.weights.clear();
         s.lengths.clear();
         s.list_offset.clear();
-        s.slots.assign(1024, 0);
+        // The previous node's table size (nodes of a run are alike): no regrowth node after node.
+        s.slots.assign(std::max<size_t>(1024, s.slots.size()), 0);
         mask = s.slots.size() - 1;
     }
     bool equal(uint32_t list, const uint16_t* e, size_t n) const {
@@ -206,6 +209,8 @@ UnitPartition make_unit_partition(const uint32_t* unit_starts, size_t unit_count
             p.position[t] = j;
         }
     }
+    p.unit_position.resize(triangle_count);
+    for (size_t t = 0; t < triangle_count; ++t) p.unit_position[t] = {p.unit_of_triangle[t], p.position[t]};
     return p;
 }
 
@@ -220,7 +225,7 @@ KeptNode keep_fragments(uint64_t visible, uint64_t single, const uint32_t* start
     uint16_t units[kMaxListLength];
     bool repeated = false;
     for (size_t p = 0; p < pixel_count; ++p) {
-        reduce_pixel(fragments + starts[p], starts[p + 1] - starts[p], partition, s.reduced, repeated);
+        reduce_pixel(fragments + starts[p], starts[p + 1] - starts[p], partition, s.reduced, s.kept, repeated);
         if (s.reduced.size() < 2) {
             ++node.single;  // only the nearest is left: it passes under every order, nothing else does
             continue;
@@ -233,8 +238,7 @@ KeptNode keep_fragments(uint64_t visible, uint64_t single, const uint32_t* start
             continue;
         }
         for (size_t j = 0; j < s.reduced.size(); ++j)
-            units[j] = uint16_t(partition.unit_of_triangle[s.reduced[j] & kTriangleMask] |
-                                (s.reduced[j] & kTieBit ? kUnitTieBit : 0));
+            units[j] = uint16_t(s.kept[j].first | (s.reduced[j] & kTieBit ? kUnitTieBit : 0));
         table.add(units, s.reduced.size());
     }
     node.unit_lists = uint32_t(s.weights.size());

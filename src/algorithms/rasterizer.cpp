@@ -144,23 +144,33 @@ void rasterize_window_triangle(const WindowVertex& v0, const WindowVertex& v1, c
         step_y[i] = dx * kSubpixel;
     }
 
-    // Depth plane through the three window-space vertices (centres at integer coordinates).
-    const double ax = c[1]->x - c[0]->x, ay = c[1]->y - c[0]->y, az = c[1]->z - c[0]->z;
-    const double bx = c[2]->x - c[0]->x, by = c[2]->y - c[0]->y, bz = c[2]->z - c[0]->z;
-    const double det = ax * by - ay * bx;
-    if (det == 0.0) return;  // float-degenerate sliver: no fragment has a defined depth
-    const double dzdx = (az * by - ay * bz) / det;
-    const double dzdy = (ax * bz - az * bx) / det;
-    const double z_origin = c[0]->z - dzdx * c[0]->x - dzdy * c[0]->y;  // depth at pixel (0, 0)
+    // Depth plane through the three window-space vertices (centres at integer coordinates), set up
+    // at the first covered pixel: most small triangles of a character cover none.
+    double dzdx = 0, dzdy = 0, z_origin = 0;
+    bool have_plane = false;
+    auto set_up_plane = [&] {
+        const double ax = c[1]->x - c[0]->x, ay = c[1]->y - c[0]->y, az = c[1]->z - c[0]->z;
+        const double bx = c[2]->x - c[0]->x, by = c[2]->y - c[0]->y, bz = c[2]->z - c[0]->z;
+        const double det = ax * by - ay * bx;
+        if (det == 0.0) return false;  // float-degenerate sliver: no fragment has a defined depth
+        dzdx = (az * by - ay * bz) / det;
+        dzdy = (ax * bz - az * bx) / det;
+        z_origin = c[0]->z - dzdx * c[0]->x - dzdy * c[0]->y;  // depth at pixel (0, 0)
+        return have_plane = true;
+    };
 
     sink.reserve_more(size_t(px1 - px0 + 1) * size_t(py1 - py0 + 1));
     for (int64_t py = py0; py <= py1; ++py) {
         int64_t e0 = e_row[0], e1 = e_row[1], e2 = e_row[2];
-        const double z_row = z_origin + dzdy * double(py);
+        double z_row = have_plane ? z_origin + dzdy * double(py) : 0.0;
         const uint32_t row = uint32_t(py * resolution);
         double x = double(px0);  // double(px), exactly
         for (int64_t px = px0; px <= px1; ++px, x += 1.0) {
             if ((e0 | e1 | e2) >= 0) {
+                if (!have_plane) {
+                    if (!set_up_plane()) return;
+                    z_row = z_origin + dzdy * double(py);
+                }
                 const float depth = float(z_row + dzdx * x);
                 if (depth < 1.0f && depth >= 0.0f) sink.add(row + uint32_t(px), triangle, depth);
             }

@@ -111,6 +111,19 @@ void project(const ClipVertex& v, unsigned resolution, WindowVertex& out) {
     out.y = float(resolution) - y - 0.5f;
 }
 
+// A quick test before the full set-up: false when the triangle is culled, has zero area, or its
+// bounding box holds no pixel centre (rasterize_window_triangle would emit nothing).
+inline bool may_cover(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2, unsigned resolution,
+                      bool two_sided) {
+    const int64_t area = (v1.X - v0.X) * (v2.Y - v0.Y) - (v2.X - v0.X) * (v1.Y - v0.Y);
+    if (area == 0 || (area > 0 && !two_sided)) return false;
+    const int64_t min_x = std::min({v0.X, v1.X, v2.X}), max_x = std::max({v0.X, v1.X, v2.X});
+    const int64_t min_y = std::min({v0.Y, v1.Y, v2.Y}), max_y = std::max({v0.Y, v1.Y, v2.Y});
+    const int64_t last = int64_t(resolution - 1);
+    return std::max<int64_t>(0, -((-min_x) >> kSubpixelBits)) <= std::min<int64_t>(last, max_x >> kSubpixelBits) &&
+           std::max<int64_t>(0, -((-min_y) >> kSubpixelBits)) <= std::min<int64_t>(last, max_y >> kSubpixelBits);
+}
+
 // Rasterises one window-space triangle: culling, fill rule and depth as described at the top.
 void rasterize_window_triangle(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2,
                                uint32_t triangle, unsigned resolution, FragmentSink& sink, bool two_sided) {
@@ -326,7 +339,9 @@ void NodeRasterizer::rasterize(const float* clip_xyzw, size_t vertex_count, cons
         if (mode & kSkipTriangle) continue;
         const bool two_sided = (mode & kDrawBothFaces) != 0;
         if (s.unclipped[a] & s.unclipped[b] & s.unclipped[c]) {
-            rasterize_window_triangle(s.window[a], s.window[b], s.window[c], uint32_t(t), resolution, sink, two_sided);
+            const WindowVertex &va = s.window[a], &vb = s.window[b], &vc = s.window[c];
+            if (!may_cover(va, vb, vc, resolution, two_sided)) continue;  // most triangles: no call at all
+            rasterize_window_triangle(va, vb, vc, uint32_t(t), resolution, sink, two_sided);
         } else {
             const ClipVertex v[3] = {cv[a], cv[b], cv[c]};
             rasterize_clipped_triangle(v, uint32_t(t), resolution, sink, two_sided);

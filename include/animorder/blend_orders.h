@@ -43,7 +43,8 @@ void measured_blended_orders(const AnimatedMesh& mesh, const std::vector<BlendFr
 // k-means over the run's nodes with the blend objective (issue 18): each node is rasterised once
 // with every triangle (double-sided ones without culling) and keeps its blended fragments in
 // front of the opaque depth (BlendFragments); starting from the run's own assignment, each
-// cluster's order is the reversed integrated-distance sort over its nodes (as above) and each
+// cluster's order is the measured blend order over its nodes (measured_blended_orders, started
+// from the reversed integrated-distance sort above) and each
 // node then takes the order with the fewest mis-sorted pixels (ties: the lower cluster), until
 // no node moves or max_iterations. Returns the best iteration's orders (run.triangle_orders with
 // their blended ranges replaced; opaque ranges untouched) and assignment.

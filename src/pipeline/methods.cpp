@@ -240,7 +240,8 @@ AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double
         const Framing framing = frame_subset(result.framing, keyframes);
         result.run_radius.push_back(framing.radius);
         result.runs.push_back(cluster_nodes(mesh, result.patches, framing, keyframes, settings));
-        // Blended primitives: back to front for each cluster (blend_orders.h); with blend_clusters,
+        // Blended primitives: back to front for each cluster, in the measured blend order of its
+        // nodes (blend_orders.h; the nodes' transparent pass rasterised once); with blend_clusters,
         // by their own k clusters of the same nodes, the buffers then being the (opaque, blend)
         // cluster pairs the nodes take.
         if (has_blended_primitives(mesh) && !blend_clusters) {

@@ -162,6 +162,16 @@ step materials/bundled-blend-clusters.json $A evaluate -q --methods original,sin
   --eval-views 100 --eval-resolution 256 -r "$OUT/materials/bundled-blend-clusters.json"
 step materials/morph-stress-test.json $A evaluate "$DATA/gltf-morph-stress-test/MorphStressTest.gltf" -q \
   --methods original,static-sander07,single --eval-views 60 --eval-resolution 256 -r "$OUT/materials/morph-stress-test.json"
+# The cost of double-sided materials: the same runs with every material culled (`--single-sided`,
+# orders and OVR as before issue 18), MorphStressTest and Xbot's walk clip.
+step materials/morph-stress-test-single-sided.json $A evaluate "$DATA/gltf-morph-stress-test/MorphStressTest.gltf" -q \
+  --single-sided --methods original,static-sander07,single --eval-views 60 --eval-resolution 256 \
+  -r "$OUT/materials/morph-stress-test-single-sided.json"
+step materials/xbot-walk.json $A evaluate "$DATA/glb-xbot/Xbot.glb" --clip walk -q \
+  --methods original,static-sander07,static-nehab06,single --eval-views 60 --eval-resolution 256 -r "$OUT/materials/xbot-walk.json"
+step materials/xbot-walk-single-sided.json $A evaluate "$DATA/glb-xbot/Xbot.glb" --clip walk -q --single-sided \
+  --methods original,static-sander07,static-nehab06,single --eval-views 60 --eval-resolution 256 \
+  -r "$OUT/materials/xbot-walk-single-sided.json"
 # Measured cluster orders (issue 15: `measured`, `measured-joint`), beside `single` in the same runs
 # (same nodes, same bootstrap), in build/results/measured/: Table 1's setting on Idle; the k sweep
 # (OVR and index-buffer bytes against k) with static-nehab06 for k = 1; every Ganfaul clip at the

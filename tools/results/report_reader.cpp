@@ -158,6 +158,10 @@ Report load_report(const fs::path& path, const std::string& name) {
             if (!bc->is_boolean()) r.fail("settings.blend_clusters", "expected a boolean, got " + Reader::kind(*bc));
             report.blend_clusters = bc->get<bool>();
         }
+        if (const json* ss = r.optional(*s, "single_sided")) {
+            if (!ss->is_boolean()) r.fail("settings.single_sided", "expected a boolean, got " + Reader::kind(*ss));
+            report.single_sided = ss->get<bool>();
+        }
         const auto list = [&](const char* key, auto convert) {
             if (const json* v = r.optional(*s, key)) {
                 const std::string where = std::string("settings.") + key;

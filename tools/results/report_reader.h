@@ -54,6 +54,7 @@ struct Report {
     std::string file, input;
     long long triangles = -1, vertices = -1, nodes = -1, threads = -1;
     bool blend_clusters = false;  // settings.blend_clusters: k-means buffers with their own blend clusters
+    bool single_sided = false;    // settings.single_sided: every material culled (evaluate --single-sided)
     long long eval_views = -1, eval_resolution = -1, eval_seed = -1, resolution = -1, seed = -1, cache_size = -1;
     std::vector<double> lambdas;
     std::vector<long long> clusters, views;

@@ -3,7 +3,8 @@
 // for inputs with blended primitives, the blend table: mis-sorted pairs and pixels of the input
 // order, every method and the per-node back-to-front sort, with each method's share of the way
 // from `original` to that sort in mis-sorted pixels; then the issue's two goals on the bundled
-// character (k = 5 buffers ≥ 90% of the way; the best single static order less than half of it).
+// character (k = 5 buffers ≥ 90% of the way; the best single static order less than half of it);
+// and, for a report with a `--single-sided` twin, the OVR both ways (the cost of double-sidedness).
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -54,6 +55,37 @@ std::string blend_table(const Report& r) {
     return table({"order", "buffers", "mis-sorted pairs", "mis-sorted pixels", "of the way to the bound"}, rows);
 }
 
+// The cost of double-sided materials: each report beside its `--single-sided` twin (the same
+// input and methods with every material culled): OVR mean per method, both ways.
+std::string double_sided_table(const Inputs& in) {
+    std::vector<std::vector<std::string>> rows;
+    for (const std::string& name : in.materials) {
+        const Report& r = *in.get(name);
+        if (r.single_sided) continue;
+        const Report* culled = nullptr;
+        for (const std::string& other : in.materials) {
+            const Report& o = *in.get(other);
+            if (o.single_sided && o.input == r.input && o.clips.size() == r.clips.size() &&
+                o.eval_views == r.eval_views && o.eval_resolution == r.eval_resolution)
+                culled = &o;
+        }
+        if (!culled) continue;
+        for (const Method& m : r.methods) {
+            const Method* c = nullptr;
+            for (const Method& x : culled->methods)
+                if (x.name == m.name && x.clusters == m.clusters && x.views == m.views &&
+                    (same_lambda(x.lambda, m.lambda) || (std::isnan(x.lambda) && std::isnan(m.lambda))))
+                    c = &x;
+            if (!c) continue;
+            rows.push_back({fs::path(name).stem().string(), method_label(m, varies(r), true), f3(m.ovr_mean),
+                            f3(c->ovr_mean), percent1(m.ovr_mean / c->ovr_mean - 1.0)});
+        }
+    }
+    if (rows.empty()) return "";
+    return table({"report", "method", "OVR, double-sided drawn", "OVR, all culled (`--single-sided`)", "difference"},
+                 rows, 2);
+}
+
 }  // namespace
 
 Section materials_section(const Inputs& in) {
@@ -99,10 +131,16 @@ Section materials_section(const Inputs& in) {
         for (const std::string& l : goal_lines) b += l + "\n";
         b += "\n";
     }
+    const std::string sided = double_sided_table(in);
+    if (!sided.empty())
+        b += "The cost of double-sided materials: each run beside the same run with every material culled "
+             "(`evaluate --single-sided`: orders and OVR as before issue 18), mean OVR:\n\n" +
+             sided + "\n";
     for (const std::string& name : in.materials) {
         const Report& r = *in.get(name);
         b += "### " + fs::path(name).stem().string() + "\n\n";
-        b += protocol(r) + (r.blend_clusters ? " k-means with `--blend-clusters`." : "") + " Clips: " +
+        b += protocol(r) + (r.blend_clusters ? " k-means with `--blend-clusters`." : "") +
+             (r.single_sided ? " Every material culled (`--single-sided`)." : "") + " Clips: " +
              clip_list(r) + ".\n\n" + compact_table(r) + "\n";
         if (r.blend_bound.present) b += "Blended primitives:\n\n" + blend_table(r) + "\n";
     }

@@ -20,7 +20,6 @@
 #include "animorder/mesh_patches.h"
 #include "animorder/meshopt_order.h"
 #include "animorder/nehab06.h"
-#include "animorder/rasterizer.h"
 #include "animorder/selection_table.h"
 #include "animorder/static_sander07.h"
 #include "animorder/tipsify.h"
@@ -159,15 +158,17 @@ StaticMethodResult run_static_method(const AnimatedMesh& mesh, StaticMethod meth
             nehab.resolution = settings.nehab_resolution;
             nehab.cache_size = settings.cache_size;
             nehab.threads = settings.threads;
-            // An opaque double-sided primitive is measured without culling (the opaque pass,
-            // overdraw.h). A blended one keeps the culled graph of its own triangles, reversed
-            // (reverse_blended_primitives): on the bundled character's hair and cape it mis-sorts
-            // fewer pixels (11.5%) than its graph without culling (14.1%) or none (skipped, as in
-            // the opaque pass: 15.9%); a static order cannot be back to front from both sides.
-            std::vector<uint8_t> modes;
-            if (primitive.double_sided && primitive.alpha_mode != AlphaMode::Blend)
-                modes.assign(triangles, kDrawBothFaces);
-            nehab.triangle_modes = modes.empty() ? nullptr : modes.data();
+            // The graph is measured with back faces culled, double-sided or not (Nehab06Settings::
+            // triangle_modes can draw both faces, and evaluate counts them): measured, drawing both
+            // faces in the graph gave worse orders under the true, double-sided count, on Xbot's walk
+            // (OVR 1.865 → 1.955, automatic clusters; 1.848 → 1.969 at 640) and MorphStressTest's
+            // TheWave (2.068 → 2.208, automatic; better only at fixed counts: 1.988 → 1.918 at 64):
+            // on a closed double-sided shell every cluster hides its opposite one from one side and
+            // is hidden by it from the other, near-cancelling arcs that crowd out the concavities'.
+            // (`evaluate X --clip C --methods static-nehab06 [--nehab-clusters N] --eval-views 60
+            // --eval-resolution 256`, TheWave with 20 views.) Blended primitives likewise: their
+            // culled graph, reversed, mis-sorts fewer pixels on the bundled character's hair and
+            // cape (11.5%) than without culling (14.1%) or skipped as in the opaque pass (15.9%).
             // The clustering keyframe first: clusters come from the first listed keyframe.
             std::vector<uint32_t> keyframes{uint32_t(settings.keyframe)};
             if (settings.nehab_all_keyframes) {

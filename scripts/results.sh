@@ -5,6 +5,9 @@
 #   RESUME=1 bash scripts/results.sh   # keep the reports already in build/results, run the rest
 #   BIN=/some/dir SKIP_BUILD=1 ...     # run binaries copied elsewhere (rebuilding build/ meanwhile)
 #   STEPS_FROM_LOG=results.log RESUME=1 ...  # kept reports of an older run: commands from its log
+#   STEPS_ONLY="materials/" SKIP_BUILD=1 ...  # only the steps whose names start with one of these
+#       (space-separated) prefixes; the other kept reports in docs/results/reports stay as they are and
+#       only the matching files' lines of MANIFEST.md, SHA256SUMS and steps.tsv are replaced
 #
 # Needs ../shared/data (the real characters); without it the script says so and stops. Each step
 # writes one `animorder evaluate --report` JSON (or a benchmark's output) into build/results/ and
@@ -27,7 +30,7 @@ if [ "${SKIP_BUILD:-0}" != 1 ]; then
   cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
   cmake --build build -j"$(nproc)"
 fi
-[ "${RESUME:-0}" = 1 ] || rm -rf "$OUT"
+[ "${RESUME:-0}" = 1 ] || [ -n "${STEPS_ONLY:-}" ] || rm -rf "$OUT"
 mkdir -p "$OUT/characters"
 BIN=${BIN:-build}
 A=$BIN/animorder
@@ -45,8 +48,16 @@ record() {
   printf '%s\t%s\t%s\n' "$name" "$seconds" "$*" >> "$STEPS.tmp"
   mv "$STEPS.tmp" "$STEPS"
 }
+# only_step NAME: whether STEPS_ONLY (unset: every step) selects NAME.
+only_step() {
+  [ -z "${STEPS_ONLY:-}" ] && return 0
+  local prefix
+  for prefix in $STEPS_ONLY; do [ "${1#"$prefix"}" != "$1" ] && return 0; done
+  return 1
+}
 run_step() {
   local name=$1 to_stdout=$2; shift 2
+  only_step "$name" || return 0
   if [ -s "$OUT/$name" ]; then echo "results: $name kept"; return; fi
   echo "results: $name: $*" >&2
   local start end
@@ -139,18 +150,28 @@ nehab_keyframes character                     # no input: the bundled character
 nehab_keyframes character-all --nehab-all-keyframes
 nehab_keyframes mrfixit-all $DATA/iqm-mrfixit/mrfixit.iqm --nehab-all-keyframes
 nehab_keyframes dwarf2-b3d-all $DATA/b3d-dwarf2/dwarf2.b3d --nehab-all-keyframes
-# Issue 18, materials (build/results/materials/, not yet read by make_results): the bundled
+# Issue 18, materials (build/results/materials/, RESULTS.md's "Materials"): the bundled
 # character's blended hair cards and cape — the blend table of `evaluate` (input order, original,
-# static-sander07 reversed, k = 5 buffers on the opaque clusters, the same with their own blend
+# static-sander07 and static-nehab06 reversed, k = 5 buffers on the opaque clusters, the same with their own blend
 # clusters, the per-node back-to-front bound) — and MorphStressTest's double-sided materials (Xbot's
 # are in characters/xbot.json). 100 views at 256x256.
 mkdir -p "$OUT/materials"
-step materials/bundled.json $A evaluate -q --methods original,static-sander07,single \
+step materials/bundled.json $A evaluate -q --methods original,static-sander07,static-nehab06,single \
   --eval-views 100 --eval-resolution 256 -r "$OUT/materials/bundled.json"
 step materials/bundled-blend-clusters.json $A evaluate -q --methods original,single --blend-clusters \
   --eval-views 100 --eval-resolution 256 -r "$OUT/materials/bundled-blend-clusters.json"
 step materials/morph-stress-test.json $A evaluate "$DATA/gltf-morph-stress-test/MorphStressTest.gltf" -q \
   --methods original,static-sander07,single --eval-views 60 --eval-resolution 256 -r "$OUT/materials/morph-stress-test.json"
+# The cost of double-sided materials: the same runs with every material culled (`--single-sided`,
+# orders and OVR as before issue 18), MorphStressTest and Xbot's walk clip.
+step materials/morph-stress-test-single-sided.json $A evaluate "$DATA/gltf-morph-stress-test/MorphStressTest.gltf" -q \
+  --single-sided --methods original,static-sander07,single --eval-views 60 --eval-resolution 256 \
+  -r "$OUT/materials/morph-stress-test-single-sided.json"
+step materials/xbot-walk.json $A evaluate "$DATA/glb-xbot/Xbot.glb" --clip walk -q \
+  --methods original,static-sander07,static-nehab06,single --eval-views 60 --eval-resolution 256 -r "$OUT/materials/xbot-walk.json"
+step materials/xbot-walk-single-sided.json $A evaluate "$DATA/glb-xbot/Xbot.glb" --clip walk -q --single-sided \
+  --methods original,static-sander07,static-nehab06,single --eval-views 60 --eval-resolution 256 \
+  -r "$OUT/materials/xbot-walk-single-sided.json"
 # Measured cluster orders (issue 15: `measured`, `measured-joint`), beside `single` in the same runs
 # (same nodes, same bootstrap), in build/results/measured/: Table 1's setting on Idle; the k sweep
 # (OVR and index-buffer bytes against k) with static-nehab06 for k = 1; every Ganfaul clip at the
@@ -211,6 +232,48 @@ step optimize-ganfaul-idle.json $A optimize --method single "$GANFAUL" --clip Id
 # Keep the reports: every JSON, TSV and text report under 300 KB is copied into docs/results/reports
 # (larger ones, and the subdivided meshes, are listed in MANIFEST.md with their sha256 only).
 KEEP=docs/results/reports
+if [ -n "${STEPS_ONLY:-}" ]; then
+  # Only the selected steps' files: each replaces its own lines (and copy) among the kept ones.
+  keep_only() {  # FILE: a kept list whose lines name files in their last field
+    awk -v p="$STEPS_ONLY" 'BEGIN { n = split(p, ps, " ") }
+      { f = $NF; gsub(/`/, "", f); if ($0 ~ /^\| `/) { f = $2; gsub(/`/, "", f) }
+        if (f == "steps.tsv") next; for (i = 1; i <= n; i++) if (index(f, ps[i]) == 1) next; print }' "$1"
+  }
+  awk -F'\t' -v p="$STEPS_ONLY" 'BEGIN { n = split(p, ps, " ") }
+    { for (i = 1; i <= n; i++) if (index($1, ps[i]) == 1) next; print }' "$KEEP/steps.tsv" > "$KEEP/steps.tsv.tmp"
+  awk -F'\t' -v p="$STEPS_ONLY" 'BEGIN { n = split(p, ps, " ") }
+    NR > 1 { for (i = 1; i <= n; i++) if (index($1, ps[i]) == 1) print }' "$STEPS" 2>/dev/null >> "$KEEP/steps.tsv.tmp" || true
+  mv "$KEEP/steps.tsv.tmp" "$KEEP/steps.tsv"
+  keep_only "$KEEP/MANIFEST.md" > "$KEEP/MANIFEST.md.tmp"
+  keep_only "$KEEP/SHA256SUMS" > "$KEEP/SHA256SUMS.tmp"
+  for prefix in $STEPS_ONLY; do
+    (cd "$OUT" && find . -type f \( -name '*.json' -o -name '*.txt' -o -name '*.glb' \) ! -name '*.tmp' |
+      sed 's|^\./||' | awk -v p="$prefix" 'index($0, p) == 1') | while read -r f; do
+      bytes=$(stat -c %s "$OUT/$f")
+      sum=$(sha256sum "$OUT/$f" | cut -d' ' -f1)
+      kept=no
+      if [ "$bytes" -le 307200 ] && [ "${f##*.}" != glb ]; then
+        mkdir -p "$KEEP/$(dirname "$f")"
+        cp "$OUT/$f" "$KEEP/$f"
+        echo "$sum  $f" >> "$KEEP/SHA256SUMS.tmp"
+        kept=yes
+      fi
+      line=$(awk -F'\t' -v n="$f" '$1 == n { print $2 "\t" $3 }' "$STEPS" 2>/dev/null || true)
+      seconds=${line%%$'\t'*}; command=${line#*$'\t'}
+      echo "| \`$f\` | $kept | $bytes | \`$sum\` | ${seconds:-—} | \`${command:-—}\` |" >> "$KEEP/MANIFEST.md.tmp"
+    done
+  done
+  sum=$(sha256sum "$KEEP/steps.tsv" | cut -d' ' -f1)
+  echo "$sum  steps.tsv" >> "$KEEP/SHA256SUMS.tmp"
+  echo "| \`steps.tsv\` | yes | $(stat -c %s "$KEEP/steps.tsv") | \`$sum\` | — | \`—\` |" >> "$KEEP/MANIFEST.md.tmp"
+  # Rows in file order, as the full run writes them (header lines first).
+  { grep -v '^| `' "$KEEP/MANIFEST.md.tmp"; grep '^| `' "$KEEP/MANIFEST.md.tmp" | LC_ALL=C sort -t'`' -k2,2; } > "$KEEP/MANIFEST.md"
+  LC_ALL=C sort -k2 "$KEEP/SHA256SUMS.tmp" > "$KEEP/SHA256SUMS"
+  rm -f "$KEEP/MANIFEST.md.tmp" "$KEEP/SHA256SUMS.tmp"
+  "$BIN/make_results" --notes docs/results-notes --readme README.md "$KEEP" docs
+  echo "results: replaced the reports of steps $STEPS_ONLY; wrote docs/RESULTS.md, docs/results/ and README.md's block"
+  exit 0
+fi
 rm -rf "$KEEP"
 mkdir -p "$KEEP"
 {

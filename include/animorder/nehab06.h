@@ -88,6 +88,10 @@ struct Nehab06Settings {
     unsigned resolution = 256;
     unsigned cache_size = kDefaultCacheSize;
     unsigned threads = 0;
+    // Null (every triangle drawn, back faces culled), or one mode per triangle of the index list
+    // (kDrawBothFaces, kSkipTriangle of rasterizer.h): how the graph's and the candidates' nodes
+    // draw them (a double-sided material: no culling). Not owned.
+    const uint8_t* triangle_modes = nullptr;
 };
 
 struct Nehab06Candidate {

@@ -7,11 +7,19 @@
 // the cluster as a whole: the integrated-distance update of JCGT 2017 with the sort reversed, at
 // triangle granularity (Tipsify patches span several hair cards, so sorting patches would leave
 // the cards of one patch in cache order).
+//
+// That sort is only the start: centroid distance orders a card by its middle, while two
+// overlapping cards are mis-sorted by where they overlap. measured_blended_orders replaces it by
+// the order that minimises the fragment pairs the cluster's own nodes count as mis-sorted (the
+// measured graph and feedback-arc-set search of measured_order.cpp, triangles as units): on the
+// bundled character it took k = 5 buffers from less than two thirds of the way to the per-node
+// centroid sort past it (RESULTS.md "Materials").
 #include "animorder/blend_orders.h"
 
 #include "animorder/camera.h"
 #include "animorder/clustering.h"
 #include "animorder/invalid_input.h"
+#include "animorder/measured_order.h"
 #include "animorder/overdraw.h"
 #include "animorder/rasterizer.h"
 
@@ -25,6 +33,111 @@
 #include <string>
 
 namespace animorder {
+namespace {
+
+// Units of the measured blend order: the blended triangles (unit u ↔ triangle triangle_of[u]),
+// grouped by blended primitive (group = its rank among the blended primitives, ascending in
+// mesh.primitives order, so that groups keep the primitives' order).
+struct BlendUnits {
+    std::vector<uint32_t> unit_of_triangle;  // per triangle; 0 for opaque ones (never in BlendFragments)
+    std::vector<uint32_t> triangle_of, group;
+};
+
+BlendUnits blend_units(const AnimatedMesh& mesh) {
+    BlendUnits u;
+    u.unit_of_triangle.assign(mesh.triangle_count(), 0);
+    uint32_t g = 0;
+    for (const Primitive& p : mesh.primitives) {
+        if (p.alpha_mode != AlphaMode::Blend || p.index_count == 0) continue;
+        for (size_t t = p.first_index / 3; t < (p.first_index + p.index_count) / 3; ++t) {
+            u.unit_of_triangle[t] = uint32_t(u.triangle_of.size());
+            u.triangle_of.push_back(uint32_t(t));
+            u.group.push_back(g);
+        }
+        ++g;
+    }
+    return u;
+}
+
+}  // namespace
+
+std::vector<BlendFragments> blend_fragments_of_nodes(const AnimatedMesh& mesh, const Framing& framing,
+                                                     const ClusteringResult& run, unsigned resolution,
+                                                     unsigned threads) {
+    const size_t views = run.directions.size() / 3, node_count = run.assignment.size();
+    if (views == 0 || node_count != views * run.keyframes.size())
+        throw InvalidInput("a clustering run's assignment does not cover its nodes");
+    const std::vector<uint8_t> blended = blended_triangles(mesh);
+    const std::vector<uint8_t> modes = full_pass_modes(mesh);
+    std::vector<BlendFragments> kept(node_count);
+    struct Worker {
+        NodeRasterizer rasterizer;
+        std::vector<float> clip;
+    };
+    tbb::enumerable_thread_specific<Worker> workers;
+    tbb::task_arena arena(threads ? int(threads) : tbb::this_task_arena::max_concurrency());
+    arena.execute([&] {
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, node_count, 1), [&](const tbb::blocked_range<size_t>& range) {
+            Worker& w = workers.local();
+            w.clip.resize(mesh.vertex_count * 4);
+            for (size_t n = range.begin(); n != range.end(); ++n) {
+                const uint32_t keyframe = run.keyframes[n / views];
+                transform_to_clip(w.clip.data(), mesh.keyframe(keyframe), mesh.vertex_count,
+                                  &framing.centres[3 * size_t(keyframe)],
+                                  node_view_projection(&run.directions[3 * (n % views)], framing.radius));
+                w.rasterizer.rasterize(w.clip.data(), mesh.vertex_count, mesh.indices.data(), mesh.indices.size(),
+                                       resolution, modes.empty() ? nullptr : modes.data());
+                kept[n] = w.rasterizer.export_blend_fragments(blended.data());
+            }
+        });
+    });
+    return kept;
+}
+
+void measured_blended_orders(const AnimatedMesh& mesh, const std::vector<BlendFragments>& nodes,
+                             const std::vector<uint32_t>& assignment, std::vector<std::vector<uint32_t>>& orders,
+                             unsigned threads) {
+    if (nodes.size() != assignment.size()) throw InvalidInput("blend fragments do not match the run's nodes");
+    const BlendUnits units = blend_units(mesh);
+    if (units.triangle_of.empty()) return;
+    // BlendFragments lists each pixel's triangles nearest first with tie bits, as NodeFragments.
+    std::vector<NodeFragments> as_nodes(nodes.size());
+    for (size_t n = 0; n < nodes.size(); ++n) {
+        as_nodes[n].starts = nodes[n].starts;
+        as_nodes[n].fragments = nodes[n].fragments;
+    }
+    for (size_t c = 0; c < orders.size(); ++c) {
+        std::vector<const NodeFragments*> mine;
+        for (size_t n = 0; n < assignment.size(); ++n)
+            if (assignment[n] == c) mine.push_back(&as_nodes[n]);
+        if (mine.empty()) continue;
+        std::vector<uint32_t>& order = orders[c];
+        if (order.size() != mesh.triangle_count()) throw InvalidInput("a run's order does not cover the mesh");
+        // w(a→b): pixels where a is nearer than b, so a should come *after* b; the feedback arc
+        // set order puts `from` first, i.e. nearest first: reversed below.
+        const std::vector<Arc> arcs =
+            measured_overdraw_graph(mine.data(), mine.size(), units.unit_of_triangle.data(),
+                                    units.unit_of_triangle.size(), units.triangle_of.size(), units.group.data(), threads);
+        // The current order (back to front), reversed, as the start to beat.
+        std::vector<uint32_t> previous;
+        previous.reserve(units.triangle_of.size());
+        for (const Primitive& p : mesh.primitives) {
+            if (p.alpha_mode != AlphaMode::Blend || p.index_count == 0) continue;
+            for (size_t i = (p.first_index + p.index_count) / 3; i-- > p.first_index / 3;)
+                previous.push_back(units.unit_of_triangle[order[i]]);
+        }
+        const std::vector<uint32_t> nearest_first = measured_unit_order(
+            units.triangle_of.size(), arcs.data(), arcs.size(), units.group.data(), previous.data());
+        size_t at = 0;
+        for (const Primitive& p : mesh.primitives) {
+            if (p.alpha_mode != AlphaMode::Blend || p.index_count == 0) continue;
+            const size_t count = p.index_count / 3;
+            for (size_t i = 0; i < count; ++i)
+                order[p.first_index / 3 + i] = units.triangle_of[nearest_first[at + count - 1 - i]];
+            at += count;
+        }
+    }
+}
 
 void blended_orders_from_clusters(const AnimatedMesh& mesh, const Framing& all_keyframes, float radius,
                                   ClusteringResult& run) {
@@ -73,32 +186,9 @@ BlendClustering cluster_blend_nodes(const AnimatedMesh& mesh, const Framing& fra
     const size_t k = run.triangle_orders.size(), triangles = mesh.triangle_count();
     if (views == 0 || node_count != views * run.keyframes.size() || k == 0)
         throw InvalidInput("a clustering run's assignment does not cover its nodes");
-    const std::vector<uint8_t> blended = blended_triangles(mesh);
-    const std::vector<uint8_t> modes = full_pass_modes(mesh);
-
     // Every node's transparent pass, once.
-    std::vector<BlendFragments> kept(node_count);
-    struct Worker {
-        NodeRasterizer rasterizer;
-        std::vector<float> clip;
-    };
-    tbb::enumerable_thread_specific<Worker> workers;
+    const std::vector<BlendFragments> kept = blend_fragments_of_nodes(mesh, framing, run, resolution, threads);
     tbb::task_arena arena(threads ? int(threads) : tbb::this_task_arena::max_concurrency());
-    arena.execute([&] {
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, node_count, 1), [&](const tbb::blocked_range<size_t>& range) {
-            Worker& w = workers.local();
-            w.clip.resize(mesh.vertex_count * 4);
-            for (size_t n = range.begin(); n != range.end(); ++n) {
-                const uint32_t keyframe = run.keyframes[n / views];
-                transform_to_clip(w.clip.data(), mesh.keyframe(keyframe), mesh.vertex_count,
-                                  &framing.centres[3 * size_t(keyframe)],
-                                  node_view_projection(&run.directions[3 * (n % views)], framing.radius));
-                w.rasterizer.rasterize(w.clip.data(), mesh.vertex_count, mesh.indices.data(), mesh.indices.size(),
-                                       resolution, modes.empty() ? nullptr : modes.data());
-                kept[n] = w.rasterizer.export_blend_fragments(blended.data());
-            }
-        });
-    });
 
     BlendClustering best;
     for (const BlendFragments& f : kept) best.covered += f.covered;
@@ -107,6 +197,7 @@ BlendClustering cluster_blend_nodes(const AnimatedMesh& mesh, const Framing& fra
     std::vector<uint64_t> cost(node_count * k);
     for (size_t iteration = 0; iteration <= max_iterations; ++iteration) {
         blended_orders_from_clusters(mesh, framing, framing.radius, current);  // update
+        measured_blended_orders(mesh, kept, current.assignment, current.triangle_orders, threads);
         std::vector<const uint32_t*> pointers;
         for (const auto& o : current.triangle_orders) pointers.push_back(o.data());
         const std::vector<uint32_t> ranks = make_rank_table(pointers, triangles);

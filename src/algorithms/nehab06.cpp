@@ -195,7 +195,7 @@ void check_graph_settings(size_t views, unsigned resolution, size_t cluster_coun
 class NodeSource {
 public:
     NodeSource(const uint32_t* indices, size_t index_count, const float* keyframe_positions, size_t vertex_count,
-               Nodes nodes, unsigned resolution, unsigned threads, bool keep)
+               Nodes nodes, unsigned resolution, unsigned threads, bool keep, const uint8_t* triangle_modes = nullptr)
         : indices_(indices),
           index_count_(index_count),
           positions_(keyframe_positions),
@@ -203,6 +203,7 @@ public:
           nodes_(std::move(nodes)) {
         settings_.resolution = resolution;
         settings_.threads = threads;
+        settings_.triangle_modes = triangle_modes;
         if (keep)
             kept_ = rasterize_nodes(positions_, vertex_count_, nodes_.framing, indices_, index_count_,
                                     nodes_.list.data(), nodes_.list.size(), settings_, kMaxKeptBytes);
@@ -235,7 +236,8 @@ public:
                 transform_to_clip(w.clip.data(), positions_ + size_t(node.keyframe) * vertex_count_ * 3, vertex_count_,
                                   nodes_.framing.centres.data() + 3 * size_t(node.keyframe),
                                   node_view_projection(node.direction, nodes_.framing.radius));
-                w.rasterizer.rasterize(w.clip.data(), vertex_count_, indices_, index_count_, settings_.resolution);
+                w.rasterizer.rasterize(w.clip.data(), vertex_count_, indices_, index_count_, settings_.resolution,
+                                       settings_.triangle_modes);
                 const NodeFragments fragments = w.rasterizer.export_fragments();
                 w.seconds_raster += seconds_since(start);
                 accumulate_node(w.graph, fragments, cluster_of, rank, cluster_count);
@@ -591,7 +593,7 @@ Nehab06Result order_static_nehab06(uint32_t* order, const uint32_t* indices, siz
     const NodeSource source(
         indices, index_count, keyframe_positions, vertex_count,
         make_nodes(indices, index_count, keyframe_positions, keyframe_count, vertex_count, list, settings.views),
-        settings.resolution, settings.threads, automatic);
+        settings.resolution, settings.threads, automatic, settings.triangle_modes);
     if (source.kept()) result.seconds_rasterization = seconds_since(start);
     result.seconds_graph = result.seconds_rasterization;
 

@@ -664,3 +664,31 @@ TEST(StaticNehab06, BadInputThrows) {
     // Empty input is a no-op.
     EXPECT_EQ(order_static_nehab06(nullptr, nullptr, 0, nullptr, 0, 0, nullptr, 0, settings).cluster_count, 0u);
 }
+
+TEST(StaticNehab06, DoubleSidedTrianglesAreMeasuredWithoutCulling) {
+    // Two unit quads one above the other, A at z = 0 facing +z and B at z = 1 facing −z. Culled,
+    // every view sees at most one of them (the one facing it): no pixel is ever drawn twice and
+    // every candidate's mean OVR is exactly 1. Double-sided (kDrawBothFaces), the views from
+    // above see B over A and those from below A over B; the views are symmetric, so one static
+    // order overdraws on one side: the mean OVR is above 1.
+    Soup s;
+    const float a0[3] = {0, 0, 0}, a1[3] = {1, 0, 0}, a2[3] = {1, 1, 0}, a3[3] = {0, 1, 0};
+    const float b0[3] = {0, 0, 1}, b1[3] = {0, 1, 1}, b2[3] = {1, 1, 1}, b3[3] = {1, 0, 1};
+    s.quad(a0, a1, a2, a3);
+    s.quad(b0, b1, b2, b3);
+    Nehab06Settings settings;
+    settings.views = 42;
+    settings.resolution = 64;
+    std::vector<uint32_t> order(s.triangles());
+    const Nehab06Result culled = order_static_nehab06(order.data(), s.indices.data(), s.indices.size(),
+                                                      s.positions.data(), 1, s.vertex_count(), nullptr, 0, settings);
+    ASSERT_FALSE(culled.candidates.empty());
+    for (const Nehab06Candidate& c : culled.candidates) EXPECT_EQ(c.mean_ovr, 1.0) << c.clusters << " clusters";
+    const std::vector<uint8_t> both(s.triangles(), kDrawBothFaces);
+    settings.triangle_modes = both.data();
+    const Nehab06Result drawn = order_static_nehab06(order.data(), s.indices.data(), s.indices.size(),
+                                                     s.positions.data(), 1, s.vertex_count(), nullptr, 0, settings);
+    EXPECT_TRUE(test::is_permutation_of_iota(order));
+    ASSERT_FALSE(drawn.candidates.empty());
+    for (const Nehab06Candidate& c : drawn.candidates) EXPECT_GT(c.mean_ovr, 1.0) << c.clusters << " clusters";
+}

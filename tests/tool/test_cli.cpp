@@ -71,6 +71,21 @@ TEST_F(Cli, MaterialsBlendReportAndHeatmap) {
     EXPECT_EQ(test::slurp(path("b.png")).substr(1, 3), "PNG");
 }
 
+TEST_F(Cli, SingleSidedCullsEveryMaterial) {
+    // The bundled character's double-sided primitives (hair, cape) are blended: culling them
+    // leaves the opaque pass, hence OVR, as it is, and drops the back faces from the blend pass.
+    const std::string common = "evaluate -q --methods original --eval-views 2 --eval-resolution 64 -r ";
+    ASSERT_EQ(run(common + path("two.json").string()).exit_code, 0);
+    ASSERT_EQ(run(common + path("one.json").string() + " --single-sided").exit_code, 0);
+    const nlohmann::json two = nlohmann::json::parse(test::slurp(path("two.json")));
+    const nlohmann::json one = nlohmann::json::parse(test::slurp(path("one.json")));
+    EXPECT_EQ(two["settings"]["single_sided"], false);
+    EXPECT_EQ(one["settings"]["single_sided"], true);
+    EXPECT_EQ(one["methods"][0]["ovr_mean"], two["methods"][0]["ovr_mean"]);
+    EXPECT_LT(one["methods"][0]["blend"]["covered_pixels"].get<long>(),
+              two["methods"][0]["blend"]["covered_pixels"].get<long>());
+}
+
 TEST_F(Cli, QuietSilencesStderr) {
     const test::Outcome o = run("inspect --quiet");
     ASSERT_EQ(o.exit_code, 0);

@@ -496,12 +496,56 @@ TEST_F(MakeResults, MissingFilesSayNotRun) {
     const std::string md = test::slurp(dir_ / "docs" / "RESULTS.md");
     for (const char* file : {"ganfaul-idle.json", "ganfaul-idle-sub1.json", "ganfaul-idle-sub2.json",
                              "characters/*.json", "sweep-views.json", "sweep-lambda.json", "sweep-k.json",
-                             "ganfaul-clips.json", "render-time.json", "nehab06-bench.txt"})
+                             "ganfaul-clips.json", "render-time.json", "nehab06-bench.txt", "materials/*.json"})
         EXPECT_NE(md.find(std::string("not run: ") + file + " missing"), std::string::npos) << file;
     // The paper's rows are there even with nothing to compare them with.
     EXPECT_NE(md.find("| Ganfaul | paper, 12 animations | 13795 |"), std::string::npos);
     EXPECT_TRUE(fs::is_directory(dir_ / "docs" / "results"));
     EXPECT_TRUE(fs::is_empty(dir_ / "docs" / "results"));
+}
+
+TEST_F(MakeResults, MaterialsSectionHasTheBlendTableTheGoalsAndTheDoubleSidedCost) {
+    auto blend = [](double pairs, double pixels) {
+        return json{{"missorted_pair_fraction", pairs}, {"missorted_pixel_fraction", pixels}, {"pairs", 1000},
+                    {"covered_pixels", 800}, {"nodes", 100}};
+    };
+    json m = json::array();
+    m.push_back(method("original", nullptr, nullptr, nullptr, 1, 0.66, 1.29, 0.0));
+    m.back()["blend"] = blend(0.25, 0.2);
+    m.push_back(method("static-sander07", 0.85, nullptr, nullptr, 1, 0.89, 1.16, 0.0));
+    m.back()["blend"] = blend(0.24, 0.19);
+    m.push_back(method("single", 0.85, 5, 162, 10, 0.96, 1.07, 18.0));
+    m.back()["blend"] = blend(0.3, 0.12);
+    json bundled = report("procedural-character (bundled)", 11760, {{"walk", 31}}, m, 100, 256);
+    bundled["blend_input_order"] = blend(0.25, 0.2);
+    bundled["blend_bound"] = blend(0.13, 0.1);
+    write("materials/bundled.json", bundled);
+    json sheet = json::array({method("original", nullptr, nullptr, nullptr, 1, 0.77, 1.5, 0.0)});
+    write("materials/sheet.json", report("data/sheet.glb", 2400, {{"wave", 59}}, sheet, 60, 256));
+    sheet[0]["ovr_mean"] = 1.2;
+    json culled = report("data/sheet.glb", 2400, {{"wave", 59}}, sheet, 60, 256);
+    culled["settings"]["single_sided"] = true;
+    write("materials/sheet-single-sided.json", culled);
+
+    const test::Outcome o = run(dir_ / "in", dir_ / "docs");
+    ASSERT_EQ(o.exit_code, 0) << o.err;
+    const std::string md = section(test::slurp(dir_ / "docs" / "RESULTS.md"),
+                                   "Materials: double-sided and blended primitives");
+    ASSERT_NE(md, "");
+    // (original − method) / (original − bound) in mis-sorted pixels: (0.2 − 0.12) / (0.2 − 0.1) = 80%,
+    // static-sander07 (0.2 − 0.19) / 0.1 = 10%, less than half of 80%.
+    EXPECT_NE(md.find("- `materials/bundled.json`, single k=5: 80.0% of the way (goal ≥ 90%: not met); the best "
+                      "single static order, static-sander07: 10.0% (goal < half of k = 5's: met)."),
+              std::string::npos)
+        << md;
+    EXPECT_NE(md.find("| single k=5 | 10 | 0.300 | 0.120 | 80.0% |"), std::string::npos) << md;
+    EXPECT_NE(md.find("| input order | 1 | 0.250 | 0.200 | 0.0% |"), std::string::npos) << md;
+    EXPECT_NE(md.find("| back-to-front sort per node (bound) | per node | 0.130 | 0.100 | 100.0% |"), std::string::npos)
+        << md;
+    // 1.5 drawn both sides against 1.2 culled: 25% more.
+    EXPECT_NE(md.find("| sheet | original | 1.500 | 1.200 | 25.0% |"), std::string::npos) << md;
+    EXPECT_NE(md.find("Every material culled (`--single-sided`)."), std::string::npos) << md;
+    EXPECT_EQ(md.find("| bundled | original |"), std::string::npos) << md;  // no culled twin: no row
 }
 
 TEST_F(MakeResults, StaleChartsAreRemoved) {

@@ -56,6 +56,7 @@ struct EvaluateOptions {
     std::string report_path;
     std::string csv_path;
     bool stored = false;  // --stored: also the orders stored in INPUT (ANIMORDER_animated_triangle_orders)
+    bool single_sided = false;  // --single-sided: every material culled, as before issue 18 (its cost)
 };
 
 struct HeatmapOptions {

@@ -197,7 +197,10 @@ int run_evaluate(const EvaluateOptions& options) {
     check_output_paths(outputs, {options.common.input});
 
     std::string input_name;
-    const AnimatedMesh mesh = load_drawable_input(options.common, input_name);
+    AnimatedMesh loaded = load_drawable_input(options.common, input_name);
+    if (options.single_sided)  // the cost of double-sidedness: orders and OVR with every back face culled
+        for (Primitive& p : loaded.primitives) p.double_sided = false;
+    const AnimatedMesh& mesh = loaded;
     std::vector<Row> rows;
     for (const auto& [n, m] : plan) {
         std::string label = method_name(n);
@@ -235,6 +238,7 @@ int run_evaluate(const EvaluateOptions& options) {
                           {"nehab_views", b.nehab_views},
                           {"nehab_all_keyframes", b.nehab_all_keyframes},
                           {"blend_clusters", b.blend_clusters},
+                          {"single_sided", options.single_sided},
                           {"cache_size", options.common.cache_size},
                           {"eval_views", eval.views},
                           {"eval_resolution", eval.resolution},

@@ -176,6 +176,9 @@ int main(int argc, char** argv) {
     evaluate_cmd->add_flag(
         "--stored", evaluate.stored,
         "Also evaluate the orders stored in INPUT (ANIMORDER_animated_triangle_orders): row 'stored'");
+    evaluate_cmd->add_flag("--single-sided", evaluate.single_sided,
+                           "Draw every material single-sided (back faces culled), orders and OVR, as before issue 18: "
+                           "with a plain run, the cost of double-sided materials");
 
     HeatmapOptions heatmap;
     CLI::App* heatmap_cmd = app.add_subcommand("heatmap", "Draw a per-pixel overdraw image of one node as PNG");

@@ -19,12 +19,13 @@
 //   sweep-views.json, sweep-lambda.json, sweep-k.json                   Figs. 3, 6, 7
 //   ganfaul-clips.json                                                  Figs. 8 and 5
 //   render-time.json                                                    bench/render_time --json
+//   materials/*.json                                                    Materials (issue 18)
 //   nehab06-bench.txt and any other *.txt                               included verbatim
 //   any file a placeholder of the notes names (templates.h)
 // The notes folder (--notes; RESULTS_DIR by default) holds notes-<id>.md, appended to section <id>,
 // and readme.md, README.md's block; both are templates whose measured figures are placeholders
 // resolved from RESULTS_DIR (templates.h). Section ids: settings, table1, characters, views, lambda,
-// clusters, clips, render-time, nehab06, performance, other. The .json files are `animorder evaluate --report` outputs (README.md).
+// clusters, clips, render-time, nehab06, performance, other, materials. The .json files are `animorder evaluate --report` outputs (README.md).
 //
 // Everything is read and checked before anything is written, so a malformed report gives one
 // line on stderr, exit code 1 and no output. The output is byte-deterministic: no date, fixed
@@ -71,6 +72,7 @@ std::string build_markdown(const Inputs& in, Charts& charts, const TemplateResol
     sections.push_back(render_time_section(in));
     sections.push_back(nehab06_section(in));
     sections.push_back(performance_section(in));
+    sections.push_back(materials_section(in));
     Section other = other_section(in);
     if (!other.body.empty() || in.notes.count("other")) sections.push_back(other);
 
@@ -103,7 +105,7 @@ const char* const kUsage =
     "ganfaul-idle.json, ganfaul-idle-sub1.json, ganfaul-idle-sub2.json, characters/*.json, sweep-views.json,\n"
     "sweep-lambda.json, sweep-k.json, ganfaul-clips.json, render-time.json, *.txt; with the notes of DIR\n"
     "(default RESULTS_DIR): notes-<section>.md (sections: settings, table1, characters, views, lambda, clusters,\n"
-    "clips, render-time, nehab06, performance, other) and readme.md, README.md's generated block (--readme).\n";
+    "clips, render-time, nehab06, performance, other, materials) and readme.md, README.md's generated block (--readme).\n";
 
 std::string read_file(const fs::path& path) {
     std::ifstream in(path, std::ios::binary);

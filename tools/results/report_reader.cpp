@@ -20,7 +20,7 @@ using nlohmann::json;
 
 const std::vector<std::string> kSectionIds = {"settings", "table1",      "characters", "views",
                                               "lambda",   "clusters",    "clips",      "render-time",
-                                              "nehab06",  "performance", "other"};
+                                              "nehab06",  "performance", "other",      "materials"};
 
 const Report* Inputs::get(const std::string& name) const {
     const auto it = reports.find(name);
@@ -123,6 +123,20 @@ json parse_json(const fs::path& path, const std::string& name) {
     }
 }
 
+BlendResult load_blend(const Reader& r, const json& o, const std::string& key, const std::string& where) {
+    BlendResult b;
+    const json* v = r.optional_object(o, key);
+    if (!v) return b;
+    const std::string w = Reader::at(where, key);
+    b.present = true;
+    b.missorted_pair_fraction = r.required_number(*v, "missorted_pair_fraction", w);
+    b.missorted_pixel_fraction = r.required_number(*v, "missorted_pixel_fraction", w);
+    b.pairs = r.nullable_integer(*v, "pairs", w);
+    b.covered_pixels = r.nullable_integer(*v, "covered_pixels", w);
+    b.nodes = r.nullable_integer(*v, "nodes", w);
+    return b;
+}
+
 Report load_report(const fs::path& path, const std::string& name) {
     const json j = parse_json(path, name);
     const Reader r(name);
@@ -140,6 +154,14 @@ Report load_report(const fs::path& path, const std::string& name) {
         report.resolution = r.nullable_integer(*s, "resolution", "settings");
         report.seed = r.nullable_integer(*s, "seed", "settings");
         report.cache_size = r.nullable_integer(*s, "cache_size", "settings");
+        if (const json* bc = r.optional(*s, "blend_clusters")) {
+            if (!bc->is_boolean()) r.fail("settings.blend_clusters", "expected a boolean, got " + Reader::kind(*bc));
+            report.blend_clusters = bc->get<bool>();
+        }
+        if (const json* ss = r.optional(*s, "single_sided")) {
+            if (!ss->is_boolean()) r.fail("settings.single_sided", "expected a boolean, got " + Reader::kind(*ss));
+            report.single_sided = ss->get<bool>();
+        }
         const auto list = [&](const char* key, auto convert) {
             if (const json* v = r.optional(*s, key)) {
                 const std::string where = std::string("settings.") + key;
@@ -197,8 +219,11 @@ Report load_report(const fs::path& path, const std::string& name) {
                     method.iterations[clips->get<std::string>()] = iterations->size();
             }
         }
+        method.blend = load_blend(r, m, "blend", where);
         report.methods.push_back(method);
     }
+    report.blend_input_order = load_blend(r, j, "blend_input_order", "");
+    report.blend_bound = load_blend(r, j, "blend_bound", "");
     if (const json* t = r.optional_object(j, "timings_s")) {
         report.t_methods = r.nullable_number(*t, "methods", "timings_s");
         report.t_evaluation = r.nullable_number(*t, "evaluation", "timings_s");
@@ -261,6 +286,18 @@ Inputs load_inputs(const fs::path& dir, const fs::path& notes_dir) {
             in.characters.push_back(key);
         }
     }
+    if (fs::is_directory(dir / "materials")) {
+        std::vector<std::string> names;
+        for (const auto& entry : fs::directory_iterator(dir / "materials"))
+            if (entry.is_regular_file() && entry.path().extension() == ".json")
+                names.push_back(entry.path().filename().string());
+        std::sort(names.begin(), names.end());
+        for (const std::string& n : names) {
+            const std::string key = "materials/" + n;
+            in.reports.emplace(key, load_report(dir / "materials" / n, key));
+            in.materials.push_back(key);
+        }
+    }
     if (fs::is_regular_file(dir / "render-time.json"))
         in.render_time = std::make_unique<RenderTime>(load_render_time(dir / "render-time.json", "render-time.json"));
     std::vector<fs::path> files;
@@ -284,7 +321,7 @@ Inputs load_inputs(const fs::path& dir, const fs::path& notes_dir) {
             if (std::find(kSectionIds.begin(), kSectionIds.end(), id) == kSectionIds.end())
                 std::fprintf(stderr,
                              "make_results: %s names no section (ids: settings, table1, characters, views, lambda, "
-                             "clusters, clips, render-time, nehab06, performance, other); ignored\n",
+                             "clusters, clips, render-time, nehab06, performance, other, materials); ignored\n",
                              name.c_str());
             else
                 in.notes[id] = read_text(p);

@@ -24,6 +24,14 @@ struct ClipResult {
     long long nodes = -1;
 };
 
+// The blend error of an order over a report's nodes (issue 18: methods[i].blend,
+// blend_input_order, blend_bound); present only for inputs with blended primitives.
+struct BlendResult {
+    bool present = false;
+    double missorted_pair_fraction = kNaN, missorted_pixel_fraction = kNaN;
+    long long pairs = -1, covered_pixels = -1, nodes = -1;
+};
+
 // One row of a report's methods: a method at one setting (λ, k, views).
 struct Method {
     std::string name;
@@ -33,6 +41,7 @@ struct Method {
     double acmr = kNaN, atvr = kNaN, ovr_mean = kNaN, ovr_pooled = kNaN, time_s = kNaN;
     std::vector<ClipResult> per_clip;
     std::map<std::string, size_t> iterations;  // k-means iterations per run ("all" for joint)
+    BlendResult blend;
 };
 
 struct Clip {
@@ -44,12 +53,15 @@ struct Clip {
 struct Report {
     std::string file, input;
     long long triangles = -1, vertices = -1, nodes = -1, threads = -1;
+    bool blend_clusters = false;  // settings.blend_clusters: k-means buffers with their own blend clusters
+    bool single_sided = false;    // settings.single_sided: every material culled (evaluate --single-sided)
     long long eval_views = -1, eval_resolution = -1, eval_seed = -1, resolution = -1, seed = -1, cache_size = -1;
     std::vector<double> lambdas;
     std::vector<long long> clusters, views;
     std::vector<Clip> clips;
     std::vector<Method> methods;
     double t_methods = kNaN, t_evaluation = kNaN, t_total = kNaN;
+    BlendResult blend_input_order, blend_bound;
 };
 
 // A `bench/render_time --json` file.
@@ -73,6 +85,7 @@ extern const std::vector<std::string> kSectionIds;
 struct Inputs {
     std::map<std::string, Report> reports;  // by file name (relative to RESULTS_DIR)
     std::vector<std::string> characters;    // "characters/x.json", sorted
+    std::vector<std::string> materials;     // "materials/x.json", sorted
     std::unique_ptr<RenderTime> render_time;
     std::map<std::string, std::string> texts;  // *.txt by name, sorted
     std::map<std::string, std::string> notes;  // section id -> notes-<id>.md (templates.h)

@@ -8,6 +8,7 @@
 //   section_clips.cpp        clips         ganfaul-clips.json (Figs. 8 and 5)
 //   section_benchmarks.cpp   render-time, nehab06, performance, other   render-time.json, the reports'
 //                            static-nehab06, notes-performance.md, *.txt
+//   section_materials.cpp    materials     materials/*.json: double-sided OVR, blend error (issue 18)
 #pragma once
 
 #include <map>
@@ -52,5 +53,6 @@ Section render_time_section(const Inputs& in);
 Section nehab06_section(const Inputs& in);
 Section performance_section(const Inputs& in);  // its figures: notes-performance.md (templates.h)
 Section other_section(const Inputs& in);        // empty body when there is no other *.txt
+Section materials_section(const Inputs& in);     // materials/*.json (issue 18)
 
 }  // namespace animorder::results

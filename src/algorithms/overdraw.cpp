@@ -26,6 +26,31 @@
 
 namespace animorder {
 
+namespace {
+
+// Calls settings.progress now and then (about every 1% of the nodes, and at the end), from any
+// worker, never two at once.
+class ProgressCounter {
+public:
+    ProgressCounter(const std::function<void(size_t, size_t)>& report, size_t total)
+        : report_(report), total_(total), every_(std::max<size_t>(1, total / 100)) {}
+    void node_done() {
+        const size_t finished = ++done_;
+        if (report_ && (finished % every_ == 0 || finished == total_)) {
+            std::lock_guard<std::mutex> lock(mutex_);
+            report_(finished, total_);
+        }
+    }
+
+private:
+    const std::function<void(size_t, size_t)>& report_;
+    size_t total_, every_;
+    std::atomic<size_t> done_{0};
+    std::mutex mutex_;
+};
+
+}  // namespace
+
 std::vector<uint8_t> opaque_pass_modes(const AnimatedMesh& mesh) {
     std::vector<uint8_t> modes(mesh.triangle_count(), 0);
     bool any = false;
@@ -76,9 +101,7 @@ void score_nodes(uint64_t* visible, uint64_t* passed, const float* keyframe_posi
         std::vector<float> clip;
     };
     tbb::enumerable_thread_specific<Worker> workers;
-    std::atomic<size_t> done{0};
-    std::mutex progress_mutex;
-    const size_t report_every = std::max<size_t>(1, node_count / 100);
+    ProgressCounter progress(settings.progress, node_count);
 
     auto body = [&](const tbb::blocked_range<size_t>& range) {
         Worker& w = workers.local();
@@ -92,11 +115,7 @@ void score_nodes(uint64_t* visible, uint64_t* passed, const float* keyframe_posi
                                    settings.triangle_modes);
             visible[n] = w.rasterizer.visible_pixels();
             w.rasterizer.score(passed + n * order_count, ranks, order_count);
-            const size_t finished = ++done;
-            if (settings.progress && (finished % report_every == 0 || finished == node_count)) {
-                std::lock_guard<std::mutex> lock(progress_mutex);
-                settings.progress(finished, node_count);
-            }
+            progress.node_done();
         }
     };
     const int threads = settings.threads ? int(settings.threads) : tbb::this_task_arena::max_concurrency();
@@ -117,8 +136,7 @@ std::vector<NodeFragments> rasterize_nodes(const float* keyframe_positions, size
     // The total is the same whatever the schedule, so whether it fits is decided deterministically.
     std::atomic<size_t> total{0};
     std::atomic<bool> too_big{false};
-    std::atomic<size_t> done{0};
-    std::mutex progress_mutex;
+    ProgressCounter progress(settings.progress, node_count);
     struct Worker {
         NodeRasterizer rasterizer;
         std::vector<float> clip;
@@ -136,12 +154,7 @@ std::vector<NodeFragments> rasterize_nodes(const float* keyframe_positions, size
                                    settings.triangle_modes);
             kept[n] = w.rasterizer.export_fragments();
             if ((total += kept[n].bytes()) > max_bytes) too_big = true;
-            const size_t finished = ++done;
-            if (settings.progress &&
-                (finished % std::max<size_t>(1, node_count / 100) == 0 || finished == node_count)) {
-                std::lock_guard<std::mutex> lock(progress_mutex);
-                settings.progress(finished, node_count);
-            }
+            progress.node_done();
         }
     };
     const int threads = settings.threads ? int(settings.threads) : tbb::this_task_arena::max_concurrency();
@@ -246,9 +259,7 @@ NodeCache::~NodeCache() = default;
 
 void NodeCache::score(uint64_t* visible, uint64_t* passed, const uint32_t* ranks, size_t order_count) const {
     const std::vector<uint16_t> unit_ranks = make_unit_rank_table(ranks, order_count, partition_);
-    std::atomic<size_t> done{0};
-    std::mutex progress_mutex;
-    const size_t report_every = std::max<size_t>(1, node_count_ / 100);
+    ProgressCounter progress(settings_.progress, node_count_);
     for_nodes(node_count_, 64, [&](Worker& w, size_t n) {
         if (const KeptNode* k = kept(n)) {
             visible[n] = k->visible;
@@ -258,11 +269,7 @@ void NodeCache::score(uint64_t* visible, uint64_t* passed, const uint32_t* ranks
             visible[n] = w.rasterizer.visible_pixels();
             w.rasterizer.score(passed + n * order_count, ranks, order_count);
         }
-        const size_t finished = ++done;
-        if (settings_.progress && (finished % report_every == 0 || finished == node_count_)) {
-            std::lock_guard<std::mutex> lock(progress_mutex);
-            settings_.progress(finished, node_count_);
-        }
+        progress.node_done();
     });
 }
 

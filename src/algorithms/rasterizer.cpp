@@ -111,38 +111,37 @@ void project(const ClipVertex& v, unsigned resolution, WindowVertex& out) {
     out.y = float(resolution) - y - 0.5f;
 }
 
-// A quick test before the full set-up: false when the triangle is culled, has zero area, or its
-// bounding box holds no pixel centre (rasterize_window_triangle would emit nothing).
-inline bool may_cover(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2, unsigned resolution,
-                      bool two_sided) {
-    const int64_t area = (v1.X - v0.X) * (v2.Y - v0.Y) - (v2.X - v0.X) * (v1.Y - v0.Y);
-    if (area == 0 || (area > 0 && !two_sided)) return false;
+// What the full set-up needs first, and the cheap reasons to skip it: the signed area (zero, or
+// a culled back face: nothing drawn) and the pixel centres inside the bounding box (none: nothing
+// drawn, the fate of most small triangles of a character).
+struct TriangleBox {
+    int64_t area, px0, px1, py0, py1;
+};
+
+inline bool triangle_box(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2, unsigned resolution,
+                         bool two_sided, TriangleBox& box) {
+    // With y pointing down, OpenGL's counter-clockwise front faces have negative area.
+    box.area = (v1.X - v0.X) * (v2.Y - v0.Y) - (v2.X - v0.X) * (v1.Y - v0.Y);
+    if (box.area == 0 || (box.area > 0 && !two_sided)) return false;  // zero area, or a culled back face
     const int64_t min_x = std::min({v0.X, v1.X, v2.X}), max_x = std::max({v0.X, v1.X, v2.X});
     const int64_t min_y = std::min({v0.Y, v1.Y, v2.Y}), max_y = std::max({v0.Y, v1.Y, v2.Y});
-    const int64_t last = int64_t(resolution - 1);
-    return std::max<int64_t>(0, -((-min_x) >> kSubpixelBits)) <= std::min<int64_t>(last, max_x >> kSubpixelBits) &&
-           std::max<int64_t>(0, -((-min_y) >> kSubpixelBits)) <= std::min<int64_t>(last, max_y >> kSubpixelBits);
+    box.px0 = std::max<int64_t>(0, ceil_subpixel(min_x));
+    box.px1 = std::min<int64_t>(resolution - 1, floor_subpixel(max_x));
+    box.py0 = std::max<int64_t>(0, ceil_subpixel(min_y));
+    box.py1 = std::min<int64_t>(resolution - 1, floor_subpixel(max_y));
+    return box.px0 <= box.px1 && box.py0 <= box.py1;
 }
 
-// Rasterises one window-space triangle: culling, fill rule and depth as described at the top.
+// Rasterises one window-space triangle that passed triangle_box: fill rule and depth as
+// described at the top.
 void rasterize_window_triangle(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2,
-                               uint32_t triangle, unsigned resolution, FragmentSink& sink, bool two_sided) {
-    // With y pointing down, OpenGL's counter-clockwise front faces have negative area.
-    const int64_t area = (v1.X - v0.X) * (v2.Y - v0.Y) - (v2.X - v0.X) * (v1.Y - v0.Y);
-    if (area == 0 || (area > 0 && !two_sided)) return;  // zero area, or a culled back face
+                               const TriangleBox& box, uint32_t triangle, unsigned resolution, FragmentSink& sink) {
     // Corners with positive area, so edge functions are >= 0 inside: 0, 2, 1 for a front face,
     // 0, 1, 2 for the back face of a double-sided triangle. The fill rule depends on the edges'
     // directions on screen only, not on which corner comes first.
     const WindowVertex* c[3] = {&v0, &v2, &v1};
-    if (area > 0) std::swap(c[1], c[2]);
-
-    const int64_t min_x = std::min({c[0]->X, c[1]->X, c[2]->X}), max_x = std::max({c[0]->X, c[1]->X, c[2]->X});
-    const int64_t min_y = std::min({c[0]->Y, c[1]->Y, c[2]->Y}), max_y = std::max({c[0]->Y, c[1]->Y, c[2]->Y});
-    const int64_t px0 = std::max<int64_t>(0, ceil_subpixel(min_x));
-    const int64_t px1 = std::min<int64_t>(resolution - 1, floor_subpixel(max_x));
-    const int64_t py0 = std::max<int64_t>(0, ceil_subpixel(min_y));
-    const int64_t py1 = std::min<int64_t>(resolution - 1, floor_subpixel(max_y));
-    if (px0 > px1 || py0 > py1) return;
+    if (box.area > 0) std::swap(c[1], c[2]);
+    const int64_t px0 = box.px0, px1 = box.px1, py0 = box.py0, py1 = box.py1;
 
     // Edge a→b: E(P) = (Xb−Xa)(Py−Ya) − (Yb−Ya)(Px−Xa). Top edge: horizontal going right; left
     // edge: going up (y down, clockwise on screen). Other edges exclude their own pixel centres.
@@ -234,8 +233,11 @@ void rasterize_clipped_triangle(const ClipVertex (&v)[3], uint32_t triangle, uns
     }
     WindowVertex w[12];
     for (int i = 0; i < n; ++i) project(a[i], resolution, w[i]);
-    for (int i = 1; i + 1 < n; ++i)
-        rasterize_window_triangle(w[0], w[i], w[i + 1], triangle, resolution, sink, two_sided);
+    for (int i = 1; i + 1 < n; ++i) {
+        TriangleBox box;
+        if (triangle_box(w[0], w[i], w[i + 1], resolution, two_sided, box))
+            rasterize_window_triangle(w[0], w[i], w[i + 1], box, triangle, resolution, sink);
+    }
 }
 
 // Groups the node's fragments by pixel with an LSD radix sort on the pixel index (one counting
@@ -340,8 +342,9 @@ void NodeRasterizer::rasterize(const float* clip_xyzw, size_t vertex_count, cons
         const bool two_sided = (mode & kDrawBothFaces) != 0;
         if (s.unclipped[a] & s.unclipped[b] & s.unclipped[c]) {
             const WindowVertex &va = s.window[a], &vb = s.window[b], &vc = s.window[c];
-            if (!may_cover(va, vb, vc, resolution, two_sided)) continue;  // most triangles: no call at all
-            rasterize_window_triangle(va, vb, vc, uint32_t(t), resolution, sink, two_sided);
+            TriangleBox box;
+            if (triangle_box(va, vb, vc, resolution, two_sided, box))
+                rasterize_window_triangle(va, vb, vc, box, uint32_t(t), resolution, sink);
         } else {
             const ClipVertex v[3] = {cv[a], cv[b], cv[c]};
             rasterize_clipped_triangle(v, uint32_t(t), resolution, sink, two_sided);

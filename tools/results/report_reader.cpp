@@ -19,7 +19,7 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 const std::vector<std::string> kSectionIds = {"settings", "table1",      "characters", "views",
-                                              "lambda",   "clusters",    "clips",      "render-time",
+                                              "lambda",   "clusters",    "clips",      "measured",   "render-time",
                                               "nehab06",  "performance", "other"};
 
 const Report* Inputs::get(const std::string& name) const {
@@ -197,6 +197,9 @@ Report load_report(const fs::path& path, const std::string& name) {
                     method.iterations[clips->get<std::string>()] = iterations->size();
             }
         }
+        if (const json* stages = r.optional_object(m, "stages_s"))
+            for (auto it = stages->begin(); it != stages->end(); ++it)
+                method.stages[it.key()] = r.number(it.value(), where + ".stages_s." + it.key());
         report.methods.push_back(method);
     }
     if (const json* t = r.optional_object(j, "timings_s")) {
@@ -259,6 +262,20 @@ Inputs load_inputs(const fs::path& dir, const fs::path& notes_dir) {
             const std::string key = "characters/" + n;
             in.reports.emplace(key, load_report(dir / "characters" / n, key));
             in.characters.push_back(key);
+        }
+    }
+    // Issue 15's measured cluster orders: three Ganfaul reports and one per character.
+    if (fs::is_directory(dir / "measured")) {
+        std::vector<std::string> names;
+        for (const auto& entry : fs::directory_iterator(dir / "measured"))
+            if (entry.is_regular_file() && entry.path().extension() == ".json")
+                names.push_back(entry.path().filename().string());
+        std::sort(names.begin(), names.end());
+        for (const std::string& n : names) {
+            const std::string key = "measured/" + n;
+            in.reports.emplace(key, load_report(dir / "measured" / n, key));
+            if (n != "ganfaul-idle.json" && n != "sweep-k.json" && n != "ganfaul-clips.json")
+                in.measured_characters.push_back(key);
         }
     }
     if (fs::is_regular_file(dir / "render-time.json"))

@@ -33,6 +33,7 @@ struct Method {
     double acmr = kNaN, atvr = kNaN, ovr_mean = kNaN, ovr_pooled = kNaN, time_s = kNaN;
     std::vector<ClipResult> per_clip;
     std::map<std::string, size_t> iterations;  // k-means iterations per run ("all" for joint)
+    std::map<std::string, double> stages;      // stages_s: seconds per preprocessing stage (clustered methods)
 };
 
 struct Clip {
@@ -73,6 +74,7 @@ extern const std::vector<std::string> kSectionIds;
 struct Inputs {
     std::map<std::string, Report> reports;  // by file name (relative to RESULTS_DIR)
     std::vector<std::string> characters;    // "characters/x.json", sorted
+    std::vector<std::string> measured_characters;  // "measured/x.json" but the three Ganfaul ones, sorted
     std::unique_ptr<RenderTime> render_time;
     std::map<std::string, std::string> texts;  // *.txt by name, sorted
     std::map<std::string, std::string> notes;  // section id -> notes-<id>.md (templates.h)

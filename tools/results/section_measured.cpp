@@ -87,18 +87,18 @@ void idle_part(const Inputs& in, std::string& b) {
                 goal = "OVR " + verdict(ovr_met) + (lambda < 1 ? ", ACMR " + verdict(acmr_met) : "") + ", time " +
                        verdict(time_met);
             }
-            rows.push_back({x->name, lambda_text(lambda), "k=" + std::to_string(x->clusters), f3(x->acmr),
-                            f3(x->ovr_mean), f3(x->ovr_pooled), f1(x->time_s),
-                            x == m && s ? ratio_text(x->time_s, s->time_s) : kDash, stages_text(*x), goal});
+            rows.push_back({x->name, lambda_text(lambda), "k=" + std::to_string(x->clusters), goal, stages_text(*x),
+                            f3(x->acmr), f3(x->ovr_mean), f3(x->ovr_pooled), f1(x->time_s),
+                            x == m && s ? ratio_text(x->time_s, s->time_s) : kDash});
         }
     }
     if (const Report* idle = in.get("ganfaul-idle.json"))
         if (const Method* o = row(*idle, "oracle", 0.85))
-            rows.push_back({"oracle (ganfaul-idle.json)", "0.85", kDash, f3(o->acmr), f3(o->ovr_mean),
-                            f3(o->ovr_pooled), f1(o->time_s), kDash, kDash, kDash});
-    b += table({"method", "λ", "k", "ACMR", "OVR", "OVR pooled", "preprocessing s", "time / single",
-                "stages s", "goal"},
-               rows, 3) +
+            rows.push_back({"oracle (per node, ganfaul-idle.json)", "0.85", kDash, kDash, kDash, f3(o->acmr),
+                            f3(o->ovr_mean), f3(o->ovr_pooled), f1(o->time_s), kDash});
+    b += table({"method", "λ", "k", "goal", "stages s", "ACMR", "OVR", "OVR pooled", "preprocessing s",
+                "time / single"},
+               rows, 5) +
          "\n";
 }
 
@@ -156,9 +156,6 @@ void sweep_part(const Inputs& in, Charts& charts, std::string& b) {
                         m ? f3(m->ovr_mean) : kDash, s ? f3(s->acmr) : kDash, m ? f3(m->acmr) : kDash,
                         s ? f1(s->time_s) : kDash, m ? f1(m->time_s) : kDash});
     }
-    if (nehab)
-        rows.push_back({"static-nehab06", count(nehab->buffers), count((long long)index_bytes(*r, *nehab)), kDash,
-                        kDash, f3(nehab->acmr), kDash, f1(nehab->time_s), kDash});
     b += charts.chart("measured-k-ovr.svg", ovr, "OVR against k for single and measured");
     b += charts.chart("measured-k-bytes.svg", bytes, "OVR against index-buffer bytes for single and measured");
     b += "\n" +
@@ -170,7 +167,9 @@ void sweep_part(const Inputs& in, Charts& charts, std::string& b) {
         const Method* m1 = row(*r, "measured", kNaN, 1);
         if (m1)
             b += "One buffer: `measured` k = 1 (learnt over every keyframe of the clip) reaches OVR " +
-                 f3(m1->ovr_mean) + " against `static-nehab06`'s " + f3(nehab->ovr_mean) + " (one keyframe): " +
+                 f3(m1->ovr_mean) + " (ACMR " + f3(m1->acmr) + ", " + f1(m1->time_s) + " s) against `static-nehab06`'s " +
+                 f3(nehab->ovr_mean) + " (one keyframe; ACMR " + f3(nehab->acmr) + ", " + f1(nehab->time_s) + " s, " +
+                 count((long long)index_bytes(*r, *nehab)) + " index bytes): " +
                  (m1->ovr_mean < nehab->ovr_mean ? "better" : "**not better**") + ".\n\n";
     }
 }
@@ -195,11 +194,11 @@ void clips_part(const Inputs& in, std::string& b) {
                 goal = verdict(m->ovr_mean <= kClipsOvrGoal);
             if (std::string(name) == "measured-joint" && same_lambda(lambda, 0.85))
                 goal = verdict(m->ovr_mean <= kClipsJointOvrGoal);
-            rows.push_back({name, lambda_text(lambda), count(m->buffers), f3(m->acmr), f3(m->ovr_mean),
-                            f3(m->ovr_pooled), f1(m->time_s), goal});
+            rows.push_back({name, lambda_text(lambda), goal, count(m->buffers), f3(m->acmr), f3(m->ovr_mean),
+                            f3(m->ovr_pooled), f1(m->time_s)});
         }
     }
-    b += table({"method", "λ", "buffers", "ACMR", "OVR", "OVR pooled", "preprocessing s", "goal"}, rows, 2) + "\n";
+    b += table({"method", "λ", "goal", "buffers", "ACMR", "OVR", "OVR pooled", "preprocessing s"}, rows, 3) + "\n";
     // Per clip, λ = 0.85 (or the report's first λ).
     const double lambda = r->lambdas.empty() ? 0.85 : r->lambdas.front();
     std::vector<std::string> header = {"clip", "keyframes"};
@@ -233,7 +232,7 @@ void characters_part(const Inputs& in, std::string& b) {
          "`measured` in the same run, k = 5). Goal (issue 15): `measured`'s OVR ≤ `single`'s at the same λ and k, "
          "with ACMR within " +
          format_fixed(kAcmrTolerance, 2) +
-         ". The last column marks each row that misses it: **worse** where measured's OVR is above single's, "
+         ". The goal column marks each row that misses it: **worse** where measured's OVR is above single's, "
          "**ACMR higher** where measured's ACMR exceeds single's by more than the tolerance; \"ACMR lower\" marks "
          "an ACMR more than the tolerance below single's (outside the goal's letter, but a gain).\n\n";
     std::vector<std::vector<std::string>> rows;
@@ -257,14 +256,14 @@ void characters_part(const Inputs& in, std::string& b) {
             met += d_ovr <= 0 && d_acmr <= kAcmrTolerance;
             std::string mark;
             for (const std::string& x : marks) mark += (mark.empty() ? "" : ", ") + x;
-            rows.push_back({character, lambda_text(lambda), count(r.triangles), keyframes_total(r), f3(s->ovr_mean),
-                            f3(m->ovr_mean), format_fixed(d_ovr, 3), f3(s->acmr), f3(m->acmr),
-                            format_fixed(d_acmr, 3), f1(s->time_s), f1(m->time_s), mark.empty() ? "met" : mark});
+            rows.push_back({character, lambda_text(lambda), mark.empty() ? "met" : mark, count(r.triangles),
+                            keyframes_total(r), f3(s->ovr_mean), f3(m->ovr_mean), format_fixed(d_ovr, 3), f3(s->acmr),
+                            f3(m->acmr), format_fixed(d_acmr, 3), f1(s->time_s), f1(m->time_s)});
         }
     }
-    b += table({"character", "λ", "triangles", "keyframes", "single OVR", "measured OVR", "Δ OVR", "single ACMR",
-                "measured ACMR", "Δ ACMR", "single s", "measured s", "goal"},
-               rows, 2) +
+    b += table({"character", "λ", "goal", "triangles", "keyframes", "single OVR", "measured OVR", "Δ OVR",
+                "single ACMR", "measured ACMR", "Δ ACMR", "single s", "measured s"},
+               rows, 3) +
          "\n" + std::to_string(total) + " character × λ rows from " + std::to_string(in.measured_characters.size()) +
          " characters: measured's OVR ≤ single's in " + std::to_string(ovr_met) + "; ACMR more than " +
          format_fixed(kAcmrTolerance, 2) + " above single's in " + std::to_string(acmr_higher) + ", more than " +

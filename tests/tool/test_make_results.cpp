@@ -531,6 +531,12 @@ TEST_F(MakeResults, MeasuredSectionAgainstHandWorkedValues) {
         m.push_back(method("measured", 3, 5, 162, 5, 2.5, 1.05, 9.0, {{"Walk", 0.0}}));
         write("measured/fox.json", report("data/fox.glb", 576, {{"Walk", 24}}, m, 60, 256));
     }
+    // Characters of "Every skinned character" without a measured report are named.
+    for (const char* name : {"fox", "xbot"}) {
+        json m = json::array();
+        m.push_back(method("original", nullptr, nullptr, nullptr, 1, 0.7, 1.3, 0.0, {{"Walk", 0.0}}));
+        write(std::string("characters/") + name + ".json", report("data/x.glb", 576, {{"Walk", 24}}, m, 60, 256));
+    }
     const test::Outcome o = run(dir_ / "in", dir_ / "docs");
     ASSERT_EQ(o.exit_code, 0) << o.err;
     const std::string md = section(test::slurp(dir_ / "docs" / "RESULTS.md"), "Measured cluster orders (beyond the paper)");
@@ -556,7 +562,7 @@ TEST_F(MakeResults, MeasuredSectionAgainstHandWorkedValues) {
              "| fox | 3 | ACMR lower | 576 | 24 | 1.100 | 1.050 | -0.050 | 2.900 | 2.500 | -0.400 | 4.0 | 9.0 |",
              "2 character × λ rows from 1 characters: measured's OVR ≤ single's in 1; ACMR more than 0.02 above "
              "single's in 1, more than 0.02 below in 1; both OVR and ACMR goals met (ACMR not higher by more than "
-             "the tolerance) in 1."})
+             "the tolerance) in 1. No measured report for xbot."})
         EXPECT_NE(md.find(line), std::string::npos) << line << "\n" << md;
     for (const char* svg : {"measured-k-ovr.svg", "measured-k-bytes.svg"}) {
         const std::string text = test::slurp(dir_ / "docs" / "results" / svg);

@@ -261,6 +261,12 @@ void characters_part(const Inputs& in, std::string& b) {
                             f3(m->acmr), format_fixed(d_acmr, 3), f1(s->time_s), f1(m->time_s)});
         }
     }
+    // The characters of "Every skinned character" (characters/*.json) that have no measured report.
+    std::string missing;
+    for (const std::string& file : in.characters) {
+        const std::string character = fs::path(file).stem().string();
+        if (!in.get("measured/" + character + ".json")) missing += (missing.empty() ? "" : ", ") + character;
+    }
     b += table({"character", "λ", "goal", "triangles", "keyframes", "single OVR", "measured OVR", "Δ OVR",
                 "single ACMR", "measured ACMR", "Δ ACMR", "single s", "measured s"},
                rows, 3) +
@@ -268,7 +274,8 @@ void characters_part(const Inputs& in, std::string& b) {
          " characters: measured's OVR ≤ single's in " + std::to_string(ovr_met) + "; ACMR more than " +
          format_fixed(kAcmrTolerance, 2) + " above single's in " + std::to_string(acmr_higher) + ", more than " +
          format_fixed(kAcmrTolerance, 2) + " below in " + std::to_string(acmr_lower) + "; both OVR and ACMR goals met "
-         "(ACMR not higher by more than the tolerance) in " + std::to_string(met) + ".\n\n";
+         "(ACMR not higher by more than the tolerance) in " + std::to_string(met) + "." +
+         (missing.empty() ? std::string() : " No measured report for " + missing + ".") + "\n\n";
 }
 
 }  // namespace

@@ -5,9 +5,9 @@
 #   RESUME=1 bash scripts/results.sh   # keep the reports already in build/results, run the rest
 #   BIN=/some/dir SKIP_BUILD=1 ...     # run binaries copied elsewhere (rebuilding build/ meanwhile)
 #   STEPS_FROM_LOG=results.log RESUME=1 ...  # kept reports of an older run: commands from its log
-#   STEPS_ONLY="materials/" SKIP_BUILD=1 ...  # only the steps whose names start with one of these
-#       (space-separated) prefixes; the other kept reports in docs/results/reports stay as they are and
-#       only the matching files' lines of MANIFEST.md, SHA256SUMS and steps.tsv are replaced
+#   ONLY=measured/,sweep-k RESUME=1 ...  # only the steps whose names start with one of these prefixes;
+#       docs/results/reports then gets only those files replaced (its other files and their rows in
+#       MANIFEST.md, SHA256SUMS and steps.tsv stay as they are) before RESULTS.md is regenerated
 #
 # Needs ../shared/data (the real characters); without it the script says so and stops. Each step
 # writes one `animorder evaluate --report` JSON (or a benchmark's output) into build/results/ and
@@ -30,7 +30,7 @@ if [ "${SKIP_BUILD:-0}" != 1 ]; then
   cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
   cmake --build build -j"$(nproc)"
 fi
-[ "${RESUME:-0}" = 1 ] || [ -n "${STEPS_ONLY:-}" ] || rm -rf "$OUT"
+[ "${RESUME:-0}" = 1 ] || [ -n "${ONLY:-}" ] || rm -rf "$OUT"
 mkdir -p "$OUT/characters"
 BIN=${BIN:-build}
 A=$BIN/animorder
@@ -48,16 +48,18 @@ record() {
   printf '%s\t%s\t%s\n' "$name" "$seconds" "$*" >> "$STEPS.tmp"
   mv "$STEPS.tmp" "$STEPS"
 }
-# only_step NAME: whether STEPS_ONLY (unset: every step) selects NAME.
-only_step() {
-  [ -z "${STEPS_ONLY:-}" ] && return 0
+# selected NAME: NAME starts with one of ONLY's comma-separated prefixes (every name without ONLY).
+selected() {
+  [ -n "${ONLY:-}" ] || return 0
   local prefix
-  for prefix in $STEPS_ONLY; do [ "${1#"$prefix"}" != "$1" ] && return 0; done
+  for prefix in ${ONLY//,/ }; do
+    case "$1" in "$prefix"*) return 0 ;; esac
+  done
   return 1
 }
 run_step() {
   local name=$1 to_stdout=$2; shift 2
-  only_step "$name" || return 0
+  if ! selected "$name"; then echo "results: $name not selected (ONLY=$ONLY)"; return; fi
   if [ -s "$OUT/$name" ]; then echo "results: $name kept"; return; fi
   echo "results: $name: $*" >&2
   local start end
@@ -232,49 +234,29 @@ step optimize-ganfaul-idle.json $A optimize --method single "$GANFAUL" --clip Id
 # Keep the reports: every JSON, TSV and text report under 300 KB is copied into docs/results/reports
 # (larger ones, and the subdivided meshes, are listed in MANIFEST.md with their sha256 only).
 KEEP=docs/results/reports
-if [ -n "${STEPS_ONLY:-}" ]; then
-  # Only the selected steps' files: each replaces its own lines (and copy) among the kept ones.
-  keep_only() {  # FILE: a kept list whose lines name files in their last field
-    awk -v p="$STEPS_ONLY" 'BEGIN { n = split(p, ps, " ") }
-      { f = $NF; gsub(/`/, "", f); if ($0 ~ /^\| `/) { f = $2; gsub(/`/, "", f) }
-        if (f == "steps.tsv") next; for (i = 1; i <= n; i++) if (index(f, ps[i]) == 1) next; print }' "$1"
-  }
-  awk -F'\t' -v p="$STEPS_ONLY" 'BEGIN { n = split(p, ps, " ") }
-    { for (i = 1; i <= n; i++) if (index($1, ps[i]) == 1) next; print }' "$KEEP/steps.tsv" > "$KEEP/steps.tsv.tmp"
-  awk -F'\t' -v p="$STEPS_ONLY" 'BEGIN { n = split(p, ps, " ") }
-    NR > 1 { for (i = 1; i <= n; i++) if (index($1, ps[i]) == 1) print }' "$STEPS" 2>/dev/null >> "$KEEP/steps.tsv.tmp" || true
-  mv "$KEEP/steps.tsv.tmp" "$KEEP/steps.tsv"
-  keep_only "$KEEP/MANIFEST.md" > "$KEEP/MANIFEST.md.tmp"
-  keep_only "$KEEP/SHA256SUMS" > "$KEEP/SHA256SUMS.tmp"
-  for prefix in $STEPS_ONLY; do
-    (cd "$OUT" && find . -type f \( -name '*.json' -o -name '*.txt' -o -name '*.glb' \) ! -name '*.tmp' |
-      sed 's|^\./||' | awk -v p="$prefix" 'index($0, p) == 1') | while read -r f; do
-      bytes=$(stat -c %s "$OUT/$f")
-      sum=$(sha256sum "$OUT/$f" | cut -d' ' -f1)
-      kept=no
-      if [ "$bytes" -le 307200 ] && [ "${f##*.}" != glb ]; then
-        mkdir -p "$KEEP/$(dirname "$f")"
-        cp "$OUT/$f" "$KEEP/$f"
-        echo "$sum  $f" >> "$KEEP/SHA256SUMS.tmp"
-        kept=yes
-      fi
-      line=$(awk -F'\t' -v n="$f" '$1 == n { print $2 "\t" $3 }' "$STEPS" 2>/dev/null || true)
-      seconds=${line%%$'\t'*}; command=${line#*$'\t'}
-      echo "| \`$f\` | $kept | $bytes | \`$sum\` | ${seconds:-—} | \`${command:-—}\` |" >> "$KEEP/MANIFEST.md.tmp"
-    done
-  done
-  sum=$(sha256sum "$KEEP/steps.tsv" | cut -d' ' -f1)
-  echo "$sum  steps.tsv" >> "$KEEP/SHA256SUMS.tmp"
-  echo "| \`steps.tsv\` | yes | $(stat -c %s "$KEEP/steps.tsv") | \`$sum\` | — | \`—\` |" >> "$KEEP/MANIFEST.md.tmp"
-  # Rows in file order, as the full run writes them (header lines first).
-  { grep -v '^| `' "$KEEP/MANIFEST.md.tmp"; grep '^| `' "$KEEP/MANIFEST.md.tmp" | LC_ALL=C sort -t'`' -k2,2; } > "$KEEP/MANIFEST.md"
-  LC_ALL=C sort -k2 "$KEEP/SHA256SUMS.tmp" > "$KEEP/SHA256SUMS"
-  rm -f "$KEEP/MANIFEST.md.tmp" "$KEEP/SHA256SUMS.tmp"
-  "$BIN/make_results" --notes docs/results-notes --readme README.md "$KEEP" docs
-  echo "results: replaced the reports of steps $STEPS_ONLY; wrote docs/RESULTS.md, docs/results/ and README.md's block"
-  exit 0
+# With ONLY, the rows of the files not selected are taken from the kept MANIFEST.md, SHA256SUMS and
+# steps.tsv (their files stay); the selected files and steps.tsv are written afresh below.
+ROWS=$(mktemp) SUMS=$(mktemp) OLD_STEPS=$(mktemp)
+trap 'rm -f "$ROWS" "$SUMS" "$OLD_STEPS"' EXIT
+if [ -n "${ONLY:-}" ] && [ -s "$KEEP/MANIFEST.md" ]; then
+  sed -n 's/^| `\([^`]*\)` | .*/\1\t&/p' "$KEEP/MANIFEST.md" | while IFS=$'\t' read -r f row; do
+    if [ "$f" != steps.tsv ] && ! selected "$f"; then printf '%s\t%s\n' "$f" "$row"; fi
+  done > "$ROWS"
+  awk '{ f = $0; sub(/^[0-9a-f]+  /, "", f); print f "\t" $0 }' "$KEEP/SHA256SUMS" | while IFS=$'\t' read -r f row; do
+    if [ "$f" != steps.tsv ] && ! selected "$f"; then printf '%s\t%s\n' "$f" "$row"; fi
+  done > "$SUMS"
+  tail -n +2 "$KEEP/steps.tsv" | while IFS=$'\t' read -r f rest; do
+    selected "$f" || printf '%s\t%s\n' "$f" "$rest"
+  done > "$OLD_STEPS"
+  # steps.tsv: the kept rows of the steps not selected, then this run's rows of the selected ones.
+  { printf 'name\tseconds\tcommand\n'; cat "$OLD_STEPS"
+    [ -s "$STEPS" ] && tail -n +2 "$STEPS" | while IFS=$'\t' read -r f rest; do
+      selected "$f" && printf '%s\t%s\n' "$f" "$rest"; done; true; } > "$STEPS.merged"
+  mv "$STEPS.merged" "$STEPS"
+  while IFS= read -r f; do if selected "$f"; then rm -f "$KEEP/$f"; fi; done < <(cd "$KEEP" && find . -type f | sed 's|^\./||')
+else
+  rm -rf "$KEEP"
 fi
-rm -rf "$KEEP"
 mkdir -p "$KEEP"
 {
   echo "# The reports behind docs/RESULTS.md"
@@ -285,21 +267,23 @@ mkdir -p "$KEEP"
   echo "| file | kept | bytes | sha256 | seconds | command |"
   echo "|---|---|---|---|---|---|"
 } > "$KEEP/MANIFEST.md"
-: > "$KEEP/SHA256SUMS"
 (cd "$OUT" && find . -type f \( -name '*.json' -o -name '*.txt' -o -name '*.tsv' -o -name '*.glb' \) \
   ! -path './out/*' ! -name '*.tmp' | sed 's|^\./||' | LC_ALL=C sort) | while read -r f; do
+  if [ -n "${ONLY:-}" ] && [ "$f" != steps.tsv ] && ! selected "$f"; then continue; fi
   bytes=$(stat -c %s "$OUT/$f")
   sum=$(sha256sum "$OUT/$f" | cut -d' ' -f1)
   kept=no
   if [ "$bytes" -le 307200 ] && [ "${f##*.}" != glb ]; then
     mkdir -p "$KEEP/$(dirname "$f")"
     cp "$OUT/$f" "$KEEP/$f"
-    echo "$sum  $f" >> "$KEEP/SHA256SUMS"
+    printf '%s\t%s  %s\n' "$f" "$sum" "$f" >> "$SUMS"
     kept=yes
   fi
   line=$(awk -F'\t' -v n="$f" '$1 == n { print $2 "\t" $3 }' "$STEPS" 2>/dev/null || true)
   seconds=${line%%$'\t'*}; command=${line#*$'\t'}
-  echo "| \`$f\` | $kept | $bytes | \`$sum\` | ${seconds:-—} | \`${command:-—}\` |" >> "$KEEP/MANIFEST.md"
+  printf '%s\t%s\n' "$f" "| \`$f\` | $kept | $bytes | \`$sum\` | ${seconds:-—} | \`${command:-—}\` |" >> "$ROWS"
 done
+LC_ALL=C sort -t$'\t' -k1,1 "$ROWS" | cut -f2- >> "$KEEP/MANIFEST.md"
+LC_ALL=C sort -t$'\t' -k1,1 "$SUMS" | cut -f2- > "$KEEP/SHA256SUMS"
 "$BIN/make_results" --notes docs/results-notes --readme README.md "$KEEP" docs
 echo "results: wrote docs/RESULTS.md, docs/results/ and README.md's generated block"

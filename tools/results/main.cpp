@@ -18,6 +18,7 @@
 //   characters/*.json                                                   one table per character
 //   sweep-views.json, sweep-lambda.json, sweep-k.json                   Figs. 3, 6, 7
 //   ganfaul-clips.json                                                  Figs. 8 and 5
+//   measured/*.json                     measured cluster orders (issue 15, beyond the paper)
 //   render-time.json                                                    bench/render_time --json
 //   materials/*.json                                                    Materials (issue 18)
 //   nehab06-bench.txt and any other *.txt                               included verbatim
@@ -25,7 +26,8 @@
 // The notes folder (--notes; RESULTS_DIR by default) holds notes-<id>.md, appended to section <id>,
 // and readme.md, README.md's block; both are templates whose measured figures are placeholders
 // resolved from RESULTS_DIR (templates.h). Section ids: settings, table1, characters, views, lambda,
-// clusters, clips, render-time, nehab06, performance, other, materials. The .json files are `animorder evaluate --report` outputs (README.md).
+// clusters, clips, measured, materials, render-time, nehab06, performance, other. The .json files are
+// `animorder evaluate --report` outputs (README.md).
 //
 // Everything is read and checked before anything is written, so a malformed report gives one
 // line on stderr, exit code 1 and no output. The output is byte-deterministic: no date, fixed
@@ -69,10 +71,11 @@ std::string build_markdown(const Inputs& in, Charts& charts, const TemplateResol
     sections.push_back(lambda_section(in, charts));
     sections.push_back(clusters_section(in, charts));
     sections.push_back(clips_section(in, charts));
+    sections.push_back(measured_section(in, charts));
+    sections.push_back(materials_section(in));
     sections.push_back(render_time_section(in));
     sections.push_back(nehab06_section(in));
     sections.push_back(performance_section(in));
-    sections.push_back(materials_section(in));
     Section other = other_section(in);
     if (!other.body.empty() || in.notes.count("other")) sections.push_back(other);
 
@@ -103,9 +106,10 @@ const char* const kUsage =
     "usage: make_results [--notes DIR] [--readme README.md] RESULTS_DIR OUT_DIR\n"
     "Writes OUT_DIR/RESULTS.md and OUT_DIR/results/*.svg from the reports in RESULTS_DIR (see scripts/results.sh):\n"
     "ganfaul-idle.json, ganfaul-idle-sub1.json, ganfaul-idle-sub2.json, characters/*.json, sweep-views.json,\n"
-    "sweep-lambda.json, sweep-k.json, ganfaul-clips.json, render-time.json, *.txt; with the notes of DIR\n"
-    "(default RESULTS_DIR): notes-<section>.md (sections: settings, table1, characters, views, lambda, clusters,\n"
-    "clips, render-time, nehab06, performance, other, materials) and readme.md, README.md's generated block (--readme).\n";
+    "sweep-lambda.json, sweep-k.json, ganfaul-clips.json, measured/*.json, materials/*.json, render-time.json,\n"
+    "*.txt; with the notes of DIR (default RESULTS_DIR): notes-<section>.md (sections: settings, table1,\n"
+    "characters, views, lambda, clusters, clips, measured, materials, render-time, nehab06, performance, other)\n"
+    "and readme.md, README.md's generated block (--readme).\n";
 
 std::string read_file(const fs::path& path) {
     std::ifstream in(path, std::ios::binary);

@@ -18,9 +18,9 @@ namespace animorder::results {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-const std::vector<std::string> kSectionIds = {"settings", "table1",      "characters", "views",
-                                              "lambda",   "clusters",    "clips",      "render-time",
-                                              "nehab06",  "performance", "other",      "materials"};
+const std::vector<std::string> kSectionIds = {"settings", "table1",      "characters", "views",     "lambda",
+                                              "clusters", "clips",       "measured",   "materials", "render-time",
+                                              "nehab06",  "performance", "other"};
 
 const Report* Inputs::get(const std::string& name) const {
     const auto it = reports.find(name);
@@ -220,6 +220,9 @@ Report load_report(const fs::path& path, const std::string& name) {
             }
         }
         method.blend = load_blend(r, m, "blend", where);
+        if (const json* stages = r.optional_object(m, "stages_s"))
+            for (auto it = stages->begin(); it != stages->end(); ++it)
+                method.stages[it.key()] = r.number(it.value(), where + ".stages_s." + it.key());
         report.methods.push_back(method);
     }
     report.blend_input_order = load_blend(r, j, "blend_input_order", "");
@@ -265,6 +268,24 @@ RenderTime load_render_time(const fs::path& path, const std::string& name) {
     return rt;
 }
 
+// Every report of a subfolder into `reports`, keyed "folder/name.json"; the keys, sorted.
+std::vector<std::string> load_folder(const fs::path& dir, const std::string& folder,
+                                     std::map<std::string, Report>& reports) {
+    std::vector<std::string> keys;
+    if (!fs::is_directory(dir / folder)) return keys;
+    std::vector<std::string> names;
+    for (const auto& entry : fs::directory_iterator(dir / folder))
+        if (entry.is_regular_file() && entry.path().extension() == ".json")
+            names.push_back(entry.path().filename().string());
+    std::sort(names.begin(), names.end());
+    for (const std::string& n : names) {
+        const std::string key = folder + "/" + n;
+        reports.emplace(key, load_report(dir / folder / n, key));
+        keys.push_back(key);
+    }
+    return keys;
+}
+
 }  // namespace
 
 Inputs load_inputs(const fs::path& dir, const fs::path& notes_dir) {
@@ -274,30 +295,13 @@ Inputs load_inputs(const fs::path& dir, const fs::path& notes_dir) {
     for (const char* name : {"ganfaul-idle.json", "ganfaul-idle-sub1.json", "ganfaul-idle-sub2.json",
                              "sweep-views.json", "sweep-lambda.json", "sweep-k.json", "ganfaul-clips.json"})
         if (fs::is_regular_file(dir / name)) in.reports.emplace(name, load_report(dir / name, name));
-    if (fs::is_directory(dir / "characters")) {
-        std::vector<std::string> names;
-        for (const auto& entry : fs::directory_iterator(dir / "characters"))
-            if (entry.is_regular_file() && entry.path().extension() == ".json")
-                names.push_back(entry.path().filename().string());
-        std::sort(names.begin(), names.end());
-        for (const std::string& n : names) {
-            const std::string key = "characters/" + n;
-            in.reports.emplace(key, load_report(dir / "characters" / n, key));
-            in.characters.push_back(key);
-        }
-    }
-    if (fs::is_directory(dir / "materials")) {
-        std::vector<std::string> names;
-        for (const auto& entry : fs::directory_iterator(dir / "materials"))
-            if (entry.is_regular_file() && entry.path().extension() == ".json")
-                names.push_back(entry.path().filename().string());
-        std::sort(names.begin(), names.end());
-        for (const std::string& n : names) {
-            const std::string key = "materials/" + n;
-            in.reports.emplace(key, load_report(dir / "materials" / n, key));
-            in.materials.push_back(key);
-        }
-    }
+    in.characters = load_folder(dir, "characters", in.reports);
+    in.materials = load_folder(dir, "materials", in.reports);
+    // Issue 15's measured cluster orders: three Ganfaul reports and one per character.
+    for (const std::string& key : load_folder(dir, "measured", in.reports))
+        if (key != "measured/ganfaul-idle.json" && key != "measured/sweep-k.json" &&
+            key != "measured/ganfaul-clips.json")
+            in.measured_characters.push_back(key);
     if (fs::is_regular_file(dir / "render-time.json"))
         in.render_time = std::make_unique<RenderTime>(load_render_time(dir / "render-time.json", "render-time.json"));
     std::vector<fs::path> files;

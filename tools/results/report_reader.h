@@ -42,6 +42,7 @@ struct Method {
     std::vector<ClipResult> per_clip;
     std::map<std::string, size_t> iterations;  // k-means iterations per run ("all" for joint)
     BlendResult blend;
+    std::map<std::string, double> stages;  // stages_s: seconds per preprocessing stage (clustered methods)
 };
 
 struct Clip {
@@ -83,9 +84,10 @@ extern const std::vector<std::string> kSectionIds;
 
 // Everything in RESULTS_DIR that make_results reads.
 struct Inputs {
-    std::map<std::string, Report> reports;  // by file name (relative to RESULTS_DIR)
-    std::vector<std::string> characters;    // "characters/x.json", sorted
-    std::vector<std::string> materials;     // "materials/x.json", sorted
+    std::map<std::string, Report> reports;         // by file name (relative to RESULTS_DIR)
+    std::vector<std::string> characters;           // "characters/x.json", sorted
+    std::vector<std::string> materials;            // "materials/x.json", sorted
+    std::vector<std::string> measured_characters;  // "measured/x.json" but the three Ganfaul ones, sorted
     std::unique_ptr<RenderTime> render_time;
     std::map<std::string, std::string> texts;  // *.txt by name, sorted
     std::map<std::string, std::string> notes;  // section id -> notes-<id>.md (templates.h)

@@ -6,6 +6,7 @@
 //   section_characters.cpp   characters    characters/*.json
 //   section_sweeps.cpp       views, lambda, clusters   sweep-views.json, sweep-lambda.json, sweep-k.json (Figs. 3, 6, 7)
 //   section_clips.cpp        clips         ganfaul-clips.json (Figs. 8 and 5)
+//   section_measured.cpp     measured      measured/*.json: measured cluster orders (issue 15) against single
 //   section_benchmarks.cpp   render-time, nehab06, performance, other   render-time.json, the reports'
 //                            static-nehab06, notes-performance.md, *.txt
 //   section_materials.cpp    materials     materials/*.json: double-sided OVR, blend error (issue 18)
@@ -49,6 +50,7 @@ Section views_section(const Inputs& in, Charts& charts);
 Section lambda_section(const Inputs& in, Charts& charts);
 Section clusters_section(const Inputs& in, Charts& charts);
 Section clips_section(const Inputs& in, Charts& charts);
+Section measured_section(const Inputs& in, Charts& charts);
 Section render_time_section(const Inputs& in);
 Section nehab06_section(const Inputs& in);
 Section performance_section(const Inputs& in);  // its figures: notes-performance.md (templates.h)

@@ -12,3 +12,7 @@ for t in "${targets[@]}"; do
   echo "sanitized: $t"
   "build-asan/tests/$t" --gtest_brief=1
 done
+# The kept fragments of k-means (hand-worked and random lists, the bundled character's budgets).
+cmake --build build-asan -j"$(nproc)" --target test_kept_fragments
+echo "sanitized: test_kept_fragments"
+build-asan/tests/test_kept_fragments --gtest_brief=1 --gtest_filter='KeptFragments.*:NodeCache.BundledCharacterScores*'

@@ -245,11 +245,13 @@ KeptNode keep_fragments(uint64_t visible, uint64_t single, const uint32_t* start
     node.unit_entries = uint32_t(s.entries.size());
     const Layout l = layout_of(node);
     node.data = std::vector<uint8_t>(l.total, 0);  // exactly its size: bytes() is deterministic
-    uint8_t* d = node.data.data();
-    std::memcpy(d + l.weights, s.weights.data(), 2 * s.weights.size());
-    std::memcpy(d + l.entries, s.entries.data(), 2 * s.entries.size());
-    std::memcpy(d + l.lengths, s.lengths.data(), s.lengths.size());
-    std::memcpy(d + l.triangles, s.triangle_lists.data(), 4 * s.triangle_lists.size());
+    auto put = [&](size_t offset, const auto& from) {
+        if (!from.empty()) std::memcpy(node.data.data() + offset, from.data(), from.size() * sizeof(from[0]));
+    };
+    put(l.weights, s.weights);
+    put(l.entries, s.entries);
+    put(l.lengths, s.lengths);
+    put(l.triangles, s.triangle_lists);
     return node;
 }
 

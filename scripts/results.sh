@@ -121,25 +121,30 @@ step sweep-lambda.json $A evaluate "$GANFAUL" --clip Idle -q --methods original,
   --lambda 0.7,0.85,1,1.5,2,3 --eval-views 100 --eval-resolution 256 -r "$OUT/sweep-lambda.json"
 step sweep-k.json $A evaluate "$GANFAUL" --clip Idle -q --methods single -k 1,2,3,5,7,10 \
   --eval-views 100 --eval-resolution 256 -r "$OUT/sweep-k.json"
+# The skinned characters of ../shared/data, each as FUNC NAME INPUT [--clip CLIPS]: one list for
+# every per-character step.
+each_character() {
+  "$1" xbot $DATA/glb-xbot/Xbot.glb
+  "$1" barbarian $DATA/pg-barbarian/model.fbx --clip $DATA/pg-barbarian/anims
+  "$1" goblin $DATA/pg-goblin/model.fbx --clip $DATA/pg-goblin/anims
+  "$1" witch $DATA/pg-witch/model.fbx --clip $DATA/pg-witch/anims
+  "$1" cesiumman $DATA/gltf-cesiumman/CesiumMan.glb
+  "$1" fox $DATA/gltf-fox/Fox.glb
+  "$1" robot-expressive $DATA/glb-robot-expressive/RobotExpressive.glb
+  "$1" bob $DATA/md5-bob/Bob.md5mesh
+  "$1" wuson $DATA/x-wuson/Testwuson.X
+  "$1" dwarf $DATA/x-dwarf/dwarf.x
+  "$1" dwarf2-b3d $DATA/b3d-dwarf2/dwarf2.b3d
+  "$1" bcn-epileptic $DATA/x-bcn-epileptic/BCN_Epileptic.X
+  "$1" mrfixit $DATA/iqm-mrfixit/mrfixit.iqm
+}
 # Every other skinned character of ../shared/data, lambda 0.85 and 3, 60 views at 256x256.
 character() {
   local name=$1; shift
   step "characters/$name.json" $A evaluate "$@" -q --methods "$ALL" --lambda 0.85,3 \
     --eval-views 60 --eval-resolution 256 -r "$OUT/characters/$name.json"
 }
-character xbot $DATA/glb-xbot/Xbot.glb
-character barbarian $DATA/pg-barbarian/model.fbx --clip $DATA/pg-barbarian/anims
-character goblin $DATA/pg-goblin/model.fbx --clip $DATA/pg-goblin/anims
-character witch $DATA/pg-witch/model.fbx --clip $DATA/pg-witch/anims
-character cesiumman $DATA/gltf-cesiumman/CesiumMan.glb
-character fox $DATA/gltf-fox/Fox.glb
-character robot-expressive $DATA/glb-robot-expressive/RobotExpressive.glb
-character bob $DATA/md5-bob/Bob.md5mesh
-character wuson $DATA/x-wuson/Testwuson.X
-character dwarf $DATA/x-dwarf/dwarf.x
-character dwarf2-b3d $DATA/b3d-dwarf2/dwarf2.b3d
-character bcn-epileptic $DATA/x-bcn-epileptic/BCN_Epileptic.X
-character mrfixit $DATA/iqm-mrfixit/mrfixit.iqm
+each_character character
 # static-nehab06 with --nehab-all-keyframes against the default (first keyframe), the same
 # evaluation as the character tables (their static-nehab06 rows are the default's).
 mkdir -p "$OUT/nehab06-keyframes"
@@ -190,19 +195,7 @@ measured_character() {
   step "measured/$name.json" $A evaluate "$@" -q --methods single,measured --lambda 0.85,3 \
     --eval-views 60 --eval-resolution 256 -r "$OUT/measured/$name.json"
 }
-measured_character xbot $DATA/glb-xbot/Xbot.glb
-measured_character barbarian $DATA/pg-barbarian/model.fbx --clip $DATA/pg-barbarian/anims
-measured_character goblin $DATA/pg-goblin/model.fbx --clip $DATA/pg-goblin/anims
-measured_character witch $DATA/pg-witch/model.fbx --clip $DATA/pg-witch/anims
-measured_character cesiumman $DATA/gltf-cesiumman/CesiumMan.glb
-measured_character fox $DATA/gltf-fox/Fox.glb
-measured_character robot-expressive $DATA/glb-robot-expressive/RobotExpressive.glb
-measured_character bob $DATA/md5-bob/Bob.md5mesh
-measured_character wuson $DATA/x-wuson/Testwuson.X
-measured_character dwarf $DATA/x-dwarf/dwarf.x
-measured_character dwarf2-b3d $DATA/b3d-dwarf2/dwarf2.b3d
-measured_character bcn-epileptic $DATA/x-bcn-epileptic/BCN_Epileptic.X
-measured_character mrfixit $DATA/iqm-mrfixit/mrfixit.iqm
+each_character measured_character
 # The OpenGL rendering-time check (original vs single, expensive fragment shader).
 # llvmpipe renders on the CPU: 10 views at every 4th keyframe (150 nodes) keeps it near a minute.
 if [ -x "$BIN/bench/render_time" ]; then

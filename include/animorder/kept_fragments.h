@@ -19,11 +19,11 @@
 namespace animorder {
 
 // Triangles grouped into units that every scored order keeps contiguous, each unit drawn in a
-// fixed inner order: position[t] is t's place in the concatenation of the units' inner orders.
+// fixed inner order: unit_position[t] is t's unit and its place in the concatenation of the units'
+// inner orders (side by side: the dropping test reads both at once); unit_of_triangle[t] its unit.
 struct UnitPartition {
     std::vector<uint32_t> unit_of_triangle;
-    std::vector<uint32_t> position;
-    std::vector<std::pair<uint32_t, uint32_t>> unit_position;  // both, side by side (one cache line)
+    std::vector<std::pair<uint32_t, uint32_t>> unit_position;
     size_t unit_count = 0;
 };
 

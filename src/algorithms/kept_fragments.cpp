@@ -197,7 +197,7 @@ UnitPartition make_unit_partition(const uint32_t* unit_starts, size_t unit_count
     UnitPartition p;
     p.unit_count = unit_count;
     p.unit_of_triangle.assign(triangle_count, UINT32_MAX);
-    p.position.assign(triangle_count, 0);
+    p.unit_position.assign(triangle_count, {0, 0});
     for (size_t u = 0; u < unit_count; ++u) {
         if (unit_starts[u + 1] < unit_starts[u]) throw InvalidInput("unit partition: unit starts go backwards");
         for (uint32_t j = unit_starts[u]; j < unit_starts[u + 1]; ++j) {
@@ -206,11 +206,9 @@ UnitPartition make_unit_partition(const uint32_t* unit_starts, size_t unit_count
                 throw InvalidInput("unit partition: triangle " + std::to_string(t) +
                                    " is out of range or listed twice");
             p.unit_of_triangle[t] = uint32_t(u);
-            p.position[t] = j;
+            p.unit_position[t] = {uint32_t(u), j};
         }
     }
-    p.unit_position.resize(triangle_count);
-    for (size_t t = 0; t < triangle_count; ++t) p.unit_position[t] = {p.unit_of_triangle[t], p.position[t]};
     return p;
 }
 

@@ -62,7 +62,8 @@ std::vector<uint32_t> face_order(const UnitPartition& p, const std::vector<uint3
         std::vector<uint32_t> mine;
         for (uint32_t t = 0; t < p.unit_of_triangle.size(); ++t)
             if (p.unit_of_triangle[t] == u) mine.push_back(t);
-        std::sort(mine.begin(), mine.end(), [&](uint32_t a, uint32_t b) { return p.position[a] < p.position[b]; });
+        std::sort(mine.begin(), mine.end(),
+                  [&](uint32_t a, uint32_t b) { return p.unit_position[a].second < p.unit_position[b].second; });
         faces.insert(faces.end(), mine.begin(), mine.end());
     }
     return faces;

@@ -132,6 +132,12 @@ void accumulate_node(PairCounts& table, const NodeFragments& node, const uint32_
     }
 }
 
+// One entry of a unit's signed adjacency in sift_order: s > 0 when the unit should come first.
+struct Neighbour {
+    uint32_t unit;
+    int64_t s;
+};
+
 }  // namespace
 
 struct MeasuredPairCounts::State {
@@ -211,11 +217,20 @@ std::vector<Arc> MeasuredPairCounts::arcs() const {
             for (uint32_t hi = lo + 1; hi < c.units; ++hi)
                 net(lo, hi, c.dense[size_t(lo) * c.units + hi], c.dense[size_t(hi) * c.units + lo]);
     } else {
-        std::vector<PairTable::Slot> all;
+        // In key order, whatever the table's layout: bucketed by the lower unit, then each
+        // bucket (a unit's few hundred pairs at most) sorted by the higher one.
+        std::vector<size_t> first(c.units + 1, 0);
         for (const PairTable::Slot& s : c.sparse.slots)
-            if (s.key != UINT64_MAX) all.push_back(s);
-        std::sort(all.begin(), all.end(),
-                  [](const PairTable::Slot& a, const PairTable::Slot& b) { return a.key < b.key; });
+            if (s.key != UINT64_MAX && s.min_front != s.max_front) ++first[(s.key >> 32) + 1];
+        std::partial_sum(first.begin(), first.end(), first.begin());
+        std::vector<PairTable::Slot> all(first[c.units]);
+        std::vector<size_t> fill(first.begin(), first.end() - 1);
+        for (const PairTable::Slot& s : c.sparse.slots)
+            if (s.key != UINT64_MAX && s.min_front != s.max_front) all[fill[s.key >> 32]++] = s;
+        for (size_t lo = 0; lo < c.units; ++lo)
+            std::sort(all.begin() + long(first[lo]), all.begin() + long(first[lo + 1]),
+                      [](const PairTable::Slot& a, const PairTable::Slot& b) { return a.key < b.key; });
+        arcs.reserve(all.size());
         for (const PairTable::Slot& s : all) net(uint32_t(s.key >> 32), uint32_t(s.key), s.min_front, s.max_front);
     }
     return arcs;
@@ -238,23 +253,49 @@ uint64_t sift_order(uint32_t* order, size_t unit_count, const Arc* arcs, size_t 
         if (a.from >= unit_count || a.to >= unit_count)
             throw InvalidInput("sifting: arc " + std::to_string(i) + " names a unit outside 0.." +
                                std::to_string(unit_count));
-        if (group && group[a.from] != group[a.to]) continue;
+        if (a.from == a.to || (group && group[a.from] != group[a.to])) continue;
         ++start[a.from + 1];
         ++start[a.to + 1];
     }
     std::partial_sum(start.begin(), start.end(), start.begin());
-    std::vector<std::pair<uint32_t, int64_t>> adjacency(start[unit_count]);
+    std::vector<uint32_t> position(unit_count);
+    for (size_t i = 0; i < unit_count; ++i) position[order[i]] = uint32_t(i);
+    // Each unit's neighbours, sorted by their current position when the unit is visited. Moving
+    // one unit keeps the relative order of all others, so a list goes stale only when one of its
+    // own neighbours moves: it is sorted again then, by insertion when few moved.
+    std::vector<Neighbour> adjacency(start[unit_count]);
     {
+        // Each unit's arcs (s from the unit's side), then handed to the other ends in order of
+        // the unit's position: every list comes out sorted by position, in linear time.
+        std::vector<Neighbour> of_unit(start[unit_count]);
         std::vector<size_t> fill(start.begin(), start.end() - 1);
         for (size_t i = 0; i < arc_count; ++i) {
             const Arc& a = arcs[i];
-            if (group && group[a.from] != group[a.to]) continue;
-            adjacency[fill[a.from]++] = {a.to, int64_t(a.weight)};
-            adjacency[fill[a.to]++] = {a.from, -int64_t(a.weight)};
+            if (a.from == a.to || (group && group[a.from] != group[a.to])) continue;
+            of_unit[fill[a.from]++] = {a.to, int64_t(a.weight)};
+            of_unit[fill[a.to]++] = {a.from, -int64_t(a.weight)};
+        }
+        fill.assign(start.begin(), start.end() - 1);
+        for (size_t x = 0; x < unit_count; ++x) {
+            const uint32_t v = order[x];
+            for (size_t e = start[v]; e < start[v + 1]; ++e) adjacency[fill[of_unit[e].unit]++] = {v, -of_unit[e].s};
         }
     }
-    std::vector<uint32_t> position(unit_count);
-    for (size_t i = 0; i < unit_count; ++i) position[order[i]] = uint32_t(i);
+    const auto before = [&](const Neighbour& a, const Neighbour& b) {
+        return position[a.unit] < position[b.unit] || (a.unit == b.unit && a.s < b.s);
+    };
+    std::vector<uint32_t> stale(unit_count, 0);  // neighbours moved since the list was sorted
+    const auto sort_neighbours = [&](uint32_t u) {
+        const auto begin = adjacency.begin() + start[u], end = adjacency.begin() + start[u + 1];
+        if (size_t(stale[u]) * 16 >= size_t(end - begin)) {
+            std::sort(begin, end, before);
+        } else {
+            for (auto n = begin + (begin != end); n < end; ++n)
+                for (auto m = n; m != begin && before(*m, *(m - 1)); --m) std::iter_swap(m, m - 1);
+        }
+        stale[u] = 0;
+    };
+    for (uint32_t u = 0; u < unit_count; ++u) sort_neighbours(u);  // only a pair given twice is out of place
     // Each group's block [first, last] in the order.
     std::vector<uint32_t> block_first(unit_count), block_last(unit_count);
     for (size_t i = 0; i < unit_count;) {
@@ -264,34 +305,31 @@ uint64_t sift_order(uint32_t* order, size_t unit_count, const Arc* arcs, size_t 
         i = j;
     }
 
-    std::vector<std::pair<uint32_t, int64_t>> left, right;  // (position, s(u, v)) of u's neighbours
     for (size_t pass = 0; pass < max_passes; ++pass) {
         bool moved = false;
         for (uint32_t u = 0; u < unit_count; ++u) {
             const uint32_t i = position[u];
-            left.clear();
-            right.clear();
-            for (size_t e = start[u]; e < start[u + 1]; ++e) {
-                const uint32_t p = position[adjacency[e].first];
-                (p < i ? left : right).emplace_back(p, adjacency[e].second);
-            }
+            if (stale[u]) sort_neighbours(u);
+            const auto begin = adjacency.begin() + start[u], end = adjacency.begin() + start[u + 1];
+            const auto split = std::partition_point(begin, end, [&](const Neighbour& n) { return position[n.unit] < i; });
             // Moving u left past v changes the cost by −s(u, v), right past v by +s(u, v); the
             // best target is just before (left) or after (right) some neighbour.
             int64_t best = 0;
             uint32_t target = i;
-            std::sort(left.begin(), left.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
             int64_t delta = 0;
-            for (const auto& [p, s] : left) {
-                delta -= s;
-                if (delta < best && p >= block_first[i]) best = delta, target = p;
+            // (A neighbour's position is read only for a new best: the walks are plain sums.)
+            for (auto n = split; n != begin;) {
+                --n;
+                delta -= n->s;
+                if (delta < best && position[n->unit] >= block_first[i]) best = delta, target = position[n->unit];
             }
-            std::sort(right.begin(), right.end());
             delta = 0;
-            for (const auto& [p, s] : right) {
-                delta += s;
-                if (delta < best && p <= block_last[i]) best = delta, target = p;
+            for (auto n = split; n != end; ++n) {
+                delta += n->s;
+                if (delta < best && position[n->unit] <= block_last[i]) best = delta, target = position[n->unit];
             }
             if (target == i) continue;
+            for (auto n = begin; n != end; ++n) ++stale[n->unit];
             if (target < i) {
                 for (uint32_t x = i; x > target; --x) order[x] = order[x - 1], position[order[x]] = x;
             } else {
@@ -338,16 +376,25 @@ std::vector<uint32_t> measured_unit_order(size_t unit_count, const Arc* arcs, si
     std::vector<uint32_t> local(unit_count);
     std::vector<uint32_t> greedy;
     greedy.reserve(unit_count);
+    // Each group's arcs, in the given order: one pass over the arcs, not one per group.
+    std::vector<uint32_t> block_of_unit(unit_count, 0);  // the rank of the unit's group among the groups
+    size_t blocks = 0;
+    for (size_t i = 0; i < unit_count; ++i) {
+        const bool first = i == 0 || (group && group[units[i]] != group[units[i - 1]]);
+        block_of_unit[units[i]] = first ? uint32_t(blocks++) : block_of_unit[units[i - 1]];
+    }
+    std::vector<std::vector<size_t>> arcs_of_block(blocks);
+    for (size_t a = 0; a < arc_count; ++a)
+        if (!group || group[arcs[a].from] == group[arcs[a].to]) arcs_of_block[block_of_unit[arcs[a].from]].push_back(a);
     for (size_t i = 0; i < unit_count;) {
         size_t j = i;
         while (j < unit_count && (!group || group[units[j]] == group[units[i]])) ++j;
         for (size_t x = i; x < j; ++x) local[units[x]] = uint32_t(x - i);
         std::vector<Arc> inside;
-        for (size_t a = 0; a < arc_count; ++a) {
-            const uint32_t g = group ? group[units[i]] : 0;
-            if (group && (group[arcs[a].from] != g || group[arcs[a].to] != g)) continue;
+        const std::vector<size_t>& block_arcs = arcs_of_block[block_of_unit[units[i]]];
+        inside.reserve(block_arcs.size());
+        for (const size_t a : block_arcs)
             inside.push_back({local[arcs[a].from], local[arcs[a].to], arcs[a].weight});
-        }
         for (uint32_t x : order_feedback_arc_set(j - i, inside.data(), inside.size())) greedy.push_back(units[i + x]);
         i = j;
     }

@@ -365,6 +365,78 @@ TEST(Sifting, KeepsEveryGroupInItsBlock) {
     }
 }
 
+// The plain statement of sifting, as sift_order first did it: per unit, its neighbours sorted
+// by position on each side (no lists kept sorted between moves). A second method for
+// sift_order's bookkeeping: both must move the same units to the same places.
+std::vector<uint32_t> plain_sift(std::vector<uint32_t> order, const std::vector<Arc>& arcs,
+                                 const std::vector<uint32_t>& group) {
+    const size_t n = order.size();
+    std::vector<std::vector<std::pair<uint32_t, int64_t>>> adjacency(n);
+    for (const Arc& a : arcs) {
+        if (group[a.from] != group[a.to]) continue;
+        adjacency[a.from].emplace_back(a.to, int64_t(a.weight));
+        adjacency[a.to].emplace_back(a.from, -int64_t(a.weight));
+    }
+    std::vector<uint32_t> position(n);
+    for (size_t i = 0; i < n; ++i) position[order[i]] = uint32_t(i);
+    for (size_t pass = 0; pass < 32; ++pass) {
+        bool moved = false;
+        for (uint32_t u = 0; u < n; ++u) {
+            const uint32_t i = position[u];
+            uint32_t first = i, last = i;  // u's group block
+            while (first > 0 && group[order[first - 1]] == group[u]) --first;
+            while (last + 1 < n && group[order[last + 1]] == group[u]) ++last;
+            std::vector<std::pair<uint32_t, int64_t>> left, right;
+            for (const auto& [v, s] : adjacency[u]) (position[v] < i ? left : right).emplace_back(position[v], s);
+            std::sort(left.rbegin(), left.rend());
+            std::sort(right.begin(), right.end());
+            int64_t best = 0, delta = 0;
+            uint32_t target = i;
+            for (const auto& [p, s] : left)
+                if ((delta -= s) < best && p >= first) best = delta, target = p;
+            delta = 0;
+            for (const auto& [p, s] : right)
+                if ((delta += s) < best && p <= last) best = delta, target = p;
+            if (target == i) continue;
+            order.erase(order.begin() + i);
+            order.insert(order.begin() + target, u);
+            for (size_t x = 0; x < n; ++x) position[order[x]] = uint32_t(x);
+            moved = true;
+        }
+        if (!moved) break;
+    }
+    return order;
+}
+
+TEST(Sifting, MovesTheSameUnitsAsThePlainStatementOnLargerGraphs) {
+    std::mt19937 rng(15);
+    for (int trial = 0; trial < 40; ++trial) {
+        const size_t n = 20 + rng() % 180;
+        std::vector<Arc> arcs;
+        for (uint32_t a = 0; a < n; ++a)
+            for (uint32_t b = a + 1; b < n; ++b) {
+                if (rng() % 4 != 0) continue;  // sparse, as measured graphs are
+                const uint64_t w = 1 + rng() % 1000;
+                arcs.push_back(rng() % 2 ? Arc{a, b, w} : Arc{b, a, w});
+            }
+        std::vector<uint32_t> group(n, 0);
+        const uint32_t groups = 1 + trial % 3;
+        for (size_t u = 0; u < n; ++u) group[u] = uint32_t(u * groups / n);  // contiguous blocks
+        std::vector<uint32_t> order(n);
+        std::iota(order.begin(), order.end(), 0u);
+        for (size_t i = 0; i < n;) {  // shuffle inside each block
+            size_t j = i;
+            while (j < n && group[j] == group[i]) ++j;
+            std::shuffle(order.begin() + long(i), order.begin() + long(j), rng);
+            i = j;
+        }
+        const std::vector<uint32_t> expected = plain_sift(order, arcs, group);
+        const uint64_t weight = sift_order(order.data(), n, arcs.data(), arcs.size(), group.data());
+        ASSERT_EQ(order, expected) << "trial " << trial;
+        ASSERT_EQ(weight, cost(order, arcs));
+    }
+}
+
 TEST(MeasuredOrder, RejectsAPreviousOrderThatIsNoPermutation) {
     const std::vector<Arc> arcs = {{0, 1, 1}};
     const std::vector<uint32_t> bad = {0, 0};

@@ -32,6 +32,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 namespace animorder {
@@ -63,12 +64,19 @@ struct NodeRasterizer::State {
     uint64_t visible = 0, single = 0;
     // Per-vertex setup, done once per node rather than once per triangle corner.
     std::vector<WindowVertex> window;
-    std::vector<uint8_t> unclipped;   // inside the near, far and guard-band planes
+    // The batched pre-pass's view of the vertices: snapped X, Y as int32 pairs, and why a vertex
+    // cannot take the pre-pass (kClippedVertex, kWideVertex; 0 when it can).
+    std::vector<int32_t> snapped;
+    std::vector<uint8_t> vertex_flags;
     std::vector<uint32_t> histogram;  // counting sort of the fragments by pixel
+    std::vector<uint32_t> pixel_count;  // per pixel, zero between nodes (kPixelImageLimit pixels at most)
+    std::vector<uint64_t> touched;      // bitmap of the pixels with fragments, zero between nodes
+    std::vector<uint64_t> keys;         // one pixel's (depth, triangle) sort keys
 };
 
 namespace {
 
+constexpr uint32_t kPixelImageLimit = uint32_t(1) << 20;  // pixels up to which group_fragments keeps a count image
 constexpr int kSubpixelBits = 8;
 constexpr int64_t kSubpixel = int64_t(1) << kSubpixelBits;  // 256
 constexpr float kGuardBand = 2.0f;                          // |x|, |y| <= 2w: twice the viewport, never a visible pixel
@@ -156,36 +164,33 @@ void rasterize_window_triangle(const WindowVertex& v0, const WindowVertex& v1, c
         step_y[i] = dx * kSubpixel;
     }
 
-    // Depth plane through the three window-space vertices (centres at integer coordinates), set up
-    // at the first covered pixel: most small triangles of a character cover none.
-    double dzdx = 0, dzdy = 0, z_origin = 0;
-    bool have_plane = false;
-    auto set_up_plane = [&] {
-        const double ax = c[1]->x - c[0]->x, ay = c[1]->y - c[0]->y, az = c[1]->z - c[0]->z;
-        const double bx = c[2]->x - c[0]->x, by = c[2]->y - c[0]->y, bz = c[2]->z - c[0]->z;
-        const double det = ax * by - ay * bx;
-        if (det == 0.0) return false;  // float-degenerate sliver: no fragment has a defined depth
-        dzdx = (az * by - ay * bz) / det;
-        dzdy = (ax * bz - az * bx) / det;
-        z_origin = c[0]->z - dzdx * c[0]->x - dzdy * c[0]->y;  // depth at pixel (0, 0)
-        return have_plane = true;
-    };
+    // A box of one pixel (the most common drawn case): its centre covered or nothing drawn.
+    if (px0 == px1 && py0 == py1 && (e_row[0] | e_row[1] | e_row[2]) < 0) return;
 
+    // Depth plane through the three window-space vertices (centres at integer coordinates). A
+    // float-degenerate sliver (det = 0) draws nothing: no fragment has a defined depth.
+    const double ax = c[1]->x - c[0]->x, ay = c[1]->y - c[0]->y, az = c[1]->z - c[0]->z;
+    const double bx = c[2]->x - c[0]->x, by = c[2]->y - c[0]->y, bz = c[2]->z - c[0]->z;
+    const double det = ax * by - ay * bx;
+    if (det == 0.0) return;
+    const double dzdx = (az * by - ay * bz) / det;
+    const double dzdy = (ax * bz - az * bx) / det;
+    const double z_origin = c[0]->z - dzdx * c[0]->x - dzdy * c[0]->y;  // depth at pixel (0, 0)
+
+    // Every pixel of the box is written and the count advances only for a covered pixel whose
+    // depth lies in [0, 1): no branch on coverage.
     sink.reserve_more(size_t(px1 - px0 + 1) * size_t(py1 - py0 + 1));
+    Fragment* out = sink.fragments.data();
+    size_t count = sink.count;
     for (int64_t py = py0; py <= py1; ++py) {
         int64_t e0 = e_row[0], e1 = e_row[1], e2 = e_row[2];
-        double z_row = have_plane ? z_origin + dzdy * double(py) : 0.0;
+        const double z_row = z_origin + dzdy * double(py);
         const uint32_t row = uint32_t(py * resolution);
         double x = double(px0);  // double(px), exactly
         for (int64_t px = px0; px <= px1; ++px, x += 1.0) {
-            if ((e0 | e1 | e2) >= 0) {
-                if (!have_plane) {
-                    if (!set_up_plane()) return;
-                    z_row = z_origin + dzdy * double(py);
-                }
-                const float depth = float(z_row + dzdx * x);
-                if (depth < 1.0f && depth >= 0.0f) sink.add(row + uint32_t(px), triangle, depth);
-            }
+            const float depth = float(z_row + dzdx * x);
+            out[count] = {row + uint32_t(px), triangle, depth};
+            count += size_t((e0 | e1 | e2) >= 0) & size_t(depth < 1.0f) & size_t(depth >= 0.0f);
             e0 += step_x[0];
             e1 += step_x[1];
             e2 += step_x[2];
@@ -194,6 +199,7 @@ void rasterize_window_triangle(const WindowVertex& v0, const WindowVertex& v1, c
         e_row[1] += step_y[1];
         e_row[2] += step_y[2];
     }
+    sink.count = count;
 }
 
 // Sutherland–Hodgman against one plane: keeps the part where dot(plane, v) >= 0.
@@ -252,6 +258,35 @@ void group_fragments(NodeRasterizer::State& s) {
     while ((uint64_t(1) << bits) < pixels) ++bits;
     Fragment* from = s.raw.data();
     Fragment* to = s.sorted.data();
+    if (pixels <= kPixelImageLimit) {
+        // A counting sort whose cost follows the covered pixels, not the viewport: per-pixel counts
+        // in an image that is all zero between nodes, and a bitmap of the touched pixels walked in
+        // pixel order (64 pixels a word). Both are returned to zero where touched.
+        s.pixel_count.resize(pixels);
+        s.touched.resize((size_t(pixels) + 63) / 64);
+        uint32_t* count = s.pixel_count.data();
+        uint64_t* touched = s.touched.data();
+        for (size_t f = 0; f < n; ++f) {
+            const uint32_t p = from[f].pixel;
+            ++count[p];
+            touched[p >> 6] |= uint64_t(1) << (p & 63);
+        }
+        uint32_t offset = 0;
+        for (size_t w = 0; w < s.touched.size(); ++w)
+            for (uint64_t bits_left = touched[w]; bits_left; bits_left &= bits_left - 1) {
+                const size_t p = w * 64 + size_t(__builtin_ctzll(bits_left));
+                const uint32_t c = count[p];
+                count[p] = offset;
+                offset += c;
+            }
+        for (size_t f = 0; f < n; ++f) to[count[from[f].pixel]++] = from[f];
+        for (size_t f = 0; f < n; ++f) {
+            count[to[f].pixel] = 0;
+            touched[to[f].pixel >> 6] = 0;
+        }
+        std::swap(from, to);
+        bits = 0;  // no radix pass
+    }
     // Up to 2^16 pixels (256²) one counting pass; beyond, passes of 11 bits.
     const int digit_bits = bits <= 16 ? 16 : 11;
     const uint32_t digits = uint32_t(1) << digit_bits;
@@ -272,6 +307,8 @@ void group_fragments(NodeRasterizer::State& s) {
     if (s.multi_fragment.size() < n) s.multi_fragment.resize(n);
     uint32_t* out = s.multi_fragment.data();
     uint32_t written = 0;
+    if (s.keys.size() < n) s.keys.resize(n);
+    uint64_t* key_scratch = s.keys.data();
     for (size_t i = 0; i < n;) {
         size_t end = i + 1;
         while (end < n && from[end].pixel == from[i].pixel) ++end;
@@ -279,21 +316,24 @@ void group_fragments(NodeRasterizer::State& s) {
         if (end - i == 1) {
             s.single_pixels.push_back(from[i].pixel);
         } else {
-            // Insertion sort in place by (depth, triangle): a handful of fragments, deterministic.
-            for (size_t j = i + 1; j < end; ++j) {
-                const Fragment f = from[j];
-                size_t k = j;
-                for (; k > i && (from[k - 1].depth > f.depth ||
-                                 (from[k - 1].depth == f.depth && from[k - 1].triangle > f.triangle));
-                     --k)
-                    from[k] = from[k - 1];
-                from[k] = f;
+            // Insertion sort by (depth, triangle) as one 64-bit key: a depth is a float in [0, 1),
+            // whose bits order as its values once −0 is made +0 (adding +0 does that); so keys
+            // compare as the pair, and equal high halves are equal depths.
+            uint64_t* keys = key_scratch;
+            for (size_t j = i; j < end; ++j) {
+                const float depth = from[j].depth + 0.0f;
+                uint32_t bits_of_depth;
+                std::memcpy(&bits_of_depth, &depth, 4);
+                const uint64_t key = uint64_t(bits_of_depth) << 32 | from[j].triangle;
+                size_t k = j - i;
+                for (; k > 0 && keys[k - 1] > key; --k) keys[k] = keys[k - 1];
+                keys[k] = key;
             }
             s.multi_pixel.push_back(from[i].pixel);
             s.multi_start.push_back(written);
-            out[written++] = from[i].triangle;
-            for (size_t j = i + 1; j < end; ++j)
-                out[written++] = from[j].triangle | (from[j].depth == from[j - 1].depth ? kTieBit : 0);
+            out[written++] = uint32_t(keys[0]);
+            for (size_t j = 1; j < end - i; ++j)
+                out[written++] = uint32_t(keys[j]) | ((keys[j] >> 32) == (keys[j - 1] >> 32) ? kTieBit : 0);
         }
         i = end;
     }
@@ -318,6 +358,33 @@ void NodeRasterizer::visit_fragments(const std::function<void(uint32_t, uint32_t
     for (size_t f = 0; f < s.raw_count; ++f) visit(s.raw[f].pixel, s.raw[f].triangle, s.raw[f].depth);
 }
 
+namespace {
+
+constexpr uint8_t kClippedVertex = 1;  // outside the near, far or guard-band planes: the triangle is clipped
+constexpr uint8_t kWideVertex = 2;     // snapped X or Y not inside ±kCompactLimit (or not a number): exact path
+constexpr int64_t kCompactLimit = int64_t(1) << 24;  // |x| <= 1.5 · 16384 pixels is below 2^23
+constexpr size_t kBatch = 128;  // triangles per pre-pass batch
+
+// The box test of triangle_box for a batch of triangles whose vertices are all compact and
+// unclipped: int32 arithmetic over arrays that the compiler vectorises. keep[i] is non-zero
+// exactly when the bounding box, clamped to the viewport, holds a pixel centre.
+void batch_box_test(size_t n, const int32_t* x0, const int32_t* y0, const int32_t* x1, const int32_t* y1,
+                    const int32_t* x2, const int32_t* y2, int32_t last, int32_t* keep, int32_t (*box)[4]) {
+    for (size_t i = 0; i < n; ++i) {
+        const int32_t min_x = std::min(x0[i], std::min(x1[i], x2[i])), max_x = std::max(x0[i], std::max(x1[i], x2[i]));
+        const int32_t min_y = std::min(y0[i], std::min(y1[i], y2[i])), max_y = std::max(y0[i], std::max(y1[i], y2[i]));
+        const int32_t px0 = std::max(0, -((-min_x) >> kSubpixelBits)), px1 = std::min(last, max_x >> kSubpixelBits);
+        const int32_t py0 = std::max(0, -((-min_y) >> kSubpixelBits)), py1 = std::min(last, max_y >> kSubpixelBits);
+        keep[i] = int32_t(px0 <= px1) & int32_t(py0 <= py1);
+        box[i][0] = px0;
+        box[i][1] = px1;
+        box[i][2] = py0;
+        box[i][3] = py1;
+    }
+}
+
+}  // namespace
+
 void NodeRasterizer::rasterize(const float* clip_xyzw, size_t vertex_count, const uint32_t* indices, size_t index_count,
                                unsigned resolution, const uint8_t* modes) {
     validate_indices(indices, index_count, vertex_count);
@@ -328,26 +395,78 @@ void NodeRasterizer::rasterize(const float* clip_xyzw, size_t vertex_count, cons
 
     const ClipVertex* cv = reinterpret_cast<const ClipVertex*>(clip_xyzw);
     s.window.resize(vertex_count);
-    s.unclipped.resize(vertex_count);
+    s.snapped.resize(2 * vertex_count);
+    s.vertex_flags.resize(vertex_count);
     for (size_t v = 0; v < vertex_count; ++v) {
-        s.unclipped[v] = inside_all(cv[v]);
-        if (s.unclipped[v]) project(cv[v], resolution, s.window[v]);
+        if (!inside_all(cv[v])) {
+            s.vertex_flags[v] = kClippedVertex;
+            s.snapped[2 * v] = s.snapped[2 * v + 1] = 0;
+            continue;
+        }
+        WindowVertex& w = s.window[v];
+        project(cv[v], resolution, w);
+        const bool compact = w.X > -kCompactLimit && w.X < kCompactLimit && w.Y > -kCompactLimit && w.Y < kCompactLimit;
+        s.vertex_flags[v] = compact ? 0 : kWideVertex;
+        s.snapped[2 * v] = compact ? int32_t(w.X) : 0;
+        s.snapped[2 * v + 1] = compact ? int32_t(w.Y) : 0;
     }
 
+    // Triangles in batches: gather the snapped corners, test area and box for the whole batch at
+    // once, then draw the survivors in triangle order (the order of the fragments is unchanged).
     FragmentSink sink{s.raw};
-    for (size_t t = 0; t < index_count / 3; ++t) {
-        const uint32_t a = indices[3 * t], b = indices[3 * t + 1], c = indices[3 * t + 2];
-        const uint8_t mode = modes ? modes[t] : 0;
-        if (mode & kSkipTriangle) continue;
-        const bool two_sided = (mode & kDrawBothFaces) != 0;
-        if (s.unclipped[a] & s.unclipped[b] & s.unclipped[c]) {
-            const WindowVertex &va = s.window[a], &vb = s.window[b], &vc = s.window[c];
-            TriangleBox box;
-            if (triangle_box(va, vb, vc, resolution, two_sided, box))
-                rasterize_window_triangle(va, vb, vc, box, uint32_t(t), resolution, sink);
-        } else {
-            const ClipVertex v[3] = {cv[a], cv[b], cv[c]};
-            rasterize_clipped_triangle(v, uint32_t(t), resolution, sink, two_sided);
+    const size_t triangle_count = index_count / 3;
+    const int32_t* xy = s.snapped.data();
+    const uint8_t* flags = s.vertex_flags.data();
+    alignas(16) int32_t x0[kBatch], y0[kBatch], x1[kBatch], y1[kBatch], x2[kBatch], y2[kBatch], keep[kBatch];
+    uint8_t two[kBatch];
+    int32_t boxes[kBatch][4];
+    int64_t areas[kBatch];
+    uint8_t special[kBatch];
+    uint32_t draw[kBatch];
+    for (size_t first = 0; first < triangle_count; first += kBatch) {
+        const size_t n = std::min(kBatch, triangle_count - first);
+        const uint32_t* tri = indices + 3 * first;
+        for (size_t i = 0; i < n; ++i) {
+            const uint32_t a = tri[3 * i], b = tri[3 * i + 1], c = tri[3 * i + 2];
+            const uint8_t mode = modes ? modes[first + i] : 0;
+            x0[i] = xy[2 * a];
+            y0[i] = xy[2 * a + 1];
+            x1[i] = xy[2 * b];
+            y1[i] = xy[2 * b + 1];
+            x2[i] = xy[2 * c];
+            y2[i] = xy[2 * c + 1];
+            two[i] = mode & kDrawBothFaces;
+            // Skipped: never drawn; a clipped or wide corner: the exact path below.
+            special[i] = (mode & kSkipTriangle) ? 0 : uint8_t(1 + (flags[a] | flags[b] | flags[c]));
+        }
+        batch_box_test(n, x0, y0, x1, y1, x2, y2, int32_t(resolution - 1), keep, boxes);
+        size_t m = 0;
+        for (size_t i = 0; i < n; ++i) {
+            // As triangle_box: y points down, so OpenGL's counter-clockwise front faces have
+            // negative area; |coordinates| < 2^24 keeps the int64 products exact.
+            const int64_t area = int64_t(x1[i] - x0[i]) * (y2[i] - y0[i]) - int64_t(x2[i] - x0[i]) * (y1[i] - y0[i]);
+            const bool drawn = (area < 0) | ((area > 0) & (two[i] != 0));
+            areas[i] = area;
+            draw[m] = uint32_t(i);
+            m += (special[i] > 1) | ((special[i] == 1) & drawn & (keep[i] != 0));
+        }
+        for (size_t j = 0; j < m; ++j) {
+            const size_t t = first + draw[j];
+            const uint32_t a = indices[3 * t], b = indices[3 * t + 1], c = indices[3 * t + 2];
+            const bool two_sided = two[draw[j]] != 0;
+            if (special[draw[j]] == 1) {  // passed the pre-pass: its box is known
+                const int32_t* known = boxes[draw[j]];
+                const TriangleBox box{areas[draw[j]], known[0], known[1], known[2], known[3]};
+                rasterize_window_triangle(s.window[a], s.window[b], s.window[c], box, uint32_t(t), resolution, sink);
+            } else if (!((special[draw[j]] - 1) & kClippedVertex)) {
+                const WindowVertex &va = s.window[a], &vb = s.window[b], &vc = s.window[c];
+                TriangleBox box;
+                if (triangle_box(va, vb, vc, resolution, two_sided, box))
+                    rasterize_window_triangle(va, vb, vc, box, uint32_t(t), resolution, sink);
+            } else {
+                const ClipVertex v[3] = {cv[a], cv[b], cv[c]};
+                rasterize_clipped_triangle(v, uint32_t(t), resolution, sink, two_sided);
+            }
         }
     }
     s.raw_count = sink.count;  // the arrays keep their size: no re-zeroing on the next node

@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <map>
 #include <numeric>
@@ -593,4 +594,56 @@ TEST(Rasterizer, ClippedTrianglesAmongOthersDrawAsWhenAlone) {
         ASSERT_EQ(std::memcmp(&std::get<2>(got[f]), &std::get<2>(alone[f]), 4), 0);
     }
     EXPECT_GT(got.size(), 100u);
+}
+
+// The grouped lists scoring walks (visible and single-fragment pixels; per pixel with several
+// fragments its triangles nearest first, ties flagged) against a std::sort of the node's raw
+// fragments, at a viewport small enough for the count-image grouping and one beyond it (the radix
+// passes). Duplicated triangles make exact depth ties.
+TEST(Rasterizer, GroupedListsEqualASortOfTheRawFragments) {
+    for (unsigned resolution : {40u, 1100u}) {
+        std::mt19937 rng(resolution);
+        std::uniform_real_distribution<float> any(-1.0f, 1.0f), depth(-0.9f, 0.9f), size(0.0f, 0.3f);
+        std::vector<float> clip;
+        std::vector<uint32_t> ib;
+        for (int i = 0; i < 300; ++i) {
+            const float x = any(rng), y = any(rng), r = size(rng) * (resolution > 100 ? 0.15f : 1.0f);
+            const uint32_t first = uint32_t(clip.size() / 4);
+            for (int k = 0; k < 3; ++k) {
+                const float angle = float(k) * 2.0944f + any(rng) * 0.3f;
+                clip.insert(clip.end(), {x + r * std::cos(angle), y + r * std::sin(angle), depth(rng), 1.0f});
+            }
+            ib.insert(ib.end(), {first, first + 1, first + 2});
+            if (i % 4 == 0) ib.insert(ib.end(), {first, first + 1, first + 2});  // an exact tie
+        }
+        const std::vector<uint8_t> modes(ib.size() / 3, kDrawBothFaces);
+        NodeRasterizer r;
+        r.rasterize(clip.data(), clip.size() / 4, ib.data(), ib.size(), resolution, modes.data());
+        std::vector<std::tuple<uint32_t, float, uint32_t>> raw;
+        r.visit_fragments([&](uint32_t p, uint32_t t, float z) { raw.emplace_back(p, z, t); });
+        std::sort(raw.begin(), raw.end());
+        uint64_t visible = 0, single = 0;
+        std::vector<uint32_t> starts{0}, fragments;
+        for (size_t i = 0; i < raw.size();) {
+            size_t end = i;
+            while (end < raw.size() && std::get<0>(raw[end]) == std::get<0>(raw[i])) ++end;
+            ++visible;
+            if (end - i == 1) {
+                ++single;
+            } else {
+                for (size_t j = i; j < end; ++j)
+                    fragments.push_back(std::get<2>(raw[j]) |
+                                        (j > i && std::get<1>(raw[j]) == std::get<1>(raw[j - 1]) ? 0x80000000u : 0u));
+                starts.push_back(uint32_t(fragments.size()));
+            }
+            i = end;
+        }
+        const NodeFragments got = r.export_fragments();
+        EXPECT_EQ(got.visible, visible) << resolution;
+        EXPECT_EQ(got.single, single) << resolution;
+        EXPECT_EQ(got.starts, starts) << resolution;
+        EXPECT_EQ(got.fragments, fragments) << resolution;
+        EXPECT_GT(starts.size(), 100u);
+        EXPECT_NE(std::count_if(fragments.begin(), fragments.end(), [](uint32_t f) { return f >> 31; }), 0);
+    }
 }

@@ -112,7 +112,7 @@ struct NodeRasterizer::State {
     std::vector<uint32_t> histogram;  // counting sort of the fragments by pixel
     std::vector<uint32_t> pixel_count;  // per pixel, zero between nodes (kPixelImageLimit pixels at most)
     std::vector<uint64_t> touched;      // bitmap of the pixels with fragments, zero between nodes
-    std::vector<uint64_t> keys;         // one pixel's (depth, triangle) sort keys
+    std::vector<uint64_t> keys;         // (depth, triangle) sort keys of the fragments being grouped
     BatchSetup setup;
 };
 
@@ -134,9 +134,8 @@ int64_t round_half_away(float v) { return int64_t(v >= 0.0f ? v + 0.5f : v - 0.5
 int64_t floor_subpixel(int64_t a) { return a >> kSubpixelBits; }
 int64_t ceil_subpixel(int64_t a) { return -((-a) >> kSubpixelBits); }
 
-// Where the rasteriser puts fragments: three parallel arrays (pixel, triangle, depth).
-// Capacity is ensured once per triangle (its bounding box bounds its fragments), so adding a
-// fragment is one plain store.
+// Where the rasteriser puts fragments (pixel, triangle, depth). Capacity is ensured once per
+// triangle (its bounding box bounds its fragments), so a fragment is one plain store.
 struct FragmentSink {
     std::vector<Fragment>& fragments;
     size_t count = 0;
@@ -145,7 +144,6 @@ struct FragmentSink {
         if (count + more <= fragments.size()) return;
         fragments.resize(std::max(2 * fragments.size(), count + more));
     }
-    void add(uint32_t p, uint32_t t, float z) { fragments[count++] = {p, t, z}; }
 };
 
 void project(const ClipVertex& v, unsigned resolution, WindowVertex& out) {

@@ -32,6 +32,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 namespace animorder {
@@ -49,12 +50,53 @@ struct Fragment {
     float depth;
 };
 
+namespace {
+
+constexpr size_t kBatch = 128;  // triangles per pre-pass batch
+
+// rasterize_window_triangle's set-up for a batch of triangles, as straight-line double arithmetic
+// over arrays (vectorised). Exact: snapped coordinates are integers below 2^24 in magnitude, so
+// every edge-function term is an integer below 2^51; the depth plane repeats the scalar code's
+// double operations one for one.
+struct BatchSetup {
+    // In: corners in positive order (snapped X, Y), first pixel centre of the box, the plane
+    // differences (corner 1 − corner 0, corner 2 − corner 0, in float) and corner 0.
+    double X[3][kBatch], Y[3][kBatch], px0[kBatch], py0[kBatch];
+    double ax[kBatch], ay[kBatch], az[kBatch], bx[kBatch], by[kBatch], bz[kBatch], x[kBatch], y[kBatch], z[kBatch];
+    // Out: edge functions at the first pixel centre and their steps, the plane.
+    double e[3][kBatch], sx[3][kBatch], sy[3][kBatch], det[kBatch], dzdx[kBatch], dzdy[kBatch], z_origin[kBatch];
+
+    void compute(size_t n) {
+        for (int k = 0; k < 3; ++k) {
+            const int b = (k + 1) % 3;
+            for (size_t j = 0; j < n; ++j) {
+                const double dx = X[b][j] - X[k][j], dy = Y[b][j] - Y[k][j];
+                // 1 unless a top or left edge (dy < 0, or dy = 0 and dx > 0): branch-free selects.
+                const double right = dx > 0.0 ? 0.0 : 1.0;
+                const double flat = dy == 0.0 ? right : 1.0;
+                const double bias = dy < 0.0 ? 0.0 : flat;
+                e[k][j] = dx * (py0[j] * 256.0 - Y[k][j]) - dy * (px0[j] * 256.0 - X[k][j]) - bias;
+                sx[k][j] = -dy * 256.0;
+                sy[k][j] = dx * 256.0;
+            }
+        }
+        for (size_t j = 0; j < n; ++j) {
+            det[j] = ax[j] * by[j] - ay[j] * bx[j];
+            dzdx[j] = (az[j] * by[j] - ay[j] * bz[j]) / det[j];
+            dzdy[j] = (ax[j] * bz[j] - az[j] * bx[j]) / det[j];
+            z_origin[j] = z[j] - dzdx[j] * x[j] - dzdy[j] * y[j];
+        }
+    }
+};
+
+}  // namespace
+
 struct NodeRasterizer::State {
     unsigned resolution = 0;
     // Raw fragments, in rasterisation order: the first raw_count entries are this node's.
     std::vector<Fragment> raw, sorted;
     size_t raw_count = 0;
-    std::vector<uint32_t> single_pixels;  // pixels with exactly one fragment
+    std::vector<uint32_t> single_pixels;  // pixels with exactly one fragment: the first `single` entries
     // Per pixel fragment count; start of the pixel's slots among the multi-fragment pixels.
     // Pixels with two or more fragments, their fragments nearest first: what scoring walks.
     // A fragment is its triangle index, with kTieBit set when its depth equals the previous one's.
@@ -63,12 +105,20 @@ struct NodeRasterizer::State {
     uint64_t visible = 0, single = 0;
     // Per-vertex setup, done once per node rather than once per triangle corner.
     std::vector<WindowVertex> window;
-    std::vector<uint8_t> unclipped;   // inside the near, far and guard-band planes
+    // The batched pre-pass's view of the vertices: snapped X, Y as int32 pairs, and why a vertex
+    // cannot take the pre-pass (kClippedVertex, kWideVertex; 0 when it can).
+    std::vector<int32_t> snapped;
+    std::vector<uint8_t> vertex_flags;
     std::vector<uint32_t> histogram;  // counting sort of the fragments by pixel
+    std::vector<uint32_t> pixel_count;  // per pixel, zero between nodes (kPixelImageLimit pixels at most)
+    std::vector<uint64_t> touched;      // bitmap of the pixels with fragments, zero between nodes
+    std::vector<uint64_t> keys;         // (depth, triangle) sort keys of the fragments being grouped
+    BatchSetup setup;
 };
 
 namespace {
 
+constexpr uint32_t kPixelImageLimit = uint32_t(1) << 20;  // pixels up to which group_fragments keeps a count image
 constexpr int kSubpixelBits = 8;
 constexpr int64_t kSubpixel = int64_t(1) << kSubpixelBits;  // 256
 constexpr float kGuardBand = 2.0f;                          // |x|, |y| <= 2w: twice the viewport, never a visible pixel
@@ -84,9 +134,8 @@ int64_t round_half_away(float v) { return int64_t(v >= 0.0f ? v + 0.5f : v - 0.5
 int64_t floor_subpixel(int64_t a) { return a >> kSubpixelBits; }
 int64_t ceil_subpixel(int64_t a) { return -((-a) >> kSubpixelBits); }
 
-// Where the rasteriser puts fragments: three parallel arrays (pixel, triangle, depth).
-// Capacity is ensured once per triangle (its bounding box bounds its fragments), so adding a
-// fragment is one plain store.
+// Where the rasteriser puts fragments (pixel, triangle, depth). Capacity is ensured once per
+// triangle (its bounding box bounds its fragments), so a fragment is one plain store.
 struct FragmentSink {
     std::vector<Fragment>& fragments;
     size_t count = 0;
@@ -95,7 +144,6 @@ struct FragmentSink {
         if (count + more <= fragments.size()) return;
         fragments.resize(std::max(2 * fragments.size(), count + more));
     }
-    void add(uint32_t p, uint32_t t, float z) { fragments[count++] = {p, t, z}; }
 };
 
 void project(const ClipVertex& v, unsigned resolution, WindowVertex& out) {
@@ -132,6 +180,37 @@ inline bool triangle_box(const WindowVertex& v0, const WindowVertex& v1, const W
     return box.px0 <= box.px1 && box.py0 <= box.py1;
 }
 
+// Writes the fragments of one set-up triangle: edge functions at the box's first pixel centre and
+// their steps, the depth plane. Every pixel of the box is written and the count advances only for
+// a covered pixel whose depth lies in [0, 1): no branch on coverage.
+inline void emit_box(const int64_t (&e_first)[3], const int64_t (&step_x)[3], const int64_t (&step_y)[3], double dzdx,
+                     double dzdy, double z_origin, const TriangleBox& box, uint32_t triangle, unsigned resolution,
+                     FragmentSink& sink) {
+    const int64_t px0 = box.px0, px1 = box.px1, py0 = box.py0, py1 = box.py1;
+    int64_t e_row[3] = {e_first[0], e_first[1], e_first[2]};
+    sink.reserve_more(size_t(px1 - px0 + 1) * size_t(py1 - py0 + 1));
+    Fragment* out = sink.fragments.data();
+    size_t count = sink.count;
+    for (int64_t py = py0; py <= py1; ++py) {
+        int64_t e0 = e_row[0], e1 = e_row[1], e2 = e_row[2];
+        const double z_row = z_origin + dzdy * double(py);
+        const uint32_t row = uint32_t(py * resolution);
+        double x = double(px0);  // double(px), exactly
+        for (int64_t px = px0; px <= px1; ++px, x += 1.0) {
+            const float depth = float(z_row + dzdx * x);
+            out[count] = {row + uint32_t(px), triangle, depth};
+            count += size_t((e0 | e1 | e2) >= 0) & size_t(depth < 1.0f) & size_t(depth >= 0.0f);
+            e0 += step_x[0];
+            e1 += step_x[1];
+            e2 += step_x[2];
+        }
+        e_row[0] += step_y[0];
+        e_row[1] += step_y[1];
+        e_row[2] += step_y[2];
+    }
+    sink.count = count;
+}
+
 // Rasterises one window-space triangle that passed triangle_box: fill rule and depth as
 // described at the top.
 void rasterize_window_triangle(const WindowVertex& v0, const WindowVertex& v1, const WindowVertex& v2,
@@ -156,44 +235,20 @@ void rasterize_window_triangle(const WindowVertex& v0, const WindowVertex& v1, c
         step_y[i] = dx * kSubpixel;
     }
 
-    // Depth plane through the three window-space vertices (centres at integer coordinates), set up
-    // at the first covered pixel: most small triangles of a character cover none.
-    double dzdx = 0, dzdy = 0, z_origin = 0;
-    bool have_plane = false;
-    auto set_up_plane = [&] {
-        const double ax = c[1]->x - c[0]->x, ay = c[1]->y - c[0]->y, az = c[1]->z - c[0]->z;
-        const double bx = c[2]->x - c[0]->x, by = c[2]->y - c[0]->y, bz = c[2]->z - c[0]->z;
-        const double det = ax * by - ay * bx;
-        if (det == 0.0) return false;  // float-degenerate sliver: no fragment has a defined depth
-        dzdx = (az * by - ay * bz) / det;
-        dzdy = (ax * bz - az * bx) / det;
-        z_origin = c[0]->z - dzdx * c[0]->x - dzdy * c[0]->y;  // depth at pixel (0, 0)
-        return have_plane = true;
-    };
+    // A box of one pixel (the most common drawn case): its centre covered or nothing drawn.
+    if (px0 == px1 && py0 == py1 && (e_row[0] | e_row[1] | e_row[2]) < 0) return;
 
-    sink.reserve_more(size_t(px1 - px0 + 1) * size_t(py1 - py0 + 1));
-    for (int64_t py = py0; py <= py1; ++py) {
-        int64_t e0 = e_row[0], e1 = e_row[1], e2 = e_row[2];
-        double z_row = have_plane ? z_origin + dzdy * double(py) : 0.0;
-        const uint32_t row = uint32_t(py * resolution);
-        double x = double(px0);  // double(px), exactly
-        for (int64_t px = px0; px <= px1; ++px, x += 1.0) {
-            if ((e0 | e1 | e2) >= 0) {
-                if (!have_plane) {
-                    if (!set_up_plane()) return;
-                    z_row = z_origin + dzdy * double(py);
-                }
-                const float depth = float(z_row + dzdx * x);
-                if (depth < 1.0f && depth >= 0.0f) sink.add(row + uint32_t(px), triangle, depth);
-            }
-            e0 += step_x[0];
-            e1 += step_x[1];
-            e2 += step_x[2];
-        }
-        e_row[0] += step_y[0];
-        e_row[1] += step_y[1];
-        e_row[2] += step_y[2];
-    }
+    // Depth plane through the three window-space vertices (centres at integer coordinates). A
+    // float-degenerate sliver (det = 0) draws nothing: no fragment has a defined depth.
+    const double ax = c[1]->x - c[0]->x, ay = c[1]->y - c[0]->y, az = c[1]->z - c[0]->z;
+    const double bx = c[2]->x - c[0]->x, by = c[2]->y - c[0]->y, bz = c[2]->z - c[0]->z;
+    const double det = ax * by - ay * bx;
+    if (det == 0.0) return;
+    const double dzdx = (az * by - ay * bz) / det;
+    const double dzdy = (ax * bz - az * bx) / det;
+    const double z_origin = c[0]->z - dzdx * c[0]->x - dzdy * c[0]->y;  // depth at pixel (0, 0)
+
+    emit_box(e_row, step_x, step_y, dzdx, dzdy, z_origin, box, triangle, resolution, sink);
 }
 
 // Sutherland–Hodgman against one plane: keeps the part where dot(plane, v) >= 0.
@@ -244,7 +299,88 @@ void rasterize_clipped_triangle(const ClipVertex (&v)[3], uint32_t triangle, uns
 // pass up to 256² pixels, passes of 11 bits beyond): linear in the fragments, never a loop over every pixel of the
 // viewport. Each pixel with two or more fragments is then sorted by depth into the compact list
 // that scoring walks; a single-fragment pixel only counts, its fragment passes under every order.
+// group_fragments for viewports up to kPixelImageLimit pixels, with the same results: a counting
+// sort whose cost follows the covered pixels, not the viewport. Per-pixel counts live in an image
+// that is all zero between nodes, and a bitmap of the touched pixels is walked in pixel order (64
+// pixels a word); both are returned to zero where touched. A pixel's lone fragment is never moved;
+// the fragments of the other pixels are moved as (depth, triangle) keys, one 64-bit integer each:
+// a depth is a float in [0, 1), whose bits order as its values once −0 is made +0 (adding +0 does
+// that), so the keys compare as the pairs, and equal high halves are equal depths.
+void group_fragments_by_image(NodeRasterizer::State& s) {
+    const size_t n = s.raw_count;
+    const uint32_t pixels = s.resolution * s.resolution;
+    s.pixel_count.resize(pixels);
+    s.touched.resize((size_t(pixels) + 63) / 64);
+    if (s.single_pixels.size() < n) s.single_pixels.resize(n);
+    if (s.multi_pixel.size() < n) s.multi_pixel.resize(n);
+    if (s.multi_start.size() < n + 1) s.multi_start.resize(n + 1);
+    if (s.multi_fragment.size() < n) s.multi_fragment.resize(n);
+    if (s.keys.size() < n + 1) s.keys.resize(n + 1);
+    uint32_t* count = s.pixel_count.data();
+    uint64_t* touched = s.touched.data();
+    const Fragment* raw = s.raw.data();
+    for (size_t f = 0; f < n; ++f) {
+        const uint32_t p = raw[f].pixel;
+        ++count[p];
+        touched[p >> 6] |= uint64_t(1) << (p & 63);
+    }
+    // Pixels in order: a single one is listed; a multiple one gets its slots. Afterwards count[p]
+    // is the pixel's next slot, or for a single pixel kLone | the spare slot past the end.
+    constexpr uint32_t kLone = uint32_t(1) << 31;
+    uint32_t* single = s.single_pixels.data();
+    uint32_t* multi = s.multi_pixel.data();
+    uint32_t* starts = s.multi_start.data();
+    size_t singles = 0, multis = 0;
+    uint32_t offset = 0;
+    for (size_t w = 0; w < s.touched.size(); ++w)
+        for (uint64_t bits_left = touched[w]; bits_left; bits_left &= bits_left - 1) {
+            const uint32_t p = uint32_t(w * 64 + size_t(__builtin_ctzll(bits_left)));
+            const uint32_t c = count[p];
+            single[singles] = p;
+            multi[multis] = p;
+            starts[multis] = offset;
+            singles += c == 1;
+            multis += c != 1;
+            count[p] = c == 1 ? kLone : offset;
+            offset += c == 1 ? 0 : c;
+        }
+    starts[multis] = offset;
+    for (size_t i = 0; i < singles; ++i) count[single[i]] = kLone | offset;
+    uint64_t* keys = s.keys.data();
+    for (size_t f = 0; f < n; ++f) {
+        uint32_t& slot = count[raw[f].pixel];
+        const float depth = raw[f].depth + 0.0f;
+        uint32_t depth_bits;
+        std::memcpy(&depth_bits, &depth, 4);
+        keys[slot & ~kLone] = uint64_t(depth_bits) << 32 | raw[f].triangle;
+        slot += (slot >> 31) ^ 1;
+    }
+    for (size_t i = 0; i < singles; ++i) count[single[i]] = 0;
+    for (size_t i = 0; i < multis; ++i) count[multi[i]] = 0;
+    std::fill(s.touched.begin(), s.touched.end(), 0);
+    // Each multiple pixel: insertion sort of its keys (a handful), then its triangles nearest first.
+    uint32_t* out = s.multi_fragment.data();
+    for (size_t m = 0; m < multis; ++m) {
+        uint64_t* k = keys + starts[m];
+        const size_t c = starts[m + 1] - starts[m];
+        for (size_t j = 1; j < c; ++j) {
+            const uint64_t key = k[j];
+            size_t i = j;
+            for (; i > 0 && k[i - 1] > key; --i) k[i] = k[i - 1];
+            k[i] = key;
+        }
+        uint32_t* o = out + starts[m];
+        o[0] = uint32_t(k[0]);
+        for (size_t j = 1; j < c; ++j) o[j] = uint32_t(k[j]) | ((k[j] >> 32) == (k[j - 1] >> 32) ? kTieBit : 0);
+    }
+    s.single = singles;
+    s.visible = singles + multis;
+    s.multi_count = multis;
+}
+
 void group_fragments(NodeRasterizer::State& s) {
+    const uint32_t image_pixels = s.resolution * s.resolution;
+    if (image_pixels <= kPixelImageLimit) return group_fragments_by_image(s);
     const size_t n = s.raw_count;
     s.sorted.resize(std::max(s.sorted.size(), n));
     const uint32_t pixels = s.resolution * s.resolution;
@@ -272,6 +408,8 @@ void group_fragments(NodeRasterizer::State& s) {
     if (s.multi_fragment.size() < n) s.multi_fragment.resize(n);
     uint32_t* out = s.multi_fragment.data();
     uint32_t written = 0;
+    if (s.keys.size() < n) s.keys.resize(n);
+    uint64_t* key_scratch = s.keys.data();
     for (size_t i = 0; i < n;) {
         size_t end = i + 1;
         while (end < n && from[end].pixel == from[i].pixel) ++end;
@@ -279,21 +417,24 @@ void group_fragments(NodeRasterizer::State& s) {
         if (end - i == 1) {
             s.single_pixels.push_back(from[i].pixel);
         } else {
-            // Insertion sort in place by (depth, triangle): a handful of fragments, deterministic.
-            for (size_t j = i + 1; j < end; ++j) {
-                const Fragment f = from[j];
-                size_t k = j;
-                for (; k > i && (from[k - 1].depth > f.depth ||
-                                 (from[k - 1].depth == f.depth && from[k - 1].triangle > f.triangle));
-                     --k)
-                    from[k] = from[k - 1];
-                from[k] = f;
+            // Insertion sort by (depth, triangle) as one 64-bit key: a depth is a float in [0, 1),
+            // whose bits order as its values once −0 is made +0 (adding +0 does that); so keys
+            // compare as the pair, and equal high halves are equal depths.
+            uint64_t* keys = key_scratch;
+            for (size_t j = i; j < end; ++j) {
+                const float depth = from[j].depth + 0.0f;
+                uint32_t bits_of_depth;
+                std::memcpy(&bits_of_depth, &depth, 4);
+                const uint64_t key = uint64_t(bits_of_depth) << 32 | from[j].triangle;
+                size_t k = j - i;
+                for (; k > 0 && keys[k - 1] > key; --k) keys[k] = keys[k - 1];
+                keys[k] = key;
             }
             s.multi_pixel.push_back(from[i].pixel);
             s.multi_start.push_back(written);
-            out[written++] = from[i].triangle;
-            for (size_t j = i + 1; j < end; ++j)
-                out[written++] = from[j].triangle | (from[j].depth == from[j - 1].depth ? kTieBit : 0);
+            out[written++] = uint32_t(keys[0]);
+            for (size_t j = 1; j < end - i; ++j)
+                out[written++] = uint32_t(keys[j]) | ((keys[j] >> 32) == (keys[j - 1] >> 32) ? kTieBit : 0);
         }
         i = end;
     }
@@ -318,6 +459,31 @@ void NodeRasterizer::visit_fragments(const std::function<void(uint32_t, uint32_t
     for (size_t f = 0; f < s.raw_count; ++f) visit(s.raw[f].pixel, s.raw[f].triangle, s.raw[f].depth);
 }
 
+namespace {
+
+constexpr uint8_t kClippedVertex = 1;  // outside the near, far or guard-band planes: the triangle is clipped
+constexpr uint8_t kWideVertex = 2;     // snapped X or Y not inside ±kCompactLimit (or not a number): exact path
+constexpr int64_t kCompactLimit = int64_t(1) << 24;  // |x| <= 1.5 · 16384 pixels is below 2^23
+// The box test of triangle_box for a batch of triangles whose vertices are all compact and
+// unclipped: int32 arithmetic over arrays that the compiler vectorises. keep[i] is non-zero
+// exactly when the bounding box, clamped to the viewport, holds a pixel centre.
+void batch_box_test(size_t n, const int32_t* x0, const int32_t* y0, const int32_t* x1, const int32_t* y1,
+                    const int32_t* x2, const int32_t* y2, int32_t last, int32_t* keep, int32_t (*box)[4]) {
+    for (size_t i = 0; i < n; ++i) {
+        const int32_t min_x = std::min(x0[i], std::min(x1[i], x2[i])), max_x = std::max(x0[i], std::max(x1[i], x2[i]));
+        const int32_t min_y = std::min(y0[i], std::min(y1[i], y2[i])), max_y = std::max(y0[i], std::max(y1[i], y2[i]));
+        const int32_t px0 = std::max(0, -((-min_x) >> kSubpixelBits)), px1 = std::min(last, max_x >> kSubpixelBits);
+        const int32_t py0 = std::max(0, -((-min_y) >> kSubpixelBits)), py1 = std::min(last, max_y >> kSubpixelBits);
+        keep[i] = int32_t(px0 <= px1) & int32_t(py0 <= py1);
+        box[i][0] = px0;
+        box[i][1] = px1;
+        box[i][2] = py0;
+        box[i][3] = py1;
+    }
+}
+
+}  // namespace
+
 void NodeRasterizer::rasterize(const float* clip_xyzw, size_t vertex_count, const uint32_t* indices, size_t index_count,
                                unsigned resolution, const uint8_t* modes) {
     validate_indices(indices, index_count, vertex_count);
@@ -328,26 +494,112 @@ void NodeRasterizer::rasterize(const float* clip_xyzw, size_t vertex_count, cons
 
     const ClipVertex* cv = reinterpret_cast<const ClipVertex*>(clip_xyzw);
     s.window.resize(vertex_count);
-    s.unclipped.resize(vertex_count);
+    s.snapped.resize(2 * vertex_count);
+    s.vertex_flags.resize(vertex_count);
     for (size_t v = 0; v < vertex_count; ++v) {
-        s.unclipped[v] = inside_all(cv[v]);
-        if (s.unclipped[v]) project(cv[v], resolution, s.window[v]);
+        if (!inside_all(cv[v])) {
+            s.vertex_flags[v] = kClippedVertex;
+            s.snapped[2 * v] = s.snapped[2 * v + 1] = 0;
+            continue;
+        }
+        WindowVertex& w = s.window[v];
+        project(cv[v], resolution, w);
+        const bool compact = w.X > -kCompactLimit && w.X < kCompactLimit && w.Y > -kCompactLimit && w.Y < kCompactLimit;
+        s.vertex_flags[v] = compact ? 0 : kWideVertex;
+        s.snapped[2 * v] = compact ? int32_t(w.X) : 0;
+        s.snapped[2 * v + 1] = compact ? int32_t(w.Y) : 0;
     }
 
+    // Triangles in batches: gather the snapped corners, test area and box for the whole batch at
+    // once, then draw the survivors in triangle order (the order of the fragments is unchanged).
     FragmentSink sink{s.raw};
-    for (size_t t = 0; t < index_count / 3; ++t) {
-        const uint32_t a = indices[3 * t], b = indices[3 * t + 1], c = indices[3 * t + 2];
-        const uint8_t mode = modes ? modes[t] : 0;
-        if (mode & kSkipTriangle) continue;
-        const bool two_sided = (mode & kDrawBothFaces) != 0;
-        if (s.unclipped[a] & s.unclipped[b] & s.unclipped[c]) {
-            const WindowVertex &va = s.window[a], &vb = s.window[b], &vc = s.window[c];
-            TriangleBox box;
-            if (triangle_box(va, vb, vc, resolution, two_sided, box))
-                rasterize_window_triangle(va, vb, vc, box, uint32_t(t), resolution, sink);
-        } else {
-            const ClipVertex v[3] = {cv[a], cv[b], cv[c]};
-            rasterize_clipped_triangle(v, uint32_t(t), resolution, sink, two_sided);
+    const size_t triangle_count = index_count / 3;
+    const int32_t* xy = s.snapped.data();
+    const uint8_t* flags = s.vertex_flags.data();
+    alignas(16) int32_t x0[kBatch], y0[kBatch], x1[kBatch], y1[kBatch], x2[kBatch], y2[kBatch], keep[kBatch];
+    uint8_t two[kBatch];
+    int32_t boxes[kBatch][4];
+    int64_t areas[kBatch];
+    uint8_t special[kBatch];
+    uint32_t draw[kBatch];
+    BatchSetup& setup = s.setup;
+    for (size_t first = 0; first < triangle_count; first += kBatch) {
+        const size_t n = std::min(kBatch, triangle_count - first);
+        const uint32_t* tri = indices + 3 * first;
+        for (size_t i = 0; i < n; ++i) {
+            const uint32_t a = tri[3 * i], b = tri[3 * i + 1], c = tri[3 * i + 2];
+            const uint8_t mode = modes ? modes[first + i] : 0;
+            x0[i] = xy[2 * a];
+            y0[i] = xy[2 * a + 1];
+            x1[i] = xy[2 * b];
+            y1[i] = xy[2 * b + 1];
+            x2[i] = xy[2 * c];
+            y2[i] = xy[2 * c + 1];
+            two[i] = mode & kDrawBothFaces;
+            // Skipped: never drawn; a clipped or wide corner: the exact path below.
+            special[i] = (mode & kSkipTriangle) ? 0 : uint8_t(1 + (flags[a] | flags[b] | flags[c]));
+        }
+        batch_box_test(n, x0, y0, x1, y1, x2, y2, int32_t(resolution - 1), keep, boxes);
+        size_t m = 0;
+        for (size_t i = 0; i < n; ++i) {
+            // As triangle_box: y points down, so OpenGL's counter-clockwise front faces have
+            // negative area; |coordinates| < 2^24 keeps the int64 products exact.
+            const int64_t area = int64_t(x1[i] - x0[i]) * (y2[i] - y0[i]) - int64_t(x2[i] - x0[i]) * (y1[i] - y0[i]);
+            const bool drawn = (area < 0) | ((area > 0) & (two[i] != 0));
+            areas[i] = area;
+            draw[m] = uint32_t(i);
+            m += (special[i] > 1) | ((special[i] == 1) & drawn & (keep[i] != 0));
+        }
+        // The set-up of rasterize_window_triangle for every drawn triangle of the batch at once.
+        // Corners in positive order: 0, 2, 1 for a front face (negative area), else 0, 1, 2.
+        for (size_t j = 0; j < m; ++j) {
+            const size_t i = draw[j];
+            const bool fast = special[i] == 1, front = areas[i] < 0;
+            const size_t t = first + i;
+            const WindowVertex& w0 = s.window[indices[3 * t]];
+            const WindowVertex& w1 = s.window[indices[3 * t + (front ? 2 : 1)]];
+            const WindowVertex& w2 = s.window[indices[3 * t + (front ? 1 : 2)]];
+            setup.X[0][j] = x0[i];
+            setup.Y[0][j] = y0[i];
+            setup.X[1][j] = front ? x2[i] : x1[i];
+            setup.Y[1][j] = front ? y2[i] : y1[i];
+            setup.X[2][j] = front ? x1[i] : x2[i];
+            setup.Y[2][j] = front ? y1[i] : y2[i];
+            setup.px0[j] = boxes[i][0];
+            setup.py0[j] = boxes[i][2];
+            // As rasterize_window_triangle: differences in float, then widened.
+            setup.ax[j] = fast ? w1.x - w0.x : 0.0f;
+            setup.ay[j] = fast ? w1.y - w0.y : 0.0f;
+            setup.az[j] = fast ? w1.z - w0.z : 0.0f;
+            setup.bx[j] = fast ? w2.x - w0.x : 0.0f;
+            setup.by[j] = fast ? w2.y - w0.y : 0.0f;
+            setup.bz[j] = fast ? w2.z - w0.z : 0.0f;
+            setup.x[j] = fast ? w0.x : 0.0f;
+            setup.y[j] = fast ? w0.y : 0.0f;
+            setup.z[j] = fast ? w0.z : 0.0f;
+        }
+        setup.compute(m);
+        for (size_t j = 0; j < m; ++j) {
+            const size_t t = first + draw[j];
+            const uint32_t a = indices[3 * t], b = indices[3 * t + 1], c = indices[3 * t + 2];
+            const bool two_sided = two[draw[j]] != 0;
+            if (special[draw[j]] == 1) {  // passed the pre-pass: its box and set-up are known
+                if (setup.det[j] == 0.0) continue;  // float-degenerate sliver: no fragment has a defined depth
+                const int32_t* known = boxes[draw[j]];
+                const TriangleBox box{areas[draw[j]], known[0], known[1], known[2], known[3]};
+                const int64_t e[3] = {int64_t(setup.e[0][j]), int64_t(setup.e[1][j]), int64_t(setup.e[2][j])};
+                const int64_t sx[3] = {int64_t(setup.sx[0][j]), int64_t(setup.sx[1][j]), int64_t(setup.sx[2][j])};
+                const int64_t sy[3] = {int64_t(setup.sy[0][j]), int64_t(setup.sy[1][j]), int64_t(setup.sy[2][j])};
+                emit_box(e, sx, sy, setup.dzdx[j], setup.dzdy[j], setup.z_origin[j], box, uint32_t(t), resolution, sink);
+            } else if (!((special[draw[j]] - 1) & kClippedVertex)) {
+                const WindowVertex &va = s.window[a], &vb = s.window[b], &vc = s.window[c];
+                TriangleBox box;
+                if (triangle_box(va, vb, vc, resolution, two_sided, box))
+                    rasterize_window_triangle(va, vb, vc, box, uint32_t(t), resolution, sink);
+            } else {
+                const ClipVertex v[3] = {cv[a], cv[b], cv[c]};
+                rasterize_clipped_triangle(v, uint32_t(t), resolution, sink, two_sided);
+            }
         }
     }
     s.raw_count = sink.count;  // the arrays keep their size: no re-zeroing on the next node
@@ -436,7 +688,7 @@ std::vector<uint32_t> NodeRasterizer::passed_per_pixel(const uint32_t* ranks, si
     const State& s = *state_;
     if (order_index >= order_count) throw InvalidInput("order index out of range");
     std::vector<uint32_t> image(size_t(s.resolution) * s.resolution, 0);
-    for (uint32_t p : s.single_pixels) image[p] = 1;
+    for (size_t i = 0; i < s.single; ++i) image[s.single_pixels[i]] = 1;
     std::vector<uint32_t> scratch(2 * order_count);
     for (size_t m = 0; m < s.multi_count; ++m) {
         const uint32_t begin = s.multi_start[m];
@@ -452,9 +704,9 @@ BlendFragments NodeRasterizer::export_blend_fragments(const uint8_t* blended) co
     BlendFragments out;
     // A pixel's lone fragment is counted when blended (no opaque fragment hides it); the grouped
     // lists keep only its pixel, so its triangle comes from the raw fragments.
-    if (!s.single_pixels.empty()) {
+    if (s.single > 0) {
         std::vector<uint8_t> single(size_t(s.resolution) * s.resolution, 0);
-        for (uint32_t p : s.single_pixels) single[p] = 1;
+        for (size_t i = 0; i < s.single; ++i) single[s.single_pixels[i]] = 1;
         for (size_t f = 0; f < s.raw_count; ++f)
             if (single[s.raw[f].pixel] && blended[s.raw[f].triangle]) ++out.covered;
     }

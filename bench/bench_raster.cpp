@@ -1,0 +1,128 @@
+// Per-node cost of the overdraw engine on one thread (issue 19): transform to clip space,
+// NodeRasterizer::rasterize and keep_fragments, as CPU time of this thread (CLOCK_THREAD_CPUTIME_ID,
+// so other processes on a shared machine do not count), over a spread of nodes of a character
+// (default protocol: 162 views, 256², λ = 0.85). Also prints a hash of every output (raw fragments in
+// order, grouped lists, counts, kept nodes): two builds that print the same hash produced the same
+// bits. A plain runner, never a test.
+//
+//   build/bench/bench_raster ../shared/data/glb-xbot/Xbot.glb
+//   build/bench/bench_raster ../shared/data/mixamo-ganfaul/Ganfaul.gltf --clip Idle [--keyframes 4] [--repeat 2]
+#include "animorder/camera.h"
+#include "animorder/kept_fragments.h"
+#include "animorder/load.h"
+#include "animorder/mesh_patches.h"
+#include "animorder/overdraw.h"
+#include "animorder/rasterizer.h"
+#include "animorder/viewpoints.h"
+
+#include <time.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <exception>
+#include <string>
+#include <vector>
+
+using namespace animorder;
+
+namespace {
+
+double thread_seconds() {
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+// FNV-1a over bytes.
+struct Hash {
+    uint64_t h = 1469598103934665603ull;
+    void add(const void* data, size_t bytes) {
+        const auto* p = static_cast<const unsigned char*>(data);
+        for (size_t i = 0; i < bytes; ++i) h = (h ^ p[i]) * 1099511628211ull;
+    }
+    template <typename T>
+    void value(const T& v) {
+        add(&v, sizeof v);
+    }
+};
+
+}  // namespace
+
+int main(int argc, char** argv) try {
+    if (argc < 2) {
+        std::fprintf(stderr, "usage: bench_raster CHARACTER [--clip NAME] [--keyframes N] [--repeat N]\n");
+        return 1;
+    }
+    std::vector<std::string> clips;
+    size_t keyframe_samples = 4, repeats = 2;
+    for (int i = 2; i + 1 < argc; i += 2) {
+        if (!std::strcmp(argv[i], "--clip")) clips.push_back(argv[i + 1]);
+        else if (!std::strcmp(argv[i], "--keyframes")) keyframe_samples = std::strtoul(argv[i + 1], nullptr, 10);
+        else if (!std::strcmp(argv[i], "--repeat")) repeats = std::strtoul(argv[i + 1], nullptr, 10);
+        else {
+            std::fprintf(stderr, "bench_raster: unknown option %s\n", argv[i]);
+            return 1;
+        }
+    }
+    AnimatedMesh mesh = load_character(argv[1]);
+    if (!clips.empty()) mesh = select_clips(mesh, clips);
+    const Framing framing = frame_animated_mesh(mesh);
+    const MeshPatches patches = build_mesh_patches(mesh, 0.85);
+    const UnitPartition partition = make_unit_partition(patches.patch_starts.data(), patches.patch_count(),
+                                                        patches.cache_order.data(), mesh.triangle_count());
+    const std::vector<float> directions = icosphere_directions(icosphere_subdivisions_for(162));
+    const size_t views = directions.size() / 3;
+    const std::vector<uint8_t> modes = opaque_pass_modes(mesh);
+    const size_t step = std::max<size_t>(1, mesh.keyframe_count() / std::max<size_t>(1, keyframe_samples));
+
+    std::vector<float> clip(mesh.vertex_count * 4);
+    NodeRasterizer rasterizer;
+    KeepScratch scratch;
+    double transform_s = 0, raster_s = 0, keep_s = 0;
+    size_t nodes = 0, fragments = 0;
+    Hash hash;
+    for (size_t rep = 0; rep < repeats; ++rep)
+        for (size_t k = 0; k < mesh.keyframe_count(); k += step)
+            for (size_t v = 0; v < views; ++v) {
+                const double t0 = thread_seconds();
+                transform_to_clip(clip.data(), mesh.keyframe(uint32_t(k)), mesh.vertex_count, &framing.centres[3 * k],
+                                  node_view_projection(&directions[3 * v], framing.radius));
+                const double t1 = thread_seconds();
+                rasterizer.rasterize(clip.data(), mesh.vertex_count, mesh.indices.data(), mesh.indices.size(), 256,
+                                     modes.empty() ? nullptr : modes.data());
+                const double t2 = thread_seconds();
+                const NodeRasterizer::FragmentLists lists = rasterizer.fragment_lists();
+                const KeptNode kept = keep_fragments(lists.visible, lists.single, lists.starts, lists.pixels,
+                                                     lists.fragments, partition, scratch);
+                const double t3 = thread_seconds();
+                transform_s += t1 - t0;
+                raster_s += t2 - t1;
+                keep_s += t3 - t2;
+                ++nodes;
+                fragments += rasterizer.fragments();
+                if (rep == 0) {
+                    rasterizer.visit_fragments([&](uint32_t p, uint32_t t, float z) {
+                        hash.value(p);
+                        hash.value(t);
+                        hash.value(z);
+                    });
+                    hash.value(lists.visible);
+                    hash.value(lists.single);
+                    hash.value(lists.pixels);
+                    if (lists.pixels) {
+                        hash.add(lists.starts, (lists.pixels + 1) * 4);
+                        hash.add(lists.fragments + lists.starts[0], (lists.starts[lists.pixels] - lists.starts[0]) * 4);
+                    }
+                    hash.add(kept.data.data(), kept.data.size());
+                }
+            }
+    std::printf("%zu triangles, %zu nodes, %.0f fragments/node: transform %.3f ms/node, rasterize %.3f ms/node, "
+                "keep %.3f ms/node (thread CPU time); output hash %016llx\n",
+                mesh.triangle_count(), nodes, double(fragments) / double(nodes), 1e3 * transform_s / double(nodes),
+                1e3 * raster_s / double(nodes), 1e3 * keep_s / double(nodes), (unsigned long long)hash.h);
+    return 0;
+} catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_raster: %s\n", e.what());
+    return 1;
+}

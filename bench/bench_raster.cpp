@@ -1,5 +1,5 @@
 // Per-node cost of the overdraw engine on one thread (issue 19): transform to clip space,
-// NodeRasterizer::rasterize and keep_fragments, as CPU time of this thread (CLOCK_THREAD_CPUTIME_ID,
+// NodeRasterizer::rasterize_validated and keep_fragments, as CPU time of this thread (CLOCK_THREAD_CPUTIME_ID,
 // so other processes on a shared machine do not count), over a spread of nodes of a character
 // (default protocol: 162 views, 256², λ = 0.85). Also prints a hash of every output (raw fragments in
 // order, grouped lists, counts, kept nodes): two builds that print the same hash produced the same
@@ -13,6 +13,7 @@
 #include "animorder/mesh_patches.h"
 #include "animorder/overdraw.h"
 #include "animorder/rasterizer.h"
+#include "animorder/triangle_order.h"
 #include "animorder/viewpoints.h"
 
 #include <time.h>
@@ -77,6 +78,7 @@ int main(int argc, char** argv) try {
     const size_t step = std::max<size_t>(1, mesh.keyframe_count() / std::max<size_t>(1, keyframe_samples));
 
     std::vector<float> clip(mesh.vertex_count * 4);
+    validate_indices(mesh.indices.data(), mesh.indices.size(), mesh.vertex_count);  // once, as NodeCache does
     NodeRasterizer rasterizer;
     KeepScratch scratch;
     double transform_s = 0, raster_s = 0, keep_s = 0;
@@ -89,8 +91,8 @@ int main(int argc, char** argv) try {
                 transform_to_clip(clip.data(), mesh.keyframe(uint32_t(k)), mesh.vertex_count, &framing.centres[3 * k],
                                   node_view_projection(&directions[3 * v], framing.radius));
                 const double t1 = thread_seconds();
-                rasterizer.rasterize(clip.data(), mesh.vertex_count, mesh.indices.data(), mesh.indices.size(), 256,
-                                     modes.empty() ? nullptr : modes.data());
+                rasterizer.rasterize_validated(clip.data(), mesh.vertex_count, mesh.indices.data(), mesh.indices.size(),
+                                               256, modes.empty() ? nullptr : modes.data());
                 const double t2 = thread_seconds();
                 const NodeRasterizer::FragmentLists lists = rasterizer.fragment_lists();
                 const KeptNode kept = keep_fragments(lists.visible, lists.single, lists.starts, lists.pixels,

@@ -487,6 +487,11 @@ void batch_box_test(size_t n, const int32_t* x0, const int32_t* y0, const int32_
 void NodeRasterizer::rasterize(const float* clip_xyzw, size_t vertex_count, const uint32_t* indices, size_t index_count,
                                unsigned resolution, const uint8_t* modes) {
     validate_indices(indices, index_count, vertex_count);
+    rasterize_validated(clip_xyzw, vertex_count, indices, index_count, resolution, modes);
+}
+
+void NodeRasterizer::rasterize_validated(const float* clip_xyzw, size_t vertex_count, const uint32_t* indices,
+                                         size_t index_count, unsigned resolution, const uint8_t* modes) {
     if (resolution == 0 || resolution > 16384)
         throw InvalidInput("resolution " + std::to_string(resolution) + " is outside 1..16384");
     State& s = *state_;

@@ -35,6 +35,15 @@
 #include <cstring>
 #include <string>
 
+// The per-node code is compiled twice (rasterize_node below): portable (SSE2 on x86-64) and, on
+// x86 with GCC or Clang, for AVX2, run where the CPU has it (wider vectors for the batched
+// pre-pass and set-up). Both do the same IEEE operations in the same order (no FMA: AVX2 alone
+// does not allow contraction), so they give the same bits; test_rasterizer compares them.
+#if (defined(__GNUC__) || defined(__clang__)) && (defined(__x86_64__) || defined(__i386__))
+#define ANIMORDER_RASTER_AVX2 1
+#endif
+#define ANIMORDER_INLINE inline __attribute__((always_inline))
+
 namespace animorder {
 
 // A vertex in window space: snapped fixed-point x and y (y down, pixel centres at integer
@@ -66,7 +75,7 @@ struct BatchSetup {
     // Out: edge functions at the first pixel centre and their steps, the plane.
     double e[3][kBatch], sx[3][kBatch], sy[3][kBatch], det[kBatch], dzdx[kBatch], dzdy[kBatch], z_origin[kBatch];
 
-    void compute(size_t n) {
+    ANIMORDER_INLINE void compute(size_t n) {
         for (int k = 0; k < 3; ++k) {
             const int b = (k + 1) % 3;
             for (size_t j = 0; j < n; ++j) {
@@ -111,6 +120,7 @@ struct NodeRasterizer::State {
     std::vector<int32_t> snapped;
     std::vector<uint8_t> vertex_flags;
     std::vector<float> plane;
+    bool simd = true;                 // the AVX2 copy where the CPU has it (set_simd)
     std::vector<uint32_t> histogram;  // counting sort of the fragments by pixel
     std::vector<uint32_t> pixel_count;  // per pixel, zero between nodes (kPixelImageLimit pixels at most)
     std::vector<uint64_t> touched;      // bitmap of the pixels with fragments, zero between nodes
@@ -185,9 +195,9 @@ inline bool triangle_box(const WindowVertex& v0, const WindowVertex& v1, const W
 // Writes the fragments of one set-up triangle: edge functions at the box's first pixel centre and
 // their steps, the depth plane. Every pixel of the box is written and the count advances only for
 // a covered pixel whose depth lies in [0, 1): no branch on coverage.
-inline void emit_box(const int64_t (&e_first)[3], const int64_t (&step_x)[3], const int64_t (&step_y)[3], double dzdx,
-                     double dzdy, double z_origin, const TriangleBox& box, uint32_t triangle, unsigned resolution,
-                     FragmentSink& sink) {
+ANIMORDER_INLINE void emit_box(const int64_t (&e_first)[3], const int64_t (&step_x)[3], const int64_t (&step_y)[3],
+                               double dzdx, double dzdy, double z_origin, const TriangleBox& box, uint32_t triangle,
+                               unsigned resolution, FragmentSink& sink) {
     const int64_t px0 = box.px0, px1 = box.px1, py0 = box.py0, py1 = box.py1;
     int64_t e_row[3] = {e_first[0], e_first[1], e_first[2]};
     sink.reserve_more(size_t(px1 - px0 + 1) * size_t(py1 - py0 + 1));
@@ -216,9 +226,9 @@ inline void emit_box(const int64_t (&e_first)[3], const int64_t (&step_x)[3], co
 // emit_box for a box of at most 2 × 2 pixels (most drawn triangles of a character at 256²):
 // its four pixels unrolled, those past the box's right or bottom end masked like uncovered ones,
 // so no loop exit to mispredict. The same arithmetic and the same fragment order as emit_box.
-inline void emit_small_box(const int64_t (&e)[3], const int64_t (&step_x)[3], const int64_t (&step_y)[3], double dzdx,
-                           double dzdy, double z_origin, const TriangleBox& box, uint32_t triangle, unsigned resolution,
-                           FragmentSink& sink) {
+ANIMORDER_INLINE void emit_small_box(const int64_t (&e)[3], const int64_t (&step_x)[3], const int64_t (&step_y)[3],
+                                     double dzdx, double dzdy, double z_origin, const TriangleBox& box,
+                                     uint32_t triangle, unsigned resolution, FragmentSink& sink) {
     sink.reserve_more(4);
     Fragment* out = sink.fragments.data();
     size_t count = sink.count;
@@ -501,8 +511,9 @@ constexpr int32_t kSpecialVertex = int32_t(1) << 30;
 // The box test of triangle_box for a batch of triangles whose vertices are all compact and
 // unclipped: int32 arithmetic over arrays that the compiler vectorises. keep[i] is non-zero
 // exactly when the bounding box, clamped to the viewport, holds a pixel centre.
-void batch_box_test(size_t n, const int32_t* x0, const int32_t* y0, const int32_t* x1, const int32_t* y1,
-                    const int32_t* x2, const int32_t* y2, int32_t last, int32_t* keep, int32_t (*box)[4]) {
+ANIMORDER_INLINE void batch_box_test(size_t n, const int32_t* x0, const int32_t* y0, const int32_t* x1,
+                                     const int32_t* y1, const int32_t* x2, const int32_t* y2, int32_t last,
+                                     int32_t* keep, int32_t (*box)[4]) {
     for (size_t i = 0; i < n; ++i) {
         const int32_t min_x = std::min(x0[i], std::min(x1[i], x2[i])), max_x = std::max(x0[i], std::max(x1[i], x2[i]));
         const int32_t min_y = std::min(y0[i], std::min(y1[i], y2[i])), max_y = std::max(y0[i], std::max(y1[i], y2[i]));
@@ -518,6 +529,15 @@ void batch_box_test(size_t n, const int32_t* x0, const int32_t* y0, const int32_
 
 }  // namespace
 
+namespace {
+void rasterize_node_portable(NodeRasterizer::State& s, const float* clip_xyzw, size_t vertex_count,
+                             const uint32_t* indices, size_t index_count, unsigned resolution, const uint8_t* modes);
+#ifdef ANIMORDER_RASTER_AVX2
+void rasterize_node_avx2(NodeRasterizer::State& s, const float* clip_xyzw, size_t vertex_count, const uint32_t* indices,
+                         size_t index_count, unsigned resolution, const uint8_t* modes);
+#endif
+}  // namespace
+
 void NodeRasterizer::rasterize(const float* clip_xyzw, size_t vertex_count, const uint32_t* indices, size_t index_count,
                                unsigned resolution, const uint8_t* modes) {
     validate_indices(indices, index_count, vertex_count);
@@ -530,7 +550,31 @@ void NodeRasterizer::rasterize_validated(const float* clip_xyzw, size_t vertex_c
         throw InvalidInput("resolution " + std::to_string(resolution) + " is outside 1..16384");
     State& s = *state_;
     s.resolution = resolution;
+#ifdef ANIMORDER_RASTER_AVX2
+    if (s.simd && simd_available())
+        return rasterize_node_avx2(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes);
+#endif
+    rasterize_node_portable(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes);
+}
 
+bool NodeRasterizer::simd_available() {
+#ifdef ANIMORDER_RASTER_AVX2
+    static const bool avx2 = __builtin_cpu_supports("avx2");
+    return avx2;
+#else
+    return false;
+#endif
+}
+
+void NodeRasterizer::set_simd(bool allowed) { state_->simd = allowed; }
+
+namespace {
+
+// One node after the checks: project the vertices, pre-pass and set up the triangles in
+// batches, draw them, group the fragments. Inlined into the two copies below.
+ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip_xyzw, size_t vertex_count,
+                                     const uint32_t* indices, size_t index_count, unsigned resolution,
+                                     const uint8_t* modes) {
     const ClipVertex* cv = reinterpret_cast<const ClipVertex*>(clip_xyzw);
     s.snapped.resize(2 * vertex_count);
     s.vertex_flags.resize(vertex_count);
@@ -661,6 +705,22 @@ void NodeRasterizer::rasterize_validated(const float* clip_xyzw, size_t vertex_c
 
     group_fragments(s);
 }
+
+void rasterize_node_portable(NodeRasterizer::State& s, const float* clip_xyzw, size_t vertex_count,
+                             const uint32_t* indices, size_t index_count, unsigned resolution, const uint8_t* modes) {
+    rasterize_node(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes);
+}
+
+#ifdef ANIMORDER_RASTER_AVX2
+__attribute__((target("avx2"))) void rasterize_node_avx2(NodeRasterizer::State& s, const float* clip_xyzw,
+                                                         size_t vertex_count, const uint32_t* indices,
+                                                         size_t index_count, unsigned resolution,
+                                                         const uint8_t* modes) {
+    rasterize_node(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes);
+}
+#endif
+
+}  // namespace
 
 namespace {
 

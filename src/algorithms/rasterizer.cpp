@@ -607,10 +607,10 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
     const uint8_t* flags = s.vertex_flags.data();
     const float* plane = s.plane.data();
     alignas(16) int32_t x0[kBatch], y0[kBatch], x1[kBatch], y1[kBatch], x2[kBatch], y2[kBatch], keep[kBatch];
-    uint8_t two[kBatch];
+    int32_t two[kBatch];
     int32_t boxes[kBatch][4];
     int64_t areas[kBatch];
-    uint8_t special[kBatch];
+    int32_t special[kBatch];
     uint32_t draw[kBatch];
     BatchSetup& setup = s.setup;
     for (size_t first = 0; first < triangle_count; first += kBatch) {
@@ -628,18 +628,21 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
             two[i] = mode & kDrawBothFaces;
             // Skipped: never drawn (0); a clipped or wide corner: an exact path below (2).
             const bool exact = (x0[i] == kSpecialVertex) | (x1[i] == kSpecialVertex) | (x2[i] == kSpecialVertex);
-            special[i] = (mode & kSkipTriangle) ? 0 : uint8_t(1 + exact);
+            special[i] = (mode & kSkipTriangle) ? 0 : 1 + int32_t(exact);
         }
         batch_box_test(n, x0, y0, x1, y1, x2, y2, int32_t(resolution - 1), keep, boxes);
-        size_t m = 0;
-        for (size_t i = 0; i < n; ++i) {
+        for (size_t i = 0; i < n; ++i) {  // int32 and int64 lanes only: vectorised
             // As triangle_box: y points down, so OpenGL's counter-clockwise front faces have
             // negative area; |coordinates| < 2^24 keeps the int64 products exact.
             const int64_t area = int64_t(x1[i] - x0[i]) * (y2[i] - y0[i]) - int64_t(x2[i] - x0[i]) * (y1[i] - y0[i]);
-            const bool drawn = (area < 0) | ((area > 0) & (two[i] != 0));
+            const int32_t drawn = int32_t(area < 0) | (int32_t(area > 0) & two[i]);
             areas[i] = area;
+            keep[i] = int32_t(special[i] > 1) | (int32_t(special[i] == 1) & drawn & keep[i]);
+        }
+        size_t m = 0;
+        for (size_t i = 0; i < n; ++i) {
             draw[m] = uint32_t(i);
-            m += (special[i] > 1) | ((special[i] == 1) & drawn & (keep[i] != 0));
+            m += size_t(keep[i]);
         }
         // The set-up of rasterize_window_triangle for every drawn triangle of the batch at once.
         // Corners in positive order: 0, 2, 1 for a front face (negative area), else 0, 1, 2.

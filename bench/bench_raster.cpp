@@ -7,6 +7,7 @@
 //
 //   build/bench/bench_raster ../shared/data/glb-xbot/Xbot.glb
 //   build/bench/bench_raster ../shared/data/mixamo-ganfaul/Ganfaul.gltf --clip Idle [--keyframes 4] [--repeat 2]
+//   ... --simd 0: the rasteriser's portable copy even where the CPU has AVX2
 #include "animorder/camera.h"
 #include "animorder/kept_fragments.h"
 #include "animorder/load.h"
@@ -52,15 +53,18 @@ struct Hash {
 
 int main(int argc, char** argv) try {
     if (argc < 2) {
-        std::fprintf(stderr, "usage: bench_raster CHARACTER [--clip NAME] [--keyframes N] [--repeat N]\n");
+        std::fprintf(stderr, "usage: bench_raster CHARACTER [--clip NAME] [--keyframes N] [--repeat N] [--simd 0|1]\n");
         return 1;
     }
     std::vector<std::string> clips;
     size_t keyframe_samples = 4, repeats = 2;
+    bool simd = true;
     for (int i = 2; i + 1 < argc; i += 2) {
         if (!std::strcmp(argv[i], "--clip")) clips.push_back(argv[i + 1]);
         else if (!std::strcmp(argv[i], "--keyframes")) keyframe_samples = std::strtoul(argv[i + 1], nullptr, 10);
         else if (!std::strcmp(argv[i], "--repeat")) repeats = std::strtoul(argv[i + 1], nullptr, 10);
+        else if (!std::strcmp(argv[i], "--simd"))
+            simd = std::strcmp(argv[i + 1], "0") != 0;
         else {
             std::fprintf(stderr, "bench_raster: unknown option %s\n", argv[i]);
             return 1;
@@ -80,6 +84,7 @@ int main(int argc, char** argv) try {
     std::vector<float> clip(mesh.vertex_count * 4);
     validate_indices(mesh.indices.data(), mesh.indices.size(), mesh.vertex_count);  // once, as NodeCache does
     NodeRasterizer rasterizer;
+    rasterizer.set_simd(simd);
     KeepScratch scratch;
     double transform_s = 0, raster_s = 0, keep_s = 0;
     size_t nodes = 0, fragments = 0;
@@ -119,6 +124,7 @@ int main(int argc, char** argv) try {
                     hash.add(kept.data.data(), kept.data.size());
                 }
             }
+    std::printf("%s: ", simd && NodeRasterizer::simd_available() ? "AVX2 copy" : "portable copy");
     std::printf("%zu triangles, %zu nodes, %.0f fragments/node: transform %.3f ms/node, rasterize %.3f ms/node, "
                 "keep %.3f ms/node (thread CPU time); output hash %016llx\n",
                 mesh.triangle_count(), nodes, double(fragments) / double(nodes), 1e3 * transform_s / double(nodes),

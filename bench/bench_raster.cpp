@@ -1,5 +1,5 @@
 // Per-node cost of the overdraw engine on one thread (issue 19): transform to clip space,
-// NodeRasterizer::rasterize and keep_fragments, as CPU time of this thread (CLOCK_THREAD_CPUTIME_ID,
+// NodeRasterizer::rasterize_validated and keep_fragments, as CPU time of this thread (CLOCK_THREAD_CPUTIME_ID,
 // so other processes on a shared machine do not count), over a spread of nodes of a character
 // (default protocol: 162 views, 256², λ = 0.85). Also prints a hash of every output (raw fragments in
 // order, grouped lists, counts, kept nodes): two builds that print the same hash produced the same
@@ -7,12 +7,14 @@
 //
 //   build/bench/bench_raster ../shared/data/glb-xbot/Xbot.glb
 //   build/bench/bench_raster ../shared/data/mixamo-ganfaul/Ganfaul.gltf --clip Idle [--keyframes 4] [--repeat 2]
+//   ... --simd 0: the rasteriser's portable copy even where the CPU has AVX2
 #include "animorder/camera.h"
 #include "animorder/kept_fragments.h"
 #include "animorder/load.h"
 #include "animorder/mesh_patches.h"
 #include "animorder/overdraw.h"
 #include "animorder/rasterizer.h"
+#include "animorder/triangle_order.h"
 #include "animorder/viewpoints.h"
 
 #include <time.h>
@@ -51,15 +53,18 @@ struct Hash {
 
 int main(int argc, char** argv) try {
     if (argc < 2) {
-        std::fprintf(stderr, "usage: bench_raster CHARACTER [--clip NAME] [--keyframes N] [--repeat N]\n");
+        std::fprintf(stderr, "usage: bench_raster CHARACTER [--clip NAME] [--keyframes N] [--repeat N] [--simd 0|1]\n");
         return 1;
     }
     std::vector<std::string> clips;
     size_t keyframe_samples = 4, repeats = 2;
+    bool simd = true;
     for (int i = 2; i + 1 < argc; i += 2) {
         if (!std::strcmp(argv[i], "--clip")) clips.push_back(argv[i + 1]);
         else if (!std::strcmp(argv[i], "--keyframes")) keyframe_samples = std::strtoul(argv[i + 1], nullptr, 10);
         else if (!std::strcmp(argv[i], "--repeat")) repeats = std::strtoul(argv[i + 1], nullptr, 10);
+        else if (!std::strcmp(argv[i], "--simd"))
+            simd = std::strcmp(argv[i + 1], "0") != 0;
         else {
             std::fprintf(stderr, "bench_raster: unknown option %s\n", argv[i]);
             return 1;
@@ -77,7 +82,9 @@ int main(int argc, char** argv) try {
     const size_t step = std::max<size_t>(1, mesh.keyframe_count() / std::max<size_t>(1, keyframe_samples));
 
     std::vector<float> clip(mesh.vertex_count * 4);
+    validate_indices(mesh.indices.data(), mesh.indices.size(), mesh.vertex_count);  // once, as NodeCache does
     NodeRasterizer rasterizer;
+    rasterizer.set_simd(simd);
     KeepScratch scratch;
     double transform_s = 0, raster_s = 0, keep_s = 0;
     size_t nodes = 0, fragments = 0;
@@ -89,8 +96,8 @@ int main(int argc, char** argv) try {
                 transform_to_clip(clip.data(), mesh.keyframe(uint32_t(k)), mesh.vertex_count, &framing.centres[3 * k],
                                   node_view_projection(&directions[3 * v], framing.radius));
                 const double t1 = thread_seconds();
-                rasterizer.rasterize(clip.data(), mesh.vertex_count, mesh.indices.data(), mesh.indices.size(), 256,
-                                     modes.empty() ? nullptr : modes.data());
+                rasterizer.rasterize_validated(clip.data(), mesh.vertex_count, mesh.indices.data(), mesh.indices.size(),
+                                               256, modes.empty() ? nullptr : modes.data());
                 const double t2 = thread_seconds();
                 const NodeRasterizer::FragmentLists lists = rasterizer.fragment_lists();
                 const KeptNode kept = keep_fragments(lists.visible, lists.single, lists.starts, lists.pixels,
@@ -117,6 +124,7 @@ int main(int argc, char** argv) try {
                     hash.add(kept.data.data(), kept.data.size());
                 }
             }
+    std::printf("%s: ", simd && NodeRasterizer::simd_available() ? "AVX2 copy" : "portable copy");
     std::printf("%zu triangles, %zu nodes, %.0f fragments/node: transform %.3f ms/node, rasterize %.3f ms/node, "
                 "keep %.3f ms/node (thread CPU time); output hash %016llx\n",
                 mesh.triangle_count(), nodes, double(fragments) / double(nodes), 1e3 * transform_s / double(nodes),

@@ -33,6 +33,18 @@ public:
     void rasterize(const float* clip_xyzw, size_t vertex_count, const uint32_t* indices, size_t index_count,
                    unsigned resolution, const uint8_t* modes = nullptr);
 
+    // rasterize for indices the caller has already checked with validate_indices against this
+    // vertex_count (a mesh drawn at many nodes is checked once, not once per node). Unchecked
+    // indices here are undefined behaviour; everything else (the resolution) is still checked.
+    void rasterize_validated(const float* clip_xyzw, size_t vertex_count, const uint32_t* indices, size_t index_count,
+                             unsigned resolution, const uint8_t* modes = nullptr);
+
+    // Where the CPU has AVX2 (simd_available), rasterize runs a copy of its per-node code compiled
+    // for it: the same operations in the same order, so the same bits. set_simd(false) makes this
+    // instance run the portable copy (tests compare the two).
+    static bool simd_available();
+    void set_simd(bool allowed);
+
     // Pixels covered by at least one fragment (what the depth buffer shows after any order).
     uint64_t visible_pixels() const;
     // Fragments generated (what a draw with the depth test off would shade).

@@ -111,8 +111,8 @@ void score_nodes(uint64_t* visible, uint64_t* passed, const float* keyframe_posi
             const Mat4d vp = node_view_projection(node.direction, framing.radius);
             transform_to_clip(w.clip.data(), keyframe_positions + size_t(node.keyframe) * vertex_count * 3,
                               vertex_count, framing.centres.data() + 3 * size_t(node.keyframe), vp);
-            w.rasterizer.rasterize(w.clip.data(), vertex_count, indices, index_count, settings.resolution,
-                                   settings.triangle_modes);
+            w.rasterizer.rasterize_validated(w.clip.data(), vertex_count, indices, index_count, settings.resolution,
+                                             settings.triangle_modes);
             visible[n] = w.rasterizer.visible_pixels();
             w.rasterizer.score(passed + n * order_count, ranks, order_count);
             progress.node_done();
@@ -150,8 +150,8 @@ std::vector<NodeFragments> rasterize_nodes(const float* keyframe_positions, size
             transform_to_clip(w.clip.data(), keyframe_positions + size_t(node.keyframe) * vertex_count * 3,
                               vertex_count, framing.centres.data() + 3 * size_t(node.keyframe),
                               node_view_projection(node.direction, framing.radius));
-            w.rasterizer.rasterize(w.clip.data(), vertex_count, indices, index_count, settings.resolution,
-                                   settings.triangle_modes);
+            w.rasterizer.rasterize_validated(w.clip.data(), vertex_count, indices, index_count, settings.resolution,
+                                             settings.triangle_modes);
             kept[n] = w.rasterizer.export_fragments();
             if ((total += kept[n].bytes()) > max_bytes) too_big = true;
             progress.node_done();
@@ -205,8 +205,8 @@ void NodeCache::rasterize_node(Worker& w, size_t n) const {
     transform_to_clip(w.clip.data(), positions_ + size_t(node.keyframe) * vertex_count_ * 3, vertex_count_,
                       framing_.centres.data() + 3 * size_t(node.keyframe),
                       node_view_projection(node.direction, framing_.radius));
-    w.rasterizer.rasterize(w.clip.data(), vertex_count_, indices_, index_count_, settings_.resolution,
-                           settings_.triangle_modes);
+    w.rasterizer.rasterize_validated(w.clip.data(), vertex_count_, indices_, index_count_, settings_.resolution,
+                                     settings_.triangle_modes);
 }
 
 NodeCache::NodeCache(const float* keyframe_positions, size_t vertex_count, const Framing& framing,

@@ -35,6 +35,15 @@
 #include <cstring>
 #include <string>
 
+// The per-node code is compiled twice (rasterize_node below): portable (SSE2 on x86-64) and, on
+// x86 with GCC or Clang, for AVX2, run where the CPU has it (wider vectors for the batched
+// pre-pass and set-up). Both do the same IEEE operations in the same order (no FMA: AVX2 alone
+// does not allow contraction), so they give the same bits; test_rasterizer compares them.
+#if (defined(__GNUC__) || defined(__clang__)) && (defined(__x86_64__) || defined(__i386__))
+#define ANIMORDER_RASTER_AVX2 1
+#endif
+#define ANIMORDER_INLINE inline __attribute__((always_inline))
+
 namespace animorder {
 
 // A vertex in window space: snapped fixed-point x and y (y down, pixel centres at integer
@@ -66,7 +75,7 @@ struct BatchSetup {
     // Out: edge functions at the first pixel centre and their steps, the plane.
     double e[3][kBatch], sx[3][kBatch], sy[3][kBatch], det[kBatch], dzdx[kBatch], dzdy[kBatch], z_origin[kBatch];
 
-    void compute(size_t n) {
+    ANIMORDER_INLINE void compute(size_t n) {
         for (int k = 0; k < 3; ++k) {
             const int b = (k + 1) % 3;
             for (size_t j = 0; j < n; ++j) {
@@ -103,12 +112,15 @@ struct NodeRasterizer::State {
     size_t multi_count = 0;
     std::vector<uint32_t> multi_pixel, multi_start, multi_fragment;
     uint64_t visible = 0, single = 0;
-    // Per-vertex setup, done once per node rather than once per triangle corner.
-    std::vector<WindowVertex> window;
-    // The batched pre-pass's view of the vertices: snapped X, Y as int32 pairs, and why a vertex
-    // cannot take the pre-pass (kClippedVertex, kWideVertex; 0 when it can).
+    // Per-vertex setup, done once per node rather than once per triangle corner. The batched
+    // pre-pass's view of the vertices: snapped X, Y as int32 pairs (kSpecialVertex for a vertex that
+    // cannot take the pre-pass), why it cannot (kClippedVertex, kWideVertex; 0 when it can), and
+    // the window-space x, y, z of the depth plane (4 floats a vertex, the fourth unused). The rare
+    // triangles of the exact paths project their corners again (the same function, the same bits).
     std::vector<int32_t> snapped;
     std::vector<uint8_t> vertex_flags;
+    std::vector<float> plane;
+    bool simd = true;                 // the AVX2 copy where the CPU has it (set_simd)
     std::vector<uint32_t> histogram;  // counting sort of the fragments by pixel
     std::vector<uint32_t> pixel_count;  // per pixel, zero between nodes (kPixelImageLimit pixels at most)
     std::vector<uint64_t> touched;      // bitmap of the pixels with fragments, zero between nodes
@@ -146,7 +158,7 @@ struct FragmentSink {
     }
 };
 
-void project(const ClipVertex& v, unsigned resolution, WindowVertex& out) {
+inline void project(const ClipVertex& v, unsigned resolution, WindowVertex& out) {
     const float half = 0.5f * float(resolution);
     const float inv_w = 1.0f / v.w;
     const float x = v.x * inv_w * half + half;  // OpenGL window coordinates, y up
@@ -183,9 +195,9 @@ inline bool triangle_box(const WindowVertex& v0, const WindowVertex& v1, const W
 // Writes the fragments of one set-up triangle: edge functions at the box's first pixel centre and
 // their steps, the depth plane. Every pixel of the box is written and the count advances only for
 // a covered pixel whose depth lies in [0, 1): no branch on coverage.
-inline void emit_box(const int64_t (&e_first)[3], const int64_t (&step_x)[3], const int64_t (&step_y)[3], double dzdx,
-                     double dzdy, double z_origin, const TriangleBox& box, uint32_t triangle, unsigned resolution,
-                     FragmentSink& sink) {
+ANIMORDER_INLINE void emit_box(const int64_t (&e_first)[3], const int64_t (&step_x)[3], const int64_t (&step_y)[3],
+                               double dzdx, double dzdy, double z_origin, const TriangleBox& box, uint32_t triangle,
+                               unsigned resolution, FragmentSink& sink) {
     const int64_t px0 = box.px0, px1 = box.px1, py0 = box.py0, py1 = box.py1;
     int64_t e_row[3] = {e_first[0], e_first[1], e_first[2]};
     sink.reserve_more(size_t(px1 - px0 + 1) * size_t(py1 - py0 + 1));
@@ -207,6 +219,35 @@ inline void emit_box(const int64_t (&e_first)[3], const int64_t (&step_x)[3], co
         e_row[0] += step_y[0];
         e_row[1] += step_y[1];
         e_row[2] += step_y[2];
+    }
+    sink.count = count;
+}
+
+// emit_box for a box of at most 2 × 2 pixels (most drawn triangles of a character at 256²):
+// its four pixels unrolled, those past the box's right or bottom end masked like uncovered ones,
+// so no loop exit to mispredict. The same arithmetic and the same fragment order as emit_box.
+ANIMORDER_INLINE void emit_small_box(const int64_t (&e)[3], const int64_t (&step_x)[3], const int64_t (&step_y)[3],
+                                     double dzdx, double dzdy, double z_origin, const TriangleBox& box,
+                                     uint32_t triangle, unsigned resolution, FragmentSink& sink) {
+    sink.reserve_more(4);
+    Fragment* out = sink.fragments.data();
+    size_t count = sink.count;
+    const bool wide = box.px1 > box.px0, tall = box.py1 > box.py0;
+    const double x0 = double(box.px0), x1 = x0 + 1.0;
+    for (int dy = 0; dy < 2; ++dy) {
+        const int64_t py = box.py0 + dy;
+        const double z_row = z_origin + dzdy * double(py);
+        const uint32_t row = uint32_t(py * resolution) + uint32_t(box.px0);
+        const bool row_in = dy == 0 || tall;
+        const int64_t a0 = e[0] + (dy ? step_y[0] : 0), a1 = e[1] + (dy ? step_y[1] : 0),
+                      a2 = e[2] + (dy ? step_y[2] : 0);
+        const float d0 = float(z_row + dzdx * x0);
+        out[count] = {row, triangle, d0};
+        count += size_t(row_in) & size_t((a0 | a1 | a2) >= 0) & size_t(d0 < 1.0f) & size_t(d0 >= 0.0f);
+        const float d1 = float(z_row + dzdx * x1);
+        const int64_t b0 = a0 + step_x[0], b1 = a1 + step_x[1], b2 = a2 + step_x[2];
+        out[count] = {row + 1, triangle, d1};
+        count += size_t(row_in & wide) & size_t((b0 | b1 | b2) >= 0) & size_t(d1 < 1.0f) & size_t(d1 >= 0.0f);
     }
     sink.count = count;
 }
@@ -464,11 +505,15 @@ namespace {
 constexpr uint8_t kClippedVertex = 1;  // outside the near, far or guard-band planes: the triangle is clipped
 constexpr uint8_t kWideVertex = 2;     // snapped X or Y not inside ±kCompactLimit (or not a number): exact path
 constexpr int64_t kCompactLimit = int64_t(1) << 24;  // |x| <= 1.5 · 16384 pixels is below 2^23
+// The snapped X and Y of a clipped or wide vertex: outside ±kCompactLimit, so never a compact
+// coordinate, and small enough that the pre-pass's int32 differences and shifts stay defined.
+constexpr int32_t kSpecialVertex = int32_t(1) << 30;
 // The box test of triangle_box for a batch of triangles whose vertices are all compact and
 // unclipped: int32 arithmetic over arrays that the compiler vectorises. keep[i] is non-zero
 // exactly when the bounding box, clamped to the viewport, holds a pixel centre.
-void batch_box_test(size_t n, const int32_t* x0, const int32_t* y0, const int32_t* x1, const int32_t* y1,
-                    const int32_t* x2, const int32_t* y2, int32_t last, int32_t* keep, int32_t (*box)[4]) {
+ANIMORDER_INLINE void batch_box_test(size_t n, const int32_t* x0, const int32_t* y0, const int32_t* x1,
+                                     const int32_t* y1, const int32_t* x2, const int32_t* y2, int32_t last,
+                                     int32_t* keep, int32_t (*box)[4]) {
     for (size_t i = 0; i < n; ++i) {
         const int32_t min_x = std::min(x0[i], std::min(x1[i], x2[i])), max_x = std::max(x0[i], std::max(x1[i], x2[i]));
         const int32_t min_y = std::min(y0[i], std::min(y1[i], y2[i])), max_y = std::max(y0[i], std::max(y1[i], y2[i]));
@@ -484,30 +529,74 @@ void batch_box_test(size_t n, const int32_t* x0, const int32_t* y0, const int32_
 
 }  // namespace
 
+namespace {
+void rasterize_node_portable(NodeRasterizer::State& s, const float* clip_xyzw, size_t vertex_count,
+                             const uint32_t* indices, size_t index_count, unsigned resolution, const uint8_t* modes);
+#ifdef ANIMORDER_RASTER_AVX2
+void rasterize_node_avx2(NodeRasterizer::State& s, const float* clip_xyzw, size_t vertex_count, const uint32_t* indices,
+                         size_t index_count, unsigned resolution, const uint8_t* modes);
+#endif
+}  // namespace
+
 void NodeRasterizer::rasterize(const float* clip_xyzw, size_t vertex_count, const uint32_t* indices, size_t index_count,
                                unsigned resolution, const uint8_t* modes) {
     validate_indices(indices, index_count, vertex_count);
+    rasterize_validated(clip_xyzw, vertex_count, indices, index_count, resolution, modes);
+}
+
+void NodeRasterizer::rasterize_validated(const float* clip_xyzw, size_t vertex_count, const uint32_t* indices,
+                                         size_t index_count, unsigned resolution, const uint8_t* modes) {
     if (resolution == 0 || resolution > 16384)
         throw InvalidInput("resolution " + std::to_string(resolution) + " is outside 1..16384");
     State& s = *state_;
     s.resolution = resolution;
+#ifdef ANIMORDER_RASTER_AVX2
+    if (s.simd && simd_available())
+        return rasterize_node_avx2(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes);
+#endif
+    rasterize_node_portable(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes);
+}
 
+bool NodeRasterizer::simd_available() {
+#ifdef ANIMORDER_RASTER_AVX2
+    static const bool avx2 = __builtin_cpu_supports("avx2");
+    return avx2;
+#else
+    return false;
+#endif
+}
+
+void NodeRasterizer::set_simd(bool allowed) { state_->simd = allowed; }
+
+namespace {
+
+// One node after the checks: project the vertices, pre-pass and set up the triangles in
+// batches, draw them, group the fragments. Inlined into the two copies below.
+ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip_xyzw, size_t vertex_count,
+                                     const uint32_t* indices, size_t index_count, unsigned resolution,
+                                     const uint8_t* modes) {
     const ClipVertex* cv = reinterpret_cast<const ClipVertex*>(clip_xyzw);
-    s.window.resize(vertex_count);
     s.snapped.resize(2 * vertex_count);
     s.vertex_flags.resize(vertex_count);
+    s.plane.resize(4 * vertex_count);
     for (size_t v = 0; v < vertex_count; ++v) {
+        float* plane = &s.plane[4 * v];
         if (!inside_all(cv[v])) {
             s.vertex_flags[v] = kClippedVertex;
-            s.snapped[2 * v] = s.snapped[2 * v + 1] = 0;
+            s.snapped[2 * v] = s.snapped[2 * v + 1] = kSpecialVertex;
+            plane[0] = plane[1] = plane[2] = plane[3] = 0.0f;
             continue;
         }
-        WindowVertex& w = s.window[v];
+        WindowVertex w;
         project(cv[v], resolution, w);
         const bool compact = w.X > -kCompactLimit && w.X < kCompactLimit && w.Y > -kCompactLimit && w.Y < kCompactLimit;
         s.vertex_flags[v] = compact ? 0 : kWideVertex;
-        s.snapped[2 * v] = compact ? int32_t(w.X) : 0;
-        s.snapped[2 * v + 1] = compact ? int32_t(w.Y) : 0;
+        s.snapped[2 * v] = compact ? int32_t(w.X) : kSpecialVertex;
+        s.snapped[2 * v + 1] = compact ? int32_t(w.Y) : kSpecialVertex;
+        plane[0] = w.x;
+        plane[1] = w.y;
+        plane[2] = w.z;
+        plane[3] = 0.0f;
     }
 
     // Triangles in batches: gather the snapped corners, test area and box for the whole batch at
@@ -516,11 +605,12 @@ void NodeRasterizer::rasterize(const float* clip_xyzw, size_t vertex_count, cons
     const size_t triangle_count = index_count / 3;
     const int32_t* xy = s.snapped.data();
     const uint8_t* flags = s.vertex_flags.data();
+    const float* plane = s.plane.data();
     alignas(16) int32_t x0[kBatch], y0[kBatch], x1[kBatch], y1[kBatch], x2[kBatch], y2[kBatch], keep[kBatch];
-    uint8_t two[kBatch];
+    int32_t two[kBatch];
     int32_t boxes[kBatch][4];
     int64_t areas[kBatch];
-    uint8_t special[kBatch];
+    int32_t special[kBatch];
     uint32_t draw[kBatch];
     BatchSetup& setup = s.setup;
     for (size_t first = 0; first < triangle_count; first += kBatch) {
@@ -536,19 +626,23 @@ void NodeRasterizer::rasterize(const float* clip_xyzw, size_t vertex_count, cons
             x2[i] = xy[2 * c];
             y2[i] = xy[2 * c + 1];
             two[i] = mode & kDrawBothFaces;
-            // Skipped: never drawn; a clipped or wide corner: the exact path below.
-            special[i] = (mode & kSkipTriangle) ? 0 : uint8_t(1 + (flags[a] | flags[b] | flags[c]));
+            // Skipped: never drawn (0); a clipped or wide corner: an exact path below (2).
+            const bool exact = (x0[i] == kSpecialVertex) | (x1[i] == kSpecialVertex) | (x2[i] == kSpecialVertex);
+            special[i] = (mode & kSkipTriangle) ? 0 : 1 + int32_t(exact);
         }
         batch_box_test(n, x0, y0, x1, y1, x2, y2, int32_t(resolution - 1), keep, boxes);
-        size_t m = 0;
-        for (size_t i = 0; i < n; ++i) {
+        for (size_t i = 0; i < n; ++i) {  // int32 and int64 lanes only: vectorised
             // As triangle_box: y points down, so OpenGL's counter-clockwise front faces have
             // negative area; |coordinates| < 2^24 keeps the int64 products exact.
             const int64_t area = int64_t(x1[i] - x0[i]) * (y2[i] - y0[i]) - int64_t(x2[i] - x0[i]) * (y1[i] - y0[i]);
-            const bool drawn = (area < 0) | ((area > 0) & (two[i] != 0));
+            const int32_t drawn = int32_t(area < 0) | (int32_t(area > 0) & two[i]);
             areas[i] = area;
+            keep[i] = int32_t(special[i] > 1) | (int32_t(special[i] == 1) & drawn & keep[i]);
+        }
+        size_t m = 0;
+        for (size_t i = 0; i < n; ++i) {
             draw[m] = uint32_t(i);
-            m += (special[i] > 1) | ((special[i] == 1) & drawn & (keep[i] != 0));
+            m += size_t(keep[i]);
         }
         // The set-up of rasterize_window_triangle for every drawn triangle of the batch at once.
         // Corners in positive order: 0, 2, 1 for a front face (negative area), else 0, 1, 2.
@@ -556,9 +650,9 @@ void NodeRasterizer::rasterize(const float* clip_xyzw, size_t vertex_count, cons
             const size_t i = draw[j];
             const bool fast = special[i] == 1, front = areas[i] < 0;
             const size_t t = first + i;
-            const WindowVertex& w0 = s.window[indices[3 * t]];
-            const WindowVertex& w1 = s.window[indices[3 * t + (front ? 2 : 1)]];
-            const WindowVertex& w2 = s.window[indices[3 * t + (front ? 1 : 2)]];
+            const float* w0 = plane + 4 * size_t(indices[3 * t]);
+            const float* w1 = plane + 4 * size_t(indices[3 * t + (front ? 2 : 1)]);
+            const float* w2 = plane + 4 * size_t(indices[3 * t + (front ? 1 : 2)]);
             setup.X[0][j] = x0[i];
             setup.Y[0][j] = y0[i];
             setup.X[1][j] = front ? x2[i] : x1[i];
@@ -568,15 +662,15 @@ void NodeRasterizer::rasterize(const float* clip_xyzw, size_t vertex_count, cons
             setup.px0[j] = boxes[i][0];
             setup.py0[j] = boxes[i][2];
             // As rasterize_window_triangle: differences in float, then widened.
-            setup.ax[j] = fast ? w1.x - w0.x : 0.0f;
-            setup.ay[j] = fast ? w1.y - w0.y : 0.0f;
-            setup.az[j] = fast ? w1.z - w0.z : 0.0f;
-            setup.bx[j] = fast ? w2.x - w0.x : 0.0f;
-            setup.by[j] = fast ? w2.y - w0.y : 0.0f;
-            setup.bz[j] = fast ? w2.z - w0.z : 0.0f;
-            setup.x[j] = fast ? w0.x : 0.0f;
-            setup.y[j] = fast ? w0.y : 0.0f;
-            setup.z[j] = fast ? w0.z : 0.0f;
+            setup.ax[j] = fast ? w1[0] - w0[0] : 0.0f;
+            setup.ay[j] = fast ? w1[1] - w0[1] : 0.0f;
+            setup.az[j] = fast ? w1[2] - w0[2] : 0.0f;
+            setup.bx[j] = fast ? w2[0] - w0[0] : 0.0f;
+            setup.by[j] = fast ? w2[1] - w0[1] : 0.0f;
+            setup.bz[j] = fast ? w2[2] - w0[2] : 0.0f;
+            setup.x[j] = fast ? w0[0] : 0.0f;
+            setup.y[j] = fast ? w0[1] : 0.0f;
+            setup.z[j] = fast ? w0[2] : 0.0f;
         }
         setup.compute(m);
         for (size_t j = 0; j < m; ++j) {
@@ -590,9 +684,17 @@ void NodeRasterizer::rasterize(const float* clip_xyzw, size_t vertex_count, cons
                 const int64_t e[3] = {int64_t(setup.e[0][j]), int64_t(setup.e[1][j]), int64_t(setup.e[2][j])};
                 const int64_t sx[3] = {int64_t(setup.sx[0][j]), int64_t(setup.sx[1][j]), int64_t(setup.sx[2][j])};
                 const int64_t sy[3] = {int64_t(setup.sy[0][j]), int64_t(setup.sy[1][j]), int64_t(setup.sy[2][j])};
-                emit_box(e, sx, sy, setup.dzdx[j], setup.dzdy[j], setup.z_origin[j], box, uint32_t(t), resolution, sink);
-            } else if (!((special[draw[j]] - 1) & kClippedVertex)) {
-                const WindowVertex &va = s.window[a], &vb = s.window[b], &vc = s.window[c];
+                if (box.px1 - box.px0 < 2 && box.py1 - box.py0 < 2)
+                    emit_small_box(e, sx, sy, setup.dzdx[j], setup.dzdy[j], setup.z_origin[j], box, uint32_t(t),
+                                   resolution, sink);
+                else
+                    emit_box(e, sx, sy, setup.dzdx[j], setup.dzdy[j], setup.z_origin[j], box, uint32_t(t), resolution,
+                             sink);
+            } else if (!((flags[a] | flags[b] | flags[c]) & kClippedVertex)) {
+                WindowVertex va, vb, vc;  // projected again: the same bits as the vertex pass
+                project(cv[a], resolution, va);
+                project(cv[b], resolution, vb);
+                project(cv[c], resolution, vc);
                 TriangleBox box;
                 if (triangle_box(va, vb, vc, resolution, two_sided, box))
                     rasterize_window_triangle(va, vb, vc, box, uint32_t(t), resolution, sink);
@@ -606,6 +708,22 @@ void NodeRasterizer::rasterize(const float* clip_xyzw, size_t vertex_count, cons
 
     group_fragments(s);
 }
+
+void rasterize_node_portable(NodeRasterizer::State& s, const float* clip_xyzw, size_t vertex_count,
+                             const uint32_t* indices, size_t index_count, unsigned resolution, const uint8_t* modes) {
+    rasterize_node(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes);
+}
+
+#ifdef ANIMORDER_RASTER_AVX2
+__attribute__((target("avx2"))) void rasterize_node_avx2(NodeRasterizer::State& s, const float* clip_xyzw,
+                                                         size_t vertex_count, const uint32_t* indices,
+                                                         size_t index_count, unsigned resolution,
+                                                         const uint8_t* modes) {
+    rasterize_node(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes);
+}
+#endif
+
+}  // namespace
 
 namespace {
 

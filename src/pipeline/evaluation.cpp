@@ -122,8 +122,8 @@ std::vector<OrderEvaluation> evaluate_methods(const AnimatedMesh& mesh, const st
         }
         transform_to_clip(w.clip.data(), mesh.keyframe(node.keyframe), mesh.vertex_count,
                           &all.centres[3 * node.keyframe], node_view_projection(node.direction, framing.radius));
-        w.rasterizer.rasterize(w.clip.data(), mesh.vertex_count, mesh.indices.data(), mesh.indices.size(),
-                               settings.resolution, modes.empty() ? nullptr : modes.data());
+        w.rasterizer.rasterize_validated(w.clip.data(), mesh.vertex_count, mesh.indices.data(), mesh.indices.size(),
+                                         settings.resolution, modes.empty() ? nullptr : modes.data());
         visible[node.index] = w.rasterizer.visible_pixels();
         w.rasterizer.score(&passed[node.index * method_count], w.ranks.data(), method_count);
     };

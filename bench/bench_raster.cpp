@@ -8,6 +8,8 @@
 //   build/bench/bench_raster ../shared/data/glb-xbot/Xbot.glb
 //   build/bench/bench_raster ../shared/data/mixamo-ganfaul/Ganfaul.gltf --clip Idle [--keyframes 4] [--repeat 2]
 //   ... --simd 0: the rasteriser's portable copy even where the CPU has AVX2
+//   ... --simd both: the portable copy, then the AVX2 copy (where the CPU has it) in the same run,
+//       with their ratio and whether their hashes agree
 #include "animorder/camera.h"
 #include "animorder/kept_fragments.h"
 #include "animorder/load.h"
@@ -53,18 +55,23 @@ struct Hash {
 
 int main(int argc, char** argv) try {
     if (argc < 2) {
-        std::fprintf(stderr, "usage: bench_raster CHARACTER [--clip NAME] [--keyframes N] [--repeat N] [--simd 0|1]\n");
+        std::fprintf(stderr,
+                     "usage: bench_raster CHARACTER [--clip NAME] [--keyframes N] [--repeat N] [--simd 0|1|both]\n");
         return 1;
     }
     std::vector<std::string> clips;
     size_t keyframe_samples = 4, repeats = 2;
-    bool simd = true;
+    std::vector<bool> copies = {true};  // the rasteriser's copies to time: AVX2 allowed or not
     for (int i = 2; i + 1 < argc; i += 2) {
-        if (!std::strcmp(argv[i], "--clip")) clips.push_back(argv[i + 1]);
-        else if (!std::strcmp(argv[i], "--keyframes")) keyframe_samples = std::strtoul(argv[i + 1], nullptr, 10);
-        else if (!std::strcmp(argv[i], "--repeat")) repeats = std::strtoul(argv[i + 1], nullptr, 10);
+        if (!std::strcmp(argv[i], "--clip"))
+            clips.push_back(argv[i + 1]);
+        else if (!std::strcmp(argv[i], "--keyframes"))
+            keyframe_samples = std::strtoul(argv[i + 1], nullptr, 10);
+        else if (!std::strcmp(argv[i], "--repeat"))
+            repeats = std::strtoul(argv[i + 1], nullptr, 10);
         else if (!std::strcmp(argv[i], "--simd"))
-            simd = std::strcmp(argv[i + 1], "0") != 0;
+            copies = !std::strcmp(argv[i + 1], "both") ? std::vector<bool>{false, true}
+                                                       : std::vector<bool>{std::strcmp(argv[i + 1], "0") != 0};
         else {
             std::fprintf(stderr, "bench_raster: unknown option %s\n", argv[i]);
             return 1;
@@ -83,52 +90,68 @@ int main(int argc, char** argv) try {
 
     std::vector<float> clip(mesh.vertex_count * 4);
     validate_indices(mesh.indices.data(), mesh.indices.size(), mesh.vertex_count);  // once, as NodeCache does
-    NodeRasterizer rasterizer;
-    rasterizer.set_simd(simd);
-    KeepScratch scratch;
-    double transform_s = 0, raster_s = 0, keep_s = 0;
-    size_t nodes = 0, fragments = 0;
-    Hash hash;
-    for (size_t rep = 0; rep < repeats; ++rep)
-        for (size_t k = 0; k < mesh.keyframe_count(); k += step)
-            for (size_t v = 0; v < views; ++v) {
-                const double t0 = thread_seconds();
-                transform_to_clip(clip.data(), mesh.keyframe(uint32_t(k)), mesh.vertex_count, &framing.centres[3 * k],
-                                  node_view_projection(&directions[3 * v], framing.radius));
-                const double t1 = thread_seconds();
-                rasterizer.rasterize_validated(clip.data(), mesh.vertex_count, mesh.indices.data(), mesh.indices.size(),
-                                               256, modes.empty() ? nullptr : modes.data());
-                const double t2 = thread_seconds();
-                const NodeRasterizer::FragmentLists lists = rasterizer.fragment_lists();
-                const KeptNode kept = keep_fragments(lists.visible, lists.single, lists.starts, lists.pixels,
-                                                     lists.fragments, partition, scratch);
-                const double t3 = thread_seconds();
-                transform_s += t1 - t0;
-                raster_s += t2 - t1;
-                keep_s += t3 - t2;
-                ++nodes;
-                fragments += rasterizer.fragments();
-                if (rep == 0) {
-                    rasterizer.visit_fragments([&](uint32_t p, uint32_t t, float z) {
-                        hash.value(p);
-                        hash.value(t);
-                        hash.value(z);
-                    });
-                    hash.value(lists.visible);
-                    hash.value(lists.single);
-                    hash.value(lists.pixels);
-                    if (lists.pixels) {
-                        hash.add(lists.starts, (lists.pixels + 1) * 4);
-                        hash.add(lists.fragments + lists.starts[0], (lists.starts[lists.pixels] - lists.starts[0]) * 4);
+    struct Timing {
+        double rasterize_ms = 0;
+        uint64_t hash = 0;
+    };
+    const auto measure = [&](bool simd) {
+        NodeRasterizer rasterizer;
+        rasterizer.set_simd(simd);
+        KeepScratch scratch;
+        double transform_s = 0, raster_s = 0, keep_s = 0;
+        size_t nodes = 0, fragments = 0;
+        Hash hash;
+        for (size_t rep = 0; rep < repeats; ++rep)
+            for (size_t k = 0; k < mesh.keyframe_count(); k += step)
+                for (size_t v = 0; v < views; ++v) {
+                    const double t0 = thread_seconds();
+                    transform_to_clip(clip.data(), mesh.keyframe(uint32_t(k)), mesh.vertex_count,
+                                      &framing.centres[3 * k],
+                                      node_view_projection(&directions[3 * v], framing.radius));
+                    const double t1 = thread_seconds();
+                    rasterizer.rasterize_validated(clip.data(), mesh.vertex_count, mesh.indices.data(),
+                                                   mesh.indices.size(), 256, modes.empty() ? nullptr : modes.data());
+                    const double t2 = thread_seconds();
+                    const NodeRasterizer::FragmentLists lists = rasterizer.fragment_lists();
+                    const KeptNode kept = keep_fragments(lists.visible, lists.single, lists.starts, lists.pixels,
+                                                         lists.fragments, partition, scratch);
+                    const double t3 = thread_seconds();
+                    transform_s += t1 - t0;
+                    raster_s += t2 - t1;
+                    keep_s += t3 - t2;
+                    ++nodes;
+                    fragments += rasterizer.fragments();
+                    if (rep == 0) {
+                        rasterizer.visit_fragments([&](uint32_t p, uint32_t t, float z) {
+                            hash.value(p);
+                            hash.value(t);
+                            hash.value(z);
+                        });
+                        hash.value(lists.visible);
+                        hash.value(lists.single);
+                        hash.value(lists.pixels);
+                        if (lists.pixels) {
+                            hash.add(lists.starts, (lists.pixels + 1) * 4);
+                            hash.add(lists.fragments + lists.starts[0],
+                                     (lists.starts[lists.pixels] - lists.starts[0]) * 4);
+                        }
+                        hash.add(kept.data.data(), kept.data.size());
                     }
-                    hash.add(kept.data.data(), kept.data.size());
                 }
-            }
-    std::printf("%s: ", simd && NodeRasterizer::simd_available() ? "AVX2 copy" : "portable copy");
-    std::printf("%zu triangles, %zu nodes, %.0f fragments/node: transform %.3f ms/node, rasterize %.3f ms/node, "
-                "keep %.3f ms/node (thread CPU time); output hash %016llx\n",
-                mesh.triangle_count(), nodes, double(fragments) / double(nodes), 1e3 * transform_s / double(nodes),
-                1e3 * raster_s / double(nodes), 1e3 * keep_s / double(nodes), (unsigned long long)hash.h);
+        std::printf("%s: ", simd && NodeRasterizer::simd_available() ? "AVX2 copy" : "portable copy");
+        std::printf(
+            "%zu triangles, %zu nodes, %.0f fragments/node: transform %.3f ms/node, rasterize %.3f ms/node, "
+            "keep %.3f ms/node (thread CPU time); output hash %016llx\n",
+            mesh.triangle_count(), nodes, double(fragments) / double(nodes), 1e3 * transform_s / double(nodes),
+            1e3 * raster_s / double(nodes), 1e3 * keep_s / double(nodes), (unsigned long long)hash.h);
+        return Timing{1e3 * raster_s / double(nodes), hash.h};
+    };
+    std::vector<Timing> timings;
+    for (const bool simd : copies) timings.push_back(measure(simd));
+    if (timings.size() == 2 && NodeRasterizer::simd_available())
+        std::printf("rasterize: AVX2 copy %.2fx the portable copy's speed; hashes %s\n",
+                    timings[0].rasterize_ms / timings[1].rasterize_ms,
+                    timings[0].hash == timings[1].hash ? "equal" : "DIFFER");
     return 0;
 } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_raster: %s\n", e.what());

@@ -150,13 +150,24 @@ void score_kept_k(uint64_t* passed, const KeptNode& node, const uint16_t* unit_r
     uint16_t scratch[2 * K] = {};
     for (uint32_t list = 0; list < node.unit_lists; ++list) {
         const uint32_t n = lengths[list];
-        uint16_t ties = 0;
-        for (uint32_t j = 0; j < n; ++j) ties |= e[j];
+        // One walk as if no depths were equal (nearly every list), noting any tie on the way; a
+        // list with ties is replayed again with its tie groups.
         uint32_t passes[K] = {};
-        if (ties & kUnitTieBit)
+        uint16_t running[K];
+        for (size_t o = 0; o < K; ++o) running[o] = UINT16_MAX;
+        uint16_t ties = 0;
+        for (uint32_t j = 0; j < n; ++j) {
+            ties |= e[j];
+            const uint16_t* r = unit_ranks + size_t(e[j] & ~kUnitTieBit) * K;
+            for (size_t o = 0; o < K; ++o) {
+                passes[o] += r[o] < running[o];
+                running[o] = std::min(running[o], r[o]);
+            }
+        }
+        if (ties & kUnitTieBit) {
+            for (size_t o = 0; o < K; ++o) passes[o] = 0;
             replay_list(e, n, kUnitTieBit, unit_ranks, K, scratch, scratch + K, [&](size_t o) { ++passes[o]; });
-        else
-            replay_untied_list(e, n, unit_ranks, passes);
+        }
         for (size_t o = 0; o < K; ++o) count[o] += uint64_t(passes[o]) * weights[list];
         e += n;
     }

@@ -64,18 +64,25 @@ TEST(ScoreNodes, IdenticalWithOneOrTwoThreads) {
     }
 }
 
-TEST(ScoreNodes, RejectsAKeyframeOutOfRange) {
-    const AnimatedMesh mesh = make_uv_sphere(500);
-    const Framing framing =
+// A sphere of one keyframe, framed, with the rank table of its stored order.
+struct FramedSphere {
+    AnimatedMesh mesh = make_uv_sphere(500);
+    Framing framing =
         frame_keyframes(mesh.keyframe(0), 1, mesh.vertex_count, mesh.indices.data(), mesh.indices.size());
-    std::vector<uint32_t> order(mesh.triangle_count());
-    for (size_t i = 0; i < order.size(); ++i) order[i] = uint32_t(i);
-    const std::vector<uint32_t> ranks = make_rank_table({order.data()}, order.size());
+    std::vector<uint32_t> order, ranks;
+    FramedSphere() : order(mesh.triangle_count()) {
+        for (size_t i = 0; i < order.size(); ++i) order[i] = uint32_t(i);
+        ranks = make_rank_table({order.data()}, order.size());
+    }
+};
+
+TEST(ScoreNodes, RejectsAKeyframeOutOfRange) {
+    const FramedSphere s;
     OverdrawNode node;
     node.keyframe = 3;
     uint64_t visible = 0, passed = 0;
-    EXPECT_THROW(score_nodes(&visible, &passed, mesh.keyframe(0), mesh.vertex_count, framing, mesh.indices.data(),
-                             mesh.indices.size(), &node, 1, ranks.data(), 1, ScoreSettings{}),
+    EXPECT_THROW(score_nodes(&visible, &passed, s.mesh.keyframe(0), s.mesh.vertex_count, s.framing,
+                             s.mesh.indices.data(), s.mesh.indices.size(), &node, 1, s.ranks.data(), 1, ScoreSettings{}),
                  InvalidInput);
 }
 
@@ -83,31 +90,27 @@ TEST(ScoreNodes, RejectsAKeyframeOutOfRange) {
 // mesh): each entry point checks the indices itself, so an index past the vertices is InvalidInput
 // before any node is drawn, never a read out of bounds.
 TEST(ScoreNodes, EveryEntryPointRejectsAnIndexPastTheVertices) {
-    const AnimatedMesh mesh = make_uv_sphere(500);
-    const Framing framing =
-        frame_keyframes(mesh.keyframe(0), 1, mesh.vertex_count, mesh.indices.data(), mesh.indices.size());
+    const FramedSphere s;
+    const AnimatedMesh& mesh = s.mesh;
     std::vector<uint32_t> bad = mesh.indices;
     bad[bad.size() / 2] = uint32_t(mesh.vertex_count);  // one past the last vertex
-    std::vector<uint32_t> order(mesh.triangle_count());
-    for (size_t i = 0; i < order.size(); ++i) order[i] = uint32_t(i);
-    const std::vector<uint32_t> ranks = make_rank_table({order.data()}, order.size());
     OverdrawNode node;
     node.keyframe = 0;
     uint64_t visible = 0, passed = 0;
-    EXPECT_THROW(score_nodes(&visible, &passed, mesh.keyframe(0), mesh.vertex_count, framing, bad.data(), bad.size(),
-                             &node, 1, ranks.data(), 1, ScoreSettings{}),
+    EXPECT_THROW(score_nodes(&visible, &passed, mesh.keyframe(0), mesh.vertex_count, s.framing, bad.data(), bad.size(),
+                             &node, 1, s.ranks.data(), 1, ScoreSettings{}),
                  InvalidInput);
-    EXPECT_THROW(rasterize_nodes(mesh.keyframe(0), mesh.vertex_count, framing, bad.data(), bad.size(), &node, 1,
+    EXPECT_THROW(rasterize_nodes(mesh.keyframe(0), mesh.vertex_count, s.framing, bad.data(), bad.size(), &node, 1,
                                  ScoreSettings{}, size_t(1) << 30),
                  InvalidInput);
-    const uint32_t starts[2] = {0, uint32_t(order.size())};
-    EXPECT_THROW(
-        NodeCache(mesh.keyframe(0), mesh.vertex_count, framing, bad.data(), bad.size(), &node, 1,
-                  make_unit_partition(starts, 1, order.data(), order.size()), ScoreSettings{}, size_t(1) << 30),
-        InvalidInput);
+    const uint32_t starts[2] = {0, uint32_t(s.order.size())};
+    const UnitPartition one_unit = make_unit_partition(starts, 1, s.order.data(), s.order.size());
+    EXPECT_THROW(NodeCache(mesh.keyframe(0), mesh.vertex_count, s.framing, bad.data(), bad.size(), &node, 1, one_unit,
+                           ScoreSettings{}, size_t(1) << 30),
+                 InvalidInput);
     // The same calls with the good indices draw the node.
-    NodeCache good(mesh.keyframe(0), mesh.vertex_count, framing, mesh.indices.data(), mesh.indices.size(), &node, 1,
-                   make_unit_partition(starts, 1, order.data(), order.size()), ScoreSettings{}, size_t(1) << 30);
-    good.score(&visible, &passed, ranks.data(), 1);
+    NodeCache good(mesh.keyframe(0), mesh.vertex_count, s.framing, mesh.indices.data(), mesh.indices.size(), &node, 1,
+                   one_unit, ScoreSettings{}, size_t(1) << 30);
+    good.score(&visible, &passed, s.ranks.data(), 1);
     EXPECT_GT(visible, 1000u);
 }

@@ -67,8 +67,7 @@ TEST(ScoreNodes, IdenticalWithOneOrTwoThreads) {
 // A sphere of one keyframe, framed, with the rank table of its stored order.
 struct FramedSphere {
     AnimatedMesh mesh = make_uv_sphere(500);
-    Framing framing =
-        frame_keyframes(mesh.keyframe(0), 1, mesh.vertex_count, mesh.indices.data(), mesh.indices.size());
+    Framing framing = frame_keyframes(mesh.keyframe(0), 1, mesh.vertex_count, mesh.indices.data(), mesh.indices.size());
     std::vector<uint32_t> order, ranks;
     FramedSphere() : order(mesh.triangle_count()) {
         for (size_t i = 0; i < order.size(); ++i) order[i] = uint32_t(i);
@@ -81,9 +80,10 @@ TEST(ScoreNodes, RejectsAKeyframeOutOfRange) {
     OverdrawNode node;
     node.keyframe = 3;
     uint64_t visible = 0, passed = 0;
-    EXPECT_THROW(score_nodes(&visible, &passed, s.mesh.keyframe(0), s.mesh.vertex_count, s.framing,
-                             s.mesh.indices.data(), s.mesh.indices.size(), &node, 1, s.ranks.data(), 1, ScoreSettings{}),
-                 InvalidInput);
+    EXPECT_THROW(
+        score_nodes(&visible, &passed, s.mesh.keyframe(0), s.mesh.vertex_count, s.framing, s.mesh.indices.data(),
+                    s.mesh.indices.size(), &node, 1, s.ranks.data(), 1, ScoreSettings{}),
+        InvalidInput);
 }
 
 // The per-node loops rasterise with NodeRasterizer::rasterize_validated (indices checked once per

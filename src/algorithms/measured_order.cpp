@@ -311,7 +311,8 @@ uint64_t sift_order(uint32_t* order, size_t unit_count, const Arc* arcs, size_t 
             const uint32_t i = position[u];
             if (stale[u]) sort_neighbours(u);
             const auto begin = adjacency.begin() + start[u], end = adjacency.begin() + start[u + 1];
-            const auto split = std::partition_point(begin, end, [&](const Neighbour& n) { return position[n.unit] < i; });
+            const auto split =
+                std::partition_point(begin, end, [&](const Neighbour& n) { return position[n.unit] < i; });
             // Moving u left past v changes the cost by −s(u, v), right past v by +s(u, v); the
             // best target is just before (left) or after (right) some neighbour.
             int64_t best = 0;
@@ -393,8 +394,7 @@ std::vector<uint32_t> measured_unit_order(size_t unit_count, const Arc* arcs, si
         std::vector<Arc> inside;
         const std::vector<size_t>& block_arcs = arcs_of_block[block_of_unit[units[i]]];
         inside.reserve(block_arcs.size());
-        for (const size_t a : block_arcs)
-            inside.push_back({local[arcs[a].from], local[arcs[a].to], arcs[a].weight});
+        for (const size_t a : block_arcs) inside.push_back({local[arcs[a].from], local[arcs[a].to], arcs[a].weight});
         for (uint32_t x : order_feedback_arc_set(j - i, inside.data(), inside.size())) greedy.push_back(units[i + x]);
         i = j;
     }

@@ -120,8 +120,8 @@ struct NodeRasterizer::State {
     std::vector<int32_t> snapped;
     std::vector<uint8_t> vertex_flags;
     std::vector<float> plane;
-    bool simd = true;                 // the AVX2 copy where the CPU has it (set_simd)
-    std::vector<uint32_t> histogram;  // counting sort of the fragments by pixel
+    bool simd = true;                   // the AVX2 copy where the CPU has it (set_simd)
+    std::vector<uint32_t> histogram;    // counting sort of the fragments by pixel
     std::vector<uint32_t> pixel_count;  // per pixel, zero between nodes (kPixelImageLimit pixels at most)
     std::vector<uint64_t> touched;      // bitmap of the pixels with fragments, zero between nodes
     std::vector<uint64_t> keys;         // (depth, triangle) sort keys of the fragments being grouped
@@ -677,7 +677,7 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
             const size_t t = first + draw[j];
             const uint32_t a = indices[3 * t], b = indices[3 * t + 1], c = indices[3 * t + 2];
             const bool two_sided = two[draw[j]] != 0;
-            if (special[draw[j]] == 1) {  // passed the pre-pass: its box and set-up are known
+            if (special[draw[j]] == 1) {            // passed the pre-pass: its box and set-up are known
                 if (setup.det[j] == 0.0) continue;  // float-degenerate sliver: no fragment has a defined depth
                 const int32_t* known = boxes[draw[j]];
                 const TriangleBox box{areas[draw[j]], known[0], known[1], known[2], known[3]};

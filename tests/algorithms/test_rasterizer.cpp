@@ -460,9 +460,9 @@ RefVertex reference_project(const float* v, unsigned resolution) {
 }
 
 std::vector<std::tuple<uint32_t, uint32_t, float>> reference_fragments(const std::vector<float>& clip,
-                                                                        const std::vector<uint32_t>& ib,
-                                                                        const std::vector<uint8_t>& modes,
-                                                                        unsigned resolution) {
+                                                                       const std::vector<uint32_t>& ib,
+                                                                       const std::vector<uint8_t>& modes,
+                                                                       unsigned resolution) {
     std::vector<std::tuple<uint32_t, uint32_t, float>> out;
     for (size_t t = 0; t < ib.size() / 3; ++t) {
         if (modes[t] & kSkipTriangle) continue;
@@ -515,7 +515,7 @@ TEST(Rasterizer, FragmentsEqualAPlainPerPixelReference) {
         std::vector<float> clip;
         std::vector<uint32_t> ib;
         std::vector<uint8_t> modes;
-        auto add = [&](const float (&p)[3][3], uint8_t mode) {
+        auto add = [&](const float(&p)[3][3], uint8_t mode) {
             for (const auto& v : p) {
                 ib.push_back(uint32_t(clip.size() / 4));
                 const float w = 0.5f + 1.5f * (float(rng() % 1000) / 1000.0f);  // perspective: w varies
@@ -546,7 +546,8 @@ TEST(Rasterizer, FragmentsEqualAPlainPerPixelReference) {
                 }
                 default:  // corners on pixel centres: edges through centres
                     for (auto& v : p)
-                        v[0] = centre(int(rng() % resolution)), v[1] = centre(int(rng() % resolution)), v[2] = depth(rng);
+                        v[0] = centre(int(rng() % resolution)), v[1] = centre(int(rng() % resolution)),
+                        v[2] = depth(rng);
                     break;
             }
             add(p, mode);

@@ -336,10 +336,6 @@ void rasterize_clipped_triangle(const ClipVertex (&v)[3], uint32_t triangle, uns
     }
 }
 
-// Groups the node's fragments by pixel with an LSD radix sort on the pixel index (one counting
-// pass up to 256² pixels, passes of 11 bits beyond): linear in the fragments, never a loop over every pixel of the
-// viewport. Each pixel with two or more fragments is then sorted by depth into the compact list
-// that scoring walks; a single-fragment pixel only counts, its fragment passes under every order.
 // group_fragments for viewports up to kPixelImageLimit pixels, with the same results: a counting
 // sort whose cost follows the covered pixels, not the viewport. Per-pixel counts live in an image
 // that is all zero between nodes, and a bitmap of the touched pixels is walked in pixel order (64
@@ -419,6 +415,11 @@ void group_fragments_by_image(NodeRasterizer::State& s) {
     s.multi_count = multis;
 }
 
+// Groups the node's fragments by pixel: group_fragments_by_image up to kPixelImageLimit pixels,
+// beyond an LSD radix sort on the pixel index in passes of 11 bits (linear in the fragments, never
+// a loop over every pixel of the viewport). Each pixel with two or more fragments is then sorted
+// by depth into the compact list that scoring walks; a single-fragment pixel only counts, its
+// fragment passes under every order.
 void group_fragments(NodeRasterizer::State& s) {
     const uint32_t image_pixels = s.resolution * s.resolution;
     if (image_pixels <= kPixelImageLimit) return group_fragments_by_image(s);

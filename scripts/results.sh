@@ -196,6 +196,14 @@ measured_character() {
     --eval-views 60 --eval-resolution 256 -r "$OUT/measured/$name.json"
 }
 each_character measured_character
+# Why measured loses to single on Xbot at lambda 3 (RESULTS.md): single-triangle units learnt from the
+# few nodes of a 2-keyframe pose, with the default 162 and with 642 learnt views per keyframe.
+mkdir -p "$OUT/measured-views"
+for views in 162 642; do
+  step "measured-views/xbot-sad-pose-$views.json" $A evaluate $DATA/glb-xbot/Xbot.glb --clip sad_pose -q \
+    --methods single,measured --lambda 3 --views $views --eval-views 60 --eval-resolution 256 \
+    -r "$OUT/measured-views/xbot-sad-pose-$views.json"
+done
 # The OpenGL rendering-time check (original vs single, expensive fragment shader).
 # llvmpipe renders on the CPU: 10 views at every 4th keyframe (150 nodes) keeps it near a minute.
 if [ -x "$BIN/bench/render_time" ]; then

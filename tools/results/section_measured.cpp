@@ -60,17 +60,20 @@ std::string stages_text(const Method& m) {
     return s.empty() ? kDash : s;
 }
 
+// A part's heading and its report; a part whose report is missing says so and ends there.
+const Report* open_part(const Inputs& in, const char* heading, const char* file, std::string& b) {
+    b += std::string("### ") + heading + "\n\n";
+    const Report* r = report_or_not_run(in, file, b);
+    if (!r) b += "\n";
+    return r;
+}
+
 void idle_part(const Inputs& in, std::string& b) {
-    b += "### Table 1's setting: Ganfaul Idle\n\n";
-    const Report* r = report_or_not_run(in, "measured/ganfaul-idle.json", b);
-    if (!r) {
-        b += "\n";
-        return;
-    }
-    b += "`measured/ganfaul-idle.json`: " + protocol(*r) +
-         " Goals (issue 15): at λ = 0.85 OVR ≤ " + format_fixed(kIdleOvrGoal085, 2) + " with ACMR ≤ " +
-         format_fixed(kIdleAcmrGoal085, 2) + ", at λ = 3 OVR ≤ " + format_fixed(kIdleOvrGoal3, 3) +
-         ", preprocessing at most " + format_fixed(kTimeRatioGoal, 0) +
+    const Report* r = open_part(in, "Table 1's setting: Ganfaul Idle", "measured/ganfaul-idle.json", b);
+    if (!r) return;
+    b += "`measured/ganfaul-idle.json`: " + protocol(*r) + " Goals (issue 15): at λ = 0.85 OVR ≤ " +
+         format_fixed(kIdleOvrGoal085, 2) + " with ACMR ≤ " + format_fixed(kIdleAcmrGoal085, 2) + ", at λ = 3 OVR ≤ " +
+         format_fixed(kIdleOvrGoal3, 3) + ", preprocessing at most " + format_fixed(kTimeRatioGoal, 0) +
          "× `single`'s. Seconds per stage are summed over the k-means iterations (the measured graphs and their "
          "orders are part of `update`).\n\n";
     std::vector<std::vector<std::string>> rows;
@@ -96,19 +99,16 @@ void idle_part(const Inputs& in, std::string& b) {
         if (const Method* o = row(*idle, "oracle", 0.85))
             rows.push_back({"oracle (per node, ganfaul-idle.json)", "0.85", kDash, kDash, kDash, f3(o->acmr),
                             f3(o->ovr_mean), f3(o->ovr_pooled), f1(o->time_s), kDash});
-    b += table({"method", "λ", "k", "goal", "stages s", "ACMR", "OVR", "OVR pooled", "preprocessing s",
-                "time / single"},
-               rows, 5) +
-         "\n";
+    b +=
+        table({"method", "λ", "k", "goal", "stages s", "ACMR", "OVR", "OVR pooled", "preprocessing s", "time / single"},
+              rows, 5) +
+        "\n";
 }
 
 void sweep_part(const Inputs& in, Charts& charts, std::string& b) {
-    b += "### The curve to choose from: k against overdraw and index-buffer bytes\n\n";
-    const Report* r = report_or_not_run(in, "measured/sweep-k.json", b);
-    if (!r) {
-        b += "\n";
-        return;
-    }
+    const Report* r = open_part(in, "The curve to choose from: k against overdraw and index-buffer bytes",
+                                "measured/sweep-k.json", b);
+    if (!r) return;
     std::set<long long> ks;
     for (const Method& m : r->methods)
         if ((m.name == "single" || m.name == "measured") && m.clusters > 0) ks.insert(m.clusters);
@@ -159,28 +159,24 @@ void sweep_part(const Inputs& in, Charts& charts, std::string& b) {
     b += charts.chart("measured-k-ovr.svg", ovr, "OVR against k for single and measured");
     b += charts.chart("measured-k-bytes.svg", bytes, "OVR against index-buffer bytes for single and measured");
     b += "\n" +
-         table({"k", "buffers", "index bytes", "single OVR", "measured OVR", "single ACMR", "measured ACMR",
-                "single s", "measured s"},
+         table({"k", "buffers", "index bytes", "single OVR", "measured OVR", "single ACMR", "measured ACMR", "single s",
+                "measured s"},
                rows) +
          "\n";
     if (nehab) {
         const Method* m1 = row(*r, "measured", kNaN, 1);
         if (m1)
             b += "One buffer: `measured` k = 1 (learnt over every keyframe of the clip) reaches OVR " +
-                 f3(m1->ovr_mean) + " (ACMR " + f3(m1->acmr) + ", " + f1(m1->time_s) + " s) against `static-nehab06`'s " +
-                 f3(nehab->ovr_mean) + " (one keyframe; ACMR " + f3(nehab->acmr) + ", " + f1(nehab->time_s) + " s, " +
-                 count((long long)index_bytes(*r, *nehab)) + " index bytes): " +
-                 (m1->ovr_mean < nehab->ovr_mean ? "better" : "**not better**") + ".\n\n";
+                 f3(m1->ovr_mean) + " (ACMR " + f3(m1->acmr) + ", " + f1(m1->time_s) +
+                 " s) against `static-nehab06`'s " + f3(nehab->ovr_mean) + " (one keyframe; ACMR " + f3(nehab->acmr) +
+                 ", " + f1(nehab->time_s) + " s, " + count((long long)index_bytes(*r, *nehab)) +
+                 " index bytes): " + (m1->ovr_mean < nehab->ovr_mean ? "better" : "**not better**") + ".\n\n";
     }
 }
 
 void clips_part(const Inputs& in, std::string& b) {
-    b += "### Every Ganfaul clip\n\n";
-    const Report* r = report_or_not_run(in, "measured/ganfaul-clips.json", b);
-    if (!r) {
-        b += "\n";
-        return;
-    }
+    const Report* r = open_part(in, "Every Ganfaul clip", "measured/ganfaul-clips.json", b);
+    if (!r) return;
     b += "`measured/ganfaul-clips.json`: " + protocol(*r) + " Goals (issue 15, λ = 0.85): `measured` OVR ≤ " +
          format_fixed(kClipsOvrGoal, 2) + ", `measured-joint` ≤ " + format_fixed(kClipsJointOvrGoal, 2) + ".\n\n";
     const char* const names[] = {"single", "joint", "measured", "measured-joint"};
@@ -273,9 +269,11 @@ void characters_part(const Inputs& in, std::string& b) {
          "\n" + std::to_string(total) + " character × λ rows from " + std::to_string(in.measured_characters.size()) +
          " characters: measured's OVR ≤ single's in " + std::to_string(ovr_met) + "; ACMR more than " +
          format_fixed(kAcmrTolerance, 2) + " above single's in " + std::to_string(acmr_higher) + ", more than " +
-         format_fixed(kAcmrTolerance, 2) + " below in " + std::to_string(acmr_lower) + "; both OVR and ACMR goals met "
-         "(ACMR not higher by more than the tolerance) in " + std::to_string(met) + "." +
-         (missing.empty() ? std::string() : " No measured report for " + missing + ".") + "\n\n";
+         format_fixed(kAcmrTolerance, 2) + " below in " + std::to_string(acmr_lower) +
+         "; both OVR and ACMR goals met "
+         "(ACMR not higher by more than the tolerance) in " +
+         std::to_string(met) + "." + (missing.empty() ? std::string() : " No measured report for " + missing + ".") +
+         "\n\n";
 }
 
 }  // namespace

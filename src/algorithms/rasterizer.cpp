@@ -102,8 +102,12 @@ struct BatchSetup {
 
 struct NodeRasterizer::State {
     unsigned resolution = 0;
-    // Raw fragments, in rasterisation order: the first raw_count entries are this node's.
-    std::vector<Fragment> raw, sorted;
+    // Raw fragments, in rasterisation order, as three arrays (pixel, triangle, depth): the first
+    // raw_count entries are this node's. One array per field lets the AVX2 copy store a row's
+    // covered pixels with a few vector stores. `sorted`, `gathered`: group_fragments' radix sort.
+    std::vector<uint32_t> raw_pixel, raw_triangle;
+    std::vector<float> raw_depth;
+    std::vector<Fragment> sorted, gathered;
     size_t raw_count = 0;
     std::vector<uint32_t> single_pixels;  // pixels with exactly one fragment: the first `single` entries
     // Per pixel fragment count; start of the pixel's slots among the multi-fragment pixels.
@@ -149,12 +153,17 @@ int64_t ceil_subpixel(int64_t a) { return -((-a) >> kSubpixelBits); }
 // Where the rasteriser puts fragments (pixel, triangle, depth). Capacity is ensured once per
 // triangle (its bounding box bounds its fragments), so a fragment is one plain store.
 struct FragmentSink {
-    std::vector<Fragment>& fragments;
+    std::vector<uint32_t>& pixel;
+    std::vector<uint32_t>& triangle;
+    std::vector<float>& depth;
     size_t count = 0;
 
     void reserve_more(size_t more) {
-        if (count + more <= fragments.size()) return;
-        fragments.resize(std::max(2 * fragments.size(), count + more));
+        if (count + more <= pixel.size()) return;
+        const size_t size = std::max(2 * pixel.size(), count + more);
+        pixel.resize(size);
+        triangle.resize(size);
+        depth.resize(size);
     }
 };
 
@@ -201,7 +210,9 @@ ANIMORDER_INLINE void emit_box(const int64_t (&e_first)[3], const int64_t (&step
     const int64_t px0 = box.px0, px1 = box.px1, py0 = box.py0, py1 = box.py1;
     int64_t e_row[3] = {e_first[0], e_first[1], e_first[2]};
     sink.reserve_more(size_t(px1 - px0 + 1) * size_t(py1 - py0 + 1));
-    Fragment* out = sink.fragments.data();
+    uint32_t* out_pixel = sink.pixel.data();
+    uint32_t* out_triangle = sink.triangle.data();
+    float* out_depth = sink.depth.data();
     size_t count = sink.count;
     for (int64_t py = py0; py <= py1; ++py) {
         int64_t e0 = e_row[0], e1 = e_row[1], e2 = e_row[2];
@@ -210,7 +221,9 @@ ANIMORDER_INLINE void emit_box(const int64_t (&e_first)[3], const int64_t (&step
         double x = double(px0);  // double(px), exactly
         for (int64_t px = px0; px <= px1; ++px, x += 1.0) {
             const float depth = float(z_row + dzdx * x);
-            out[count] = {row + uint32_t(px), triangle, depth};
+            out_pixel[count] = row + uint32_t(px);
+            out_triangle[count] = triangle;
+            out_depth[count] = depth;
             count += size_t((e0 | e1 | e2) >= 0) & size_t(depth < 1.0f) & size_t(depth >= 0.0f);
             e0 += step_x[0];
             e1 += step_x[1];
@@ -230,7 +243,9 @@ ANIMORDER_INLINE void emit_small_box(const int64_t (&e)[3], const int64_t (&step
                                      double dzdx, double dzdy, double z_origin, const TriangleBox& box,
                                      uint32_t triangle, unsigned resolution, FragmentSink& sink) {
     sink.reserve_more(4);
-    Fragment* out = sink.fragments.data();
+    uint32_t* out_pixel = sink.pixel.data();
+    uint32_t* out_triangle = sink.triangle.data();
+    float* out_depth = sink.depth.data();
     size_t count = sink.count;
     const bool wide = box.px1 > box.px0, tall = box.py1 > box.py0;
     const double x0 = double(box.px0), x1 = x0 + 1.0;
@@ -242,11 +257,15 @@ ANIMORDER_INLINE void emit_small_box(const int64_t (&e)[3], const int64_t (&step
         const int64_t a0 = e[0] + (dy ? step_y[0] : 0), a1 = e[1] + (dy ? step_y[1] : 0),
                       a2 = e[2] + (dy ? step_y[2] : 0);
         const float d0 = float(z_row + dzdx * x0);
-        out[count] = {row, triangle, d0};
+        out_pixel[count] = row;
+        out_triangle[count] = triangle;
+        out_depth[count] = d0;
         count += size_t(row_in) & size_t((a0 | a1 | a2) >= 0) & size_t(d0 < 1.0f) & size_t(d0 >= 0.0f);
         const float d1 = float(z_row + dzdx * x1);
         const int64_t b0 = a0 + step_x[0], b1 = a1 + step_x[1], b2 = a2 + step_x[2];
-        out[count] = {row + 1, triangle, d1};
+        out_pixel[count] = row + 1;
+        out_triangle[count] = triangle;
+        out_depth[count] = d1;
         count += size_t(row_in & wide) & size_t((b0 | b1 | b2) >= 0) & size_t(d1 < 1.0f) & size_t(d1 >= 0.0f);
     }
     sink.count = count;
@@ -355,9 +374,11 @@ void group_fragments_by_image(NodeRasterizer::State& s) {
     if (s.keys.size() < n + 1) s.keys.resize(n + 1);
     uint32_t* count = s.pixel_count.data();
     uint64_t* touched = s.touched.data();
-    const Fragment* raw = s.raw.data();
+    const uint32_t* raw_pixel = s.raw_pixel.data();
+    const uint32_t* raw_triangle = s.raw_triangle.data();
+    const float* raw_depth = s.raw_depth.data();
     for (size_t f = 0; f < n; ++f) {
-        const uint32_t p = raw[f].pixel;
+        const uint32_t p = raw_pixel[f];
         ++count[p];
         touched[p >> 6] |= uint64_t(1) << (p & 63);
     }
@@ -385,11 +406,11 @@ void group_fragments_by_image(NodeRasterizer::State& s) {
     for (size_t i = 0; i < singles; ++i) count[single[i]] = kLone | offset;
     uint64_t* keys = s.keys.data();
     for (size_t f = 0; f < n; ++f) {
-        uint32_t& slot = count[raw[f].pixel];
-        const float depth = raw[f].depth + 0.0f;
+        uint32_t& slot = count[raw_pixel[f]];
+        const float depth = raw_depth[f] + 0.0f;
         uint32_t depth_bits;
         std::memcpy(&depth_bits, &depth, 4);
-        keys[slot & ~kLone] = uint64_t(depth_bits) << 32 | raw[f].triangle;
+        keys[slot & ~kLone] = uint64_t(depth_bits) << 32 | raw_triangle[f];
         slot += (slot >> 31) ^ 1;
     }
     for (size_t i = 0; i < singles; ++i) count[single[i]] = 0;
@@ -425,10 +446,12 @@ void group_fragments(NodeRasterizer::State& s) {
     if (image_pixels <= kPixelImageLimit) return group_fragments_by_image(s);
     const size_t n = s.raw_count;
     s.sorted.resize(std::max(s.sorted.size(), n));
+    s.gathered.resize(std::max(s.gathered.size(), n));
+    for (size_t f = 0; f < n; ++f) s.gathered[f] = {s.raw_pixel[f], s.raw_triangle[f], s.raw_depth[f]};
     const uint32_t pixels = s.resolution * s.resolution;
     int bits = 0;
     while ((uint64_t(1) << bits) < pixels) ++bits;
-    Fragment* from = s.raw.data();
+    Fragment* from = s.gathered.data();
     Fragment* to = s.sorted.data();
     // Up to 2^16 pixels (256²) one counting pass; beyond, passes of 11 bits.
     const int digit_bits = bits <= 16 ? 16 : 11;
@@ -498,7 +521,7 @@ uint64_t NodeRasterizer::fragments() const { return state_->raw_count; }
 
 void NodeRasterizer::visit_fragments(const std::function<void(uint32_t, uint32_t, float)>& visit) const {
     const State& s = *state_;
-    for (size_t f = 0; f < s.raw_count; ++f) visit(s.raw[f].pixel, s.raw[f].triangle, s.raw[f].depth);
+    for (size_t f = 0; f < s.raw_count; ++f) visit(s.raw_pixel[f], s.raw_triangle[f], s.raw_depth[f]);
 }
 
 namespace {
@@ -602,7 +625,7 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
 
     // Triangles in batches: gather the snapped corners, test area and box for the whole batch at
     // once, then draw the survivors in triangle order (the order of the fragments is unchanged).
-    FragmentSink sink{s.raw};
+    FragmentSink sink{s.raw_pixel, s.raw_triangle, s.raw_depth};
     const size_t triangle_count = index_count / 3;
     const int32_t* xy = s.snapped.data();
     const uint8_t* flags = s.vertex_flags.data();
@@ -827,7 +850,7 @@ BlendFragments NodeRasterizer::export_blend_fragments(const uint8_t* blended) co
         std::vector<uint8_t> single(size_t(s.resolution) * s.resolution, 0);
         for (size_t i = 0; i < s.single; ++i) single[s.single_pixels[i]] = 1;
         for (size_t f = 0; f < s.raw_count; ++f)
-            if (single[s.raw[f].pixel] && blended[s.raw[f].triangle]) ++out.covered;
+            if (single[s.raw_pixel[f]] && blended[s.raw_triangle[f]]) ++out.covered;
     }
     out.starts.push_back(0);
     for (size_t m = 0; m < s.multi_count; ++m) {

@@ -312,6 +312,45 @@ __attribute__((target("avx2"))) void emit_box_avx2(const int64_t (&e_first)[3], 
     }
     sink.count = count;
 }
+
+// emit_small_box in the AVX2 copy: the box's four pixels are the four lanes (x0 y0, x1 y0, x0 y1,
+// x1 y1, emit_small_box's order), edge values e, e + sx, e + sy, e + sx + sy (integers below 2^53:
+// exact in double), depths emit_small_box's float(z_row + dzdx · x), then packed and stored as in
+// emit_box_avx2. Takes BatchSetup's doubles as they are: no conversion to int64.
+__attribute__((target("avx2"))) void emit_small_box_avx2(const double (&e)[3], const double (&step_x)[3],
+                                                         const double (&step_y)[3], double dzdx, double dzdy,
+                                                         double z_origin, const TriangleBox& box, uint32_t triangle,
+                                                         unsigned resolution, FragmentSink& sink) {
+    sink.reserve_more(4);
+    const size_t count = sink.count;
+    const double x0 = double(box.px0), x1 = x0 + 1.0;
+    const double z_row0 = z_origin + dzdy * double(box.py0), z_row1 = z_origin + dzdy * double(box.py0 + 1);
+    const __m256d zero = _mm256_setzero_pd();
+    const __m256d a0 = _mm256_add_pd(_mm256_set1_pd(e[0]),
+                                     _mm256_set_pd(step_x[0] + step_y[0], step_y[0], step_x[0], 0.0));
+    const __m256d a1 = _mm256_add_pd(_mm256_set1_pd(e[1]),
+                                     _mm256_set_pd(step_x[1] + step_y[1], step_y[1], step_x[1], 0.0));
+    const __m256d a2 = _mm256_add_pd(_mm256_set1_pd(e[2]),
+                                     _mm256_set_pd(step_x[2] + step_y[2], step_y[2], step_x[2], 0.0));
+    const __m256d covered = _mm256_and_pd(_mm256_cmp_pd(a0, zero, _CMP_GE_OQ),
+                                          _mm256_and_pd(_mm256_cmp_pd(a1, zero, _CMP_GE_OQ),
+                                                        _mm256_cmp_pd(a2, zero, _CMP_GE_OQ)));
+    const __m256d x = _mm256_set_pd(x1, x0, x1, x0), z_row = _mm256_set_pd(z_row1, z_row1, z_row0, z_row0);
+    const __m128 depth = _mm256_cvtpd_ps(_mm256_add_pd(z_row, _mm256_mul_pd(_mm256_set1_pd(dzdx), x)));
+    const __m128 in_range = _mm_and_ps(_mm_cmplt_ps(depth, _mm_set1_ps(1.0f)), _mm_cmpge_ps(depth, _mm_setzero_ps()));
+    const bool wide = box.px1 > box.px0, tall = box.py1 > box.py0;
+    const int in_box = 1 | int(wide) << 1 | int(tall) << 2 | int(wide && tall) << 3;
+    const int mask = _mm256_movemask_pd(covered) & _mm_movemask_ps(in_range) & in_box;
+    const __m128i order = _mm_load_si128(reinterpret_cast<const __m128i*>(kLaneCompaction.lanes[mask]));
+    const uint32_t row = uint32_t(box.py0 * resolution) + uint32_t(box.px0);
+    const __m128i pixels = _mm_add_epi32(_mm_set1_epi32(int32_t(row)),
+                                         _mm_set_epi32(int32_t(resolution + 1), int32_t(resolution), 1, 0));
+    _mm_storeu_ps(reinterpret_cast<float*>(sink.pixel.data() + count),
+                  _mm_permutevar_ps(_mm_castsi128_ps(pixels), order));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(sink.triangle.data() + count), _mm_set1_epi32(int32_t(triangle)));
+    _mm_storeu_ps(sink.depth.data() + count, _mm_permutevar_ps(depth, order));
+    sink.count = count + kLaneCompaction.count[mask];
+}
 #endif
 
 // emit_box for a box of at most 2 × 2 pixels (most drawn triangles of a character at 256²):
@@ -785,6 +824,16 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
                 if (setup.det[j] == 0.0) continue;  // float-degenerate sliver: no fragment has a defined depth
                 const int32_t* known = boxes[draw[j]];
                 const TriangleBox box{areas[draw[j]], known[0], known[1], known[2], known[3]};
+#ifdef ANIMORDER_RASTER_AVX2
+                if (kAvx2 && box.px1 - box.px0 < 2 && box.py1 - box.py0 < 2) {
+                    const double e[3] = {setup.e[0][j], setup.e[1][j], setup.e[2][j]};
+                    const double sx[3] = {setup.sx[0][j], setup.sx[1][j], setup.sx[2][j]};
+                    const double sy[3] = {setup.sy[0][j], setup.sy[1][j], setup.sy[2][j]};
+                    emit_small_box_avx2(e, sx, sy, setup.dzdx[j], setup.dzdy[j], setup.z_origin[j], box, uint32_t(t),
+                                        resolution, sink);
+                    continue;
+                }
+#endif
                 const int64_t e[3] = {int64_t(setup.e[0][j]), int64_t(setup.e[1][j]), int64_t(setup.e[2][j])};
                 const int64_t sx[3] = {int64_t(setup.sx[0][j]), int64_t(setup.sx[1][j]), int64_t(setup.sx[2][j])};
                 const int64_t sy[3] = {int64_t(setup.sy[0][j]), int64_t(setup.sy[1][j]), int64_t(setup.sy[2][j])};

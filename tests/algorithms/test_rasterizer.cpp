@@ -571,6 +571,63 @@ TEST(Rasterizer, FragmentsEqualAPlainPerPixelReference) {
     }
 }
 
+// The per-box paths of both copies against the plain reference: boxes of 1 × 1, 1 × 2, 2 × 1 and
+// 2 × 2 pixels (the AVX2 copy's one-vector path), and boxes 3 to 10 pixels wide (its 4-pixel groups:
+// one group, two, three, with masked lanes past the box), mixed in one batch; boxes cut by the
+// viewport's edges; both faces; depths at and next to 0 and 1 (some fragments round to depth 1
+// and are dropped).
+TEST(Rasterizer, SmallAndWideBoxesEqualThePlainReference) {
+    std::mt19937 rng(23);
+    const unsigned resolution = 24;
+    const float sizes[] = {0.3f, 0.7f, 1.2f, 1.8f, 2.6f, 3.4f, 4.5f, 6.2f, 8.7f};
+    const float depths[] = {-1.0f, -0.99999994f, -0.9999999f, 0.9999999f, 0.99999994f, 1.0f};
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    std::vector<float> clip;
+    std::vector<uint32_t> ib;
+    std::vector<uint8_t> modes;
+    for (int i = 0; i < 600; ++i) {
+        // In pixels (centre of pixel i at i), from just off the left or top edge to just off the right
+        // or bottom one; the size picks the box.
+        const float x = -1.5f + unit(rng) * (float(resolution) + 1.0f), y = -1.5f + unit(rng) * (float(resolution) + 1.0f);
+        const float w = sizes[rng() % 9], h = sizes[rng() % 9], a = unit(rng), b = unit(rng);
+        const float px[3] = {x, x + w, x + b * w}, py[3] = {y, y + a * h, y + h};
+        const bool flip = rng() % 2;
+        for (int k = 0; k < 3; ++k) {
+            const int c = flip ? 2 - k : k;
+            const float z = rng() % 3 ? depths[rng() % 6] : unit(rng) * 2.0f - 1.0f;
+            const float clip_w = i % 4 ? 1.0f : 0.5f + unit(rng);  // some perspective
+            ib.push_back(uint32_t(clip.size() / 4));
+            const float nx = (2.0f * px[c] + 1.0f) / float(resolution) - 1.0f;
+            const float ny = (2.0f * py[c] + 1.0f) / float(resolution) - 1.0f;
+            clip.insert(clip.end(), {nx * clip_w, ny * clip_w, z * clip_w, clip_w});
+        }
+        modes.push_back(rng() % 2 ? kDrawBothFaces : 0);
+    }
+    const auto expected = reference_fragments(clip, ib, modes, resolution);
+    size_t near_zero = 0, near_one = 0;  // drawn fragments at the ends of the depth range
+    for (const auto& f : expected) {
+        near_zero += std::get<2>(f) < 0.001f;
+        near_one += std::get<2>(f) > 0.999f;
+    }
+    for (bool simd : {false, true}) {
+        if (simd && !NodeRasterizer::simd_available()) continue;
+        NodeRasterizer r;
+        r.set_simd(simd);
+        r.rasterize(clip.data(), clip.size() / 4, ib.data(), ib.size(), resolution, modes.data());
+        const auto got = engine_fragments(r);
+        ASSERT_EQ(got.size(), expected.size()) << "simd " << simd;
+        for (size_t f = 0; f < got.size(); ++f) {
+            ASSERT_EQ(std::get<0>(got[f]), std::get<0>(expected[f])) << "fragment " << f << " simd " << simd;
+            ASSERT_EQ(std::get<1>(got[f]), std::get<1>(expected[f])) << "fragment " << f << " simd " << simd;
+            ASSERT_EQ(std::memcmp(&std::get<2>(got[f]), &std::get<2>(expected[f]), 4), 0)
+                << "fragment " << f << " simd " << simd;
+        }
+    }
+    EXPECT_GT(expected.size(), 1000u) << near_zero << " " << near_one;
+    EXPECT_GT(near_zero, 5u);
+    EXPECT_GT(near_one, 5u);
+}
+
 // Clipped triangles (crossing the near plane or the guard band) among unclipped ones: each
 // triangle's fragments are the same drawn alone or in the batch, and in triangle order.
 TEST(Rasterizer, ClippedTrianglesAmongOthersDrawAsWhenAlone) {

@@ -118,13 +118,17 @@ struct NodeRasterizer::State {
     std::vector<uint32_t> multi_pixel, multi_start, multi_fragment;
     uint64_t visible = 0, single = 0;
     // Per-vertex setup, done once per node rather than once per triangle corner. The batched
-    // pre-pass's view of the vertices: snapped X, Y as int32 pairs (kSpecialVertex for a vertex that
-    // cannot take the pre-pass), why it cannot (kClippedVertex, kWideVertex; 0 when it can), and
-    // the window-space x, y, z of the depth plane (4 floats a vertex, the fourth unused). The rare
-    // triangles of the exact paths project their corners again (the same function, the same bits).
-    std::vector<int32_t> snapped;
+    // pre-pass's view of the vertices: one 32-byte record a vertex (one cache line for both
+    // gathers) with snapped X, Y as int32 (kSpecialVertex for a vertex that cannot take the
+    // pre-pass) and the window-space x, y, z of the depth plane; why a vertex cannot take the
+    // pre-pass (kClippedVertex, kWideVertex; 0 when it can). The rare triangles of the exact paths
+    // project their corners again (the same function, the same bits).
+    struct alignas(32) VertexRecord {
+        int32_t X, Y;
+        float x, y, z, unused[3];
+    };
+    std::vector<VertexRecord> vertices;
     std::vector<uint8_t> vertex_flags;
-    std::vector<float> plane;
     bool simd = true;                   // the AVX2 copy where the CPU has it (set_simd)
     std::vector<uint32_t> histogram;    // counting sort of the fragments by pixel
     std::vector<uint32_t> pixel_count;  // per pixel, zero between nodes (kPixelImageLimit pixels at most)
@@ -317,7 +321,7 @@ __attribute__((target("avx2"))) void emit_box_avx2(const int64_t (&e_first)[3], 
 // x1 y1, emit_small_box's order), edge values e, e + sx, e + sy, e + sx + sy (integers below 2^53:
 // exact in double), depths emit_small_box's float(z_row + dzdx · x), then packed and stored as in
 // emit_box_avx2. Takes BatchSetup's doubles as they are: no conversion to int64.
-__attribute__((target("avx2"))) void emit_small_box_avx2(const double (&e)[3], const double (&step_x)[3],
+__attribute__((target("avx2"))) inline void emit_small_box_avx2(const double (&e)[3], const double (&step_x)[3],
                                                          const double (&step_y)[3], double dzdx, double dzdy,
                                                          double z_origin, const TriangleBox& box, uint32_t triangle,
                                                          unsigned resolution, FragmentSink& sink) {
@@ -719,36 +723,29 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
                                      const uint32_t* indices, size_t index_count, unsigned resolution,
                                      const uint8_t* modes) {
     const ClipVertex* cv = reinterpret_cast<const ClipVertex*>(clip_xyzw);
-    s.snapped.resize(2 * vertex_count);
+    s.vertices.resize(vertex_count);
     s.vertex_flags.resize(vertex_count);
-    s.plane.resize(4 * vertex_count);
     for (size_t v = 0; v < vertex_count; ++v) {
-        float* plane = &s.plane[4 * v];
+        NodeRasterizer::State::VertexRecord& record = s.vertices[v];
         if (!inside_all(cv[v])) {
             s.vertex_flags[v] = kClippedVertex;
-            s.snapped[2 * v] = s.snapped[2 * v + 1] = kSpecialVertex;
-            plane[0] = plane[1] = plane[2] = plane[3] = 0.0f;
+            record = {kSpecialVertex, kSpecialVertex, 0.0f, 0.0f, 0.0f, {0.0f, 0.0f, 0.0f}};
             continue;
         }
         WindowVertex w;
         project(cv[v], resolution, w);
         const bool compact = w.X > -kCompactLimit && w.X < kCompactLimit && w.Y > -kCompactLimit && w.Y < kCompactLimit;
         s.vertex_flags[v] = compact ? 0 : kWideVertex;
-        s.snapped[2 * v] = compact ? int32_t(w.X) : kSpecialVertex;
-        s.snapped[2 * v + 1] = compact ? int32_t(w.Y) : kSpecialVertex;
-        plane[0] = w.x;
-        plane[1] = w.y;
-        plane[2] = w.z;
-        plane[3] = 0.0f;
+        record = {compact ? int32_t(w.X) : kSpecialVertex, compact ? int32_t(w.Y) : kSpecialVertex, w.x, w.y, w.z,
+                  {0.0f, 0.0f, 0.0f}};
     }
 
     // Triangles in batches: gather the snapped corners, test area and box for the whole batch at
     // once, then draw the survivors in triangle order (the order of the fragments is unchanged).
     FragmentSink sink{s.raw_pixel, s.raw_triangle, s.raw_depth};
     const size_t triangle_count = index_count / 3;
-    const int32_t* xy = s.snapped.data();
+    const NodeRasterizer::State::VertexRecord* vertex = s.vertices.data();
     const uint8_t* flags = s.vertex_flags.data();
-    const float* plane = s.plane.data();
     alignas(16) int32_t x0[kBatch], y0[kBatch], x1[kBatch], y1[kBatch], x2[kBatch], y2[kBatch], keep[kBatch];
     int32_t two[kBatch];
     int32_t boxes[kBatch][4];
@@ -762,12 +759,12 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
         for (size_t i = 0; i < n; ++i) {
             const uint32_t a = tri[3 * i], b = tri[3 * i + 1], c = tri[3 * i + 2];
             const uint8_t mode = modes ? modes[first + i] : 0;
-            x0[i] = xy[2 * a];
-            y0[i] = xy[2 * a + 1];
-            x1[i] = xy[2 * b];
-            y1[i] = xy[2 * b + 1];
-            x2[i] = xy[2 * c];
-            y2[i] = xy[2 * c + 1];
+            x0[i] = vertex[a].X;
+            y0[i] = vertex[a].Y;
+            x1[i] = vertex[b].X;
+            y1[i] = vertex[b].Y;
+            x2[i] = vertex[c].X;
+            y2[i] = vertex[c].Y;
             two[i] = mode & kDrawBothFaces;
             // Skipped: never drawn (0); a clipped or wide corner: an exact path below (2).
             const bool exact = (x0[i] == kSpecialVertex) | (x1[i] == kSpecialVertex) | (x2[i] == kSpecialVertex);
@@ -793,9 +790,9 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
             const size_t i = draw[j];
             const bool fast = special[i] == 1, front = areas[i] < 0;
             const size_t t = first + i;
-            const float* w0 = plane + 4 * size_t(indices[3 * t]);
-            const float* w1 = plane + 4 * size_t(indices[3 * t + (front ? 2 : 1)]);
-            const float* w2 = plane + 4 * size_t(indices[3 * t + (front ? 1 : 2)]);
+            const auto* w0 = vertex + indices[3 * t];
+            const auto* w1 = vertex + indices[3 * t + (front ? 2 : 1)];
+            const auto* w2 = vertex + indices[3 * t + (front ? 1 : 2)];
             setup.X[0][j] = x0[i];
             setup.Y[0][j] = y0[i];
             setup.X[1][j] = front ? x2[i] : x1[i];
@@ -805,15 +802,15 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
             setup.px0[j] = boxes[i][0];
             setup.py0[j] = boxes[i][2];
             // As rasterize_window_triangle: differences in float, then widened.
-            setup.ax[j] = fast ? w1[0] - w0[0] : 0.0f;
-            setup.ay[j] = fast ? w1[1] - w0[1] : 0.0f;
-            setup.az[j] = fast ? w1[2] - w0[2] : 0.0f;
-            setup.bx[j] = fast ? w2[0] - w0[0] : 0.0f;
-            setup.by[j] = fast ? w2[1] - w0[1] : 0.0f;
-            setup.bz[j] = fast ? w2[2] - w0[2] : 0.0f;
-            setup.x[j] = fast ? w0[0] : 0.0f;
-            setup.y[j] = fast ? w0[1] : 0.0f;
-            setup.z[j] = fast ? w0[2] : 0.0f;
+            setup.ax[j] = fast ? w1->x - w0->x : 0.0f;
+            setup.ay[j] = fast ? w1->y - w0->y : 0.0f;
+            setup.az[j] = fast ? w1->z - w0->z : 0.0f;
+            setup.bx[j] = fast ? w2->x - w0->x : 0.0f;
+            setup.by[j] = fast ? w2->y - w0->y : 0.0f;
+            setup.bz[j] = fast ? w2->z - w0->z : 0.0f;
+            setup.x[j] = fast ? w0->x : 0.0f;
+            setup.y[j] = fast ? w0->y : 0.0f;
+            setup.z[j] = fast ? w0->z : 0.0f;
         }
         setup.compute(m);
         for (size_t j = 0; j < m; ++j) {

@@ -257,19 +257,20 @@ struct LaneCompaction {
 };
 constexpr LaneCompaction kLaneCompaction;
 
-// emit_box in the AVX2 copy: 4 pixels of a row at a time, in double lanes. Exact: the edge values
-// e + k·step are integers below 2^53 in magnitude (BatchSetup's bound plus at most 2^14 · 2^33),
-// so double holds them and their signs decide coverage as in emit_box; the depth of a lane is
+// emit_box in the AVX2 copy, from BatchSetup's doubles (no conversion to int64): 4 pixels of a row
+// at a time, in double lanes. Exact: the edge values e + k·step_x + r·step_y are integers below
+// 2^53 in magnitude (BatchSetup's bound plus at most 2 · 2^14 · 2^33), so double holds them, sums
+// included, and their signs decide coverage as in emit_box; the depth of a lane is
 // emit_box's float(z_row + dzdx · double(px)), the same multiply, add and conversion (to nearest,
 // no FMA). The covered lanes are packed to the front (a lane permutation) and stored to the three
 // arrays with one 16-byte store each: the fragments of emit_box, in its order. Up to 3 slots past
 // the fragments are written too (reserved).
-__attribute__((target("avx2"))) void emit_box_avx2(const int64_t (&e_first)[3], const int64_t (&step_x)[3],
-                                                   const int64_t (&step_y)[3], double dzdx, double dzdy,
+__attribute__((target("avx2"))) void emit_box_avx2(const double (&e_first)[3], const double (&step_x)[3],
+                                                   const double (&step_y)[3], double dzdx, double dzdy,
                                                    double z_origin, const TriangleBox& box, uint32_t triangle,
                                                    unsigned resolution, FragmentSink& sink) {
     const int64_t px0 = box.px0, px1 = box.px1, py0 = box.py0, py1 = box.py1;
-    int64_t e_row[3] = {e_first[0], e_first[1], e_first[2]};
+    double e_row[3] = {e_first[0], e_first[1], e_first[2]};
     sink.reserve_more(size_t(px1 - px0 + 1) * size_t(py1 - py0 + 1) + 4);
     uint32_t* out_pixel = sink.pixel.data();
     uint32_t* out_triangle = sink.triangle.data();
@@ -279,8 +280,8 @@ __attribute__((target("avx2"))) void emit_box_avx2(const int64_t (&e_first)[3], 
     const __m128i lane_index = _mm_set_epi32(3, 2, 1, 0);
     __m256d lane_step[3], group_step[3];
     for (int i = 0; i < 3; ++i) {
-        lane_step[i] = _mm256_mul_pd(lane, _mm256_set1_pd(double(step_x[i])));
-        group_step[i] = _mm256_set1_pd(4.0 * double(step_x[i]));
+        lane_step[i] = _mm256_mul_pd(lane, _mm256_set1_pd(step_x[i]));
+        group_step[i] = _mm256_set1_pd(4.0 * step_x[i]);
     }
     const __m256d slope = _mm256_set1_pd(dzdx), last = _mm256_set1_pd(double(px1)), zero = _mm256_setzero_pd();
     const __m128 one_f = _mm_set1_ps(1.0f), zero_f = _mm_setzero_ps();
@@ -288,9 +289,9 @@ __attribute__((target("avx2"))) void emit_box_avx2(const int64_t (&e_first)[3], 
     for (int64_t py = py0; py <= py1; ++py) {
         const __m256d z_row = _mm256_set1_pd(z_origin + dzdy * double(py));
         const uint32_t row = uint32_t(py * resolution);
-        __m256d a0 = _mm256_add_pd(_mm256_set1_pd(double(e_row[0])), lane_step[0]);
-        __m256d a1 = _mm256_add_pd(_mm256_set1_pd(double(e_row[1])), lane_step[1]);
-        __m256d a2 = _mm256_add_pd(_mm256_set1_pd(double(e_row[2])), lane_step[2]);
+        __m256d a0 = _mm256_add_pd(_mm256_set1_pd(e_row[0]), lane_step[0]);
+        __m256d a1 = _mm256_add_pd(_mm256_set1_pd(e_row[1]), lane_step[1]);
+        __m256d a2 = _mm256_add_pd(_mm256_set1_pd(e_row[2]), lane_step[2]);
         for (int64_t px = px0; px <= px1; px += 4) {
             const __m256d x = _mm256_add_pd(_mm256_set1_pd(double(px)), lane);
             const __m256d covered = _mm256_and_pd(
@@ -822,12 +823,16 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
                 const int32_t* known = boxes[draw[j]];
                 const TriangleBox box{areas[draw[j]], known[0], known[1], known[2], known[3]};
 #ifdef ANIMORDER_RASTER_AVX2
-                if (kAvx2 && box.px1 - box.px0 < 2 && box.py1 - box.py0 < 2) {
+                if (kAvx2) {  // the set-up's doubles as they are: no conversion to int64
                     const double e[3] = {setup.e[0][j], setup.e[1][j], setup.e[2][j]};
                     const double sx[3] = {setup.sx[0][j], setup.sx[1][j], setup.sx[2][j]};
                     const double sy[3] = {setup.sy[0][j], setup.sy[1][j], setup.sy[2][j]};
-                    emit_small_box_avx2(e, sx, sy, setup.dzdx[j], setup.dzdy[j], setup.z_origin[j], box, uint32_t(t),
-                                        resolution, sink);
+                    if (box.px1 - box.px0 < 2 && box.py1 - box.py0 < 2)
+                        emit_small_box_avx2(e, sx, sy, setup.dzdx[j], setup.dzdy[j], setup.z_origin[j], box,
+                                            uint32_t(t), resolution, sink);
+                    else
+                        emit_box_avx2(e, sx, sy, setup.dzdx[j], setup.dzdy[j], setup.z_origin[j], box, uint32_t(t),
+                                      resolution, sink);
                     continue;
                 }
 #endif
@@ -837,11 +842,6 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
                 if (box.px1 - box.px0 < 2 && box.py1 - box.py0 < 2)
                     emit_small_box(e, sx, sy, setup.dzdx[j], setup.dzdy[j], setup.z_origin[j], box, uint32_t(t),
                                    resolution, sink);
-#ifdef ANIMORDER_RASTER_AVX2
-                else if (kAvx2)
-                    emit_box_avx2(e, sx, sy, setup.dzdx[j], setup.dzdy[j], setup.z_origin[j], box, uint32_t(t),
-                                  resolution, sink);
-#endif
                 else
                     emit_box(e, sx, sy, setup.dzdx[j], setup.dzdy[j], setup.z_origin[j], box, uint32_t(t), resolution,
                              sink);

@@ -266,9 +266,9 @@ constexpr LaneCompaction kLaneCompaction;
 // arrays with one 16-byte store each: the fragments of emit_box, in its order. Up to 3 slots past
 // the fragments are written too (reserved).
 __attribute__((target("avx2"))) void emit_box_avx2(const double (&e_first)[3], const double (&step_x)[3],
-                                                   const double (&step_y)[3], double dzdx, double dzdy,
-                                                   double z_origin, const TriangleBox& box, uint32_t triangle,
-                                                   unsigned resolution, FragmentSink& sink) {
+                                                   const double (&step_y)[3], double dzdx, double dzdy, double z_origin,
+                                                   const TriangleBox& box, uint32_t triangle, unsigned resolution,
+                                                   FragmentSink& sink) {
     const int64_t px0 = box.px0, px1 = box.px1, py0 = box.py0, py1 = box.py1;
     double e_row[3] = {e_first[0], e_first[1], e_first[2]};
     sink.reserve_more(size_t(px1 - px0 + 1) * size_t(py1 - py0 + 1) + 4);
@@ -294,9 +294,9 @@ __attribute__((target("avx2"))) void emit_box_avx2(const double (&e_first)[3], c
         __m256d a2 = _mm256_add_pd(_mm256_set1_pd(e_row[2]), lane_step[2]);
         for (int64_t px = px0; px <= px1; px += 4) {
             const __m256d x = _mm256_add_pd(_mm256_set1_pd(double(px)), lane);
-            const __m256d covered = _mm256_and_pd(
-                _mm256_and_pd(_mm256_cmp_pd(a0, zero, _CMP_GE_OQ), _mm256_cmp_pd(a1, zero, _CMP_GE_OQ)),
-                _mm256_and_pd(_mm256_cmp_pd(a2, zero, _CMP_GE_OQ), _mm256_cmp_pd(x, last, _CMP_LE_OQ)));
+            const __m256d covered =
+                _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(a0, zero, _CMP_GE_OQ), _mm256_cmp_pd(a1, zero, _CMP_GE_OQ)),
+                              _mm256_and_pd(_mm256_cmp_pd(a2, zero, _CMP_GE_OQ), _mm256_cmp_pd(x, last, _CMP_LE_OQ)));
             const __m128 depth = _mm256_cvtpd_ps(_mm256_add_pd(z_row, _mm256_mul_pd(slope, x)));
             const __m128 in_range = _mm_and_ps(_mm_cmplt_ps(depth, one_f), _mm_cmpge_ps(depth, zero_f));
             const int mask = _mm256_movemask_pd(covered) & _mm_movemask_ps(in_range);
@@ -323,23 +323,24 @@ __attribute__((target("avx2"))) void emit_box_avx2(const double (&e_first)[3], c
 // exact in double), depths emit_small_box's float(z_row + dzdx · x), then packed and stored as in
 // emit_box_avx2. Takes BatchSetup's doubles as they are: no conversion to int64.
 __attribute__((target("avx2"))) inline void emit_small_box_avx2(const double (&e)[3], const double (&step_x)[3],
-                                                         const double (&step_y)[3], double dzdx, double dzdy,
-                                                         double z_origin, const TriangleBox& box, uint32_t triangle,
-                                                         unsigned resolution, FragmentSink& sink) {
+                                                                const double (&step_y)[3], double dzdx, double dzdy,
+                                                                double z_origin, const TriangleBox& box,
+                                                                uint32_t triangle, unsigned resolution,
+                                                                FragmentSink& sink) {
     sink.reserve_more(4);
     const size_t count = sink.count;
     const double x0 = double(box.px0), x1 = x0 + 1.0;
     const double z_row0 = z_origin + dzdy * double(box.py0), z_row1 = z_origin + dzdy * double(box.py0 + 1);
     const __m256d zero = _mm256_setzero_pd();
-    const __m256d a0 = _mm256_add_pd(_mm256_set1_pd(e[0]),
-                                     _mm256_set_pd(step_x[0] + step_y[0], step_y[0], step_x[0], 0.0));
-    const __m256d a1 = _mm256_add_pd(_mm256_set1_pd(e[1]),
-                                     _mm256_set_pd(step_x[1] + step_y[1], step_y[1], step_x[1], 0.0));
-    const __m256d a2 = _mm256_add_pd(_mm256_set1_pd(e[2]),
-                                     _mm256_set_pd(step_x[2] + step_y[2], step_y[2], step_x[2], 0.0));
-    const __m256d covered = _mm256_and_pd(_mm256_cmp_pd(a0, zero, _CMP_GE_OQ),
-                                          _mm256_and_pd(_mm256_cmp_pd(a1, zero, _CMP_GE_OQ),
-                                                        _mm256_cmp_pd(a2, zero, _CMP_GE_OQ)));
+    const __m256d a0 =
+        _mm256_add_pd(_mm256_set1_pd(e[0]), _mm256_set_pd(step_x[0] + step_y[0], step_y[0], step_x[0], 0.0));
+    const __m256d a1 =
+        _mm256_add_pd(_mm256_set1_pd(e[1]), _mm256_set_pd(step_x[1] + step_y[1], step_y[1], step_x[1], 0.0));
+    const __m256d a2 =
+        _mm256_add_pd(_mm256_set1_pd(e[2]), _mm256_set_pd(step_x[2] + step_y[2], step_y[2], step_x[2], 0.0));
+    const __m256d covered =
+        _mm256_and_pd(_mm256_cmp_pd(a0, zero, _CMP_GE_OQ),
+                      _mm256_and_pd(_mm256_cmp_pd(a1, zero, _CMP_GE_OQ), _mm256_cmp_pd(a2, zero, _CMP_GE_OQ)));
     const __m256d x = _mm256_set_pd(x1, x0, x1, x0), z_row = _mm256_set_pd(z_row1, z_row1, z_row0, z_row0);
     const __m128 depth = _mm256_cvtpd_ps(_mm256_add_pd(z_row, _mm256_mul_pd(_mm256_set1_pd(dzdx), x)));
     const __m128 in_range = _mm_and_ps(_mm_cmplt_ps(depth, _mm_set1_ps(1.0f)), _mm_cmpge_ps(depth, _mm_setzero_ps()));
@@ -348,8 +349,8 @@ __attribute__((target("avx2"))) inline void emit_small_box_avx2(const double (&e
     const int mask = _mm256_movemask_pd(covered) & _mm_movemask_ps(in_range) & in_box;
     const __m128i order = _mm_load_si128(reinterpret_cast<const __m128i*>(kLaneCompaction.lanes[mask]));
     const uint32_t row = uint32_t(box.py0 * resolution) + uint32_t(box.px0);
-    const __m128i pixels = _mm_add_epi32(_mm_set1_epi32(int32_t(row)),
-                                         _mm_set_epi32(int32_t(resolution + 1), int32_t(resolution), 1, 0));
+    const __m128i pixels =
+        _mm_add_epi32(_mm_set1_epi32(int32_t(row)), _mm_set_epi32(int32_t(resolution + 1), int32_t(resolution), 1, 0));
     _mm_storeu_ps(reinterpret_cast<float*>(sink.pixel.data() + count),
                   _mm_permutevar_ps(_mm_castsi128_ps(pixels), order));
     _mm_storeu_si128(reinterpret_cast<__m128i*>(sink.triangle.data() + count), _mm_set1_epi32(int32_t(triangle)));
@@ -737,7 +738,11 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
         project(cv[v], resolution, w);
         const bool compact = w.X > -kCompactLimit && w.X < kCompactLimit && w.Y > -kCompactLimit && w.Y < kCompactLimit;
         s.vertex_flags[v] = compact ? 0 : kWideVertex;
-        record = {compact ? int32_t(w.X) : kSpecialVertex, compact ? int32_t(w.Y) : kSpecialVertex, w.x, w.y, w.z,
+        record = {compact ? int32_t(w.X) : kSpecialVertex,
+                  compact ? int32_t(w.Y) : kSpecialVertex,
+                  w.x,
+                  w.y,
+                  w.z,
                   {0.0f, 0.0f, 0.0f}};
     }
 

@@ -588,7 +588,8 @@ TEST(Rasterizer, SmallAndWideBoxesEqualThePlainReference) {
     for (int i = 0; i < 600; ++i) {
         // In pixels (centre of pixel i at i), from just off the left or top edge to just off the right
         // or bottom one; the size picks the box.
-        const float x = -1.5f + unit(rng) * (float(resolution) + 1.0f), y = -1.5f + unit(rng) * (float(resolution) + 1.0f);
+        const float x = -1.5f + unit(rng) * (float(resolution) + 1.0f),
+                    y = -1.5f + unit(rng) * (float(resolution) + 1.0f);
         const float w = sizes[rng() % 9], h = sizes[rng() % 9], a = unit(rng), b = unit(rng);
         const float px[3] = {x, x + w, x + b * w}, py[3] = {y, y + a * h, y + h};
         const bool flip = rng() % 2;

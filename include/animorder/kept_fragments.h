@@ -50,11 +50,18 @@ struct KeptNode {
     size_t bytes() const { return data.capacity() + sizeof(*this); }
 };
 
-// Working memory of keep_fragments, reused between nodes.
+// Working memory of keep_fragments, reused between nodes (its list table too: each slot is
+// stamped with the node that filled it, so nothing is cleared node after node).
 struct KeepScratch {
-    std::vector<uint32_t> reduced, slots, list_offset;
-    std::vector<std::pair<uint32_t, uint32_t>> kept;
-    std::vector<uint16_t> entries, weights;
+    struct Slot {
+        uint32_t stamp = 0;  // generation << 8 | the list's length; a slot of another generation is empty
+        uint32_t list = 0;   // the list's index
+    };
+    std::vector<Slot> slots;
+    uint32_t generation = 0;
+    std::vector<uint64_t> keys;  // per list: its first four entries side by side
+    std::vector<uint32_t> reduced, kept_unit, kept_position, list_offset;
+    std::vector<uint16_t> units, entries, weights;
     std::vector<uint8_t> lengths;
     std::vector<uint32_t> triangle_lists;
 };

@@ -28,27 +28,34 @@ namespace {
 
 constexpr uint32_t kMaxWeight = UINT16_MAX;
 
-uint64_t hash_list(const uint16_t* e, size_t n) {
-    uint64_t h = 0x9e3779b97f4a7c15ULL ^ n;
-    for (size_t i = 0; i < n; ++i) {
+// A list's first four entries side by side (zeros beyond its end): with its length, the whole of
+// nearly every list, so most lookups compare one word.
+uint64_t key_of(const uint16_t* e, size_t n) {
+    uint64_t key = 0;
+    for (size_t i = 0; i < n && i < 4; ++i) key |= uint64_t(e[i]) << (16 * i);
+    return key;
+}
+
+uint64_t hash_list(uint64_t key, const uint16_t* e, size_t n) {
+    uint64_t h = (key ^ (uint64_t(n) << 59)) * 0x9e3779b97f4a7c15ULL;
+    for (size_t i = 4; i < n; ++i) {
         h ^= e[i];
         h *= 0xff51afd7ed558ccdULL;
-        h ^= h >> 29;
     }
-    return h;
+    return h ^ (h >> 29);
 }
 
 // Drops the fragments of reduction 1 from one pixel's list into `out` (tie bits recomputed: an
-// entry is tied when its depth equals the previous kept entry's). Sets `repeated` when a unit
-// still appears twice. `kept` holds the kept entries' (unit, position).
-void reduce_pixel(const uint32_t* f, uint32_t n, const UnitPartition& partition, std::vector<uint32_t>& out,
-                  std::vector<std::pair<uint32_t, uint32_t>>& kept, bool& repeated) {
-    out.clear();
-    kept.clear();
+// entry is tied when its depth equals the previous kept entry's) and returns how many are kept;
+// kept_unit and kept_position hold the kept entries' unit and position (each array at least n
+// long). Sets `repeated` when a unit still appears twice.
+uint32_t reduce_pixel(const uint32_t* f, uint32_t n, const UnitPartition& partition, uint32_t* out,
+                      uint32_t* kept_unit, uint32_t* kept_position, bool& repeated) {
     repeated = false;
     const size_t triangles = partition.unit_of_triangle.size();
     const std::pair<uint32_t, uint32_t>* unit_position = partition.unit_position.data();
     bool previous_at_kept_depth = true;  // the previous fragment's depth equals the last kept one's
+    uint32_t kept = 0;
     for (uint32_t j = 0; j < n; ++j) {
         const uint32_t t = f[j] & kTriangleMask;
         if (t >= triangles)
@@ -57,54 +64,74 @@ void reduce_pixel(const uint32_t* f, uint32_t n, const UnitPartition& partition,
         const bool tied = j > 0 && (f[j] & kTieBit) && previous_at_kept_depth;
         const auto [unit, position] = unit_position[t];
         bool dominated = false, same_unit = false;
-        for (const auto& [u, p] : kept) {
-            if (u != unit) continue;
-            same_unit = true;
-            dominated |= p < position;
+        for (uint32_t i = 0; i < kept; ++i) {
+            const bool same = kept_unit[i] == unit;
+            same_unit |= same;
+            dominated |= same && kept_position[i] < position;
         }
         if (dominated) {
             previous_at_kept_depth = tied;
             continue;
         }
         repeated |= same_unit;
-        out.push_back(t | (tied ? kTieBit : 0));
-        kept.emplace_back(unit, position);
+        out[kept] = t | (tied ? kTieBit : 0);
+        kept_unit[kept] = unit;
+        kept_position[kept] = position;
+        ++kept;
         previous_at_kept_depth = true;
     }
+    return kept;
 }
 
-// The deduplicated unit lists of one node, in order of first appearance.
+// The deduplicated unit lists of one node, in order of first appearance. Which list a pixel
+// joins never depends on the hash: a list's content has one slot, and grow() reinserts the lists
+// in list order (so a full list is met before its later copy, as when it was first filled).
 struct ListTable {
     KeepScratch& s;
     size_t mask = 0;
+    uint32_t generation = 0;
 
     explicit ListTable(KeepScratch& scratch) : s(scratch) {
         s.entries.clear();
         s.weights.clear();
         s.lengths.clear();
         s.list_offset.clear();
-        // The previous node's table size (nodes of a run are alike): no regrowth node after node.
-        s.slots.assign(std::max<size_t>(1024, s.slots.size()), 0);
+        s.keys.clear();
+        // The previous node's table (nodes of a run are alike): no regrowth node after node, and
+        // no clearing either: a new generation empties every slot.
+        if (s.slots.size() < 1024 || ++s.generation >= (1u << 24)) {
+            s.slots.assign(std::max<size_t>(1024, s.slots.size()), KeepScratch::Slot{});
+            s.generation = 1;
+        }
+        generation = s.generation;
         mask = s.slots.size() - 1;
     }
-    bool equal(uint32_t list, const uint16_t* e, size_t n) const {
-        return s.lengths[list] == n && std::memcmp(&s.entries[s.list_offset[list]], e, n * sizeof(uint16_t)) == 0;
+    void insert(uint32_t list) {
+        const uint16_t* e = &s.entries[s.list_offset[list]];
+        const size_t n = s.lengths[list];
+        size_t i = hash_list(s.keys[list], e, n) & mask;
+        while ((s.slots[i].stamp >> 8) == generation) i = (i + 1) & mask;
+        s.slots[i] = {generation << 8 | uint32_t(n), list};
     }
     void grow() {
-        s.slots.assign(s.slots.size() * 2, 0);
+        s.slots.assign(s.slots.size() * 2, KeepScratch::Slot{});
         mask = s.slots.size() - 1;
-        for (uint32_t list = 0; list < s.weights.size(); ++list) {
-            size_t i = hash_list(&s.entries[s.list_offset[list]], s.lengths[list]) & mask;
-            while (s.slots[i] != 0) i = (i + 1) & mask;
-            s.slots[i] = list + 1;
-        }
+        for (uint32_t list = 0; list < s.weights.size(); ++list) insert(list);
     }
-    // One more pixel with this list. A full weight starts a second copy (later pixels count there).
+    // One more pixel with this list (n ≤ kMaxListLength). A full weight starts a second copy
+    // (later pixels count there).
     void add(const uint16_t* e, size_t n) {
-        size_t i = hash_list(e, n) & mask;
-        for (; s.slots[i] != 0; i = (i + 1) & mask) {
-            const uint32_t list = s.slots[i] - 1;
-            if (!equal(list, e, n)) continue;
+        const uint64_t key = key_of(e, n);
+        const uint32_t stamp = generation << 8 | uint32_t(n);
+        size_t i = hash_list(key, e, n) & mask;
+        for (;; i = (i + 1) & mask) {
+            const KeepScratch::Slot& slot = s.slots[i];
+            if ((slot.stamp >> 8) != generation) break;  // empty
+            if (slot.stamp != stamp) continue;
+            const uint32_t list = slot.list;
+            if (s.keys[list] != key) continue;
+            if (n > 4 && std::memcmp(&s.entries[s.list_offset[list] + 4], e + 4, (n - 4) * sizeof(uint16_t)) != 0)
+                continue;
             if (s.weights[list] < kMaxWeight) {
                 ++s.weights[list];
                 return;
@@ -116,7 +143,8 @@ struct ListTable {
         s.entries.insert(s.entries.end(), e, e + n);
         s.lengths.push_back(uint8_t(n));
         s.weights.push_back(1);
-        s.slots[i] = list + 1;
+        s.keys.push_back(key);
+        s.slots[i] = {stamp, list};
         if (2 * s.weights.size() > s.slots.size()) grow();
     }
 };
@@ -231,24 +259,32 @@ KeptNode keep_fragments(uint64_t visible, uint64_t single, const uint32_t* start
     const bool unit_lists = partition.unit_count <= kMaxListedUnits;
     ListTable table(s);
     s.triangle_lists.clear();
-    uint16_t units[kMaxListLength];
     bool repeated = false;
     for (size_t p = 0; p < pixel_count; ++p) {
-        reduce_pixel(fragments + starts[p], starts[p + 1] - starts[p], partition, s.reduced, s.kept, repeated);
-        if (s.reduced.size() < 2) {
+        const uint32_t n = starts[p + 1] - starts[p];
+        if (s.reduced.size() < n) {
+            s.reduced.resize(n);
+            s.kept_unit.resize(n);
+            s.kept_position.resize(n);
+            s.units.resize(n);
+        }
+        const uint32_t kept = reduce_pixel(fragments + starts[p], n, partition, s.reduced.data(), s.kept_unit.data(),
+                                           s.kept_position.data(), repeated);
+        if (kept < 2) {
             ++node.single;  // only the nearest is left: it passes under every order, nothing else does
             continue;
         }
-        if (!unit_lists || repeated || s.reduced.size() > kMaxListLength) {
-            s.triangle_lists.push_back(uint32_t(s.reduced.size()));
-            s.triangle_lists.insert(s.triangle_lists.end(), s.reduced.begin(), s.reduced.end());
+        if (!unit_lists || repeated || kept > kMaxListLength) {
+            s.triangle_lists.push_back(kept);
+            s.triangle_lists.insert(s.triangle_lists.end(), s.reduced.begin(), s.reduced.begin() + kept);
             ++node.triangle_lists;
-            node.triangle_entries += uint32_t(s.reduced.size());
+            node.triangle_entries += kept;
             continue;
         }
-        for (size_t j = 0; j < s.reduced.size(); ++j)
-            units[j] = uint16_t(s.kept[j].first | (s.reduced[j] & kTieBit ? kUnitTieBit : 0));
-        table.add(units, s.reduced.size());
+        uint16_t* units = s.units.data();
+        for (uint32_t j = 0; j < kept; ++j)
+            units[j] = uint16_t(s.kept_unit[j] | (s.reduced[j] & kTieBit ? kUnitTieBit : 0));
+        table.add(units, kept);
     }
     node.unit_lists = uint32_t(s.weights.size());
     node.unit_entries = uint32_t(s.entries.size());

@@ -168,6 +168,48 @@ const T* at(const KeptNode& n, size_t offset) {
     return reinterpret_cast<const T*>(n.data.data() + offset);
 }
 
+// Bit j of the result set when entry j of the unit entries opens a list (one walk over the
+// lengths), so that score_unit_lists_1 walks all entries at once, with no branch per list.
+const uint64_t* list_start_bits(const KeptNode& node, const uint8_t* lengths) {
+    static thread_local std::vector<uint64_t> bits;
+    bits.assign(size_t(node.unit_entries) / 64 + 1, 0);
+    uint32_t start = 0;
+    for (uint32_t list = 0; list < node.unit_lists; ++list) {
+        bits[start >> 6] |= uint64_t(1) << (start & 63);
+        start += lengths[list];
+    }
+    return bits.data();
+}
+
+// One order: every unit list at once, entry by entry, replayed as replay_list does (an entry
+// passes iff its rank beats the running minimum and nothing of its own tie group passed before
+// it) without a branch: a list's first entry resets the running minimum, a tied entry keeps the
+// minimum from before its group, and each pass counts its list's weight. (A list's length is
+// 2 to 5 or so at random, so a loop per list guesses its exit wrong about once a list.)
+void score_unit_lists_1(uint64_t* passed, const KeptNode& node, const uint16_t* unit_ranks) {
+    const Layout l = layout_of(node);
+    const uint16_t* weights = at<uint16_t>(node, l.weights);
+    const uint16_t* e = at<uint16_t>(node, l.entries);
+    const uint64_t* starts = list_start_bits(node, at<uint8_t>(node, l.lengths));
+    uint64_t count = 0;
+    uint32_t running = UINT16_MAX, before = UINT16_MAX, weight = 0;
+    const uint16_t* list_weight = weights - 1;  // the current list's
+    for (uint32_t j = 0; j < node.unit_entries; ++j) {
+        const uint32_t start = uint32_t(starts[j >> 6] >> (j & 63)) & 1;
+        list_weight += start;
+        weight = *list_weight;
+        const uint32_t u = e[j], r = unit_ranks[u & ~uint32_t(kUnitTieBit)];
+        running |= 0u - start;  // UINT16_MAX at a list's start
+        running &= UINT16_MAX;
+        const bool tied = (u & kUnitTieBit) && !start;
+        before = tied ? before : running;
+        const uint32_t pass = uint32_t(r < running) & uint32_t(running == before);
+        running = std::min(running, r);
+        count += weight & (0u - pass);
+    }
+    passed[0] += count;
+}
+
 template <size_t K>
 void score_kept_k(uint64_t* passed, const KeptNode& node, const uint16_t* unit_ranks) {
     const Layout l = layout_of(node);
@@ -204,7 +246,7 @@ void score_kept_k(uint64_t* passed, const KeptNode& node, const uint16_t* unit_r
 
 void score_unit_lists_any(uint64_t* passed, const KeptNode& node, const uint16_t* unit_ranks, size_t order_count) {
     switch (order_count) {
-        case 1: return score_kept_k<1>(passed, node, unit_ranks);
+        case 1: return score_unit_lists_1(passed, node, unit_ranks);
         case 2: return score_kept_k<2>(passed, node, unit_ranks);
         case 3: return score_kept_k<3>(passed, node, unit_ranks);
         case 4: return score_kept_k<4>(passed, node, unit_ranks);

@@ -29,11 +29,11 @@ namespace {
 constexpr uint32_t kMaxWeight = UINT16_MAX;
 
 // A list's first four entries side by side (zeros beyond its end): with its length, the whole of
-// nearly every list, so most lookups compare one word.
+// nearly every list, so most lookups compare one word. `e` must have four entries readable.
 uint64_t key_of(const uint16_t* e, size_t n) {
-    uint64_t key = 0;
-    for (size_t i = 0; i < n && i < 4; ++i) key |= uint64_t(e[i]) << (16 * i);
-    return key;
+    uint64_t key;
+    std::memcpy(&key, e, sizeof key);
+    return n >= 4 ? key : key & ((uint64_t(1) << (16 * n)) - 1);
 }
 
 uint64_t hash_list(uint64_t key, const uint16_t* e, size_t n) {
@@ -47,10 +47,11 @@ uint64_t hash_list(uint64_t key, const uint16_t* e, size_t n) {
 
 // Drops the fragments of reduction 1 from one pixel's list into `out` (tie bits recomputed: an
 // entry is tied when its depth equals the previous kept entry's) and returns how many are kept;
-// kept_unit and kept_position hold the kept entries' unit and position (each array at least n
-// long). Sets `repeated` when a unit still appears twice.
+// kept_unit and kept_position hold the kept entries' unit and position, units their unit list
+// entries (unit | kUnitTieBit when tied; each array at least n long). Sets `repeated` when a
+// unit still appears twice.
 uint32_t reduce_pixel(const uint32_t* f, uint32_t n, const UnitPartition& partition, uint32_t* out,
-                      uint32_t* kept_unit, uint32_t* kept_position, bool& repeated) {
+                      uint32_t* kept_unit, uint32_t* kept_position, uint16_t* units, bool& repeated) {
     repeated = false;
     const size_t triangles = partition.unit_of_triangle.size();
     const std::pair<uint32_t, uint32_t>* unit_position = partition.unit_position.data();
@@ -75,6 +76,7 @@ uint32_t reduce_pixel(const uint32_t* f, uint32_t n, const UnitPartition& partit
         }
         repeated |= same_unit;
         out[kept] = t | (tied ? kTieBit : 0);
+        units[kept] = uint16_t(unit | (tied ? kUnitTieBit : 0));
         kept_unit[kept] = unit;
         kept_position[kept] = position;
         ++kept;
@@ -118,12 +120,12 @@ struct ListTable {
         mask = s.slots.size() - 1;
         for (uint32_t list = 0; list < s.weights.size(); ++list) insert(list);
     }
-    // One more pixel with this list (n ≤ kMaxListLength). A full weight starts a second copy
-    // (later pixels count there).
-    void add(const uint16_t* e, size_t n) {
-        const uint64_t key = key_of(e, n);
+    const KeepScratch::Slot* slot_of(uint64_t hash) const { return &s.slots[hash & mask]; }
+    // One more pixel with this list (n ≤ kMaxListLength; key and hash its key_of and hash_list). A
+    // full weight starts a second copy (later pixels count there).
+    void add(const uint16_t* e, size_t n, uint64_t key, uint64_t hash) {
         const uint32_t stamp = generation << 8 | uint32_t(n);
-        size_t i = hash_list(key, e, n) & mask;
+        size_t i = hash & mask;
         for (;; i = (i + 1) & mask) {
             const KeepScratch::Slot& slot = s.slots[i];
             if ((slot.stamp >> 8) != generation) break;  // empty
@@ -302,16 +304,28 @@ KeptNode keep_fragments(uint64_t visible, uint64_t single, const uint32_t* start
     ListTable table(s);
     s.triangle_lists.clear();
     bool repeated = false;
+    // A unit list waits one pixel before it is looked up, its slot fetched meanwhile (the table is
+    // larger than the nearest cache); lookups still run in pixel order. Two halves of s.units
+    // take turns: the pending list's and the current pixel's.
+    uint16_t* pending = nullptr;
+    uint32_t pending_n = 0;
+    uint64_t pending_key = 0, pending_hash = 0;
     for (size_t p = 0; p < pixel_count; ++p) {
         const uint32_t n = starts[p + 1] - starts[p];
         if (s.reduced.size() < n) {
             s.reduced.resize(n);
             s.kept_unit.resize(n);
             s.kept_position.resize(n);
-            s.units.resize(n);
         }
+        if (s.units.size() < 2 * std::max<size_t>(n, 4)) {
+            std::vector<uint16_t> units(2 * std::max<size_t>(n, 4));
+            if (pending) std::copy(pending, pending + pending_n, units.begin());
+            s.units.swap(units);
+            if (pending) pending = s.units.data();
+        }
+        uint16_t* units = s.units.data() + (pending == s.units.data() ? s.units.size() / 2 : 0);
         const uint32_t kept = reduce_pixel(fragments + starts[p], n, partition, s.reduced.data(), s.kept_unit.data(),
-                                           s.kept_position.data(), repeated);
+                                           s.kept_position.data(), units, repeated);
         if (kept < 2) {
             ++node.single;  // only the nearest is left: it passes under every order, nothing else does
             continue;
@@ -323,11 +337,14 @@ KeptNode keep_fragments(uint64_t visible, uint64_t single, const uint32_t* start
             node.triangle_entries += kept;
             continue;
         }
-        uint16_t* units = s.units.data();
-        for (uint32_t j = 0; j < kept; ++j)
-            units[j] = uint16_t(s.kept_unit[j] | (s.reduced[j] & kTieBit ? kUnitTieBit : 0));
-        table.add(units, kept);
+        if (pending) table.add(pending, pending_n, pending_key, pending_hash);
+        pending = units;
+        pending_n = kept;
+        pending_key = key_of(units, kept);
+        pending_hash = hash_list(pending_key, units, kept);
+        __builtin_prefetch(table.slot_of(pending_hash));
     }
+    if (pending) table.add(pending, pending_n, pending_key, pending_hash);
     node.unit_lists = uint32_t(s.weights.size());
     node.unit_entries = uint32_t(s.entries.size());
     const Layout l = layout_of(node);

@@ -188,7 +188,9 @@ const uint64_t* list_start_bits(const KeptNode& node, const uint8_t* lengths) {
 // it) without a branch: a list's first entry resets the running minimum, a tied entry keeps the
 // minimum from before its group, and each pass counts its list's weight. (A list's length is
 // 2 to 5 or so at random, so a loop per list guesses its exit wrong about once a list.)
-void score_unit_lists_1(uint64_t* passed, const KeptNode& node, const uint16_t* unit_ranks) {
+// Not inlined: in score_kept's body the walk's pointers spill to the stack (a third slower).
+__attribute__((noinline)) void score_unit_lists_1(uint64_t* passed, const KeptNode& node,
+                                                  const uint16_t* unit_ranks) {
     const Layout l = layout_of(node);
     const uint16_t* weights = at<uint16_t>(node, l.weights);
     const uint16_t* e = at<uint16_t>(node, l.entries);
@@ -203,8 +205,8 @@ void score_unit_lists_1(uint64_t* passed, const KeptNode& node, const uint16_t* 
         const uint32_t u = e[j], r = unit_ranks[u & ~uint32_t(kUnitTieBit)];
         running |= 0u - start;  // UINT16_MAX at a list's start
         running &= UINT16_MAX;
-        const bool tied = (u & kUnitTieBit) && !start;
-        before = tied ? before : running;
+        // Ties are rare: a branch on the tie bit alone is nearly always guessed right.
+        if (__builtin_expect((u & kUnitTieBit) == 0, 1) || start) before = running;
         const uint32_t pass = uint32_t(r < running) & uint32_t(running == before);
         running = std::min(running, r);
         count += weight & (0u - pass);
@@ -212,50 +214,68 @@ void score_unit_lists_1(uint64_t* passed, const KeptNode& node, const uint16_t* 
     passed[0] += count;
 }
 
+typedef int16_t I16x8 __attribute__((vector_size(16)));
+typedef uint16_t U16x8 __attribute__((vector_size(16)));
+typedef uint32_t U32x4 __attribute__((vector_size(16)));
+
+// 2 to 8 orders side by side, one vector lane each (rows of 8 ranks ^ 0x8000: signed compares
+// order them as the ranks), list by list. The replay is replay_list's: an entry passes iff its
+// rank beats the running minimum and nothing of its own tie group passed before it. A list of 2
+// to 4 entries without ties (most of them) takes four steps without a branch (a shorter list
+// repeats its last entry, which can neither pass nor lower the minimum).
 template <size_t K>
-void score_kept_k(uint64_t* passed, const KeptNode& node, const uint16_t* unit_ranks) {
+void score_unit_lists_k(uint64_t* passed, const KeptNode& node, const uint16_t* unit_ranks) {
+    static_assert(K >= 2 && K <= 8 && unit_rank_stride(K) == 8, "one lane per order");
     const Layout l = layout_of(node);
     const uint16_t* weights = at<uint16_t>(node, l.weights);
     const uint16_t* e = at<uint16_t>(node, l.entries);
     const uint8_t* lengths = at<uint8_t>(node, l.lengths);
-    uint64_t count[K] = {};
-    uint16_t scratch[2 * K] = {};
+    const auto row = [unit_ranks](uint32_t u) {
+        I16x8 r;
+        std::memcpy(&r, unit_ranks + size_t(u & ~uint32_t(kUnitTieBit)) * 8, sizeof r);
+        return r;
+    };
+    U32x4 low = {}, high = {};
     for (uint32_t list = 0; list < node.unit_lists; ++list) {
         const uint32_t n = lengths[list];
-        // One walk as if no depths were equal (nearly every list), noting any tie on the way; a
-        // list with ties is replayed again with its tie groups.
-        uint32_t passes[K] = {};
-        uint16_t running[K];
-        for (size_t o = 0; o < K; ++o) running[o] = UINT16_MAX;
-        uint16_t ties = 0;
-        for (uint32_t j = 0; j < n; ++j) {
-            ties |= e[j];
-            const uint16_t* r = unit_ranks + size_t(e[j] & ~kUnitTieBit) * K;
-            for (size_t o = 0; o < K; ++o) {
-                passes[o] += r[o] < running[o];
-                running[o] = std::min(running[o], r[o]);
+        I16x8 running = I16x8{} + INT16_MAX, passes = {};
+        const uint32_t u1 = e[1], u2 = e[std::min(2u, n - 1)], u3 = e[std::min(3u, n - 1)];
+        if (n <= 4 && !((u1 | u2 | u3) & kUnitTieBit)) {
+            for (const uint32_t u : {uint32_t(e[0]), u1, u2, u3}) {
+                const I16x8 r = row(u);
+                const I16x8 below = r < running;
+                passes -= below;
+                running ^= (running ^ r) & below;
+            }
+        } else {
+            I16x8 before = running;
+            for (uint32_t j = 0; j < n; ++j) {
+                const I16x8 r = row(e[j]);
+                if (j == 0 || !(e[j] & kUnitTieBit)) before = running;
+                const I16x8 below = r < running;
+                passes -= below & (running == before);
+                running ^= (running ^ r) & below;
             }
         }
-        if (ties & kUnitTieBit) {
-            for (size_t o = 0; o < K; ++o) passes[o] = 0;
-            replay_list(e, n, kUnitTieBit, unit_ranks, K, scratch, scratch + K, [&](size_t o) { ++passes[o]; });
-        }
-        for (size_t o = 0; o < K; ++o) count[o] += uint64_t(passes[o]) * weights[list];
+        const U32x4 w = U32x4{} + uint32_t(weights[list]);
+        const U16x8 p = U16x8(passes);
+        low += U32x4(__builtin_shufflevector(p, U16x8{}, 0, 8, 1, 9, 2, 10, 3, 11)) * w;
+        if constexpr (K > 4) high += U32x4(__builtin_shufflevector(p, U16x8{}, 4, 12, 5, 13, 6, 14, 7, 15)) * w;
         e += n;
     }
-    for (size_t o = 0; o < K; ++o) passed[o] += count[o];
+    for (size_t o = 0; o < K; ++o) passed[o] += o < 4 ? low[o] : high[o - 4];
 }
 
 void score_unit_lists_any(uint64_t* passed, const KeptNode& node, const uint16_t* unit_ranks, size_t order_count) {
     switch (order_count) {
         case 1: return score_unit_lists_1(passed, node, unit_ranks);
-        case 2: return score_kept_k<2>(passed, node, unit_ranks);
-        case 3: return score_kept_k<3>(passed, node, unit_ranks);
-        case 4: return score_kept_k<4>(passed, node, unit_ranks);
-        case 5: return score_kept_k<5>(passed, node, unit_ranks);
-        case 6: return score_kept_k<6>(passed, node, unit_ranks);
-        case 7: return score_kept_k<7>(passed, node, unit_ranks);
-        case 8: return score_kept_k<8>(passed, node, unit_ranks);
+        case 2: return score_unit_lists_k<2>(passed, node, unit_ranks);
+        case 3: return score_unit_lists_k<3>(passed, node, unit_ranks);
+        case 4: return score_unit_lists_k<4>(passed, node, unit_ranks);
+        case 5: return score_unit_lists_k<5>(passed, node, unit_ranks);
+        case 6: return score_unit_lists_k<6>(passed, node, unit_ranks);
+        case 7: return score_unit_lists_k<7>(passed, node, unit_ranks);
+        case 8: return score_unit_lists_k<8>(passed, node, unit_ranks);
         default: break;
     }
     const Layout l = layout_of(node);
@@ -363,7 +383,8 @@ std::vector<uint16_t> make_unit_rank_table(const uint32_t* triangle_ranks, size_
                                            const UnitPartition& partition) {
     const size_t units = partition.unit_count, triangles = partition.unit_of_triangle.size();
     if (units > kMaxListedUnits) return {};  // every list is kept per triangle
-    std::vector<uint16_t> table(units * order_count);
+    const size_t stride = unit_rank_stride(order_count);
+    std::vector<uint16_t> table(units * stride, 0);
     std::vector<uint32_t> low(units), high(units), size(units), by_position(units);
     for (size_t o = 0; o < order_count; ++o) {
         std::fill(low.begin(), low.end(), UINT32_MAX);
@@ -381,7 +402,8 @@ std::vector<uint16_t> make_unit_rank_table(const uint32_t* triangle_ranks, size_
                                    ": kept fragments score unit orders only");
         std::iota(by_position.begin(), by_position.end(), 0u);
         std::sort(by_position.begin(), by_position.end(), [&](uint32_t a, uint32_t b) { return low[a] < low[b]; });
-        for (size_t i = 0; i < units; ++i) table[size_t(by_position[i]) * order_count + o] = uint16_t(i);
+        const uint16_t bias = stride == 8 ? 0x8000 : 0;  // see unit_rank_stride: signed lanes
+        for (size_t i = 0; i < units; ++i) table[size_t(by_position[i]) * stride + o] = uint16_t(i ^ bias);
     }
     return table;
 }

@@ -220,9 +220,10 @@ typedef uint32_t U32x4 __attribute__((vector_size(16)));
 
 // 2 to 8 orders side by side, one vector lane each (rows of 8 ranks ^ 0x8000: signed compares
 // order them as the ranks), list by list. The replay is replay_list's: an entry passes iff its
-// rank beats the running minimum and nothing of its own tie group passed before it. A list of 2
-// to 4 entries without ties (most of them) takes four steps without a branch (a shorter list
-// repeats its last entry, which can neither pass nor lower the minimum).
+// rank beats the running minimum and nothing of its own tie group passed before it. A list
+// without ties among its first four entries (most of them) takes those in four steps without a
+// branch (a shorter list repeats its last entry, which can neither pass nor lower the minimum),
+// then any more one by one.
 template <size_t K>
 void score_unit_lists_k(uint64_t* passed, const KeptNode& node, const uint16_t* unit_ranks) {
     static_assert(K >= 2 && K <= 8 && unit_rank_stride(K) == 8, "one lane per order");
@@ -240,11 +241,23 @@ void score_unit_lists_k(uint64_t* passed, const KeptNode& node, const uint16_t* 
         const uint32_t n = lengths[list];
         I16x8 running = I16x8{} + INT16_MAX, passes = {};
         const uint32_t u1 = e[1], u2 = e[std::min(2u, n - 1)], u3 = e[std::min(3u, n - 1)];
-        if (n <= 4 && !((u1 | u2 | u3) & kUnitTieBit)) {
-            for (const uint32_t u : {uint32_t(e[0]), u1, u2, u3}) {
+        if (!((u1 | u2 | u3) & kUnitTieBit)) {
+            const auto step = [&](uint32_t u) {
                 const I16x8 r = row(u);
                 const I16x8 below = r < running;
                 passes -= below;
+                running ^= (running ^ r) & below;
+            };
+            step(e[0]);
+            step(u1);
+            step(u2);
+            I16x8 before = running;  // entry 3 starts a group: a tie at entry 4 reads this
+            step(u3);
+            for (uint32_t j = 4; j < n; ++j) {
+                const I16x8 r = row(e[j]);
+                if (!(e[j] & kUnitTieBit)) before = running;
+                const I16x8 below = r < running;
+                passes -= below & (running == before);
                 running ^= (running ^ r) & below;
             }
         } else {

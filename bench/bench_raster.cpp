@@ -158,10 +158,11 @@ int main(int argc, char** argv) try {
             mesh.triangle_count(), nodes, double(fragments) / double(nodes), 1e3 * transform_s / double(nodes),
             1e3 * raster_s / double(nodes), 1e3 * keep_s / double(nodes), (unsigned long long)hash.h);
         const double hashed = double(nodes / std::max<size_t>(1, repeats));
-        std::printf("  kept per node: %.0f multi-fragment pixels -> %.0f unit lists (%.0f entries), %.0f triangle "
-                    "lists; kept hash %016llx\n",
-                    multi / hashed, unit_lists / hashed, unit_entries / hashed, triangle_lists / hashed,
-                    (unsigned long long)kept_hash.h);
+        std::printf(
+            "  kept per node: %.0f multi-fragment pixels -> %.0f unit lists (%.0f entries), %.0f triangle "
+            "lists; kept hash %016llx\n",
+            multi / hashed, unit_lists / hashed, unit_entries / hashed, triangle_lists / hashed,
+            (unsigned long long)kept_hash.h);
         return Timing{1e3 * raster_s / double(nodes), hash.h};
     };
     std::vector<Timing> timings;

@@ -79,9 +79,7 @@ std::vector<uint16_t> make_unit_rank_table(const uint32_t* triangle_ranks, size_
                                            const UnitPartition& partition);
 
 // A unit's row in make_unit_rank_table: 2 to 8 orders padded to 8 (one vector for score_kept).
-constexpr size_t unit_rank_stride(size_t order_count) {
-    return order_count < 2 || order_count > 8 ? order_count : 8;
-}
+constexpr size_t unit_rank_stride(size_t order_count) { return order_count < 2 || order_count > 8 ? order_count : 8; }
 
 // passed[o] for each order: what score_fragments gives on the node's NodeFragments.
 void score_kept(uint64_t* passed, const KeptNode& node, const uint16_t* unit_ranks, const uint32_t* triangle_ranks,

@@ -50,8 +50,8 @@ uint64_t hash_list(uint64_t key, const uint16_t* e, size_t n) {
 // kept_unit and kept_position hold the kept entries' unit and position, units their unit list
 // entries (unit | kUnitTieBit when tied; each array at least n long). Sets `repeated` when a
 // unit still appears twice.
-uint32_t reduce_pixel(const uint32_t* f, uint32_t n, const UnitPartition& partition, uint32_t* out,
-                      uint32_t* kept_unit, uint32_t* kept_position, uint16_t* units, bool& repeated) {
+uint32_t reduce_pixel(const uint32_t* f, uint32_t n, const UnitPartition& partition, uint32_t* out, uint32_t* kept_unit,
+                      uint32_t* kept_position, uint16_t* units, bool& repeated) {
     repeated = false;
     const size_t triangles = partition.unit_of_triangle.size();
     const std::pair<uint32_t, uint32_t>* unit_position = partition.unit_position.data();
@@ -189,8 +189,7 @@ const uint64_t* list_start_bits(const KeptNode& node, const uint8_t* lengths) {
 // minimum from before its group, and each pass counts its list's weight. (A list's length is
 // 2 to 5 or so at random, so a loop per list guesses its exit wrong about once a list.)
 // Not inlined: in score_kept's body the walk's pointers spill to the stack (a third slower).
-__attribute__((noinline)) void score_unit_lists_1(uint64_t* passed, const KeptNode& node,
-                                                  const uint16_t* unit_ranks) {
+__attribute__((noinline)) void score_unit_lists_1(uint64_t* passed, const KeptNode& node, const uint16_t* unit_ranks) {
     const Layout l = layout_of(node);
     const uint16_t* weights = at<uint16_t>(node, l.weights);
     const uint16_t* e = at<uint16_t>(node, l.entries);

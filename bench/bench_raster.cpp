@@ -101,6 +101,8 @@ int main(int argc, char** argv) try {
         double transform_s = 0, raster_s = 0, keep_s = 0;
         size_t nodes = 0, fragments = 0;
         Hash hash;
+        Hash kept_hash;  // every KeptNode whole (counts and data): equal between builds = same kept nodes
+        double multi = 0, unit_lists = 0, unit_entries = 0, triangle_lists = 0;
         for (size_t rep = 0; rep < repeats; ++rep)
             for (size_t k = 0; k < mesh.keyframe_count(); k += step)
                 for (size_t v = 0; v < views; ++v) {
@@ -136,6 +138,17 @@ int main(int argc, char** argv) try {
                                      (lists.starts[lists.pixels] - lists.starts[0]) * 4);
                         }
                         hash.add(kept.data.data(), kept.data.size());
+                        kept_hash.value(kept.visible);
+                        kept_hash.value(kept.single);
+                        kept_hash.value(kept.unit_lists);
+                        kept_hash.value(kept.unit_entries);
+                        kept_hash.value(kept.triangle_lists);
+                        kept_hash.value(kept.triangle_entries);
+                        kept_hash.add(kept.data.data(), kept.data.size());
+                        multi += double(lists.pixels);
+                        unit_lists += kept.unit_lists;
+                        unit_entries += kept.unit_entries;
+                        triangle_lists += kept.triangle_lists;
                     }
                 }
         std::printf("%s: ", simd && NodeRasterizer::simd_available() ? "AVX2 copy" : "portable copy");
@@ -144,6 +157,12 @@ int main(int argc, char** argv) try {
             "keep %.3f ms/node (thread CPU time); output hash %016llx\n",
             mesh.triangle_count(), nodes, double(fragments) / double(nodes), 1e3 * transform_s / double(nodes),
             1e3 * raster_s / double(nodes), 1e3 * keep_s / double(nodes), (unsigned long long)hash.h);
+        const double hashed = double(nodes / std::max<size_t>(1, repeats));
+        std::printf(
+            "  kept per node: %.0f multi-fragment pixels -> %.0f unit lists (%.0f entries), %.0f triangle "
+            "lists; kept hash %016llx\n",
+            multi / hashed, unit_lists / hashed, unit_entries / hashed, triangle_lists / hashed,
+            (unsigned long long)kept_hash.h);
         return Timing{1e3 * raster_s / double(nodes), hash.h};
     };
     std::vector<Timing> timings;

@@ -50,11 +50,18 @@ struct KeptNode {
     size_t bytes() const { return data.capacity() + sizeof(*this); }
 };
 
-// Working memory of keep_fragments, reused between nodes.
+// Working memory of keep_fragments, reused between nodes (its list table too: each slot is
+// stamped with the node that filled it, so nothing is cleared node after node).
 struct KeepScratch {
-    std::vector<uint32_t> reduced, slots, list_offset;
-    std::vector<std::pair<uint32_t, uint32_t>> kept;
-    std::vector<uint16_t> entries, weights;
+    struct Slot {
+        uint32_t stamp = 0;  // generation << 8 | the list's length; a slot of another generation is empty
+        uint32_t list = 0;   // the list's index
+    };
+    std::vector<Slot> slots;
+    uint32_t generation = 0;
+    std::vector<uint64_t> keys;  // per list: its first four entries side by side
+    std::vector<uint32_t> reduced, kept_unit, kept_position, list_offset;
+    std::vector<uint16_t> units, entries, weights;
     std::vector<uint8_t> lengths;
     std::vector<uint32_t> triangle_lists;
 };
@@ -64,10 +71,15 @@ struct KeepScratch {
 KeptNode keep_fragments(uint64_t visible, uint64_t single, const uint32_t* starts, size_t pixel_count,
                         const uint32_t* fragments, const UnitPartition& partition, KeepScratch& scratch);
 
-// Per order, the position of every unit (u16, order-major within a unit: [u · order_count + o])
-// from a triangle rank table (make_rank_table). Throws InvalidInput when an order splits a unit.
+// Per order, the position of every unit (u16, order-major within a unit:
+// [u · unit_rank_stride(order_count) + o]) from a triangle rank table (make_rank_table). Rows of
+// 2 to 8 orders are padded to 8 lanes and hold position ^ 0x8000 (so that score_kept compares
+// them as signed 16-bit lanes). Throws InvalidInput when an order splits a unit.
 std::vector<uint16_t> make_unit_rank_table(const uint32_t* triangle_ranks, size_t order_count,
                                            const UnitPartition& partition);
+
+// A unit's row in make_unit_rank_table: 2 to 8 orders padded to 8 (one vector for score_kept).
+constexpr size_t unit_rank_stride(size_t order_count) { return order_count < 2 || order_count > 8 ? order_count : 8; }
 
 // passed[o] for each order: what score_fragments gives on the node's NodeFragments.
 void score_kept(uint64_t* passed, const KeptNode& node, const uint16_t* unit_ranks, const uint32_t* triangle_ranks,

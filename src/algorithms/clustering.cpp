@@ -433,40 +433,52 @@ size_t reseed_empty_clusters(const Nodes& nodes, const std::vector<size_t>& memb
 // to its best buffer) the mean node OVR can then only fall, so k-means settles instead of
 // cycling. `scores` are the previous orders' (from the assignment step). Returns the number of
 // clusters whose new order was kept.
-size_t keep_improved_orders(const Nodes& nodes, const std::vector<uint32_t>& assignment, const NodeScores& scores,
+//
+// Only a cluster's own nodes decide, but every node is scored with every new order (one walk
+// over the kept nodes for all of them costs little more than for one): the columns of the
+// orders kept go into `scores`, so the next assignment need not score them again.
+size_t keep_improved_orders(const Nodes& nodes, const std::vector<uint32_t>& assignment, NodeScores& scores,
                             const std::vector<std::vector<uint32_t>>& previous, const std::vector<uint8_t>& reseeded,
                             std::vector<std::vector<uint32_t>>& patch_orders) {
     const size_t k = nodes.k;
-    // Each node only needs its own cluster's candidate, and only where the candidate is new: a
-    // cluster whose order did not change keeps it (the same order cannot score lower).
-    std::vector<std::vector<uint32_t>> candidate(k);
-    std::vector<const uint32_t*> ranks(k, nullptr);
-    std::vector<std::vector<uint32_t>> rank_tables(k);
-    for (size_t c = 0; c < k; ++c) {
+    // A cluster whose order did not change keeps it (the same order cannot score lower).
+    std::vector<uint32_t> changed, column(k, UINT32_MAX);
+    std::vector<std::vector<uint32_t>> candidates;
+    for (uint32_t c = 0; c < k; ++c) {
         if (patch_orders[c] == previous[c]) continue;
-        candidate[c] = patch_order_to_triangle_order(nodes.patches, patch_orders[c]);
-        rank_tables[c] = make_rank_table({candidate[c].data()}, nodes.mesh.triangle_count());
-        ranks[c] = rank_tables[c].data();
+        column[c] = uint32_t(changed.size());
+        changed.push_back(c);
+        candidates.push_back(patch_order_to_triangle_order(nodes.patches, patch_orders[c]));
     }
-    std::vector<uint32_t> order_of_node(nodes.count);
-    for (size_t n = 0; n < nodes.count; ++n) order_of_node[n] = ranks[assignment[n]] ? assignment[n] : UINT32_MAX;
-    NodeScores after_scores{{}, std::vector<uint64_t>(nodes.count * k), {}};
-    nodes.cache->score_one(after_scores.passed.data(), k, order_of_node.data(), ranks);
+    const size_t m = changed.size();
+    std::vector<uint64_t> after_passed(nodes.count * m), visible(nodes.count);
+    if (m > 0) {
+        std::vector<const uint32_t*> pointers;
+        for (const auto& o : candidates) pointers.push_back(o.data());
+        const std::vector<uint32_t> ranks = make_rank_table(pointers, nodes.mesh.triangle_count());
+        nodes.cache->score(visible.data(), after_passed.data(), ranks.data(), m);
+    }
     std::vector<double> before(k, 0.0), after(k, 0.0);
     for (size_t n = 0; n < nodes.count; ++n) {
         if (scores.visible[n] == 0) continue;
         const uint32_t c = assignment[n];
-        if (!ranks[c]) continue;
+        if (column[c] == UINT32_MAX) continue;
         before[c] += double(scores.passed[n * k + c]) / double(scores.visible[n]);
-        after[c] += double(after_scores.passed[n * k + c]) / double(scores.visible[n]);
+        after[c] += double(after_passed[n * m + column[c]]) / double(scores.visible[n]);
     }
     size_t accepted = 0;
     for (size_t c = 0; c < k; ++c) {
         if (reseeded[c]) continue;
-        if (ranks[c] && after[c] < before[c])
+        if (column[c] != UINT32_MAX && after[c] < before[c])
             ++accepted;
         else
             patch_orders[c] = previous[c];  // no better: keep the old buffer
+    }
+    // The new orders kept (improved or re-seeded) are scored already.
+    for (size_t c = 0; c < k; ++c) {
+        if (column[c] == UINT32_MAX || patch_orders[c] == previous[c]) continue;
+        for (size_t n = 0; n < nodes.count; ++n) scores.passed[n * k + c] = after_passed[n * m + column[c]];
+        scores.scored[c] = patch_orders[c];
     }
     return accepted;
 }

@@ -28,27 +28,35 @@ namespace {
 
 constexpr uint32_t kMaxWeight = UINT16_MAX;
 
-uint64_t hash_list(const uint16_t* e, size_t n) {
-    uint64_t h = 0x9e3779b97f4a7c15ULL ^ n;
-    for (size_t i = 0; i < n; ++i) {
+// A list's first four entries side by side (zeros beyond its end): with its length, the whole of
+// nearly every list, so most lookups compare one word. `e` must have four entries readable.
+uint64_t key_of(const uint16_t* e, size_t n) {
+    uint64_t key;
+    std::memcpy(&key, e, sizeof key);
+    return n >= 4 ? key : key & ((uint64_t(1) << (16 * n)) - 1);
+}
+
+uint64_t hash_list(uint64_t key, const uint16_t* e, size_t n) {
+    uint64_t h = (key ^ (uint64_t(n) << 59)) * 0x9e3779b97f4a7c15ULL;
+    for (size_t i = 4; i < n; ++i) {
         h ^= e[i];
         h *= 0xff51afd7ed558ccdULL;
-        h ^= h >> 29;
     }
-    return h;
+    return h ^ (h >> 29);
 }
 
 // Drops the fragments of reduction 1 from one pixel's list into `out` (tie bits recomputed: an
-// entry is tied when its depth equals the previous kept entry's). Sets `repeated` when a unit
-// still appears twice. `kept` holds the kept entries' (unit, position).
-void reduce_pixel(const uint32_t* f, uint32_t n, const UnitPartition& partition, std::vector<uint32_t>& out,
-                  std::vector<std::pair<uint32_t, uint32_t>>& kept, bool& repeated) {
-    out.clear();
-    kept.clear();
+// entry is tied when its depth equals the previous kept entry's) and returns how many are kept;
+// kept_unit and kept_position hold the kept entries' unit and position, units their unit list
+// entries (unit | kUnitTieBit when tied; each array at least n long). Sets `repeated` when a
+// unit still appears twice.
+uint32_t reduce_pixel(const uint32_t* f, uint32_t n, const UnitPartition& partition, uint32_t* out, uint32_t* kept_unit,
+                      uint32_t* kept_position, uint16_t* units, bool& repeated) {
     repeated = false;
     const size_t triangles = partition.unit_of_triangle.size();
     const std::pair<uint32_t, uint32_t>* unit_position = partition.unit_position.data();
     bool previous_at_kept_depth = true;  // the previous fragment's depth equals the last kept one's
+    uint32_t kept = 0;
     for (uint32_t j = 0; j < n; ++j) {
         const uint32_t t = f[j] & kTriangleMask;
         if (t >= triangles)
@@ -57,54 +65,75 @@ void reduce_pixel(const uint32_t* f, uint32_t n, const UnitPartition& partition,
         const bool tied = j > 0 && (f[j] & kTieBit) && previous_at_kept_depth;
         const auto [unit, position] = unit_position[t];
         bool dominated = false, same_unit = false;
-        for (const auto& [u, p] : kept) {
-            if (u != unit) continue;
-            same_unit = true;
-            dominated |= p < position;
+        for (uint32_t i = 0; i < kept; ++i) {
+            const bool same = kept_unit[i] == unit;
+            same_unit |= same;
+            dominated |= same && kept_position[i] < position;
         }
         if (dominated) {
             previous_at_kept_depth = tied;
             continue;
         }
         repeated |= same_unit;
-        out.push_back(t | (tied ? kTieBit : 0));
-        kept.emplace_back(unit, position);
+        out[kept] = t | (tied ? kTieBit : 0);
+        units[kept] = uint16_t(unit | (tied ? kUnitTieBit : 0));
+        kept_unit[kept] = unit;
+        kept_position[kept] = position;
+        ++kept;
         previous_at_kept_depth = true;
     }
+    return kept;
 }
 
-// The deduplicated unit lists of one node, in order of first appearance.
+// The deduplicated unit lists of one node, in order of first appearance. Which list a pixel
+// joins never depends on the hash: a list's content has one slot, and grow() reinserts the lists
+// in list order (so a full list is met before its later copy, as when it was first filled).
 struct ListTable {
     KeepScratch& s;
     size_t mask = 0;
+    uint32_t generation = 0;
 
     explicit ListTable(KeepScratch& scratch) : s(scratch) {
         s.entries.clear();
         s.weights.clear();
         s.lengths.clear();
         s.list_offset.clear();
-        // The previous node's table size (nodes of a run are alike): no regrowth node after node.
-        s.slots.assign(std::max<size_t>(1024, s.slots.size()), 0);
+        s.keys.clear();
+        // The previous node's table (nodes of a run are alike): no regrowth node after node, and
+        // no clearing either: a new generation empties every slot.
+        if (s.slots.size() < 1024 || ++s.generation >= (1u << 24)) {
+            s.slots.assign(std::max<size_t>(1024, s.slots.size()), KeepScratch::Slot{});
+            s.generation = 1;
+        }
+        generation = s.generation;
         mask = s.slots.size() - 1;
     }
-    bool equal(uint32_t list, const uint16_t* e, size_t n) const {
-        return s.lengths[list] == n && std::memcmp(&s.entries[s.list_offset[list]], e, n * sizeof(uint16_t)) == 0;
+    void insert(uint32_t list) {
+        const uint16_t* e = &s.entries[s.list_offset[list]];
+        const size_t n = s.lengths[list];
+        size_t i = hash_list(s.keys[list], e, n) & mask;
+        while ((s.slots[i].stamp >> 8) == generation) i = (i + 1) & mask;
+        s.slots[i] = {generation << 8 | uint32_t(n), list};
     }
     void grow() {
-        s.slots.assign(s.slots.size() * 2, 0);
+        s.slots.assign(s.slots.size() * 2, KeepScratch::Slot{});
         mask = s.slots.size() - 1;
-        for (uint32_t list = 0; list < s.weights.size(); ++list) {
-            size_t i = hash_list(&s.entries[s.list_offset[list]], s.lengths[list]) & mask;
-            while (s.slots[i] != 0) i = (i + 1) & mask;
-            s.slots[i] = list + 1;
-        }
+        for (uint32_t list = 0; list < s.weights.size(); ++list) insert(list);
     }
-    // One more pixel with this list. A full weight starts a second copy (later pixels count there).
-    void add(const uint16_t* e, size_t n) {
-        size_t i = hash_list(e, n) & mask;
-        for (; s.slots[i] != 0; i = (i + 1) & mask) {
-            const uint32_t list = s.slots[i] - 1;
-            if (!equal(list, e, n)) continue;
+    const KeepScratch::Slot* slot_of(uint64_t hash) const { return &s.slots[hash & mask]; }
+    // One more pixel with this list (n ≤ kMaxListLength; key and hash its key_of and hash_list). A
+    // full weight starts a second copy (later pixels count there).
+    void add(const uint16_t* e, size_t n, uint64_t key, uint64_t hash) {
+        const uint32_t stamp = generation << 8 | uint32_t(n);
+        size_t i = hash & mask;
+        for (;; i = (i + 1) & mask) {
+            const KeepScratch::Slot& slot = s.slots[i];
+            if ((slot.stamp >> 8) != generation) break;  // empty
+            if (slot.stamp != stamp) continue;
+            const uint32_t list = slot.list;
+            if (s.keys[list] != key) continue;
+            if (n > 4 && std::memcmp(&s.entries[s.list_offset[list] + 4], e + 4, (n - 4) * sizeof(uint16_t)) != 0)
+                continue;
             if (s.weights[list] < kMaxWeight) {
                 ++s.weights[list];
                 return;
@@ -116,7 +145,8 @@ struct ListTable {
         s.entries.insert(s.entries.end(), e, e + n);
         s.lengths.push_back(uint8_t(n));
         s.weights.push_back(1);
-        s.slots[i] = list + 1;
+        s.keys.push_back(key);
+        s.slots[i] = {stamp, list};
         if (2 * s.weights.size() > s.slots.size()) grow();
     }
 };
@@ -140,50 +170,124 @@ const T* at(const KeptNode& n, size_t offset) {
     return reinterpret_cast<const T*>(n.data.data() + offset);
 }
 
+// Bit j of the result set when entry j of the unit entries opens a list (one walk over the
+// lengths), so that score_unit_lists_1 walks all entries at once, with no branch per list.
+const uint64_t* list_start_bits(const KeptNode& node, const uint8_t* lengths) {
+    static thread_local std::vector<uint64_t> bits;
+    bits.assign(size_t(node.unit_entries) / 64 + 1, 0);
+    uint32_t start = 0;
+    for (uint32_t list = 0; list < node.unit_lists; ++list) {
+        bits[start >> 6] |= uint64_t(1) << (start & 63);
+        start += lengths[list];
+    }
+    return bits.data();
+}
+
+// One order: every unit list at once, entry by entry, replayed as replay_list does (an entry
+// passes iff its rank beats the running minimum and nothing of its own tie group passed before
+// it) without a branch: a list's first entry resets the running minimum, a tied entry keeps the
+// minimum from before its group, and each pass counts its list's weight. (A list's length is
+// 2 to 5 or so at random, so a loop per list guesses its exit wrong about once a list.)
+// Not inlined: in score_kept's body the walk's pointers spill to the stack (a third slower).
+__attribute__((noinline)) void score_unit_lists_1(uint64_t* passed, const KeptNode& node, const uint16_t* unit_ranks) {
+    const Layout l = layout_of(node);
+    const uint16_t* weights = at<uint16_t>(node, l.weights);
+    const uint16_t* e = at<uint16_t>(node, l.entries);
+    const uint64_t* starts = list_start_bits(node, at<uint8_t>(node, l.lengths));
+    uint64_t count = 0;
+    uint32_t running = UINT16_MAX, before = UINT16_MAX, weight = 0;
+    const uint16_t* list_weight = weights - 1;  // the current list's
+    for (uint32_t j = 0; j < node.unit_entries; ++j) {
+        const uint32_t start = uint32_t(starts[j >> 6] >> (j & 63)) & 1;
+        list_weight += start;
+        weight = *list_weight;
+        const uint32_t u = e[j], r = unit_ranks[u & ~uint32_t(kUnitTieBit)];
+        running |= 0u - start;  // UINT16_MAX at a list's start
+        running &= UINT16_MAX;
+        // Ties are rare: a branch on the tie bit alone is nearly always guessed right.
+        if (__builtin_expect((u & kUnitTieBit) == 0, 1) || start) before = running;
+        const uint32_t pass = uint32_t(r < running) & uint32_t(running == before);
+        running = std::min(running, r);
+        count += weight & (0u - pass);
+    }
+    passed[0] += count;
+}
+
+typedef int16_t I16x8 __attribute__((vector_size(16)));
+typedef uint16_t U16x8 __attribute__((vector_size(16)));
+typedef uint32_t U32x4 __attribute__((vector_size(16)));
+
+// 2 to 8 orders side by side, one vector lane each (rows of 8 ranks ^ 0x8000: signed compares
+// order them as the ranks), list by list. The replay is replay_list's: an entry passes iff its
+// rank beats the running minimum and nothing of its own tie group passed before it. A list
+// without ties among its first four entries (most of them) takes those in four steps without a
+// branch (a shorter list repeats its last entry, which can neither pass nor lower the minimum),
+// then any more one by one.
 template <size_t K>
-void score_kept_k(uint64_t* passed, const KeptNode& node, const uint16_t* unit_ranks) {
+void score_unit_lists_k(uint64_t* passed, const KeptNode& node, const uint16_t* unit_ranks) {
+    static_assert(K >= 2 && K <= 8 && unit_rank_stride(K) == 8, "one lane per order");
     const Layout l = layout_of(node);
     const uint16_t* weights = at<uint16_t>(node, l.weights);
     const uint16_t* e = at<uint16_t>(node, l.entries);
     const uint8_t* lengths = at<uint8_t>(node, l.lengths);
-    uint64_t count[K] = {};
-    uint16_t scratch[2 * K] = {};
+    const auto row = [unit_ranks](uint32_t u) {
+        I16x8 r;
+        std::memcpy(&r, unit_ranks + size_t(u & ~uint32_t(kUnitTieBit)) * 8, sizeof r);
+        return r;
+    };
+    U32x4 low = {}, high = {};
     for (uint32_t list = 0; list < node.unit_lists; ++list) {
         const uint32_t n = lengths[list];
-        // One walk as if no depths were equal (nearly every list), noting any tie on the way; a
-        // list with ties is replayed again with its tie groups.
-        uint32_t passes[K] = {};
-        uint16_t running[K];
-        for (size_t o = 0; o < K; ++o) running[o] = UINT16_MAX;
-        uint16_t ties = 0;
-        for (uint32_t j = 0; j < n; ++j) {
-            ties |= e[j];
-            const uint16_t* r = unit_ranks + size_t(e[j] & ~kUnitTieBit) * K;
-            for (size_t o = 0; o < K; ++o) {
-                passes[o] += r[o] < running[o];
-                running[o] = std::min(running[o], r[o]);
+        I16x8 running = I16x8{} + INT16_MAX, passes = {};
+        const uint32_t u1 = e[1], u2 = e[std::min(2u, n - 1)], u3 = e[std::min(3u, n - 1)];
+        if (!((u1 | u2 | u3) & kUnitTieBit)) {
+            const auto step = [&](uint32_t u) {
+                const I16x8 r = row(u);
+                const I16x8 below = r < running;
+                passes -= below;
+                running ^= (running ^ r) & below;
+            };
+            step(e[0]);
+            step(u1);
+            step(u2);
+            I16x8 before = running;  // entry 3 starts a group: a tie at entry 4 reads this
+            step(u3);
+            for (uint32_t j = 4; j < n; ++j) {
+                const I16x8 r = row(e[j]);
+                if (!(e[j] & kUnitTieBit)) before = running;
+                const I16x8 below = r < running;
+                passes -= below & (running == before);
+                running ^= (running ^ r) & below;
+            }
+        } else {
+            I16x8 before = running;
+            for (uint32_t j = 0; j < n; ++j) {
+                const I16x8 r = row(e[j]);
+                if (j == 0 || !(e[j] & kUnitTieBit)) before = running;
+                const I16x8 below = r < running;
+                passes -= below & (running == before);
+                running ^= (running ^ r) & below;
             }
         }
-        if (ties & kUnitTieBit) {
-            for (size_t o = 0; o < K; ++o) passes[o] = 0;
-            replay_list(e, n, kUnitTieBit, unit_ranks, K, scratch, scratch + K, [&](size_t o) { ++passes[o]; });
-        }
-        for (size_t o = 0; o < K; ++o) count[o] += uint64_t(passes[o]) * weights[list];
+        const U32x4 w = U32x4{} + uint32_t(weights[list]);
+        const U16x8 p = U16x8(passes);
+        low += U32x4(__builtin_shufflevector(p, U16x8{}, 0, 8, 1, 9, 2, 10, 3, 11)) * w;
+        if constexpr (K > 4) high += U32x4(__builtin_shufflevector(p, U16x8{}, 4, 12, 5, 13, 6, 14, 7, 15)) * w;
         e += n;
     }
-    for (size_t o = 0; o < K; ++o) passed[o] += count[o];
+    for (size_t o = 0; o < K; ++o) passed[o] += o < 4 ? low[o] : high[o - 4];
 }
 
 void score_unit_lists_any(uint64_t* passed, const KeptNode& node, const uint16_t* unit_ranks, size_t order_count) {
     switch (order_count) {
-        case 1: return score_kept_k<1>(passed, node, unit_ranks);
-        case 2: return score_kept_k<2>(passed, node, unit_ranks);
-        case 3: return score_kept_k<3>(passed, node, unit_ranks);
-        case 4: return score_kept_k<4>(passed, node, unit_ranks);
-        case 5: return score_kept_k<5>(passed, node, unit_ranks);
-        case 6: return score_kept_k<6>(passed, node, unit_ranks);
-        case 7: return score_kept_k<7>(passed, node, unit_ranks);
-        case 8: return score_kept_k<8>(passed, node, unit_ranks);
+        case 1: return score_unit_lists_1(passed, node, unit_ranks);
+        case 2: return score_unit_lists_k<2>(passed, node, unit_ranks);
+        case 3: return score_unit_lists_k<3>(passed, node, unit_ranks);
+        case 4: return score_unit_lists_k<4>(passed, node, unit_ranks);
+        case 5: return score_unit_lists_k<5>(passed, node, unit_ranks);
+        case 6: return score_unit_lists_k<6>(passed, node, unit_ranks);
+        case 7: return score_unit_lists_k<7>(passed, node, unit_ranks);
+        case 8: return score_unit_lists_k<8>(passed, node, unit_ranks);
         default: break;
     }
     const Layout l = layout_of(node);
@@ -231,25 +335,48 @@ KeptNode keep_fragments(uint64_t visible, uint64_t single, const uint32_t* start
     const bool unit_lists = partition.unit_count <= kMaxListedUnits;
     ListTable table(s);
     s.triangle_lists.clear();
-    uint16_t units[kMaxListLength];
     bool repeated = false;
+    // A unit list waits one pixel before it is looked up, its slot fetched meanwhile (the table is
+    // larger than the nearest cache); lookups still run in pixel order. Two halves of s.units
+    // take turns: the pending list's and the current pixel's.
+    uint16_t* pending = nullptr;
+    uint32_t pending_n = 0;
+    uint64_t pending_key = 0, pending_hash = 0;
     for (size_t p = 0; p < pixel_count; ++p) {
-        reduce_pixel(fragments + starts[p], starts[p + 1] - starts[p], partition, s.reduced, s.kept, repeated);
-        if (s.reduced.size() < 2) {
+        const uint32_t n = starts[p + 1] - starts[p];
+        if (s.reduced.size() < n) {
+            s.reduced.resize(n);
+            s.kept_unit.resize(n);
+            s.kept_position.resize(n);
+        }
+        if (s.units.size() < 2 * std::max<size_t>(n, 4)) {
+            std::vector<uint16_t> units(2 * std::max<size_t>(n, 4));
+            if (pending) std::copy(pending, pending + pending_n, units.begin());
+            s.units.swap(units);
+            if (pending) pending = s.units.data();
+        }
+        uint16_t* units = s.units.data() + (pending == s.units.data() ? s.units.size() / 2 : 0);
+        const uint32_t kept = reduce_pixel(fragments + starts[p], n, partition, s.reduced.data(), s.kept_unit.data(),
+                                           s.kept_position.data(), units, repeated);
+        if (kept < 2) {
             ++node.single;  // only the nearest is left: it passes under every order, nothing else does
             continue;
         }
-        if (!unit_lists || repeated || s.reduced.size() > kMaxListLength) {
-            s.triangle_lists.push_back(uint32_t(s.reduced.size()));
-            s.triangle_lists.insert(s.triangle_lists.end(), s.reduced.begin(), s.reduced.end());
+        if (!unit_lists || repeated || kept > kMaxListLength) {
+            s.triangle_lists.push_back(kept);
+            s.triangle_lists.insert(s.triangle_lists.end(), s.reduced.begin(), s.reduced.begin() + kept);
             ++node.triangle_lists;
-            node.triangle_entries += uint32_t(s.reduced.size());
+            node.triangle_entries += kept;
             continue;
         }
-        for (size_t j = 0; j < s.reduced.size(); ++j)
-            units[j] = uint16_t(s.kept[j].first | (s.reduced[j] & kTieBit ? kUnitTieBit : 0));
-        table.add(units, s.reduced.size());
+        if (pending) table.add(pending, pending_n, pending_key, pending_hash);
+        pending = units;
+        pending_n = kept;
+        pending_key = key_of(units, kept);
+        pending_hash = hash_list(pending_key, units, kept);
+        __builtin_prefetch(table.slot_of(pending_hash));
     }
+    if (pending) table.add(pending, pending_n, pending_key, pending_hash);
     node.unit_lists = uint32_t(s.weights.size());
     node.unit_entries = uint32_t(s.entries.size());
     const Layout l = layout_of(node);
@@ -268,7 +395,8 @@ std::vector<uint16_t> make_unit_rank_table(const uint32_t* triangle_ranks, size_
                                            const UnitPartition& partition) {
     const size_t units = partition.unit_count, triangles = partition.unit_of_triangle.size();
     if (units > kMaxListedUnits) return {};  // every list is kept per triangle
-    std::vector<uint16_t> table(units * order_count);
+    const size_t stride = unit_rank_stride(order_count);
+    std::vector<uint16_t> table(units * stride, 0);
     std::vector<uint32_t> low(units), high(units), size(units), by_position(units);
     for (size_t o = 0; o < order_count; ++o) {
         std::fill(low.begin(), low.end(), UINT32_MAX);
@@ -286,7 +414,8 @@ std::vector<uint16_t> make_unit_rank_table(const uint32_t* triangle_ranks, size_
                                    ": kept fragments score unit orders only");
         std::iota(by_position.begin(), by_position.end(), 0u);
         std::sort(by_position.begin(), by_position.end(), [&](uint32_t a, uint32_t b) { return low[a] < low[b]; });
-        for (size_t i = 0; i < units; ++i) table[size_t(by_position[i]) * order_count + o] = uint16_t(i);
+        const uint16_t bias = stride == 8 ? 0x8000 : 0;  // see unit_rank_stride: signed lanes
+        for (size_t i = 0; i < units; ++i) table[size_t(by_position[i]) * stride + o] = uint16_t(i ^ bias);
     }
     return table;
 }

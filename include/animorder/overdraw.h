@@ -92,10 +92,6 @@ public:
     // visible[n] and passed[n · order_count + o] for every node and every order of the rank table
     // (make_rank_table over unit orders; InvalidInput for an order that splits a unit).
     void score(uint64_t* visible, uint64_t* passed, const uint32_t* ranks, size_t order_count) const;
-    // passed[n · stride + order_of_node[n]]: each node scored with one order only, ranks[c] the
-    // one-order rank table of order c; nodes whose order_of_node is UINT32_MAX are skipped.
-    void score_one(uint64_t* passed, size_t stride, const uint32_t* order_of_node,
-                   const std::vector<const uint32_t*>& ranks) const;
     // Node n's KeptNode, or nullptr when it is not kept (n >= kept_count()).
     const KeptNode* kept(size_t n) const { return n < kept_.size() ? &kept_[n] : nullptr; }
     // KeptNodes of the nodes which[0..count), rasterised again (in parallel).

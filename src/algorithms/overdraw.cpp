@@ -273,25 +273,6 @@ void NodeCache::score(uint64_t* visible, uint64_t* passed, const uint32_t* ranks
     });
 }
 
-void NodeCache::score_one(uint64_t* passed, size_t stride, const uint32_t* order_of_node,
-                          const std::vector<const uint32_t*>& ranks) const {
-    std::vector<std::vector<uint16_t>> unit_ranks;
-    for (const uint32_t* r : ranks)
-        unit_ranks.push_back(r ? make_unit_rank_table(r, 1, partition_) : std::vector<uint16_t>());
-    for_nodes(node_count_, 64, [&](Worker& w, size_t n) {
-        const uint32_t c = order_of_node[n];
-        if (c == UINT32_MAX) return;
-        if (c >= ranks.size() || !ranks[c])
-            throw InvalidInput("node cache: node " + std::to_string(n) + " names no order");
-        if (const KeptNode* k = kept(n)) {
-            score_kept(passed + n * stride + c, *k, unit_ranks[c].data(), ranks[c], 1);
-        } else {
-            rasterize_node(w, n);
-            w.rasterizer.score(passed + n * stride + c, ranks[c], 1);
-        }
-    });
-}
-
 std::vector<KeptNode> NodeCache::rasterize_again(const uint32_t* which, size_t count) const {
     std::vector<KeptNode> out(count);
     for_nodes(count, 1, [&](Worker& w, size_t i) {

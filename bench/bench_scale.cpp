@@ -62,7 +62,9 @@ int run_case(const Case& c, bool quick) {
         return 0;
     }
     const Clock::time_point start = Clock::now();
-    AnimatedMesh mesh = load_character(file.string());
+    LoadOptions options;  // as `animorder optimize --clip`: only the case's clips are sampled
+    options.clips = c.clips;
+    AnimatedMesh mesh = load_character(file.string(), {}, options);
     if (!c.clips.empty())
         mesh = select_clips(mesh, c.clips);
     else if (quick && mesh.clips.size() > 2)

@@ -24,6 +24,11 @@ struct LoadOptions {
     // whose clips would need more fails with a LoadError naming the need and this budget before
     // anything that size is allocated (`--max-memory` raises it).
     size_t max_keyframe_bytes = size_t(4) << 30;
+    // Clips to sample, by name; empty: every clip. A hint that saves the sampling (and memory) of
+    // the others: glTF files honour it when every name is one of the file's clips (otherwise all
+    // are sampled, so that select_clips names the file's clips in its error); other formats
+    // sample every clip. Callers still call select_clips for the order and the error.
+    std::vector<std::string> clips;
 };
 
 // By extension: .gltf/.glb → load_gltf (gltf_loader.h), .md2 → load_md2, .iqm → load_iqm (no

@@ -667,6 +667,21 @@ void sample_keyframes(const Scene& s, ClipChannels& c, const LoadOptions& option
     mesh.clips.push_back(c.clip);
 }
 
+// Only the clips named in `asked` (LoadOptions::clips), when each name is one of them; every
+// clip otherwise (none asked, or a name the file lacks: select_clips then reports it with the
+// file's clip names). A kept clip's keyframes are sampled as they would be among all the clips.
+void keep_asked_clips(std::vector<ClipChannels>& clips, const std::vector<std::string>& asked) {
+    const auto named = [&](const std::string& name) {
+        return std::any_of(clips.begin(), clips.end(), [&](const ClipChannels& c) { return c.clip.name == name; });
+    };
+    if (asked.empty() || !std::all_of(asked.begin(), asked.end(), named)) return;
+    clips.erase(std::remove_if(clips.begin(), clips.end(),
+                               [&](const ClipChannels& c) {
+                                   return std::find(asked.begin(), asked.end(), c.clip.name) == asked.end();
+                               }),
+                clips.end());
+}
+
 }  // namespace
 
 // The steps, in order: the file, the node hierarchy, primitives (with morph targets and skin
@@ -684,6 +699,7 @@ AnimatedMesh load_gltf(const std::string& path, const LoadOptions& options) {
     parse_rest_pose(scene);
     parse_skins(scene);
     std::vector<ClipChannels> clips = parse_animations(scene, path, options);
+    keep_asked_clips(clips, options.clips);
 
     size_t keyframes = clips.empty() ? 1 : 0;  // without animation: one static keyframe
     for (const ClipChannels& c : clips) keyframes += c.clip.keyframe_count;

@@ -390,6 +390,60 @@ TEST_F(GltfLoader, LoadingBudgetIsCheckedBeforeSampling) {
     expect_load_error("tight.gltf", clip_until(1), "loading budget", small);
 }
 
+// LoadOptions::clips: only the named clips are sampled (a clip too long for the budget is never
+// sampled when not asked), each exactly as among all the clips; a name the file lacks samples
+// every clip, so that select_clips reports the file's clip names.
+TEST_F(GltfLoader, OnlyTheAskedClipsAreSampled) {
+    Gltf g = skinned_bar();
+    const double s = std::sqrt(0.5);
+    auto add_clip = [&](const char* name, float last, std::vector<float> rotations) {
+        const int t = g.floats({0, last}, "SCALAR", 1), r = g.floats(rotations, "VEC4", 4);
+        json sampler = {{"input", t}, {"output", r}, {"interpolation", "LINEAR"}};
+        json channel = {{"sampler", 0}, {"target", {{"node", 1}, {"path", "rotation"}}}};
+        g.doc["animations"].push_back(
+            {{"name", name}, {"samplers", json::array({sampler})}, {"channels", json::array({channel})}});
+    };
+    add_clip("long", 3333, {0, 0, 0, 1, 0, 0, float(s), float(s)});   // 99,991 keyframes: 4.8 MB
+    add_clip("back", 0.5f, {0, 0, float(s), float(s), 0, 0, 0, 1});  // 16 keyframes, from 90° to 0
+    const std::string path = write("clips.gltf", g.text());
+
+    LoadOptions all;
+    const AnimatedMesh full = load_gltf(path, all);
+    ASSERT_EQ(full.clips.size(), 3u);
+    LoadOptions small;
+    small.max_keyframe_bytes = 1 << 20;
+    test::expect_one_line_load_error(path, "loading budget", [&] { load_gltf(path, small); });
+    small.clips = {"back", "bend"};
+    const AnimatedMesh two = load_gltf(path, small);
+    ASSERT_EQ(two.clips.size(), 2u);
+    EXPECT_EQ(two.clips[0].name, "bend");  // the file's order; select_clips gives the asked one
+    EXPECT_EQ(two.keyframe_count(), 31u + 16u);
+    for (const auto& names : {std::vector<std::string>{"back", "bend"}, std::vector<std::string>{"bend"}}) {
+        const AnimatedMesh a = select_clips(two, names), b = select_clips(full, names);
+        EXPECT_EQ(a.keyframe_positions, b.keyframe_positions);
+        ASSERT_EQ(a.clips.size(), b.clips.size());
+        for (size_t c = 0; c < a.clips.size(); ++c) {
+            EXPECT_EQ(a.clips[c].name, b.clips[c].name);
+            EXPECT_EQ(a.clips[c].keyframe_count, b.clips[c].keyframe_count);
+            EXPECT_EQ(a.clips[c].first_keyframe, b.clips[c].first_keyframe);
+            EXPECT_EQ(a.clips[c].start_time_s, b.clips[c].start_time_s);
+        }
+    }
+    // 'back' at t = 0.5 is the bind pose again; at t = 0 the child is turned 90°.
+    expect_position(two, 31 + 15, 2, 1, 2, 0);
+    expect_position(two, 31, 2, -1, 2, 0);
+    // A name the file lacks: every clip is sampled (here over the budget), so nothing is hidden.
+    small.clips = {"bend", "walk"};
+    test::expect_one_line_load_error(path, "loading budget", [&] { load_gltf(path, small); });
+    all.clips = {"walk"};
+    try {
+        select_clips(load_gltf(path, all), all.clips);
+        ADD_FAILURE() << "a missing clip was not reported";
+    } catch (const std::exception& e) {
+        EXPECT_NE(std::string(e.what()).find("clips: bend, long, back"), std::string::npos) << e.what();
+    }
+}
+
 // Accessors named many times are read each time: their values together count against the budget.
 TEST_F(GltfLoader, AccessorsNamedManyTimesCountAgainstTheBudget) {
     Gltf g = skinned_bar();

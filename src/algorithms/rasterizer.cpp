@@ -493,7 +493,7 @@ void group_fragments_by_image(NodeRasterizer::State& s) {
     if (s.single_pixels.size() < n) s.single_pixels.resize(n);
     if (s.multi_pixel.size() < n) s.multi_pixel.resize(n);
     if (s.multi_start.size() < n + 1) s.multi_start.resize(n + 1);
-    if (s.multi_fragment.size() < n) s.multi_fragment.resize(n);
+    if (s.multi_fragment.size() < n + 3) s.multi_fragment.resize(n + 3);
     if (s.keys.size() < n + 1) s.keys.resize(n + 1);
     uint32_t* count = s.pixel_count.data();
     uint64_t* touched = s.touched.data();
@@ -539,11 +539,34 @@ void group_fragments_by_image(NodeRasterizer::State& s) {
     for (size_t i = 0; i < singles; ++i) count[single[i]] = 0;
     for (size_t i = 0; i < multis; ++i) count[multi[i]] = 0;
     std::fill(s.touched.begin(), s.touched.end(), 0);
-    // Each multiple pixel: insertion sort of its keys (a handful), then its triangles nearest first.
+    // Each multiple pixel: its keys sorted, then its triangles nearest first. Up to 4 keys (nearly
+    // all pixels): a sorting network of compare-exchanges on 4 values, the missing ones the largest
+    // key, and 4 triangles written (those past the pixel's are overwritten by the next pixel's, or
+    // land in the 3 spare slots past the end): no branch on the data. More: insertion sort.
     uint32_t* out = s.multi_fragment.data();
     for (size_t m = 0; m < multis; ++m) {
         uint64_t* k = keys + starts[m];
         const size_t c = starts[m + 1] - starts[m];
+        if (c <= 4) {
+            constexpr uint64_t kMissing = ~uint64_t(0);
+            uint64_t v0 = k[0], v1 = k[1], v2 = c > 2 ? k[2] : kMissing, v3 = c > 3 ? k[3] : kMissing;
+            const auto exchange = [](uint64_t& a, uint64_t& b) {
+                const uint64_t lo = a < b ? a : b, hi = a < b ? b : a;
+                a = lo;
+                b = hi;
+            };
+            exchange(v0, v1);
+            exchange(v2, v3);
+            exchange(v0, v2);
+            exchange(v1, v3);
+            exchange(v1, v2);
+            uint32_t* o = out + starts[m];
+            o[0] = uint32_t(v0);
+            o[1] = uint32_t(v1) | ((v1 >> 32) == (v0 >> 32) ? kTieBit : 0);
+            o[2] = uint32_t(v2) | ((v2 >> 32) == (v1 >> 32) ? kTieBit : 0);
+            o[3] = uint32_t(v3) | ((v3 >> 32) == (v2 >> 32) ? kTieBit : 0);
+            continue;
+        }
         for (size_t j = 1; j < c; ++j) {
             const uint64_t key = k[j];
             size_t i = j;

@@ -493,7 +493,7 @@ void group_fragments_by_image(NodeRasterizer::State& s) {
     if (s.single_pixels.size() < n) s.single_pixels.resize(n);
     if (s.multi_pixel.size() < n) s.multi_pixel.resize(n);
     if (s.multi_start.size() < n + 1) s.multi_start.resize(n + 1);
-    if (s.multi_fragment.size() < n + 3) s.multi_fragment.resize(n + 3);
+    if (s.multi_fragment.size() < n + 7) s.multi_fragment.resize(n + 7);
     if (s.keys.size() < n + 1) s.keys.resize(n + 1);
     uint32_t* count = s.pixel_count.data();
     uint64_t* touched = s.touched.data();
@@ -542,7 +542,8 @@ void group_fragments_by_image(NodeRasterizer::State& s) {
     // Each multiple pixel: its keys sorted, then its triangles nearest first. Up to 4 keys (nearly
     // all pixels): a sorting network of compare-exchanges on 4 values, the missing ones the largest
     // key, and 4 triangles written (those past the pixel's are overwritten by the next pixel's, or
-    // land in the 3 spare slots past the end): no branch on the data. More: insertion sort.
+    // land in the spare slots past the end): no branch on the data. Up to 8: the same on 8 values.
+    // More: insertion sort.
     uint32_t* out = s.multi_fragment.data();
     for (size_t m = 0; m < multis; ++m) {
         uint64_t* k = keys + starts[m];
@@ -565,6 +566,26 @@ void group_fragments_by_image(NodeRasterizer::State& s) {
             o[1] = uint32_t(v1) | ((v1 >> 32) == (v0 >> 32) ? kTieBit : 0);
             o[2] = uint32_t(v2) | ((v2 >> 32) == (v1 >> 32) ? kTieBit : 0);
             o[3] = uint32_t(v3) | ((v3 >> 32) == (v2 >> 32) ? kTieBit : 0);
+            continue;
+        }
+        if (c <= 8) {  // the same with 8 keys: a 19 compare-exchange network, 7 spare slots
+            constexpr uint64_t kMissing = ~uint64_t(0);
+            uint64_t v[8];
+            for (size_t j = 0; j < 8; ++j) v[j] = j < c ? k[j < c ? j : 0] : kMissing;
+            const auto exchange = [&v](int a, int b) {
+                const uint64_t lo = v[a] < v[b] ? v[a] : v[b], hi = v[a] < v[b] ? v[b] : v[a];
+                v[a] = lo;
+                v[b] = hi;
+            };
+            exchange(0, 2), exchange(1, 3), exchange(4, 6), exchange(5, 7);
+            exchange(0, 4), exchange(1, 5), exchange(2, 6), exchange(3, 7);
+            exchange(0, 1), exchange(2, 3), exchange(4, 5), exchange(6, 7);
+            exchange(2, 4), exchange(3, 5);
+            exchange(1, 4), exchange(3, 6);
+            exchange(1, 2), exchange(3, 4), exchange(5, 6);
+            uint32_t* o = out + starts[m];
+            o[0] = uint32_t(v[0]);
+            for (size_t j = 1; j < 8; ++j) o[j] = uint32_t(v[j]) | ((v[j] >> 32) == (v[j - 1] >> 32) ? kTieBit : 0);
             continue;
         }
         for (size_t j = 1; j < c; ++j) {

@@ -43,6 +43,9 @@
 #define ANIMORDER_RASTER_AVX2 1
 #include <immintrin.h>
 #endif
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
 #define ANIMORDER_INLINE inline __attribute__((always_inline))
 
 namespace animorder {
@@ -132,7 +135,7 @@ struct NodeRasterizer::State {
     bool simd = true;                   // the AVX2 copy where the CPU has it (set_simd)
     std::vector<uint32_t> histogram;    // counting sort of the fragments by pixel
     std::vector<uint32_t> pixel_count;  // per pixel, zero between nodes (kPixelImageLimit pixels at most)
-    std::vector<uint64_t> touched;      // bitmap of the pixels with fragments, zero between nodes
+    std::vector<uint8_t> touched;       // per 64-pixel block, 1 when it has fragments; zero between nodes
     std::vector<uint64_t> keys;         // (depth, triangle) sort keys of the fragments being grouped
     BatchSetup setup;
 };
@@ -480,30 +483,32 @@ void rasterize_clipped_triangle(const ClipVertex (&v)[3], uint32_t triangle, uns
 
 // group_fragments for viewports up to kPixelImageLimit pixels, with the same results: a counting
 // sort whose cost follows the covered pixels, not the viewport. Per-pixel counts live in an image
-// that is all zero between nodes, and a bitmap of the touched pixels is walked in pixel order (64
-// pixels a word); both are returned to zero where touched. A pixel's lone fragment is never moved;
+// that is all zero between nodes (padded to whole blocks of 64 pixels), and the blocks with
+// fragments (one byte a block, set by a plain store) are walked in pixel order, each as a 64-bit
+// mask of its non-zero counts; both are returned to zero where touched. A pixel's lone fragment is never moved;
 // the fragments of the other pixels are moved as (depth, triangle) keys, one 64-bit integer each:
 // a depth is a float in [0, 1), whose bits order as its values once −0 is made +0 (adding +0 does
 // that), so the keys compare as the pairs, and equal high halves are equal depths.
 void group_fragments_by_image(NodeRasterizer::State& s) {
     const size_t n = s.raw_count;
     const uint32_t pixels = s.resolution * s.resolution;
-    s.pixel_count.resize(pixels);
-    s.touched.resize((size_t(pixels) + 63) / 64);
+    const size_t blocks = (size_t(pixels) + 63) / 64;
+    s.pixel_count.resize(blocks * 64);
+    s.touched.resize(blocks);
     if (s.single_pixels.size() < n) s.single_pixels.resize(n);
     if (s.multi_pixel.size() < n) s.multi_pixel.resize(n);
     if (s.multi_start.size() < n + 1) s.multi_start.resize(n + 1);
-    if (s.multi_fragment.size() < n) s.multi_fragment.resize(n);
+    if (s.multi_fragment.size() < n + 7) s.multi_fragment.resize(n + 7);
     if (s.keys.size() < n + 1) s.keys.resize(n + 1);
     uint32_t* count = s.pixel_count.data();
-    uint64_t* touched = s.touched.data();
+    uint8_t* touched = s.touched.data();
     const uint32_t* raw_pixel = s.raw_pixel.data();
     const uint32_t* raw_triangle = s.raw_triangle.data();
     const float* raw_depth = s.raw_depth.data();
     for (size_t f = 0; f < n; ++f) {
         const uint32_t p = raw_pixel[f];
         ++count[p];
-        touched[p >> 6] |= uint64_t(1) << (p & 63);
+        touched[p >> 6] = 1;  // a plain store: no chain through memory from one fragment to the next
     }
     // Pixels in order: a single one is listed; a multiple one gets its slots. Afterwards count[p]
     // is the pixel's next slot, or for a single pixel kLone | the spare slot past the end.
@@ -513,8 +518,21 @@ void group_fragments_by_image(NodeRasterizer::State& s) {
     uint32_t* starts = s.multi_start.data();
     size_t singles = 0, multis = 0;
     uint32_t offset = 0;
-    for (size_t w = 0; w < s.touched.size(); ++w)
-        for (uint64_t bits_left = touched[w]; bits_left; bits_left &= bits_left - 1) {
+    for (size_t w = 0; w < blocks; ++w) {
+        if (!touched[w]) continue;
+        const uint32_t* block = count + w * 64;
+        uint64_t nonzero = 0;  // the block's pixels with fragments
+#ifdef __SSE2__
+        const __m128i zero = _mm_setzero_si128();
+        for (int g = 0; g < 16; ++g) {
+            const __m128i c = _mm_loadu_si128(reinterpret_cast<const __m128i*>(block + 4 * g));
+            const int empty = _mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(c, zero)));
+            nonzero |= uint64_t(empty ^ 15) << (4 * g);
+        }
+#else
+        for (int k = 0; k < 64; ++k) nonzero |= uint64_t(block[k] != 0) << k;
+#endif
+        for (uint64_t bits_left = nonzero; bits_left; bits_left &= bits_left - 1) {
             const uint32_t p = uint32_t(w * 64 + size_t(__builtin_ctzll(bits_left)));
             const uint32_t c = count[p];
             single[singles] = p;
@@ -525,6 +543,7 @@ void group_fragments_by_image(NodeRasterizer::State& s) {
             count[p] = c == 1 ? kLone : offset;
             offset += c == 1 ? 0 : c;
         }
+    }
     starts[multis] = offset;
     for (size_t i = 0; i < singles; ++i) count[single[i]] = kLone | offset;
     uint64_t* keys = s.keys.data();
@@ -539,11 +558,55 @@ void group_fragments_by_image(NodeRasterizer::State& s) {
     for (size_t i = 0; i < singles; ++i) count[single[i]] = 0;
     for (size_t i = 0; i < multis; ++i) count[multi[i]] = 0;
     std::fill(s.touched.begin(), s.touched.end(), 0);
-    // Each multiple pixel: insertion sort of its keys (a handful), then its triangles nearest first.
+    // Each multiple pixel: its keys sorted, then its triangles nearest first. Up to 4 keys (nearly
+    // all pixels): a sorting network of compare-exchanges on 4 values, the missing ones the largest
+    // key, and 4 triangles written (those past the pixel's are overwritten by the next pixel's, or
+    // land in the spare slots past the end): no branch on the data. Up to 8: the same on 8 values.
+    // More: insertion sort.
     uint32_t* out = s.multi_fragment.data();
     for (size_t m = 0; m < multis; ++m) {
         uint64_t* k = keys + starts[m];
         const size_t c = starts[m + 1] - starts[m];
+        if (c <= 4) {
+            constexpr uint64_t kMissing = ~uint64_t(0);
+            uint64_t v0 = k[0], v1 = k[1], v2 = c > 2 ? k[2] : kMissing, v3 = c > 3 ? k[3] : kMissing;
+            const auto exchange = [](uint64_t& a, uint64_t& b) {
+                const uint64_t lo = a < b ? a : b, hi = a < b ? b : a;
+                a = lo;
+                b = hi;
+            };
+            exchange(v0, v1);
+            exchange(v2, v3);
+            exchange(v0, v2);
+            exchange(v1, v3);
+            exchange(v1, v2);
+            uint32_t* o = out + starts[m];
+            o[0] = uint32_t(v0);
+            o[1] = uint32_t(v1) | ((v1 >> 32) == (v0 >> 32) ? kTieBit : 0);
+            o[2] = uint32_t(v2) | ((v2 >> 32) == (v1 >> 32) ? kTieBit : 0);
+            o[3] = uint32_t(v3) | ((v3 >> 32) == (v2 >> 32) ? kTieBit : 0);
+            continue;
+        }
+        if (c <= 8) {  // the same with 8 keys: a 19 compare-exchange network, 7 spare slots
+            constexpr uint64_t kMissing = ~uint64_t(0);
+            uint64_t v[8];
+            for (size_t j = 0; j < 8; ++j) v[j] = j < c ? k[j < c ? j : 0] : kMissing;
+            const auto exchange = [&v](int a, int b) {
+                const uint64_t lo = v[a] < v[b] ? v[a] : v[b], hi = v[a] < v[b] ? v[b] : v[a];
+                v[a] = lo;
+                v[b] = hi;
+            };
+            exchange(0, 2), exchange(1, 3), exchange(4, 6), exchange(5, 7);
+            exchange(0, 4), exchange(1, 5), exchange(2, 6), exchange(3, 7);
+            exchange(0, 1), exchange(2, 3), exchange(4, 5), exchange(6, 7);
+            exchange(2, 4), exchange(3, 5);
+            exchange(1, 4), exchange(3, 6);
+            exchange(1, 2), exchange(3, 4), exchange(5, 6);
+            uint32_t* o = out + starts[m];
+            o[0] = uint32_t(v[0]);
+            for (size_t j = 1; j < 8; ++j) o[j] = uint32_t(v[j]) | ((v[j] >> 32) == (v[j - 1] >> 32) ? kTieBit : 0);
+            continue;
+        }
         for (size_t j = 1; j < c; ++j) {
             const uint64_t key = k[j];
             size_t i = j;

@@ -710,6 +710,17 @@ TEST(Rasterizer, GroupedListsEqualASortOfTheRawFragments) {
         EXPECT_EQ(got.fragments, fragments) << resolution;
         EXPECT_GT(starts.size(), 100u);
         EXPECT_NE(std::count_if(fragments.begin(), fragments.end(), [](uint32_t f) { return f >> 31; }), 0);
+        // At 40², pixels of 2-4, 5-8 and more fragments all occur: each of the count-image
+        // grouping's sorts (two sorting networks, insertion) is checked.
+        if (resolution != 40) continue;
+        size_t by_size[3] = {};
+        for (size_t m = 0; m + 1 < starts.size(); ++m) {
+            const uint32_t c = starts[m + 1] - starts[m];
+            ++by_size[c <= 4 ? 0 : c <= 8 ? 1 : 2];
+        }
+        EXPECT_GT(by_size[0], 0u) << resolution;
+        EXPECT_GT(by_size[1], 0u) << resolution;
+        EXPECT_GT(by_size[2], 0u) << resolution;
     }
 }
 

@@ -501,6 +501,19 @@ std::vector<std::tuple<uint32_t, uint32_t, float>> engine_fragments(const NodeRa
     return out;
 }
 
+// The same fragments in the same order, depths bit for bit.
+void expect_same_fragments(const std::vector<std::tuple<uint32_t, uint32_t, float>>& got,
+                           const std::vector<std::tuple<uint32_t, uint32_t, float>>& expected,
+                           const std::string& what) {
+    ASSERT_EQ(got.size(), expected.size()) << what;
+    for (size_t f = 0; f < got.size(); ++f) {
+        ASSERT_EQ(std::get<0>(got[f]), std::get<0>(expected[f])) << "fragment " << f << ", " << what;
+        ASSERT_EQ(std::get<1>(got[f]), std::get<1>(expected[f])) << "fragment " << f << ", " << what;
+        ASSERT_EQ(std::memcmp(&std::get<2>(got[f]), &std::get<2>(expected[f]), 4), 0)
+            << "fragment " << f << ", " << what;
+    }
+}
+
 }  // namespace
 
 // Every fragment (pixel, triangle, depth bits) and its order, against the plain reference, on
@@ -558,14 +571,8 @@ TEST(Rasterizer, FragmentsEqualAPlainPerPixelReference) {
             NodeRasterizer r;
             r.set_simd(simd);
             r.rasterize(clip.data(), clip.size() / 4, ib.data(), ib.size(), resolution, modes.data());
-            const auto got = engine_fragments(r);
-            ASSERT_EQ(got.size(), expected.size()) << "resolution " << resolution << " simd " << simd;
-            for (size_t f = 0; f < got.size(); ++f) {
-                ASSERT_EQ(std::get<0>(got[f]), std::get<0>(expected[f])) << "fragment " << f << " simd " << simd;
-                ASSERT_EQ(std::get<1>(got[f]), std::get<1>(expected[f])) << "fragment " << f << " simd " << simd;
-                ASSERT_EQ(std::memcmp(&std::get<2>(got[f]), &std::get<2>(expected[f]), 4), 0)
-                    << "fragment " << f << " simd " << simd;
-            }
+            expect_same_fragments(engine_fragments(r), expected,
+                                  "resolution " + std::to_string(resolution) + " simd " + std::to_string(simd));
         }
         EXPECT_GT(expected.size(), 200u);  // the scene draws something
     }
@@ -615,14 +622,7 @@ TEST(Rasterizer, SmallAndWideBoxesEqualThePlainReference) {
         NodeRasterizer r;
         r.set_simd(simd);
         r.rasterize(clip.data(), clip.size() / 4, ib.data(), ib.size(), resolution, modes.data());
-        const auto got = engine_fragments(r);
-        ASSERT_EQ(got.size(), expected.size()) << "simd " << simd;
-        for (size_t f = 0; f < got.size(); ++f) {
-            ASSERT_EQ(std::get<0>(got[f]), std::get<0>(expected[f])) << "fragment " << f << " simd " << simd;
-            ASSERT_EQ(std::get<1>(got[f]), std::get<1>(expected[f])) << "fragment " << f << " simd " << simd;
-            ASSERT_EQ(std::memcmp(&std::get<2>(got[f]), &std::get<2>(expected[f]), 4), 0)
-                << "fragment " << f << " simd " << simd;
-        }
+        expect_same_fragments(engine_fragments(r), expected, "simd " + std::to_string(simd));
     }
     EXPECT_GT(expected.size(), 1000u) << near_zero << " " << near_one;
     EXPECT_GT(near_zero, 5u);

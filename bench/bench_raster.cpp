@@ -1,9 +1,10 @@
 // Per-node cost of the overdraw engine on one thread (issue 19): transform to clip space,
-// NodeRasterizer::rasterize_validated and keep_fragments, as CPU time of this thread (CLOCK_THREAD_CPUTIME_ID,
-// so other processes on a shared machine do not count), over a spread of nodes of a character
-// (default protocol: 162 views, 256², λ = 0.85). Also prints a hash of every output (raw fragments in
-// order, grouped lists, counts, kept nodes): two builds that print the same hash produced the same
-// bits. A plain runner, never a test.
+// NodeRasterizer::rasterize_validated, keep_fragments and score_kept (1 and 5 random patch orders),
+// as CPU time of this thread (CLOCK_THREAD_CPUTIME_ID, so other processes on a shared machine do
+// not count), over a spread of nodes of a character (default protocol: 162 views, 256², λ = 0.85).
+// Also prints hashes: the rasteriser's output (raw fragments in order, grouped lists, counts), the
+// kept nodes, and the scores: two builds that print the same hash produced the same bits. A plain
+// runner, never a test.
 //
 //   build/bench/bench_raster ../shared/data/glb-xbot/Xbot.glb
 //   build/bench/bench_raster ../shared/data/mixamo-ganfaul/Ganfaul.gltf --clip Idle [--keyframes 4] [--repeat 2]
@@ -94,11 +95,34 @@ int main(int argc, char** argv) try {
         double rasterize_ms = 0;
         uint64_t hash = 0;
     };
+    // Random unit orders (whole patches in their inner order) for timing score_kept.
+    std::vector<std::vector<uint32_t>> unit_orders;
+    {
+        uint64_t state = 12345;
+        for (int o = 0; o < 5; ++o) {
+            std::vector<uint32_t> patch_order(patches.patch_count());
+            for (size_t i = 0; i < patch_order.size(); ++i) patch_order[i] = uint32_t(i);
+            for (size_t i = patch_order.size(); i > 1; --i) {
+                state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+                std::swap(patch_order[i - 1], patch_order[(state >> 33) % i]);
+            }
+            unit_orders.push_back(patch_order_to_triangle_order(patches, patch_order));
+        }
+    }
+    const auto rank_tables = [&](size_t count) {
+        std::vector<const uint32_t*> pointers;
+        for (size_t o = 0; o < count; ++o) pointers.push_back(unit_orders[o].data());
+        return make_rank_table(pointers, mesh.triangle_count());
+    };
+    const std::vector<uint32_t> ranks1 = rank_tables(1), ranks5 = rank_tables(5);
+    const std::vector<uint16_t> unit_ranks1 = make_unit_rank_table(ranks1.data(), 1, partition),
+                                unit_ranks5 = make_unit_rank_table(ranks5.data(), 5, partition);
     const auto measure = [&](bool simd) {
         NodeRasterizer rasterizer;
         rasterizer.set_simd(simd);
         KeepScratch scratch;
-        double transform_s = 0, raster_s = 0, keep_s = 0;
+        double transform_s = 0, raster_s = 0, keep_s = 0, score1_s = 0, score5_s = 0;
+        Hash score_hash;  // the scores of the random unit orders
         size_t nodes = 0, fragments = 0;
         Hash hash;
         Hash kept_hash;  // every KeptNode whole (counts and data): equal between builds = same kept nodes
@@ -118,6 +142,15 @@ int main(int argc, char** argv) try {
                     const KeptNode kept = keep_fragments(lists.visible, lists.single, lists.starts, lists.pixels,
                                                          lists.fragments, partition, scratch);
                     const double t3 = thread_seconds();
+                    uint64_t passed[5];
+                    score_kept(passed, kept, unit_ranks1.data(), ranks1.data(), 1);
+                    score_hash.value(passed[0]);
+                    const double t4 = thread_seconds();
+                    score_kept(passed, kept, unit_ranks5.data(), ranks5.data(), 5);
+                    for (const uint64_t p : passed) score_hash.value(p);
+                    const double t5 = thread_seconds();
+                    score1_s += t4 - t3;
+                    score5_s += t5 - t4;
                     transform_s += t1 - t0;
                     raster_s += t2 - t1;
                     keep_s += t3 - t2;
@@ -137,7 +170,6 @@ int main(int argc, char** argv) try {
                             hash.add(lists.fragments + lists.starts[0],
                                      (lists.starts[lists.pixels] - lists.starts[0]) * 4);
                         }
-                        hash.add(kept.data.data(), kept.data.size());
                         kept_hash.value(kept.visible);
                         kept_hash.value(kept.single);
                         kept_hash.value(kept.unit_lists);
@@ -157,6 +189,9 @@ int main(int argc, char** argv) try {
             "keep %.3f ms/node (thread CPU time); output hash %016llx\n",
             mesh.triangle_count(), nodes, double(fragments) / double(nodes), 1e3 * transform_s / double(nodes),
             1e3 * raster_s / double(nodes), 1e3 * keep_s / double(nodes), (unsigned long long)hash.h);
+        std::printf("  score_kept of random patch orders: 1 order %.4f ms/node, 5 orders %.4f ms/node; score hash %016llx\n",
+                    1e3 * score1_s / double(nodes), 1e3 * score5_s / double(nodes),
+                    (unsigned long long)score_hash.h);
         const double hashed = double(nodes / std::max<size_t>(1, repeats));
         std::printf(
             "  kept per node: %.0f multi-fragment pixels -> %.0f unit lists (%.0f entries), %.0f triangle "

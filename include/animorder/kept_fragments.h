@@ -39,7 +39,8 @@ constexpr size_t kMaxListedUnits = 0x8000;
 
 // One node, compact. visible: pixels covered; single: pixels whose every order passes exactly one
 // fragment. Unit lists: deduplicated, each with its weight (pixels), entries unit | 0x8000 when
-// at the depth of the previous entry. Triangle lists: the rare pixels where a unit appears twice
+// at the depth of the previous entry; stored shortest first (lists of one length in order of
+// first appearance), so that scoring walks runs of one length. Triangle lists: the rare pixels where a unit appears twice
 // after dropping (its inner order then matters), entries triangle | kTieBit, weight one.
 struct KeptNode {
     uint64_t visible = 0, single = 0;
@@ -61,7 +62,8 @@ struct KeepScratch {
     uint32_t generation = 0;
     std::vector<uint64_t> keys;  // per list: its first four entries side by side
     std::vector<uint32_t> reduced, kept_unit, kept_position, list_offset;
-    std::vector<uint16_t> units, entries, weights;
+    std::vector<uint16_t> units, entries, weights, sorted_entries;
+    std::vector<uint32_t> by_length;  // the lists' ids by length (keep_fragments stores them so)
     std::vector<uint8_t> lengths;
     std::vector<uint32_t> triangle_lists;
 };

@@ -11,6 +11,8 @@
 //   2. Between fragments of different units only the units' positions in the order matter: a
 //      list whose units are all different becomes a list of unit ids (16 bits each).
 //   3. Pixels with equal unit lists are kept once, with a weight.
+// The unit lists are stored shortest first, so that scoring (k-means scores every node again at
+// each step) walks runs of lists of one length with loops that know their trip counts.
 // A pixel left with one fragment passes one under every order (it joins `single`). The rare list
 // that still holds a unit twice keeps its triangles (their inner order decides).
 #include "animorder/kept_fragments.h"
@@ -22,11 +24,13 @@
 #include <cstring>
 #include <numeric>
 #include <string>
+#include <type_traits>
 
 namespace animorder {
 namespace {
 
 constexpr uint32_t kMaxWeight = UINT16_MAX;
+#define ANIMORDER_KEPT_INLINE inline __attribute__((always_inline))
 
 // A list's first four entries side by side (zeros beyond its end): with its length, the whole of
 // nearly every list, so most lookups compare one word. `e` must have four entries readable.
@@ -170,46 +174,64 @@ const T* at(const KeptNode& n, size_t offset) {
     return reinterpret_cast<const T*>(n.data.data() + offset);
 }
 
-// Bit j of the result set when entry j of the unit entries opens a list (one walk over the
-// lengths), so that score_unit_lists_1 walks all entries at once, with no branch per list.
-const uint64_t* list_start_bits(const KeptNode& node, const uint8_t* lengths) {
-    static thread_local std::vector<uint64_t> bits;
-    bits.assign(size_t(node.unit_entries) / 64 + 1, 0);
-    uint32_t start = 0;
-    for (uint32_t list = 0; list < node.unit_lists; ++list) {
-        bits[start >> 6] |= uint64_t(1) << (start & 63);
-        start += lengths[list];
+// One order. Scalar replay_list for a list with ties: an entry passes iff its rank beats the
+// running minimum and nothing of its own tie group passed before it.
+uint32_t replay_units_1(const uint16_t* f, uint32_t n, const uint16_t* unit_ranks) {
+    uint32_t running = UINT16_MAX, before = UINT16_MAX, passes = 0;
+    for (uint32_t j = 0; j < n; ++j) {
+        const uint32_t r = unit_ranks[f[j] & ~uint32_t(kUnitTieBit)];
+        if (j == 0 || !(f[j] & kUnitTieBit)) before = running;
+        passes += uint32_t(r < running) & uint32_t(running == before);
+        running = std::min(running, r);
     }
-    return bits.data();
+    return passes;
 }
 
-// One order: every unit list at once, entry by entry, replayed as replay_list does (an entry
-// passes iff its rank beats the running minimum and nothing of its own tie group passed before
-// it) without a branch: a list's first entry resets the running minimum, a tied entry keeps the
-// minimum from before its group, and each pass counts its list's weight. (A list's length is
-// 2 to 5 or so at random, so a loop per list guesses its exit wrong about once a list.)
-// Not inlined: in score_kept's body the walk's pointers spill to the stack (a third slower).
-__attribute__((noinline)) void score_unit_lists_1(uint64_t* passed, const KeptNode& node, const uint16_t* unit_ranks) {
+// Calls run(length, first list, end) for each run of lists of one length (keep_fragments stores
+// the lists by length), `length` a compile-time constant for 2 to 5 and 0 (any) beyond.
+template <typename Run>
+ANIMORDER_KEPT_INLINE void for_each_length_run(const KeptNode& node, const uint8_t* lengths, Run&& run) {
+    for (uint32_t list = 0; list < node.unit_lists;) {
+        const uint32_t n = lengths[list];
+        uint32_t end = list + 1;
+        while (end < node.unit_lists && lengths[end] == n) ++end;
+        switch (n) {
+            case 2: run(std::integral_constant<uint32_t, 2>{}, list, end, n); break;
+            case 3: run(std::integral_constant<uint32_t, 3>{}, list, end, n); break;
+            case 4: run(std::integral_constant<uint32_t, 4>{}, list, end, n); break;
+            case 5: run(std::integral_constant<uint32_t, 5>{}, list, end, n); break;
+            default: run(std::integral_constant<uint32_t, 0>{}, list, end, n); break;
+        }
+        list = end;
+    }
+}
+
+// One order, run by run: a list without ties takes its entries without a branch.
+void score_unit_lists_1(uint64_t* passed, const KeptNode& node, const uint16_t* unit_ranks) {
     const Layout l = layout_of(node);
     const uint16_t* weights = at<uint16_t>(node, l.weights);
     const uint16_t* e = at<uint16_t>(node, l.entries);
-    const uint64_t* starts = list_start_bits(node, at<uint8_t>(node, l.lengths));
     uint64_t count = 0;
-    uint32_t running = UINT16_MAX, before = UINT16_MAX, weight = 0;
-    const uint16_t* list_weight = weights - 1;  // the current list's
-    for (uint32_t j = 0; j < node.unit_entries; ++j) {
-        const uint32_t start = uint32_t(starts[j >> 6] >> (j & 63)) & 1;
-        list_weight += start;
-        weight = *list_weight;
-        const uint32_t u = e[j], r = unit_ranks[u & ~uint32_t(kUnitTieBit)];
-        running |= 0u - start;  // UINT16_MAX at a list's start
-        running &= UINT16_MAX;
-        // Ties are rare: a branch on the tie bit alone is nearly always guessed right.
-        if (__builtin_expect((u & kUnitTieBit) == 0, 1) || start) before = running;
-        const uint32_t pass = uint32_t(r < running) & uint32_t(running == before);
-        running = std::min(running, r);
-        count += weight & (0u - pass);
-    }
+    for_each_length_run(node, at<uint8_t>(node, l.lengths), [&](auto fixed, uint32_t first, uint32_t end, uint32_t n) {
+        constexpr uint32_t N = decltype(fixed)::value;
+        for (uint32_t list = first; list < end; ++list, e += n) {
+            uint32_t ties = 0;
+            for (uint32_t j = 1; j < (N ? N : n); ++j) ties |= e[j];
+            uint32_t passes;
+            if (__builtin_expect(ties & kUnitTieBit, 0)) {
+                passes = replay_units_1(e, n, unit_ranks);
+            } else {
+                uint32_t running = unit_ranks[e[0]];
+                passes = 1;
+                for (uint32_t j = 1; j < (N ? N : n); ++j) {
+                    const uint32_t r = unit_ranks[e[j]];
+                    passes += r < running;
+                    running = std::min(running, r);
+                }
+            }
+            count += uint64_t(weights[list]) * passes;
+        }
+    });
     passed[0] += count;
 }
 
@@ -236,45 +258,46 @@ void score_unit_lists_k(uint64_t* passed, const KeptNode& node, const uint16_t* 
         return r;
     };
     U32x4 low = {}, high = {};
-    for (uint32_t list = 0; list < node.unit_lists; ++list) {
-        const uint32_t n = lengths[list];
-        I16x8 running = I16x8{} + INT16_MAX, passes = {};
-        const uint32_t u1 = e[1], u2 = e[std::min(2u, n - 1)], u3 = e[std::min(3u, n - 1)];
-        if (!((u1 | u2 | u3) & kUnitTieBit)) {
-            const auto step = [&](uint32_t u) {
-                const I16x8 r = row(u);
-                const I16x8 below = r < running;
-                passes -= below;
-                running ^= (running ^ r) & below;
-            };
-            step(e[0]);
-            step(u1);
-            step(u2);
-            I16x8 before = running;  // entry 3 starts a group: a tie at entry 4 reads this
-            step(u3);
-            for (uint32_t j = 4; j < n; ++j) {
-                const I16x8 r = row(e[j]);
-                if (!(e[j] & kUnitTieBit)) before = running;
-                const I16x8 below = r < running;
-                passes -= below & (running == before);
-                running ^= (running ^ r) & below;
-            }
-        } else {
-            I16x8 before = running;
-            for (uint32_t j = 0; j < n; ++j) {
-                const I16x8 r = row(e[j]);
-                if (j == 0 || !(e[j] & kUnitTieBit)) before = running;
-                const I16x8 below = r < running;
-                passes -= below & (running == before);
-                running ^= (running ^ r) & below;
-            }
-        }
-        const U32x4 w = U32x4{} + uint32_t(weights[list]);
+    const auto add = [&](I16x8 passes, uint32_t weight) {
+        const U32x4 w = U32x4{} + weight;
         const U16x8 p = U16x8(passes);
         low += U32x4(__builtin_shufflevector(p, U16x8{}, 0, 8, 1, 9, 2, 10, 3, 11)) * w;
         if constexpr (K > 4) high += U32x4(__builtin_shufflevector(p, U16x8{}, 4, 12, 5, 13, 6, 14, 7, 15)) * w;
-        e += n;
-    }
+    };
+    // Any list, ties or not: replay_list's rule entry by entry.
+    const auto general = [&](const uint16_t* f, uint32_t n) {
+        I16x8 running = I16x8{} + INT16_MAX, passes = {}, before = running;
+        for (uint32_t j = 0; j < n; ++j) {
+            const I16x8 r = row(f[j]);
+            if (j == 0 || !(f[j] & kUnitTieBit)) before = running;
+            const I16x8 below = r < running;
+            passes -= below & (running == before);
+            running ^= (running ^ r) & below;
+        }
+        return passes;
+    };
+    // A run of lists of one length n (sorted so by keep_fragments): a list without ties takes its
+    // entries in n steps without a branch; N > 0 is n known at compile time.
+    const auto run = [&](auto fixed, uint32_t first, uint32_t end, uint32_t n) {
+        constexpr uint32_t N = decltype(fixed)::value;
+        for (uint32_t list = first; list < end; ++list, e += n) {
+            uint32_t ties = 0;
+            for (uint32_t j = 1; j < (N ? N : n); ++j) ties |= e[j];
+            if (__builtin_expect(ties & kUnitTieBit, 0)) {
+                add(general(e, n), weights[list]);
+                continue;
+            }
+            I16x8 running = I16x8{} + INT16_MAX, passes = {};
+            for (uint32_t j = 0; j < (N ? N : n); ++j) {
+                const I16x8 r = row(e[j]);
+                const I16x8 below = r < running;
+                passes -= below;
+                running ^= (running ^ r) & below;
+            }
+            add(passes, weights[list]);
+        }
+    };
+    for_each_length_run(node, lengths, run);
     for (size_t o = 0; o < K; ++o) passed[o] += o < 4 ? low[o] : high[o - 4];
 }
 
@@ -381,13 +404,33 @@ KeptNode keep_fragments(uint64_t visible, uint64_t single, const uint32_t* start
     node.unit_entries = uint32_t(s.entries.size());
     const Layout l = layout_of(node);
     node.data = std::vector<uint8_t>(l.total, 0);  // exactly its size: bytes() is deterministic
-    auto put = [&](size_t offset, const auto& from) {
-        if (!from.empty()) std::memcpy(node.data.data() + offset, from.data(), from.size() * sizeof(from[0]));
-    };
-    put(l.weights, s.weights);
-    put(l.entries, s.entries);
-    put(l.lengths, s.lengths);
-    put(l.triangles, s.triangle_lists);
+    // The unit lists by length, shortest first, each length in order of first appearance (a
+    // counting sort of the list ids): scoring then meets runs of one length, so its loops know
+    // their trip counts. Copied in the new order, eight entries at a time (padding both sides).
+    uint32_t first_of_length[kMaxListLength + 2] = {};
+    for (const uint8_t n : s.lengths) ++first_of_length[n + 1];
+    for (size_t n = 1; n <= kMaxListLength + 1; ++n) first_of_length[n] += first_of_length[n - 1];
+    s.by_length.resize(node.unit_lists);
+    for (uint32_t list = 0; list < node.unit_lists; ++list) s.by_length[first_of_length[s.lengths[list]]++] = list;
+    s.entries.resize(s.entries.size() + 8);
+    s.sorted_entries.resize(s.entries.size());
+    uint16_t* weights = reinterpret_cast<uint16_t*>(node.data.data() + l.weights);
+    uint8_t* lengths = node.data.data() + l.lengths;
+    uint16_t* sorted = s.sorted_entries.data();
+    for (uint32_t i = 0; i < node.unit_lists; ++i) {
+        const uint32_t list = s.by_length[i];
+        const uint8_t n = s.lengths[list];
+        const uint16_t* from = &s.entries[s.list_offset[list]];
+        weights[i] = s.weights[list];
+        std::memcpy(sorted, from, 8 * sizeof(uint16_t));
+        if (n > 8) std::memcpy(sorted + 8, from + 8, (n - 8) * sizeof(uint16_t));
+        sorted += n;
+    }
+    for (uint32_t i = 0; i < node.unit_lists; ++i) lengths[i] = s.lengths[s.by_length[i]];
+    if (node.unit_entries)
+        std::memcpy(node.data.data() + l.entries, s.sorted_entries.data(), node.unit_entries * sizeof(uint16_t));
+    if (!s.triangle_lists.empty())
+        std::memcpy(node.data.data() + l.triangles, s.triangle_lists.data(), s.triangle_lists.size() * sizeof(uint32_t));
     return node;
 }
 

@@ -198,6 +198,65 @@ TEST(KeptFragments, RandomListsScoreAsThePerTriangleListsForEveryUnitOrder) {
     }
 }
 
+// Lists of every length from 2 to 14 units (scoring has a branch-free path per length up to 5
+// and one for any length beyond), with and without ties, many pixels sharing a list, scored
+// with 1 to 9 random unit orders: the same counts as the per-triangle replay. keep_fragments
+// stores the unit lists shortest first.
+TEST(KeptFragments, ListsOfEveryLengthScoreAsThePerTriangleListsForAnyOrderCount) {
+    std::mt19937 rng(11);
+    std::vector<uint32_t> sizes(16);
+    for (uint32_t& size : sizes) size = 1 + rng() % 2;
+    std::vector<uint32_t> starts{0};
+    for (uint32_t size : sizes) starts.push_back(starts.back() + size);
+    std::vector<uint32_t> inner(starts.back());
+    std::iota(inner.begin(), inner.end(), 0u);
+    std::shuffle(inner.begin(), inner.end(), rng);
+    const UnitPartition p = make_unit_partition(starts.data(), sizes.size(), inner.data(), inner.size());
+    Lists l;
+    std::vector<std::vector<uint32_t>> drawn;
+    for (int px = 0; px < 600; ++px) {
+        if (!drawn.empty() && rng() % 3 == 0) {  // a pixel like an earlier one: a shared list
+            l.pixel(drawn[rng() % drawn.size()]);
+            continue;
+        }
+        std::vector<uint32_t> t(inner.size());
+        std::iota(t.begin(), t.end(), 0u);
+        std::shuffle(t.begin(), t.end(), rng);
+        t.resize(2 + rng() % 13);
+        if (px % 2)  // every other pixel: one triangle per unit, so nothing is dropped
+            for (uint32_t& triangle : t) triangle = starts[triangle % sizes.size()];
+        std::sort(t.begin(), t.end());
+        t.erase(std::unique(t.begin(), t.end()), t.end());
+        if (t.size() < 2) continue;
+        std::shuffle(t.begin(), t.end(), rng);
+        for (size_t j = 1; j < t.size(); ++j)
+            if (rng() % 6 == 0) t[j] |= kTie;
+        drawn.push_back(t);
+        l.pixel(t);
+    }
+    const NodeFragments full = l.node(3);
+    const KeptNode k = keep(full, p);
+    std::vector<uint32_t> lengths, scratch;
+    for_each_unit_list(k, p.unit_of_triangle.data(), p.unit_of_triangle.size(), scratch,
+                       [&](const uint32_t*, uint32_t n, uint32_t) { lengths.push_back(n); });
+    ASSERT_GE(lengths.size(), size_t(k.unit_lists));
+    lengths.resize(k.unit_lists);  // the unit lists (the triangle lists follow)
+    EXPECT_TRUE(std::is_sorted(lengths.begin(), lengths.end()));
+    for (uint32_t n = 2; n <= 10; ++n)  // the data has the lengths the test is about
+        EXPECT_NE(std::find(lengths.begin(), lengths.end(), n), lengths.end()) << "no list of " << n << " units";
+    std::vector<uint32_t> order(sizes.size());
+    std::iota(order.begin(), order.end(), 0u);
+    for (size_t count = 1; count <= 9; ++count) {
+        std::vector<std::vector<uint32_t>> orders;
+        for (size_t o = 0; o < count; ++o) {
+            std::shuffle(order.begin(), order.end(), rng);
+            orders.push_back(order);
+        }
+        SCOPED_TRACE(std::to_string(count) + " orders");
+        expect_same_counts(full, k, p, orders);
+    }
+}
+
 TEST(KeptFragments, AnOrderThatSplitsAUnitIsRefused) {
     const UnitPartition p = runs({2, 1});
     const std::vector<uint32_t> faces = {0, 2, 1};  // unit 0 split by unit 1

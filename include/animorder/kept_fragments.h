@@ -33,15 +33,18 @@ UnitPartition make_unit_partition(const uint32_t* unit_starts, size_t unit_count
                                   size_t triangle_count);
 
 // Unit lists have at most this many units (longer ones are kept per triangle), and unit ids
-// below kMaxListedUnits (a mesh with more units keeps every list per triangle).
+// below kMaxListedUnits (a mesh with more units keeps every list per triangle; bits 14 and 15 of
+// an entry are flags).
 constexpr size_t kMaxListLength = 255;
-constexpr size_t kMaxListedUnits = 0x8000;
+constexpr size_t kMaxListedUnits = 0x4000;
 
 // One node, compact. visible: pixels covered; single: pixels whose every order passes exactly one
 // fragment. Unit lists: deduplicated, each with its weight (pixels), entries unit | 0x8000 when
-// at the depth of the previous entry; stored shortest first (lists of one length in order of
-// first appearance), so that scoring walks runs of one length. Triangle lists: the rare pixels where a unit appears twice
-// after dropping (its inner order then matters), entries triangle | kTieBit, weight one.
+// at the depth of the previous entry, | 0x4000 for a unit's second entry (a farther fragment
+// that its unit draws before the nearer one: the two units' inner order is then known); stored
+// shortest first (lists of one length in order of first appearance), so that scoring walks runs
+// of one length. Triangle lists: the rare pixels where a unit appears three times or more after
+// dropping (its inner order then matters), entries triangle | kTieBit, weight one.
 struct KeptNode {
     uint64_t visible = 0, single = 0;
     uint32_t unit_lists = 0, unit_entries = 0, triangle_lists = 0, triangle_entries = 0;
@@ -73,10 +76,12 @@ struct KeepScratch {
 KeptNode keep_fragments(uint64_t visible, uint64_t single, const uint32_t* starts, size_t pixel_count,
                         const uint32_t* fragments, const UnitPartition& partition, KeepScratch& scratch);
 
-// Per order, the position of every unit (u16, order-major within a unit:
-// [u · unit_rank_stride(order_count) + o]) from a triangle rank table (make_rank_table). Rows of
-// 2 to 8 orders are padded to 8 lanes and hold position ^ 0x8000 (so that score_kept compares
-// them as signed 16-bit lanes). Throws InvalidInput when an order splits a unit.
+// Per order, the rank of every unit (u16, order-major within a unit:
+// [u · unit_rank_stride(order_count) + o]) from a triangle rank table (make_rank_table): 2 ·
+// position + 1 in row u, and 2 · position in row 0x4000 + u (a unit's second entry in a list,
+// drawn just before its first). Rows of 2 to 8 orders are padded to 8 lanes and hold rank ^ 0x8000
+// (so that score_kept compares them as signed 16-bit lanes). Throws InvalidInput when an order
+// splits a unit.
 std::vector<uint16_t> make_unit_rank_table(const uint32_t* triangle_ranks, size_t order_count,
                                            const UnitPartition& partition);
 

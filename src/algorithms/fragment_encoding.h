@@ -17,6 +17,11 @@ namespace animorder {
 constexpr uint32_t kTieBit = 0x80000000u;
 constexpr uint32_t kTriangleMask = 0x7fffffffu;
 constexpr uint16_t kUnitTieBit = 0x8000u;
+// A unit list entry with this bit is its unit's second entry in the list: a farther fragment of
+// the unit that the unit draws before its nearer one (kept_fragments.cpp). Its rank row is
+// kUnitRepeatBit rows past the unit's own (make_unit_rank_table), one step earlier in the order.
+constexpr uint16_t kUnitRepeatBit = 0x4000u;
+constexpr uint16_t kUnitMask = 0x3fffu;
 
 // Replays one pixel's list nearest first for every order, keeping the lowest rank seen so far
 // (`running`) and the lowest before the current group of equal depths (`before`). An entry passes

@@ -13,8 +13,11 @@
 //   3. Pixels with equal unit lists are kept once, with a weight.
 // The unit lists are stored shortest first, so that scoring (k-means scores every node again at
 // each step) walks runs of lists of one length with loops that know their trip counts.
-// A pixel left with one fragment passes one under every order (it joins `single`). The rare list
-// that still holds a unit twice keeps its triangles (their inner order decides).
+// A pixel left with one fragment passes one under every order (it joins `single`). A unit left
+// twice in a list (a farther fragment it draws before the nearer one: common on double-sided
+// meshes) stays a unit list, its second entry flagged: that entry ranks just before the unit's
+// first in every order. The rare list that still holds a unit three times keeps its triangles
+// (their inner order decides).
 #include "animorder/kept_fragments.h"
 #include "fragment_encoding.h"
 
@@ -52,8 +55,8 @@ uint64_t hash_list(uint64_t key, const uint16_t* e, size_t n) {
 // Drops the fragments of reduction 1 from one pixel's list into `out` (tie bits recomputed: an
 // entry is tied when its depth equals the previous kept entry's) and returns how many are kept;
 // kept_unit and kept_position hold the kept entries' unit and position, units their unit list
-// entries (unit | kUnitTieBit when tied; each array at least n long). Sets `repeated` when a
-// unit still appears twice.
+// entries (unit | kUnitTieBit when tied, | kUnitRepeatBit for the unit's second entry; each array
+// at least n long). Sets `repeated` when a unit still appears three times.
 uint32_t reduce_pixel(const uint32_t* f, uint32_t n, const UnitPartition& partition, uint32_t* out, uint32_t* kept_unit,
                       uint32_t* kept_position, uint16_t* units, bool& repeated) {
     repeated = false;
@@ -68,19 +71,20 @@ uint32_t reduce_pixel(const uint32_t* f, uint32_t n, const UnitPartition& partit
                                std::to_string(triangles));
         const bool tied = j > 0 && (f[j] & kTieBit) && previous_at_kept_depth;
         const auto [unit, position] = unit_position[t];
-        bool dominated = false, same_unit = false;
+        bool dominated = false;
+        uint32_t same_unit = 0;  // nearer entries of this unit, all drawn after it (else dominated)
         for (uint32_t i = 0; i < kept; ++i) {
             const bool same = kept_unit[i] == unit;
-            same_unit |= same;
+            same_unit += same;
             dominated |= same && kept_position[i] < position;
         }
         if (dominated) {
             previous_at_kept_depth = tied;
             continue;
         }
-        repeated |= same_unit;
+        repeated |= same_unit > 1;
         out[kept] = t | (tied ? kTieBit : 0);
-        units[kept] = uint16_t(unit | (tied ? kUnitTieBit : 0));
+        units[kept] = uint16_t(unit | (same_unit ? kUnitRepeatBit : 0) | (tied ? kUnitTieBit : 0));
         kept_unit[kept] = unit;
         kept_position[kept] = position;
         ++kept;
@@ -439,7 +443,7 @@ std::vector<uint16_t> make_unit_rank_table(const uint32_t* triangle_ranks, size_
     const size_t units = partition.unit_count, triangles = partition.unit_of_triangle.size();
     if (units > kMaxListedUnits) return {};  // every list is kept per triangle
     const size_t stride = unit_rank_stride(order_count);
-    std::vector<uint16_t> table(units * stride, 0);
+    std::vector<uint16_t> table((kUnitRepeatBit + units) * stride, 0);
     std::vector<uint32_t> low(units), high(units), size(units), by_position(units);
     for (size_t o = 0; o < order_count; ++o) {
         std::fill(low.begin(), low.end(), UINT32_MAX);
@@ -458,7 +462,10 @@ std::vector<uint16_t> make_unit_rank_table(const uint32_t* triangle_ranks, size_
         std::iota(by_position.begin(), by_position.end(), 0u);
         std::sort(by_position.begin(), by_position.end(), [&](uint32_t a, uint32_t b) { return low[a] < low[b]; });
         const uint16_t bias = stride == 8 ? 0x8000 : 0;  // see unit_rank_stride: signed lanes
-        for (size_t i = 0; i < units; ++i) table[size_t(by_position[i]) * stride + o] = uint16_t(i ^ bias);
+        for (size_t i = 0; i < units; ++i) {
+            table[size_t(by_position[i]) * stride + o] = uint16_t((2 * i + 1) ^ bias);
+            table[(kUnitRepeatBit + size_t(by_position[i])) * stride + o] = uint16_t((2 * i) ^ bias);
+        }
     }
     return table;
 }
@@ -488,7 +495,7 @@ void for_each_unit_list(const KeptNode& node, const uint32_t* unit_of_triangle, 
     for (uint32_t list = 0; list < node.unit_lists; ++list) {
         scratch.clear();
         for (uint32_t j = 0; j < lengths[list]; ++j)
-            scratch.push_back(uint32_t(e[j] & ~kUnitTieBit) | (e[j] & kUnitTieBit ? kTieBit : 0));
+            scratch.push_back(uint32_t(e[j] & kUnitMask) | (e[j] & kUnitTieBit ? kTieBit : 0));
         visit(scratch.data(), lengths[list], weights[list]);
         e += lengths[list];
     }

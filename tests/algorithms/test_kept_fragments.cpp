@@ -95,20 +95,21 @@ KeptNode keep(const NodeFragments& n, const UnitPartition& p) {
 TEST(KeptFragments, HandWorkedPixelsAreReducedAndShared) {
     const UnitPartition p = runs({2, 1, 3});  // units 0 {0,1}, 1 {2}, 2 {3,4,5}
     Lists l;
-    l.pixel({1, 0});            // unit 0 twice, the nearer (1) drawn after 0: a list kept per triangle
+    l.pixel({1, 0});            // unit 0 twice, the nearer (1) drawn after 0: 0 is the unit's second entry
     l.pixel({0, 1});            // 1 behind 0, which unit 0 draws first: dropped, one fragment left
     l.pixel({2, 3});            // units 1, 2
     l.pixel({2, 4});            // units 1, 2 again: the same unit list, weight 2
     l.pixel({3, 2, 5});         // units 2, 1; 5 behind 3 of its unit (3 drawn first): dropped
     l.pixel({2, 0, 1});         // units 1, 0; 1 behind 0: dropped
     l.pixel({3, 4 | kTie, 2});  // 4 at 3's depth, drawn after 3: dropped; the tie goes with it
+    l.pixel({5, 4, 3});         // unit 2 three times, each farther one drawn first: a list kept per triangle
     const KeptNode k = keep(l.node(5), p);
     EXPECT_EQ(k.single, 5u + 1u);  // the five lone pixels and the {0, 1} pixel
     EXPECT_EQ(k.triangle_lists, 1u);
-    EXPECT_EQ(k.triangle_entries, 2u);
-    // Unit lists in order of first appearance: {1,2} (pixels 3, 4), {2,1} (pixels 5, 7), {1,0};
-    // then the triangle list, as units.
-    EXPECT_EQ(k.unit_lists, 3u);
+    EXPECT_EQ(k.triangle_entries, 3u);
+    // Unit lists (all of length 2) in order of first appearance: {0,0} (pixel 1), {1,2} (pixels
+    // 3, 4), {2,1} (pixels 5, 7), {1,0}; then the triangle list, as units.
+    EXPECT_EQ(k.unit_lists, 4u);
     std::vector<std::vector<uint32_t>> lists;
     std::vector<uint32_t> weights, scratch;
     for_each_unit_list(k, p.unit_of_triangle.data(), p.unit_of_triangle.size(), scratch,
@@ -116,9 +117,9 @@ TEST(KeptFragments, HandWorkedPixelsAreReducedAndShared) {
                            lists.emplace_back(u, u + n);
                            weights.push_back(w);
                        });
-    const std::vector<std::vector<uint32_t>> want_lists = {{1, 2}, {2, 1}, {1, 0}, {0, 0}};
+    const std::vector<std::vector<uint32_t>> want_lists = {{0, 0}, {1, 2}, {2, 1}, {1, 0}, {2, 2, 2}};
     EXPECT_EQ(lists, want_lists);
-    EXPECT_EQ(weights, (std::vector<uint32_t>{2, 2, 1, 1}));
+    EXPECT_EQ(weights, (std::vector<uint32_t>{1, 2, 2, 1, 1}));
     // Every unit order scores as the per-triangle lists do.
     std::vector<uint32_t> order = {0, 1, 2};
     std::vector<std::vector<uint32_t>> all;

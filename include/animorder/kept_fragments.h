@@ -59,15 +59,20 @@ struct KeptNode {
 struct KeepScratch {
     struct Slot {
         uint32_t stamp = 0;  // generation << 8 | the list's length; a slot of another generation is empty
-        uint32_t list = 0;   // the list's index
+        uint32_t list = 0;   // the list's index among the lists of its length
     };
     std::vector<Slot> slots;
     uint32_t generation = 0;
-    std::vector<uint64_t> keys;  // per list: its first four entries side by side
-    std::vector<uint32_t> reduced, kept_unit, kept_position, list_offset;
-    std::vector<uint16_t> units, entries, weights, sorted_entries;
-    std::vector<uint32_t> by_length;  // the lists' ids by length (keep_fragments stores them so)
-    std::vector<uint8_t> lengths;
+    // The node's unit lists of one length n: entries (n a list), weights, and keys (the first
+    // four entries side by side); used_lengths: the lengths with lists in this node.
+    struct Lists {
+        std::vector<uint16_t> entries, weights;
+        std::vector<uint64_t> keys;
+    };
+    std::vector<Lists> lists;
+    std::vector<uint8_t> used_lengths;
+    std::vector<uint32_t> reduced, kept_unit, kept_position;
+    std::vector<uint16_t> units;
     std::vector<uint32_t> triangle_lists;
 };
 

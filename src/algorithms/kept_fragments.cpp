@@ -93,20 +93,24 @@ uint32_t reduce_pixel(const uint32_t* f, uint32_t n, const UnitPartition& partit
     return kept;
 }
 
-// The deduplicated unit lists of one node, in order of first appearance. Which list a pixel
-// joins never depends on the hash: a list's content has one slot, and grow() reinserts the lists
-// in list order (so a full list is met before its later copy, as when it was first filled).
+// The deduplicated unit lists of one node, kept per length (each length's lists in order of first
+// appearance): the node stores them shortest first without a sort. Which list a pixel joins
+// never depends on the hash: a list's content has one slot, and grow() reinserts each length's
+// lists in their order (so a full list is met before its later copy, as when it was first filled).
 struct ListTable {
     KeepScratch& s;
     size_t mask = 0;
     uint32_t generation = 0;
+    size_t lists = 0, entries = 0;
 
     explicit ListTable(KeepScratch& scratch) : s(scratch) {
-        s.entries.clear();
-        s.weights.clear();
-        s.lengths.clear();
-        s.list_offset.clear();
-        s.keys.clear();
+        if (s.lists.size() < kMaxListLength + 1) s.lists.resize(kMaxListLength + 1);
+        for (const uint8_t n : s.used_lengths) {
+            s.lists[n].entries.clear();
+            s.lists[n].weights.clear();
+            s.lists[n].keys.clear();
+        }
+        s.used_lengths.clear();
         // The previous node's table (nodes of a run are alike): no regrowth node after node, and
         // no clearing either: a new generation empties every slot.
         if (s.slots.size() < 1024 || ++s.generation >= (1u << 24)) {
@@ -116,46 +120,47 @@ struct ListTable {
         generation = s.generation;
         mask = s.slots.size() - 1;
     }
-    void insert(uint32_t list) {
-        const uint16_t* e = &s.entries[s.list_offset[list]];
-        const size_t n = s.lengths[list];
-        size_t i = hash_list(s.keys[list], e, n) & mask;
+    void insert(size_t n, uint32_t list) {
+        const KeepScratch::Lists& of = s.lists[n];
+        size_t i = hash_list(of.keys[list], &of.entries[list * n], n) & mask;
         while ((s.slots[i].stamp >> 8) == generation) i = (i + 1) & mask;
         s.slots[i] = {generation << 8 | uint32_t(n), list};
     }
     void grow() {
         s.slots.assign(s.slots.size() * 2, KeepScratch::Slot{});
         mask = s.slots.size() - 1;
-        for (uint32_t list = 0; list < s.weights.size(); ++list) insert(list);
+        for (const uint8_t n : s.used_lengths)
+            for (uint32_t list = 0; list < s.lists[n].weights.size(); ++list) insert(n, list);
     }
     const KeepScratch::Slot* slot_of(uint64_t hash) const { return &s.slots[hash & mask]; }
-    // One more pixel with this list (n ≤ kMaxListLength; key and hash its key_of and hash_list). A
-    // full weight starts a second copy (later pixels count there).
+    // One more pixel with this list (2 ≤ n ≤ kMaxListLength; key and hash its key_of and
+    // hash_list). A full weight starts a second copy (later pixels count there).
     void add(const uint16_t* e, size_t n, uint64_t key, uint64_t hash) {
         const uint32_t stamp = generation << 8 | uint32_t(n);
+        KeepScratch::Lists& of = s.lists[n];
         size_t i = hash & mask;
         for (;; i = (i + 1) & mask) {
             const KeepScratch::Slot& slot = s.slots[i];
             if ((slot.stamp >> 8) != generation) break;  // empty
             if (slot.stamp != stamp) continue;
             const uint32_t list = slot.list;
-            if (s.keys[list] != key) continue;
-            if (n > 4 && std::memcmp(&s.entries[s.list_offset[list] + 4], e + 4, (n - 4) * sizeof(uint16_t)) != 0)
-                continue;
-            if (s.weights[list] < kMaxWeight) {
-                ++s.weights[list];
+            if (of.keys[list] != key) continue;
+            if (n > 4 && std::memcmp(&of.entries[list * n + 4], e + 4, (n - 4) * sizeof(uint16_t)) != 0) continue;
+            if (of.weights[list] < kMaxWeight) {
+                ++of.weights[list];
                 return;
             }
             break;  // this slot now names the new copy
         }
-        const uint32_t list = uint32_t(s.weights.size());
-        s.list_offset.push_back(uint32_t(s.entries.size()));
-        s.entries.insert(s.entries.end(), e, e + n);
-        s.lengths.push_back(uint8_t(n));
-        s.weights.push_back(1);
-        s.keys.push_back(key);
+        if (of.weights.empty()) s.used_lengths.push_back(uint8_t(n));
+        const uint32_t list = uint32_t(of.weights.size());
+        of.entries.insert(of.entries.end(), e, e + n);
+        of.weights.push_back(1);
+        of.keys.push_back(key);
         s.slots[i] = {stamp, list};
-        if (2 * s.weights.size() > s.slots.size()) grow();
+        ++lists;
+        entries += n;
+        if (2 * lists > s.slots.size()) grow();
     }
 };
 
@@ -404,35 +409,25 @@ KeptNode keep_fragments(uint64_t visible, uint64_t single, const uint32_t* start
         __builtin_prefetch(table.slot_of(pending_hash));
     }
     if (pending) table.add(pending, pending_n, pending_key, pending_hash);
-    node.unit_lists = uint32_t(s.weights.size());
-    node.unit_entries = uint32_t(s.entries.size());
+    node.unit_lists = uint32_t(table.lists);
+    node.unit_entries = uint32_t(table.entries);
     const Layout l = layout_of(node);
     node.data = std::vector<uint8_t>(l.total, 0);  // exactly its size: bytes() is deterministic
-    // The unit lists by length, shortest first, each length in order of first appearance (a
-    // counting sort of the list ids): scoring then meets runs of one length, so its loops know
-    // their trip counts. Copied in the new order, eight entries at a time (padding both sides).
-    uint32_t first_of_length[kMaxListLength + 2] = {};
-    for (const uint8_t n : s.lengths) ++first_of_length[n + 1];
-    for (size_t n = 1; n <= kMaxListLength + 1; ++n) first_of_length[n] += first_of_length[n - 1];
-    s.by_length.resize(node.unit_lists);
-    for (uint32_t list = 0; list < node.unit_lists; ++list) s.by_length[first_of_length[s.lengths[list]]++] = list;
-    s.entries.resize(s.entries.size() + 8);
-    s.sorted_entries.resize(s.entries.size());
-    uint16_t* weights = reinterpret_cast<uint16_t*>(node.data.data() + l.weights);
+    // The unit lists shortest first (scoring then meets runs of one length, so its loops know
+    // their trip counts), each length's in order of first appearance.
+    std::sort(s.used_lengths.begin(), s.used_lengths.end());
+    uint8_t* weights = node.data.data() + l.weights;
+    uint8_t* entries = node.data.data() + l.entries;
     uint8_t* lengths = node.data.data() + l.lengths;
-    uint16_t* sorted = s.sorted_entries.data();
-    for (uint32_t i = 0; i < node.unit_lists; ++i) {
-        const uint32_t list = s.by_length[i];
-        const uint8_t n = s.lengths[list];
-        const uint16_t* from = &s.entries[s.list_offset[list]];
-        weights[i] = s.weights[list];
-        std::memcpy(sorted, from, 8 * sizeof(uint16_t));
-        if (n > 8) std::memcpy(sorted + 8, from + 8, (n - 8) * sizeof(uint16_t));
-        sorted += n;
+    for (const uint8_t n : s.used_lengths) {
+        const KeepScratch::Lists& of = s.lists[n];
+        std::memcpy(weights, of.weights.data(), of.weights.size() * sizeof(uint16_t));
+        std::memcpy(entries, of.entries.data(), of.entries.size() * sizeof(uint16_t));
+        std::memset(lengths, n, of.weights.size());
+        weights += of.weights.size() * sizeof(uint16_t);
+        entries += of.entries.size() * sizeof(uint16_t);
+        lengths += of.weights.size();
     }
-    for (uint32_t i = 0; i < node.unit_lists; ++i) lengths[i] = s.lengths[s.by_length[i]];
-    if (node.unit_entries)
-        std::memcpy(node.data.data() + l.entries, s.sorted_entries.data(), node.unit_entries * sizeof(uint16_t));
     if (!s.triangle_lists.empty())
         std::memcpy(node.data.data() + l.triangles, s.triangle_lists.data(), s.triangle_lists.size() * sizeof(uint32_t));
     return node;

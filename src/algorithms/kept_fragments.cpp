@@ -429,7 +429,8 @@ KeptNode keep_fragments(uint64_t visible, uint64_t single, const uint32_t* start
         lengths += of.weights.size();
     }
     if (!s.triangle_lists.empty())
-        std::memcpy(node.data.data() + l.triangles, s.triangle_lists.data(), s.triangle_lists.size() * sizeof(uint32_t));
+        std::memcpy(node.data.data() + l.triangles, s.triangle_lists.data(),
+                    s.triangle_lists.size() * sizeof(uint32_t));
     return node;
 }
 

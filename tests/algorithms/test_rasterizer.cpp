@@ -210,44 +210,122 @@ uint64_t brute_force_passed(const NodeRasterizer& r, const std::vector<uint32_t>
 }
 }  // namespace
 
+// Both copies (portable and AVX2), 1 to 9 orders at once (the AVX2 copy has one vector lane per
+// order up to 8, then the generic replay), against a z-buffer drawing each order; on the bundled
+// character and on a copy with every seventh triangle drawn twice (equal depths: ties).
 TEST(Rasterizer, ScoringManyOrdersEqualsDrawingEachOrderWithAZBuffer) {
-    const AnimatedMesh mesh = make_procedural_character();
-    const Framing framing = frame_animated_mesh(mesh);
-    const size_t n = mesh.triangle_count();
-    std::vector<std::vector<uint32_t>> orders(4, std::vector<uint32_t>(n));
-    std::mt19937 rng(1);
-    for (size_t i = 0; i < n; ++i) orders[0][i] = uint32_t(i);
-    for (size_t i = 0; i < n; ++i) orders[1][i] = uint32_t(n - 1 - i);
-    for (size_t o = 2; o < 4; ++o) {
-        orders[o] = orders[0];
-        for (size_t i = n; i > 1; --i) std::swap(orders[o][i - 1], orders[o][rng() % i]);
-    }
-    std::vector<const uint32_t*> pointers;
-    for (const auto& o : orders) pointers.push_back(o.data());
-    const std::vector<uint32_t> ranks = make_rank_table(pointers, n);
+    AnimatedMesh doubled = make_procedural_character();
+    const size_t original = doubled.indices.size();
+    for (size_t t = 0; 3 * t < original; t += 7)
+        for (int c = 0; c < 3; ++c) doubled.indices.push_back(doubled.indices[3 * t + c]);
+    doubled.primitives.back().index_count += doubled.indices.size() - original;
+    bool long_lists = false, ties = false;  // the data has what the replay branches on
+    for (const AnimatedMesh& mesh : {make_procedural_character(), doubled}) {
+        const Framing framing = frame_animated_mesh(mesh);
+        const size_t n = mesh.triangle_count();
+        std::vector<std::vector<uint32_t>> orders(9, std::vector<uint32_t>(n));
+        std::mt19937 rng(1);
+        for (size_t i = 0; i < n; ++i) orders[0][i] = uint32_t(i);
+        for (size_t i = 0; i < n; ++i) orders[1][i] = uint32_t(n - 1 - i);
+        for (size_t o = 2; o < orders.size(); ++o) {
+            orders[o] = orders[0];
+            for (size_t i = n; i > 1; --i) std::swap(orders[o][i - 1], orders[o][rng() % i]);
+        }
+        std::vector<std::vector<uint32_t>> ranks(orders.size() + 1);  // ranks[c]: the first c orders
+        for (size_t c = 1; c <= orders.size(); ++c) {
+            std::vector<const uint32_t*> pointers;
+            for (size_t o = 0; o < c; ++o) pointers.push_back(orders[o].data());
+            ranks[c] = make_rank_table(pointers, n);
+        }
 
-    const std::vector<float> dirs = icosphere_directions(1);
-    for (size_t v : {0u, 5u, 17u, 33u}) {
-        for (uint32_t k : {0u, uint32_t(mesh.keyframe_count() - 1)}) {
-            std::vector<float> clip(mesh.vertex_count * 4);
-            transform_to_clip(clip.data(), mesh.keyframe(k), mesh.vertex_count, &framing.centres[3 * k],
-                              node_view_projection(&dirs[3 * v], framing.radius));
-            NodeRasterizer r;
-            r.rasterize(clip.data(), mesh.vertex_count, mesh.indices.data(), mesh.indices.size(), 128);
-            std::vector<uint64_t> passed(orders.size());
-            r.score(passed.data(), ranks.data(), orders.size());
-            for (size_t o = 0; o < orders.size(); ++o) {
-                EXPECT_EQ(passed[o], brute_force_passed(r, orders[o]))
-                    << "view " << v << " keyframe " << k << " order " << o;
-                EXPECT_GE(passed[o], r.visible_pixels());
-                EXPECT_LE(passed[o], r.fragments());
+        const std::vector<float> dirs = icosphere_directions(1);
+        for (size_t v : {0u, 5u, 17u, 33u}) {
+            for (uint32_t k : {0u, uint32_t(mesh.keyframe_count() - 1)}) {
+                std::vector<float> clip(mesh.vertex_count * 4);
+                transform_to_clip(clip.data(), mesh.keyframe(k), mesh.vertex_count, &framing.centres[3 * k],
+                                  node_view_projection(&dirs[3 * v], framing.radius));
+                std::vector<uint64_t> want(orders.size());
+                for (const bool simd : {false, true}) {
+                    NodeRasterizer r;
+                    r.set_simd(simd);
+                    r.rasterize(clip.data(), mesh.vertex_count, mesh.indices.data(), mesh.indices.size(), 128);
+                    if (!simd) {
+                        for (size_t o = 0; o < orders.size(); ++o) want[o] = brute_force_passed(r, orders[o]);
+                        const NodeRasterizer::FragmentLists l = r.fragment_lists();
+                        for (size_t m = 0; m < l.pixels; ++m) {
+                            long_lists |= l.starts[m + 1] - l.starts[m] > 4;
+                            for (uint32_t f = l.starts[m]; f < l.starts[m + 1]; ++f)
+                                ties |= (l.fragments[f] >> 31) != 0;
+                        }
+                    }
+                    for (size_t c = 1; c <= orders.size(); ++c) {
+                        std::vector<uint64_t> passed(c);
+                        r.score(passed.data(), ranks[c].data(), c);
+                        for (size_t o = 0; o < c; ++o) {
+                            EXPECT_EQ(passed[o], want[o]) << "view " << v << " keyframe " << k << " order " << o
+                                                          << " of " << c << (simd ? ", AVX2 copy" : ", portable copy");
+                            EXPECT_GE(passed[o], r.visible_pixels());
+                            EXPECT_LE(passed[o], r.fragments());
+                        }
+                    }
+                    EXPECT_GT(r.fragments(), r.visible_pixels());  // the character does overlap itself
+                }
             }
-            EXPECT_GT(r.fragments(), r.visible_pixels());  // the character does overlap itself
-            // One order alone scores the same as within the batch.
-            const std::vector<uint32_t> single = make_rank_table({orders[2].data()}, n);
-            uint64_t alone = 0;
-            r.score(&alone, single.data(), 1);
-            EXPECT_EQ(alone, passed[2]);
+        }
+    }
+    EXPECT_TRUE(long_lists) << "no pixel with more than 4 fragments";
+    EXPECT_TRUE(ties) << "no fragments at equal depths";
+}
+
+// score_fragments on made-up lists of 2 to 12 fragments with equal depths anywhere in them
+// (also only past the fourth fragment, where the AVX2 copy's short-list path ends), 1 to 9
+// orders, against drawing each order into one z-buffer entry per pixel.
+TEST(Rasterizer, ScoringListsWithTiesAnywhereEqualsAZBuffer) {
+    std::mt19937 rng(5);
+    const uint32_t triangles = 40;
+    NodeFragments node;
+    node.starts.push_back(0);
+    std::vector<std::vector<float>> depths;  // per pixel, each fragment's depth
+    for (int px = 0; px < 400; ++px) {
+        std::vector<uint32_t> t(triangles);
+        std::iota(t.begin(), t.end(), 0u);
+        std::shuffle(t.begin(), t.end(), rng);
+        const uint32_t n = 2 + uint32_t(rng() % 11);
+        const uint32_t tie_from = px % 3 == 0 ? 4 : 1;  // a third of the pixels: ties only from the fifth on
+        std::vector<float> z;
+        for (uint32_t j = 0; j < n; ++j) {
+            const bool tie = j >= tie_from && rng() % 3 == 0;
+            z.push_back(tie ? z.back() : float(j + 1));
+            node.fragments.push_back(t[j] | (tie ? 0x80000000u : 0u));
+        }
+        node.starts.push_back(uint32_t(node.fragments.size()));
+        depths.push_back(z);
+    }
+    node.single = 7;
+    node.visible = node.single + depths.size();
+    std::vector<std::vector<uint32_t>> orders;
+    for (size_t c = 1; c <= 9; ++c) {
+        std::vector<uint32_t> order(triangles);
+        std::iota(order.begin(), order.end(), 0u);
+        std::shuffle(order.begin(), order.end(), rng);
+        orders.push_back(order);
+        std::vector<const uint32_t*> pointers;
+        for (const auto& o : orders) pointers.push_back(o.data());
+        const std::vector<uint32_t> ranks = make_rank_table(pointers, triangles);
+        std::vector<uint64_t> passed(c);
+        score_fragments(passed.data(), node, ranks.data(), c);
+        for (size_t o = 0; o < c; ++o) {
+            uint64_t want = node.single;
+            for (size_t m = 0; m < depths.size(); ++m) {
+                float buffer = 1e9f;
+                for (const uint32_t triangle : orders[o])
+                    for (uint32_t f = node.starts[m]; f < node.starts[m + 1]; ++f)
+                        if ((node.fragments[f] & 0x7fffffffu) == triangle && depths[m][f - node.starts[m]] < buffer) {
+                            buffer = depths[m][f - node.starts[m]];
+                            ++want;
+                        }
+            }
+            EXPECT_EQ(passed[o], want) << "order " << o << " of " << c;
         }
     }
 }

@@ -14,8 +14,13 @@ using Mat4d = std::array<double, 16>;  // column-major, as OpenGL
 // direction is within ~2.6° of ±Y. Returns projection · view (OpenGL clip space, z in [−w, w]).
 Mat4d node_view_projection(const float view_direction[3], float radius);
 
-// clip[4v..4v+3] = view_projection · (positions[v] − centre, 1), in float as a vertex shader would.
+// clip[4v..4v+3] = view_projection · (positions[v] − centre, 1), in float as a vertex shader would
+// (row by row, ((m·x + m·y) + m·z) + m, no fused multiply-add). Runs a copy compiled for AVX2
+// where the CPU has it: the same operations, so the same bits.
 void transform_to_clip(float* clip_xyzw, const float* positions, size_t vertex_count, const float centre[3],
                        const Mat4d& view_projection);
+// The same, always in the portable copy (tests compare the two).
+void transform_to_clip_portable(float* clip_xyzw, const float* positions, size_t vertex_count, const float centre[3],
+                                const Mat4d& view_projection);
 
 }  // namespace animorder

@@ -50,16 +50,64 @@ Mat4d node_view_projection(const float view_direction[3], float radius) {
     return multiply_mat4(projection, view);
 }
 
-void transform_to_clip(float* clip_xyzw, const float* positions, size_t vertex_count, const float centre[3],
-                       const Mat4d& vp) {
+namespace {
+
+// One block of up to kBlock vertices (n of them): positions moved to the frame's centre, then the
+// four rows of m · (x, y, z, 1) for every lane at once, stored interleaved. Each output is
+// ((m[row]·x + m[4+row]·y) + m[8+row]·z) + m[12+row] in float, the operations a vertex shader
+// would do, in this order and without fused multiply-adds (the AVX2 copy has no FMA to contract
+// into), so every copy gives the same bits. Lanes past n repeat vertex 0 and are not stored.
+constexpr size_t kBlock = 8;
+
+inline __attribute__((always_inline)) void transform_block(float* out, const float* positions, size_t n,
+                                                           const float* centre, const float* m) {
+    float x[kBlock], y[kBlock], z[kBlock];
+    for (size_t i = 0; i < kBlock; ++i) {
+        const size_t v = i < n ? i : 0;
+        x[i] = positions[3 * v] - centre[0];
+        y[i] = positions[3 * v + 1] - centre[1];
+        z[i] = positions[3 * v + 2] - centre[2];
+    }
+    float clip[4][kBlock];
+    for (int row = 0; row < 4; ++row)
+        for (size_t i = 0; i < kBlock; ++i)
+            clip[row][i] = m[row] * x[i] + m[4 + row] * y[i] + m[8 + row] * z[i] + m[12 + row];
+    for (size_t i = 0; i < n; ++i)
+        for (int row = 0; row < 4; ++row) out[4 * i + row] = clip[row][i];
+}
+
+inline __attribute__((always_inline)) void transform_all(float* clip_xyzw, const float* positions, size_t vertex_count,
+                                                         const float centre[3], const Mat4d& vp) {
     float m[16];
     for (int i = 0; i < 16; ++i) m[i] = float(vp[i]);
-    for (size_t v = 0; v < vertex_count; ++v) {
-        const float x = positions[3 * v] - centre[0], y = positions[3 * v + 1] - centre[1],
-                    z = positions[3 * v + 2] - centre[2];
-        float* out = clip_xyzw + 4 * v;
-        for (int row = 0; row < 4; ++row) out[row] = m[row] * x + m[4 + row] * y + m[8 + row] * z + m[12 + row];
-    }
+    size_t v = 0;
+    for (; v + kBlock <= vertex_count; v += kBlock)
+        transform_block(clip_xyzw + 4 * v, positions + 3 * v, kBlock, centre, m);
+    if (v < vertex_count) transform_block(clip_xyzw + 4 * v, positions + 3 * v, vertex_count - v, centre, m);
+}
+
+#if (defined(__GNUC__) || defined(__clang__)) && (defined(__x86_64__) || defined(__i386__))
+#define ANIMORDER_CAMERA_AVX2 1
+__attribute__((target("avx2"))) void transform_all_avx2(float* clip_xyzw, const float* positions, size_t vertex_count,
+                                                        const float centre[3], const Mat4d& vp) {
+    transform_all(clip_xyzw, positions, vertex_count, centre, vp);
+}
+#endif
+
+}  // namespace
+
+void transform_to_clip_portable(float* clip_xyzw, const float* positions, size_t vertex_count, const float centre[3],
+                                const Mat4d& vp) {
+    transform_all(clip_xyzw, positions, vertex_count, centre, vp);
+}
+
+void transform_to_clip(float* clip_xyzw, const float* positions, size_t vertex_count, const float centre[3],
+                       const Mat4d& vp) {
+#ifdef ANIMORDER_CAMERA_AVX2
+    static const bool avx2 = __builtin_cpu_supports("avx2");
+    if (avx2) return transform_all_avx2(clip_xyzw, positions, vertex_count, centre, vp);
+#endif
+    transform_all(clip_xyzw, positions, vertex_count, centre, vp);
 }
 
 }  // namespace animorder

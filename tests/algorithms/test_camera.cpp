@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <vector>
 
 using namespace animorder;
@@ -58,4 +60,48 @@ TEST(Camera, PolesUseAnotherUpVector) {
     }
     const float zero[3] = {0, 0, 1};
     EXPECT_THROW(node_view_projection(zero, 0.0f), InvalidInput);
+}
+
+// transform_to_clip works in blocks of vertices (and an AVX2 copy where the CPU has it): both
+// copies must give, bit for bit, the plain per-vertex statement of a vertex shader's multiply,
+// for every count (blocks cut short included) and coordinates of any sign and size.
+TEST(Camera, TransformIsThePlainPerVertexProductBitForBit) {
+    const float direction[3] = {0.3f, -0.8f, 0.52f};
+    const Mat4d vp = node_view_projection(direction, 1.7f);
+    float m[16];
+    for (int i = 0; i < 16; ++i) m[i] = float(vp[i]);
+    const float centre[3] = {0.25f, -1.5f, 3.0f};
+    uint32_t state = 7;
+    const auto next = [&state] {
+        state = state * 1664525u + 1013904223u;
+        return float(int32_t(state >> 8) - (1 << 23)) / float(1 << 21);  // about ±4, many bits set
+    };
+    for (size_t count : {size_t(0), size_t(1), size_t(2), size_t(7), size_t(8), size_t(9), size_t(15), size_t(16),
+                         size_t(17), size_t(1001)}) {
+        std::vector<float> positions(3 * count);
+        for (float& p : positions) p = next();
+        std::vector<float> expected(4 * count + 4, -7.0f), simd(4 * count + 4, -7.0f), portable(4 * count + 4, -7.0f);
+        for (size_t v = 0; v < count; ++v) {
+            const float x = positions[3 * v] - centre[0], y = positions[3 * v + 1] - centre[1],
+                        z = positions[3 * v + 2] - centre[2];
+            for (int row = 0; row < 4; ++row) {
+                volatile float xy = m[row] * x;  // one rounding per operation, whatever the compiler
+                volatile float t = m[4 + row] * y;
+                volatile float s = xy + t;
+                volatile float u = m[8 + row] * z;
+                volatile float su = s + u;
+                expected[4 * v + row] = su + m[12 + row];
+            }
+        }
+        transform_to_clip(simd.data(), positions.data(), count, centre, vp);
+        transform_to_clip_portable(portable.data(), positions.data(), count, centre, vp);
+        for (size_t i = 0; i < expected.size(); ++i) {  // the 4 floats past the end stay untouched
+            uint32_t a, b, c;
+            std::memcpy(&a, &expected[i], 4);
+            std::memcpy(&b, &simd[i], 4);
+            std::memcpy(&c, &portable[i], 4);
+            ASSERT_EQ(a, b) << "count " << count << ", float " << i;
+            ASSERT_EQ(a, c) << "count " << count << ", float " << i;
+        }
+    }
 }

@@ -532,8 +532,14 @@ std::vector<uint32_t> integrated_distance_order(const float* centroids, size_t k
             const float* eye = &node_eyes[3 * n];
             const float* cent = &centroids[size_t(node_keyframes[n]) * patch_count * 3];
             const uint8_t* vis = i3d && node_visible ? &node_visible[n * patch_count] : nullptr;
+            if (!vis) {  // the paper's sum: a loop without a branch, vectorised (sqrt is exact in any lane)
+                for (size_t p = block.begin(); p != block.end(); ++p) d[p] += distance(eye, cent + 3 * p);
+                if (i3d)
+                    for (size_t p = block.begin(); p != block.end(); ++p) seen[p] += 1.0;
+                continue;
+            }
             for (size_t p = block.begin(); p != block.end(); ++p) {
-                if (vis && !vis[p]) continue;  // I3D: wholly back-facing at this node
+                if (!vis[p]) continue;  // I3D: wholly back-facing at this node
                 d[p] += distance(eye, cent + 3 * p);
                 seen[p] += 1.0;
             }

@@ -740,6 +740,100 @@ ANIMORDER_INLINE void batch_box_test(size_t n, const int32_t* x0, const int32_t*
 }  // namespace
 
 namespace {
+
+#ifdef ANIMORDER_RASTER_AVX2
+// The vertex pass of rasterize_node (inside_all, project, the compact test, the record) for 8
+// vertices at a time in the AVX2 copy: the same float operations in the same order (a division,
+// products and sums rounded one by one, no FMA), so the same bits. Returns how many vertices it
+// did (a multiple of 8); the scalar loop does the rest. round_half_away's int64(v ± 0.5f) is
+// taken as an int32 truncation where |v ± 0.5f| < 2^30 (the same integer) and the compact test
+// as there: X compact iff |t| < 2^24 (t = v ± 0.5f; floats at 2^23 and above are integers), Y
+// compact iff top_row − trunc(t) lies inside ±2^24; NaN compares false (not compact).
+__attribute__((target("avx2"))) size_t project_vertices_avx2(const ClipVertex* cv, size_t count,
+                                                                           unsigned resolution,
+                                                                           NodeRasterizer::State::VertexRecord* out,
+                                                                           uint8_t* flags) {
+    const __m256 half = _mm256_set1_ps(0.5f * float(resolution)), point5 = _mm256_set1_ps(0.5f);
+    const __m256 subpixel = _mm256_set1_ps(float(kSubpixel)), guard = _mm256_set1_ps(kGuardBand);
+    const __m256 size = _mm256_set1_ps(float(resolution)), zero = _mm256_setzero_ps();
+    const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+    const __m256 limit = _mm256_set1_ps(float(kCompactLimit)), limit_y = _mm256_set1_ps(float(int32_t(1) << 30));
+    const __m256i top_row = _mm256_set1_epi32(int32_t(int64_t(resolution - 1) * kSubpixel));
+    const __m256i special = _mm256_set1_epi32(kSpecialVertex);
+    const __m256i low = _mm256_set1_epi32(-int32_t(kCompactLimit)), high = _mm256_set1_epi32(int32_t(kCompactLimit));
+    const float* p = reinterpret_cast<const float*>(cv);
+    size_t v = 0;
+    for (; v + 8 <= count; v += 8, p += 32) {
+        // Vertices 0-3 in the low halves, 4-7 in the high ones: the transpose leaves them in order.
+        const __m256 r0 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(p)), _mm_loadu_ps(p + 16), 1);
+        const __m256 r1 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(p + 4)), _mm_loadu_ps(p + 20), 1);
+        const __m256 r2 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(p + 8)), _mm_loadu_ps(p + 24), 1);
+        const __m256 r3 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(p + 12)), _mm_loadu_ps(p + 28), 1);
+        const __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpackhi_ps(r0, r1);
+        const __m256 t2 = _mm256_unpacklo_ps(r2, r3), t3 = _mm256_unpackhi_ps(r2, r3);
+        const __m256 x = _mm256_shuffle_ps(t0, t2, 0x44), y = _mm256_shuffle_ps(t0, t2, 0xEE);
+        const __m256 z = _mm256_shuffle_ps(t1, t3, 0x44), w = _mm256_shuffle_ps(t1, t3, 0xEE);
+        // inside_all
+        const __m256 w2 = _mm256_mul_ps(guard, w);
+        const __m256 inside = _mm256_and_ps(
+            _mm256_and_ps(_mm256_cmp_ps(z, _mm256_xor_ps(w, _mm256_castsi256_ps(_mm256_set1_epi32(INT32_MIN))),
+                                        _CMP_GE_OQ),
+                          _mm256_cmp_ps(z, w, _CMP_LE_OQ)),
+            _mm256_and_ps(_mm256_cmp_ps(_mm256_and_ps(x, abs_mask), w2, _CMP_LE_OQ),
+                          _mm256_cmp_ps(_mm256_and_ps(y, abs_mask), w2, _CMP_LE_OQ)));
+        // project
+        const __m256 inv_w = _mm256_div_ps(_mm256_set1_ps(1.0f), w);
+        const __m256 wx = _mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(x, inv_w), half), half);
+        const __m256 wy = _mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(y, inv_w), half), half);
+        const __m256 wz = _mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(z, inv_w), point5), point5);
+        const __m256 cx = _mm256_sub_ps(wx, point5), cy = _mm256_sub_ps(wy, point5);
+        const __m256 sx = _mm256_mul_ps(cx, subpixel), sy = _mm256_mul_ps(cy, subpixel);
+        const __m256 tx = _mm256_blendv_ps(_mm256_sub_ps(sx, point5), _mm256_add_ps(sx, point5),
+                                           _mm256_cmp_ps(sx, zero, _CMP_GE_OQ));
+        const __m256 ty = _mm256_blendv_ps(_mm256_sub_ps(sy, point5), _mm256_add_ps(sy, point5),
+                                           _mm256_cmp_ps(sy, zero, _CMP_GE_OQ));
+        const __m256i X = _mm256_cvttps_epi32(tx);
+        const __m256i Y = _mm256_sub_epi32(top_row, _mm256_cvttps_epi32(ty));
+        const __m256i compact_x = _mm256_castps_si256(_mm256_cmp_ps(_mm256_and_ps(tx, abs_mask), limit, _CMP_LT_OQ));
+        const __m256i compact_y =
+            _mm256_and_si256(_mm256_castps_si256(_mm256_cmp_ps(_mm256_and_ps(ty, abs_mask), limit_y, _CMP_LT_OQ)),
+                             _mm256_and_si256(_mm256_cmpgt_epi32(Y, low), _mm256_cmpgt_epi32(high, Y)));
+        const __m256i in = _mm256_castps_si256(inside);
+        const __m256i compact = _mm256_and_si256(_mm256_and_si256(compact_x, compact_y), in);
+        const __m256 fx = _mm256_and_ps(cx, inside);
+        const __m256 fy = _mm256_and_ps(_mm256_sub_ps(_mm256_sub_ps(size, wy), point5), inside);
+        const __m256 fz = _mm256_and_ps(wz, inside);
+        const __m256 FX = _mm256_castsi256_ps(_mm256_blendv_epi8(special, X, compact));
+        const __m256 FY = _mm256_castsi256_ps(_mm256_blendv_epi8(special, Y, compact));
+        // flags: 0 compact, kWideVertex inside but not compact, kClippedVertex outside
+        const int inside_bits = _mm256_movemask_ps(inside), compact_bits = _mm256_movemask_ps(_mm256_castsi256_ps(compact));
+        for (int i = 0; i < 8; ++i)
+            flags[v + size_t(i)] = uint8_t(!(inside_bits >> i & 1) ? kClippedVertex : (compact_bits >> i & 1) ? 0 : kWideVertex);
+        // Records: the 8 × 8 transpose of (X, Y, x, y, z, 0, 0, 0).
+        const __m256 u0 = _mm256_unpacklo_ps(FX, FY), u1 = _mm256_unpackhi_ps(FX, FY);
+        const __m256 u2 = _mm256_unpacklo_ps(fx, fy), u3 = _mm256_unpackhi_ps(fx, fy);
+        const __m256 u4 = _mm256_unpacklo_ps(fz, zero), u5 = _mm256_unpackhi_ps(fz, zero);
+        const __m256 q0 = _mm256_shuffle_ps(u0, u2, 0x44), q1 = _mm256_shuffle_ps(u0, u2, 0xEE);
+        const __m256 q2 = _mm256_shuffle_ps(u1, u3, 0x44), q3 = _mm256_shuffle_ps(u1, u3, 0xEE);
+        const __m256 q4 = _mm256_shuffle_ps(u4, zero, 0x44), q5 = _mm256_shuffle_ps(u4, zero, 0xEE);
+        const __m256 q6 = _mm256_shuffle_ps(u5, zero, 0x44), q7 = _mm256_shuffle_ps(u5, zero, 0xEE);
+        float* o = reinterpret_cast<float*>(out + v);
+        _mm256_store_ps(o + 0, _mm256_permute2f128_ps(q0, q4, 0x20));
+        _mm256_store_ps(o + 8, _mm256_permute2f128_ps(q1, q5, 0x20));
+        _mm256_store_ps(o + 16, _mm256_permute2f128_ps(q2, q6, 0x20));
+        _mm256_store_ps(o + 24, _mm256_permute2f128_ps(q3, q7, 0x20));
+        _mm256_store_ps(o + 32, _mm256_permute2f128_ps(q0, q4, 0x31));
+        _mm256_store_ps(o + 40, _mm256_permute2f128_ps(q1, q5, 0x31));
+        _mm256_store_ps(o + 48, _mm256_permute2f128_ps(q2, q6, 0x31));
+        _mm256_store_ps(o + 56, _mm256_permute2f128_ps(q3, q7, 0x31));
+    }
+    return v;
+}
+#endif
+
+}  // namespace
+
+namespace {
 void rasterize_node_portable(NodeRasterizer::State& s, const float* clip_xyzw, size_t vertex_count,
                              const uint32_t* indices, size_t index_count, unsigned resolution, const uint8_t* modes);
 #ifdef ANIMORDER_RASTER_AVX2
@@ -790,7 +884,12 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
     const ClipVertex* cv = reinterpret_cast<const ClipVertex*>(clip_xyzw);
     s.vertices.resize(vertex_count);
     s.vertex_flags.resize(vertex_count);
-    for (size_t v = 0; v < vertex_count; ++v) {
+    size_t first_vertex = 0;
+#ifdef ANIMORDER_RASTER_AVX2
+    if constexpr (kAvx2)
+        first_vertex = project_vertices_avx2(cv, vertex_count, resolution, s.vertices.data(), s.vertex_flags.data());
+#endif
+    for (size_t v = first_vertex; v < vertex_count; ++v) {
         NodeRasterizer::State::VertexRecord& record = s.vertices[v];
         if (!inside_all(cv[v])) {
             s.vertex_flags[v] = kClippedVertex;

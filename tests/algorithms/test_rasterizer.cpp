@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <random>
@@ -846,4 +847,66 @@ TEST(Rasterizer, Avx2CopyGivesThePortableBits) {
                 compared += a.size();
             }
     EXPECT_GT(compared, 100000u);  // the views draw the character
+}
+
+// The AVX2 copy's vertex pass (8 vertices at a time) against the portable one's (one at a time),
+// bit for bit, on vertices chosen to hit its branches: inside and outside each clip plane and the
+// guard band (and exactly on them), w negative, tiny and huge, subpixel coordinates exactly
+// half-way between two integers (rounding half away from zero), −0, resolutions whose half is not
+// a power of two (the products' rounding shows), and NaN and infinite coordinates (no crash, the
+// same fragments); vertex counts of every remainder modulo 8 (the scalar tail). Small triangles
+// among them, so that most vertices are drawn. Fails when a record (snapped X, Y, the depth
+// plane's x, y, z) differs: fragments then move, change depth or go (checked: rounding ties to
+// even, or x · (1/w · half) for (x · 1/w) · half, fail it).
+TEST(Rasterizer, Avx2VertexPassGivesThePortableBits) {
+    if (!NodeRasterizer::simd_available()) GTEST_SKIP() << "this CPU has no AVX2: only the portable copy runs";
+    std::mt19937 rng(20261125);
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f), small(-0.02f, 0.02f);
+    const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+    size_t fragments = 0;
+    for (const unsigned resolution : {1u, 7u, 64u, 256u}) {
+        const float half = 0.5f * float(resolution);
+        for (size_t tail = 0; tail < 8; ++tail) {
+            std::vector<float> clip;
+            const auto add = [&](float x, float y, float z, float w) { clip.insert(clip.end(), {x, y, z, w}); };
+            for (int c = 0; c < 150; ++c) {  // clusters of three nearby vertices: one small triangle each
+                const float w = c % 17 == 0 ? -1.0f : c % 13 == 0 ? 1e-30f : c % 11 == 0 ? 1e30f : 0.5f + unit(rng) * 0.4f;
+                const float x = unit(rng) * 2.2f, y = unit(rng) * 2.2f, z = unit(rng) * 1.1f;
+                for (int k = 0; k < 3; ++k) add((x + small(rng)) * w, (y + small(rng)) * w, (z + small(rng)) * w, w);
+            }
+            // On the planes: z = ±w, |x| = |y| = 2w (inside), and just beyond.
+            for (const float s : {1.0f, -1.0f}) {
+                add(0.1f, 0.1f, s, 1.0f), add(0.2f, 0.1f, s, 1.0f), add(0.1f, 0.2f, s, 1.0f);
+                add(2.0f * s, 0.0f, 0.5f, 1.0f), add(2.0f * s, 0.3f, 0.5f, 1.0f), add(1.7f * s, 0.1f, 0.5f, 1.0f);
+                add(std::nextafter(2.0f * s, 3.0f * s), 0.0f, 0.5f, 1.0f), add(1.9f * s, 0.0f, 0.5f, 1.0f),
+                    add(1.9f * s, 0.1f, 0.5f, 1.0f);
+            }
+            // Subpixel coordinates exactly half-way (x · 256 · half − 128 = k + 0.5), and −0.
+            for (int k = -4; k < 4; ++k) {
+                const float x = ((float(k) + 0.5f) / 256.0f + 0.5f - half) / half;
+                add(x, -x, 0.25f, 1.0f), add(x + 0.01f, -x, 0.25f, 1.0f), add(x, -x + 0.01f, 0.25f, 1.0f);
+            }
+            add(-0.0f, -0.0f, -0.0f, 1.0f), add(0.05f, -0.0f, -0.0f, 1.0f), add(-0.0f, 0.05f, -0.0f, 1.0f);
+            // Not numbers: NaN and infinite coordinates, and infinite w (x · 1/w is then NaN or 0).
+            add(nan, 0.0f, 0.0f, 1.0f), add(0.0f, nan, 0.0f, 1.0f), add(0.0f, 0.0f, 0.0f, nan);
+            add(inf, 0.0f, 0.0f, inf), add(0.0f, 0.1f, 0.0f, inf), add(0.1f, 0.0f, 0.5f, inf);
+            add(0.5f, 0.5f, 0.5f, inf), add(0.6f, 0.5f, 0.5f, 1.0f), add(0.5f, 0.6f, 0.5f, 1.0f);
+            while ((clip.size() / 4) % 8 != tail) add(unit(rng), unit(rng), 0.5f * unit(rng), 1.0f);
+            const size_t vertices = clip.size() / 4;
+            std::vector<uint32_t> ib;
+            for (uint32_t v = 0; v + 2 < vertices; v += 3) ib.insert(ib.end(), {v, v + 1, v + 2});
+            for (uint32_t v = 0; v + 2 < vertices; ++v) ib.insert(ib.end(), {v + 2, v + 1, v});  // back faces too
+            std::vector<uint8_t> modes(ib.size() / 3, 0);
+            for (size_t t = 0; t < modes.size(); t += 2) modes[t] = kDrawBothFaces;
+            NodeRasterizer portable, simd;
+            portable.set_simd(false);
+            portable.rasterize(clip.data(), vertices, ib.data(), ib.size(), resolution, modes.data());
+            simd.rasterize(clip.data(), vertices, ib.data(), ib.size(), resolution, modes.data());
+            const std::string what = "resolution " + std::to_string(resolution) + ", " + std::to_string(vertices) + " vertices";
+            const auto expected = engine_fragments(portable);
+            expect_same_fragments(engine_fragments(simd), expected, what);
+            fragments += expected.size();
+        }
+    }
+    EXPECT_GT(fragments, 20000u);
 }

@@ -737,10 +737,6 @@ ANIMORDER_INLINE void batch_box_test(size_t n, const int32_t* x0, const int32_t*
     }
 }
 
-}  // namespace
-
-namespace {
-
 #ifdef ANIMORDER_RASTER_AVX2
 // The vertex pass of rasterize_node (inside_all, project, the compact test, the record) for 8
 // vertices at a time in the AVX2 copy: the same float operations in the same order (a division,
@@ -749,10 +745,8 @@ namespace {
 // taken as an int32 truncation where |v ± 0.5f| < 2^30 (the same integer) and the compact test
 // as there: X compact iff |t| < 2^24 (t = v ± 0.5f; floats at 2^23 and above are integers), Y
 // compact iff top_row − trunc(t) lies inside ±2^24; NaN compares false (not compact).
-__attribute__((target("avx2"))) size_t project_vertices_avx2(const ClipVertex* cv, size_t count,
-                                                                           unsigned resolution,
-                                                                           NodeRasterizer::State::VertexRecord* out,
-                                                                           uint8_t* flags) {
+__attribute__((target("avx2"))) size_t project_vertices_avx2(const ClipVertex* cv, size_t count, unsigned resolution,
+                                                             NodeRasterizer::State::VertexRecord* out, uint8_t* flags) {
     const __m256 half = _mm256_set1_ps(0.5f * float(resolution)), point5 = _mm256_set1_ps(0.5f);
     const __m256 subpixel = _mm256_set1_ps(float(kSubpixel)), guard = _mm256_set1_ps(kGuardBand);
     const __m256 size = _mm256_set1_ps(float(resolution)), zero = _mm256_setzero_ps();
@@ -776,9 +770,9 @@ __attribute__((target("avx2"))) size_t project_vertices_avx2(const ClipVertex* c
         // inside_all
         const __m256 w2 = _mm256_mul_ps(guard, w);
         const __m256 inside = _mm256_and_ps(
-            _mm256_and_ps(_mm256_cmp_ps(z, _mm256_xor_ps(w, _mm256_castsi256_ps(_mm256_set1_epi32(INT32_MIN))),
-                                        _CMP_GE_OQ),
-                          _mm256_cmp_ps(z, w, _CMP_LE_OQ)),
+            _mm256_and_ps(
+                _mm256_cmp_ps(z, _mm256_xor_ps(w, _mm256_castsi256_ps(_mm256_set1_epi32(INT32_MIN))), _CMP_GE_OQ),
+                _mm256_cmp_ps(z, w, _CMP_LE_OQ)),
             _mm256_and_ps(_mm256_cmp_ps(_mm256_and_ps(x, abs_mask), w2, _CMP_LE_OQ),
                           _mm256_cmp_ps(_mm256_and_ps(y, abs_mask), w2, _CMP_LE_OQ)));
         // project
@@ -788,27 +782,29 @@ __attribute__((target("avx2"))) size_t project_vertices_avx2(const ClipVertex* c
         const __m256 wz = _mm256_add_ps(_mm256_mul_ps(_mm256_mul_ps(z, inv_w), point5), point5);
         const __m256 cx = _mm256_sub_ps(wx, point5), cy = _mm256_sub_ps(wy, point5);
         const __m256 sx = _mm256_mul_ps(cx, subpixel), sy = _mm256_mul_ps(cy, subpixel);
-        const __m256 tx = _mm256_blendv_ps(_mm256_sub_ps(sx, point5), _mm256_add_ps(sx, point5),
-                                           _mm256_cmp_ps(sx, zero, _CMP_GE_OQ));
-        const __m256 ty = _mm256_blendv_ps(_mm256_sub_ps(sy, point5), _mm256_add_ps(sy, point5),
-                                           _mm256_cmp_ps(sy, zero, _CMP_GE_OQ));
+        const __m256 tx =
+            _mm256_blendv_ps(_mm256_sub_ps(sx, point5), _mm256_add_ps(sx, point5), _mm256_cmp_ps(sx, zero, _CMP_GE_OQ));
+        const __m256 ty =
+            _mm256_blendv_ps(_mm256_sub_ps(sy, point5), _mm256_add_ps(sy, point5), _mm256_cmp_ps(sy, zero, _CMP_GE_OQ));
         const __m256i X = _mm256_cvttps_epi32(tx);
         const __m256i Y = _mm256_sub_epi32(top_row, _mm256_cvttps_epi32(ty));
         const __m256i compact_x = _mm256_castps_si256(_mm256_cmp_ps(_mm256_and_ps(tx, abs_mask), limit, _CMP_LT_OQ));
         const __m256i compact_y =
             _mm256_and_si256(_mm256_castps_si256(_mm256_cmp_ps(_mm256_and_ps(ty, abs_mask), limit_y, _CMP_LT_OQ)),
                              _mm256_and_si256(_mm256_cmpgt_epi32(Y, low), _mm256_cmpgt_epi32(high, Y)));
-        const __m256i in = _mm256_castps_si256(inside);
-        const __m256i compact = _mm256_and_si256(_mm256_and_si256(compact_x, compact_y), in);
+        const __m256i compact = _mm256_and_si256(_mm256_and_si256(compact_x, compact_y), _mm256_castps_si256(inside));
         const __m256 fx = _mm256_and_ps(cx, inside);
         const __m256 fy = _mm256_and_ps(_mm256_sub_ps(_mm256_sub_ps(size, wy), point5), inside);
         const __m256 fz = _mm256_and_ps(wz, inside);
         const __m256 FX = _mm256_castsi256_ps(_mm256_blendv_epi8(special, X, compact));
         const __m256 FY = _mm256_castsi256_ps(_mm256_blendv_epi8(special, Y, compact));
         // flags: 0 compact, kWideVertex inside but not compact, kClippedVertex outside
-        const int inside_bits = _mm256_movemask_ps(inside), compact_bits = _mm256_movemask_ps(_mm256_castsi256_ps(compact));
+        const int inside_bits = _mm256_movemask_ps(inside),
+                  compact_bits = _mm256_movemask_ps(_mm256_castsi256_ps(compact));
         for (int i = 0; i < 8; ++i)
-            flags[v + size_t(i)] = uint8_t(!(inside_bits >> i & 1) ? kClippedVertex : (compact_bits >> i & 1) ? 0 : kWideVertex);
+            flags[v + size_t(i)] = uint8_t(!(inside_bits >> i & 1)   ? kClippedVertex
+                                           : (compact_bits >> i & 1) ? 0
+                                                                     : kWideVertex);
         // Records: the 8 × 8 transpose of (X, Y, x, y, z, 0, 0, 0).
         const __m256 u0 = _mm256_unpacklo_ps(FX, FY), u1 = _mm256_unpackhi_ps(FX, FY);
         const __m256 u2 = _mm256_unpacklo_ps(fx, fy), u3 = _mm256_unpackhi_ps(fx, fy);

@@ -870,7 +870,10 @@ TEST(Rasterizer, Avx2VertexPassGivesThePortableBits) {
             std::vector<float> clip;
             const auto add = [&](float x, float y, float z, float w) { clip.insert(clip.end(), {x, y, z, w}); };
             for (int c = 0; c < 150; ++c) {  // clusters of three nearby vertices: one small triangle each
-                const float w = c % 17 == 0 ? -1.0f : c % 13 == 0 ? 1e-30f : c % 11 == 0 ? 1e30f : 0.5f + unit(rng) * 0.4f;
+                const float w = c % 17 == 0   ? -1.0f
+                                : c % 13 == 0 ? 1e-30f
+                                : c % 11 == 0 ? 1e30f
+                                              : 0.5f + unit(rng) * 0.4f;
                 const float x = unit(rng) * 2.2f, y = unit(rng) * 2.2f, z = unit(rng) * 1.1f;
                 for (int k = 0; k < 3; ++k) add((x + small(rng)) * w, (y + small(rng)) * w, (z + small(rng)) * w, w);
             }
@@ -902,7 +905,8 @@ TEST(Rasterizer, Avx2VertexPassGivesThePortableBits) {
             portable.set_simd(false);
             portable.rasterize(clip.data(), vertices, ib.data(), ib.size(), resolution, modes.data());
             simd.rasterize(clip.data(), vertices, ib.data(), ib.size(), resolution, modes.data());
-            const std::string what = "resolution " + std::to_string(resolution) + ", " + std::to_string(vertices) + " vertices";
+            const std::string what =
+                "resolution " + std::to_string(resolution) + ", " + std::to_string(vertices) + " vertices";
             const auto expected = engine_fragments(portable);
             expect_same_fragments(engine_fragments(simd), expected, what);
             fragments += expected.size();

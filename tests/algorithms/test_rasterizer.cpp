@@ -708,6 +708,85 @@ TEST(Rasterizer, SmallAndWideBoxesEqualThePlainReference) {
     EXPECT_GT(near_one, 5u);
 }
 
+// The pre-pass's small-box test (a triangle with a box of at most 2 × 2 pixels and corners within
+// 4 pixels of each other that covers none of the box's centres is never set up): pixel-sized
+// triangles whose corners sit on the subpixel grid, many exactly on pixel centres or on the line
+// between two (so edges pass through centres: the fill rule decides), extents just under and at
+// the 4-pixel limit, both faces, boxes cut by the viewport's edges, and long triangles reaching
+// into a corner of a 512² viewport from far beyond it, against the plain reference in both
+// copies. Fails when the test drops a covered triangle (checked: the top-left bias taken as 1 for
+// every edge, the second row's centres left out, or the 4-pixel limit lifted so that int32
+// products wrap, each fail it).
+TEST(Rasterizer, SmallBoxTestDropsOnlyTrianglesThatCoverNothing) {
+    std::mt19937 rng(2611);
+    const unsigned resolution = 12;
+    // Subpixel offsets from a pixel centre: on it, half-way to the next, random, and near 4 pixels.
+    const int32_t steps[] = {0, 128, 256, -128, -256, 384, 512, 767, 768, 1023, 1024, -1, 1, 129};
+    std::vector<float> clip;
+    std::vector<uint32_t> ib;
+    std::vector<uint8_t> modes;
+    for (int i = 0; i < 4000; ++i) {
+        // A base centre anywhere in the viewport or one pixel beyond it (boxes cut by the edges).
+        const int32_t bx = int32_t(rng() % (resolution + 2)) - 1, by = int32_t(rng() % (resolution + 2)) - 1;
+        for (int k = 0; k < 3; ++k) {
+            const int32_t ox = rng() % 3 ? steps[rng() % 14] : int32_t(rng() % 1100) - 50;
+            const int32_t oy = rng() % 3 ? steps[rng() % 14] : int32_t(rng() % 1100) - 50;
+            // Window position in pixels (centre of pixel i at i + 0.5, y up), exact in float.
+            const float x = float(bx) + 0.5f + float(ox) / 256.0f, y = float(by) + 0.5f + float(oy) / 256.0f;
+            ib.push_back(uint32_t(clip.size() / 4));
+            const float z = float(rng() % 1000) / 1000.0f * 1.8f - 0.9f;
+            clip.insert(clip.end(), {2.0f * x / float(resolution) - 1.0f, 2.0f * y / float(resolution) - 1.0f, z, 1.0f});
+        }
+        modes.push_back(rng() % 3 ? 0 : kDrawBothFaces);
+    }
+    // Long triangles from far beyond a corner of the viewport (inside the guard band) into it: boxes
+    // cut to at most 2 × 2 pixels, but corners hundreds of pixels apart (products beyond int32: such
+    // triangles must not take the test).
+    const unsigned large = 512;  // its guard band reaches 256 pixels beyond the viewport
+    std::vector<float> far_clip;
+    std::vector<uint32_t> far_ib;
+    std::vector<uint8_t> far_modes;
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    for (int i = 0; i < 300; ++i) {
+        const float sx = rng() % 2 ? 1.0f : -1.0f, sy = rng() % 2 ? 1.0f : -1.0f;  // which corner
+        const float length = 100.0f + 150.0f * unit(rng), a = unit(rng), b = unit(rng);
+        // In pixels from the corner pixel's centre, pointing out of the viewport.
+        const float near_x = -1.0f + 2.5f * unit(rng), near_y = -1.0f + 2.5f * unit(rng);
+        const float px[3] = {near_x, -length, -b * length}, py[3] = {near_y, -a * length, -length};
+        for (int k = 0; k < 3; ++k) {
+            const float cx = sx > 0 ? px[k] : float(large - 1) - px[k], cy = sy > 0 ? py[k] : float(large - 1) - py[k];
+            far_ib.push_back(uint32_t(far_clip.size() / 4));
+            far_clip.insert(far_clip.end(), {(2.0f * cx + 1.0f) / float(large) - 1.0f,
+                                             (2.0f * cy + 1.0f) / float(large) - 1.0f, 0.5f * unit(rng), 1.0f});
+        }
+        far_modes.push_back(kDrawBothFaces);
+    }
+    const auto far_expected = reference_fragments(far_clip, far_ib, far_modes, large);
+    EXPECT_GT(far_expected.size(), 50u);
+    for (bool simd : {false, true}) {
+        if (simd && !NodeRasterizer::simd_available()) continue;
+        NodeRasterizer r;
+        r.set_simd(simd);
+        r.rasterize(far_clip.data(), far_clip.size() / 4, far_ib.data(), far_ib.size(), large, far_modes.data());
+        expect_same_fragments(engine_fragments(r), far_expected, "far corners, simd " + std::to_string(simd));
+    }
+
+    const auto expected = reference_fragments(clip, ib, modes, resolution);
+    // The scene has both kinds of pixel-sized triangle: those that cover a centre and those that do not.
+    std::vector<size_t> per_triangle(ib.size() / 3, 0);
+    for (const auto& f : expected) ++per_triangle[std::get<1>(f)];
+    const size_t empty = size_t(std::count(per_triangle.begin(), per_triangle.end(), 0u));
+    EXPECT_GT(empty, 1000u);
+    EXPECT_GT(per_triangle.size() - empty, 1000u);
+    for (bool simd : {false, true}) {
+        if (simd && !NodeRasterizer::simd_available()) continue;
+        NodeRasterizer r;
+        r.set_simd(simd);
+        r.rasterize(clip.data(), clip.size() / 4, ib.data(), ib.size(), resolution, modes.data());
+        expect_same_fragments(engine_fragments(r), expected, "simd " + std::to_string(simd));
+    }
+}
+
 // Clipped triangles (crossing the near plane or the guard band) among unclipped ones: each
 // triangle's fragments are the same drawn alone or in the batch, and in triangle order.
 TEST(Rasterizer, ClippedTrianglesAmongOthersDrawAsWhenAlone) {

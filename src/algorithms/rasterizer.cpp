@@ -720,54 +720,37 @@ constexpr int64_t kCompactLimit = int64_t(1) << 24;  // |x| <= 1.5 · 16384 pixe
 constexpr int32_t kSpecialVertex = int32_t(1) << 30;
 // The box test of triangle_box for a batch of triangles whose vertices are all compact and
 // unclipped: int32 arithmetic over arrays that the compiler vectorises. keep[i] is non-zero
-// exactly when the bounding box, clamped to the viewport, holds a pixel centre. For
-// batch_small_box_test: small[i] (the box has at most 2 × 2 pixels and the corners lie within 4
-// pixels of each other), wide[i] and tall[i] (the box has a second column, a second row) and its
-// first centre (origin_x, origin_y) in subpixels.
-struct BatchBoxes {
-    int32_t box[kBatch][4];
-    alignas(32) int32_t small[kBatch], wide[kBatch], tall[kBatch], origin_x[kBatch], origin_y[kBatch];
-};
-
+// exactly when the bounding box, clamped to the viewport, holds a pixel centre.
+//
+// It also drops from `keep` the pixel-sized triangles that cover none of their box's centres:
+// about half the drawn triangles of a character whose triangles are that small, which would be
+// set up only to emit nothing. A triangle takes this test when its box has at most 2 × 2 pixels and
+// its corners lie within 4 pixels of each other; the test is BatchSetup::compute's edge functions
+// at the box's (up to) four centres, corners in positive order (0, 2, 1 for a front face, else 0,
+// 1, 2), in int32 lanes: every difference is then below 2^11 in magnitude, every product below 2^21,
+// so the values are exact (the orientation too: its area below 2^21). The other triangles' lanes
+// compute wrapped values (uint32) that are not used.
 ANIMORDER_INLINE void batch_box_test(size_t n, const int32_t* x0, const int32_t* y0, const int32_t* x1,
                                      const int32_t* y1, const int32_t* x2, const int32_t* y2, int32_t last,
-                                     int32_t* keep, BatchBoxes& out) {
+                                     int32_t* keep, int32_t (*box)[4]) {
     constexpr int32_t kNear = 4 * int32_t(kSubpixel);
     for (size_t i = 0; i < n; ++i) {
         const int32_t min_x = std::min(x0[i], std::min(x1[i], x2[i])), max_x = std::max(x0[i], std::max(x1[i], x2[i]));
         const int32_t min_y = std::min(y0[i], std::min(y1[i], y2[i])), max_y = std::max(y0[i], std::max(y1[i], y2[i]));
         const int32_t px0 = std::max(0, -((-min_x) >> kSubpixelBits)), px1 = std::min(last, max_x >> kSubpixelBits);
         const int32_t py0 = std::max(0, -((-min_y) >> kSubpixelBits)), py1 = std::min(last, max_y >> kSubpixelBits);
-        keep[i] = int32_t(px0 <= px1) & int32_t(py0 <= py1);
-        out.box[i][0] = px0;
-        out.box[i][1] = px1;
-        out.box[i][2] = py0;
-        out.box[i][3] = py1;
-        out.small[i] = int32_t(px1 - px0 < 2) & int32_t(py1 - py0 < 2) & int32_t(max_x - min_x < kNear) &
-                       int32_t(max_y - min_y < kNear);
-        out.wide[i] = int32_t(px1 > px0);
-        out.tall[i] = int32_t(py1 > py0);
-        out.origin_x[i] = px0 * int32_t(kSubpixel);
-        out.origin_y[i] = py0 * int32_t(kSubpixel);
-    }
-}
-
-// Drops from `keep` the triangles of the pre-pass (special 1) with a small box (BatchBoxes) that
-// cover none of its centres: about half the drawn triangles of a character whose triangles are
-// pixel-sized, which would be set up only to emit nothing. The test is BatchSetup::compute's edge
-// functions at the (up to) four centres, in int32 lanes (vectorised): corners in positive order
-// (0, 2, 1 for a front face, else 0, 1, 2), every difference below 2^11 in magnitude, so every
-// product below 2^21 and the values exact. Other triangles' lanes compute wrapped values (uint32)
-// and are left as they are.
-ANIMORDER_INLINE void batch_small_box_test(size_t n, const int32_t* x0, const int32_t* y0, const int32_t* x1,
-                                           const int32_t* y1, const int32_t* x2, const int32_t* y2,
-                                           const int32_t* front, const BatchBoxes& boxes, const int32_t* special,
-                                           int32_t* keep) {
-    for (size_t i = 0; i < n; ++i) {
-        const int32_t cx[3] = {x0[i], front[i] ? x2[i] : x1[i], front[i] ? x1[i] : x2[i]};
-        const int32_t cy[3] = {y0[i], front[i] ? y2[i] : y1[i], front[i] ? y1[i] : y2[i]};
-        const uint32_t X = uint32_t(boxes.origin_x[i]), Y = uint32_t(boxes.origin_y[i]);
-        const uint32_t wide = 0u - uint32_t(boxes.wide[i]), tall = 0u - uint32_t(boxes.tall[i]);
+        box[i][0] = px0;
+        box[i][1] = px1;
+        box[i][2] = py0;
+        box[i][3] = py1;
+        // The small-box test.
+        const uint32_t area = (uint32_t(x1[i]) - uint32_t(x0[i])) * (uint32_t(y2[i]) - uint32_t(y0[i])) -
+                              (uint32_t(x2[i]) - uint32_t(x0[i])) * (uint32_t(y1[i]) - uint32_t(y0[i]));
+        const bool front = int32_t(area) < 0;
+        const int32_t cx[3] = {x0[i], front ? x2[i] : x1[i], front ? x1[i] : x2[i]};
+        const int32_t cy[3] = {y0[i], front ? y2[i] : y1[i], front ? y1[i] : y2[i]};
+        const uint32_t X = uint32_t(px0) * uint32_t(kSubpixel), Y = uint32_t(py0) * uint32_t(kSubpixel);
+        const uint32_t wide = px1 > px0 ? ~0u : 0u, tall = py1 > py0 ? ~0u : 0u;
         // Per centre, the sign bit set while it is in the box and every edge value so far is >= 0.
         uint32_t inside[4] = {~0u, wide, tall, wide & tall};
         for (int k = 0; k < 3; ++k) {
@@ -782,9 +765,9 @@ ANIMORDER_INLINE void batch_small_box_test(size_t n, const int32_t* x0, const in
             inside[2] &= ~(e + sy);
             inside[3] &= ~(e + sx + sy);
         }
-        const bool tested = (special[i] == 1) & (boxes.small[i] != 0);
+        const bool small = (px1 - px0 < 2) & (py1 - py0 < 2) & (max_x - min_x < kNear) & (max_y - min_y < kNear);
         const bool covered = int32_t(inside[0] | inside[1] | inside[2] | inside[3]) < 0;
-        keep[i] &= int32_t(!tested | covered);
+        keep[i] = int32_t(px0 <= px1) & int32_t(py0 <= py1) & int32_t(!small | covered);
     }
 }
 
@@ -962,9 +945,8 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
     const NodeRasterizer::State::VertexRecord* vertex = s.vertices.data();
     const uint8_t* flags = s.vertex_flags.data();
     alignas(16) int32_t x0[kBatch], y0[kBatch], x1[kBatch], y1[kBatch], x2[kBatch], y2[kBatch], keep[kBatch];
-    int32_t two[kBatch], front[kBatch];
-    BatchBoxes batch_boxes;
-    const auto& boxes = batch_boxes.box;
+    int32_t two[kBatch];
+    int32_t boxes[kBatch][4];
     int64_t areas[kBatch];
     int32_t special[kBatch];
     uint32_t draw[kBatch];
@@ -986,17 +968,15 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
             const bool exact = (x0[i] == kSpecialVertex) | (x1[i] == kSpecialVertex) | (x2[i] == kSpecialVertex);
             special[i] = (mode & kSkipTriangle) ? 0 : 1 + int32_t(exact);
         }
-        batch_box_test(n, x0, y0, x1, y1, x2, y2, int32_t(resolution - 1), keep, batch_boxes);
+        batch_box_test(n, x0, y0, x1, y1, x2, y2, int32_t(resolution - 1), keep, boxes);
         for (size_t i = 0; i < n; ++i) {  // int32 and int64 lanes only: vectorised
             // As triangle_box: y points down, so OpenGL's counter-clockwise front faces have
             // negative area; |coordinates| < 2^24 keeps the int64 products exact.
             const int64_t area = int64_t(x1[i] - x0[i]) * (y2[i] - y0[i]) - int64_t(x2[i] - x0[i]) * (y1[i] - y0[i]);
             const int32_t drawn = int32_t(area < 0) | (int32_t(area > 0) & two[i]);
             areas[i] = area;
-            front[i] = int32_t(area < 0);
             keep[i] = int32_t(special[i] > 1) | (int32_t(special[i] == 1) & drawn & keep[i]);
         }
-        batch_small_box_test(n, x0, y0, x1, y1, x2, y2, front, batch_boxes, special, keep);
         size_t m = 0;
         for (size_t i = 0; i < n; ++i) {
             draw[m] = uint32_t(i);

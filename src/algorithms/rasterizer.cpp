@@ -956,17 +956,21 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
         const uint32_t* tri = indices + 3 * first;
         for (size_t i = 0; i < n; ++i) {
             const uint32_t a = tri[3 * i], b = tri[3 * i + 1], c = tri[3 * i + 2];
-            const uint8_t mode = modes ? modes[first + i] : 0;
             x0[i] = vertex[a].X;
             y0[i] = vertex[a].Y;
             x1[i] = vertex[b].X;
             y1[i] = vertex[b].Y;
             x2[i] = vertex[c].X;
             y2[i] = vertex[c].Y;
-            two[i] = mode & kDrawBothFaces;
+        }
+        const uint8_t* mode = modes ? modes + first : nullptr;
+        for (size_t i = 0; i < n; ++i) {  // vectorised
+            const int32_t m = mode ? mode[i] : 0;
+            two[i] = m & kDrawBothFaces;
             // Skipped: never drawn (0); a clipped or wide corner: an exact path below (2).
-            const bool exact = (x0[i] == kSpecialVertex) | (x1[i] == kSpecialVertex) | (x2[i] == kSpecialVertex);
-            special[i] = (mode & kSkipTriangle) ? 0 : 1 + int32_t(exact);
+            const int32_t exact =
+                int32_t(x0[i] == kSpecialVertex) | int32_t(x1[i] == kSpecialVertex) | int32_t(x2[i] == kSpecialVertex);
+            special[i] = (m & kSkipTriangle) ? 0 : 1 + exact;
         }
         batch_box_test(n, x0, y0, x1, y1, x2, y2, int32_t(resolution - 1), keep, boxes);
         for (size_t i = 0; i < n; ++i) {  // int32 and int64 lanes only: vectorised

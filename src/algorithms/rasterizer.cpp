@@ -121,15 +121,19 @@ struct NodeRasterizer::State {
     std::vector<uint32_t> multi_pixel, multi_start, multi_fragment;
     uint64_t visible = 0, single = 0;
     // Per-vertex setup, done once per node rather than once per triangle corner. The batched
-    // pre-pass's view of the vertices: one 32-byte record a vertex (one cache line for both
-    // gathers) with snapped X, Y as int32 (kSpecialVertex for a vertex that cannot take the
-    // pre-pass) and the window-space x, y, z of the depth plane; why a vertex cannot take the
-    // pre-pass (kClippedVertex, kWideVertex; 0 when it can). The rare triangles of the exact paths
-    // project their corners again (the same function, the same bits).
-    struct alignas(32) VertexRecord {
+    // pre-pass's view of the vertices: snapped X, Y as int32 (kSpecialVertex for a vertex that
+    // cannot take the pre-pass), 8 bytes a vertex, what the pre-pass gathers for every triangle;
+    // apart, a 16-byte record of the window-space x, y, z of the depth plane, gathered for the
+    // drawn triangles only; why a vertex cannot take the pre-pass (kClippedVertex, kWideVertex; 0
+    // when it can). The rare triangles of the exact paths project their corners again (the same
+    // function, the same bits).
+    struct Snapped {
         int32_t X, Y;
-        float x, y, z, unused[3];
     };
+    struct alignas(16) VertexRecord {
+        float x, y, z, unused;
+    };
+    std::vector<Snapped> snapped;
     std::vector<VertexRecord> vertices;
     std::vector<uint8_t> vertex_flags;
     bool simd = true;                   // the AVX2 copy where the CPU has it (set_simd)
@@ -780,6 +784,7 @@ ANIMORDER_INLINE void batch_box_test(size_t n, const int32_t* x0, const int32_t*
 // as there: X compact iff |t| < 2^24 (t = v ± 0.5f; floats at 2^23 and above are integers), Y
 // compact iff top_row − trunc(t) lies inside ±2^24; NaN compares false (not compact).
 __attribute__((target("avx2"))) size_t project_vertices_avx2(const ClipVertex* cv, size_t count, unsigned resolution,
+                                                             NodeRasterizer::State::Snapped* snapped,
                                                              NodeRasterizer::State::VertexRecord* out, uint8_t* flags) {
     const __m256 half = _mm256_set1_ps(0.5f * float(resolution)), point5 = _mm256_set1_ps(0.5f);
     const __m256 subpixel = _mm256_set1_ps(float(kSubpixel)), guard = _mm256_set1_ps(kGuardBand);
@@ -839,23 +844,20 @@ __attribute__((target("avx2"))) size_t project_vertices_avx2(const ClipVertex* c
             flags[v + size_t(i)] = uint8_t(!(inside_bits >> i & 1)   ? kClippedVertex
                                            : (compact_bits >> i & 1) ? 0
                                                                      : kWideVertex);
-        // Records: the 8 × 8 transpose of (X, Y, x, y, z, 0, 0, 0).
+        // Snapped pairs: X and Y interleaved; records: the 8 × 4 transpose of (x, y, z, 0).
         const __m256 u0 = _mm256_unpacklo_ps(FX, FY), u1 = _mm256_unpackhi_ps(FX, FY);
+        float* o = reinterpret_cast<float*>(snapped + v);
+        _mm256_storeu_ps(o + 0, _mm256_permute2f128_ps(u0, u1, 0x20));
+        _mm256_storeu_ps(o + 8, _mm256_permute2f128_ps(u0, u1, 0x31));
         const __m256 u2 = _mm256_unpacklo_ps(fx, fy), u3 = _mm256_unpackhi_ps(fx, fy);
         const __m256 u4 = _mm256_unpacklo_ps(fz, zero), u5 = _mm256_unpackhi_ps(fz, zero);
-        const __m256 q0 = _mm256_shuffle_ps(u0, u2, 0x44), q1 = _mm256_shuffle_ps(u0, u2, 0xEE);
-        const __m256 q2 = _mm256_shuffle_ps(u1, u3, 0x44), q3 = _mm256_shuffle_ps(u1, u3, 0xEE);
-        const __m256 q4 = _mm256_shuffle_ps(u4, zero, 0x44), q5 = _mm256_shuffle_ps(u4, zero, 0xEE);
-        const __m256 q6 = _mm256_shuffle_ps(u5, zero, 0x44), q7 = _mm256_shuffle_ps(u5, zero, 0xEE);
-        float* o = reinterpret_cast<float*>(out + v);
-        _mm256_store_ps(o + 0, _mm256_permute2f128_ps(q0, q4, 0x20));
-        _mm256_store_ps(o + 8, _mm256_permute2f128_ps(q1, q5, 0x20));
-        _mm256_store_ps(o + 16, _mm256_permute2f128_ps(q2, q6, 0x20));
-        _mm256_store_ps(o + 24, _mm256_permute2f128_ps(q3, q7, 0x20));
-        _mm256_store_ps(o + 32, _mm256_permute2f128_ps(q0, q4, 0x31));
-        _mm256_store_ps(o + 40, _mm256_permute2f128_ps(q1, q5, 0x31));
-        _mm256_store_ps(o + 48, _mm256_permute2f128_ps(q2, q6, 0x31));
-        _mm256_store_ps(o + 56, _mm256_permute2f128_ps(q3, q7, 0x31));
+        const __m256 q0 = _mm256_shuffle_ps(u2, u4, 0x44), q1 = _mm256_shuffle_ps(u2, u4, 0xEE);
+        const __m256 q2 = _mm256_shuffle_ps(u3, u5, 0x44), q3 = _mm256_shuffle_ps(u3, u5, 0xEE);
+        float* r = reinterpret_cast<float*>(out + v);
+        _mm256_storeu_ps(r + 0, _mm256_permute2f128_ps(q0, q1, 0x20));
+        _mm256_storeu_ps(r + 8, _mm256_permute2f128_ps(q2, q3, 0x20));
+        _mm256_storeu_ps(r + 16, _mm256_permute2f128_ps(q0, q1, 0x31));
+        _mm256_storeu_ps(r + 24, _mm256_permute2f128_ps(q2, q3, 0x31));
     }
     return v;
 }
@@ -912,36 +914,35 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
                                      const uint32_t* indices, size_t index_count, unsigned resolution,
                                      const uint8_t* modes) {
     const ClipVertex* cv = reinterpret_cast<const ClipVertex*>(clip_xyzw);
+    s.snapped.resize(vertex_count);
     s.vertices.resize(vertex_count);
     s.vertex_flags.resize(vertex_count);
     size_t first_vertex = 0;
 #ifdef ANIMORDER_RASTER_AVX2
     if constexpr (kAvx2)
-        first_vertex = project_vertices_avx2(cv, vertex_count, resolution, s.vertices.data(), s.vertex_flags.data());
+        first_vertex = project_vertices_avx2(cv, vertex_count, resolution, s.snapped.data(), s.vertices.data(),
+                                             s.vertex_flags.data());
 #endif
     for (size_t v = first_vertex; v < vertex_count; ++v) {
-        NodeRasterizer::State::VertexRecord& record = s.vertices[v];
         if (!inside_all(cv[v])) {
             s.vertex_flags[v] = kClippedVertex;
-            record = {kSpecialVertex, kSpecialVertex, 0.0f, 0.0f, 0.0f, {0.0f, 0.0f, 0.0f}};
+            s.snapped[v] = {kSpecialVertex, kSpecialVertex};
+            s.vertices[v] = {0.0f, 0.0f, 0.0f, 0.0f};
             continue;
         }
         WindowVertex w;
         project(cv[v], resolution, w);
         const bool compact = w.X > -kCompactLimit && w.X < kCompactLimit && w.Y > -kCompactLimit && w.Y < kCompactLimit;
         s.vertex_flags[v] = compact ? 0 : kWideVertex;
-        record = {compact ? int32_t(w.X) : kSpecialVertex,
-                  compact ? int32_t(w.Y) : kSpecialVertex,
-                  w.x,
-                  w.y,
-                  w.z,
-                  {0.0f, 0.0f, 0.0f}};
+        s.snapped[v] = {compact ? int32_t(w.X) : kSpecialVertex, compact ? int32_t(w.Y) : kSpecialVertex};
+        s.vertices[v] = {w.x, w.y, w.z, 0.0f};
     }
 
     // Triangles in batches: gather the snapped corners, test area and box for the whole batch at
     // once, then draw the survivors in triangle order (the order of the fragments is unchanged).
     FragmentSink sink{s.raw_pixel, s.raw_triangle, s.raw_depth};
     const size_t triangle_count = index_count / 3;
+    const NodeRasterizer::State::Snapped* corner = s.snapped.data();
     const NodeRasterizer::State::VertexRecord* vertex = s.vertices.data();
     const uint8_t* flags = s.vertex_flags.data();
     alignas(16) int32_t x0[kBatch], y0[kBatch], x1[kBatch], y1[kBatch], x2[kBatch], y2[kBatch], keep[kBatch];
@@ -956,12 +957,12 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
         const uint32_t* tri = indices + 3 * first;
         for (size_t i = 0; i < n; ++i) {
             const uint32_t a = tri[3 * i], b = tri[3 * i + 1], c = tri[3 * i + 2];
-            x0[i] = vertex[a].X;
-            y0[i] = vertex[a].Y;
-            x1[i] = vertex[b].X;
-            y1[i] = vertex[b].Y;
-            x2[i] = vertex[c].X;
-            y2[i] = vertex[c].Y;
+            x0[i] = corner[a].X;
+            y0[i] = corner[a].Y;
+            x1[i] = corner[b].X;
+            y1[i] = corner[b].Y;
+            x2[i] = corner[c].X;
+            y2[i] = corner[c].Y;
         }
         const uint8_t* mode = modes ? modes + first : nullptr;
         for (size_t i = 0; i < n; ++i) {  // vectorised

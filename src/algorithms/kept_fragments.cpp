@@ -93,6 +93,28 @@ uint32_t reduce_pixel(const uint32_t* f, uint32_t n, const UnitPartition& partit
     return kept;
 }
 
+// reduce_pixel for a list of two fragments (half the multi-fragment pixels of a character), without
+// its loops: the farther fragment is dropped when the nearer one is of its unit and drawn first.
+ANIMORDER_KEPT_INLINE uint32_t reduce_pair(const uint32_t* f, const UnitPartition& partition, uint32_t* out,
+                                           uint16_t* units, bool& repeated) {
+    repeated = false;
+    const size_t triangles = partition.unit_of_triangle.size();
+    const uint32_t t0 = f[0] & kTriangleMask, t1 = f[1] & kTriangleMask;
+    if (t0 >= triangles || t1 >= triangles)
+        throw InvalidInput("kept fragments: triangle " + std::to_string(t0 >= triangles ? t0 : t1) +
+                           ", but the partition has " + std::to_string(triangles));
+    const auto [unit0, position0] = partition.unit_position[t0];
+    const auto [unit1, position1] = partition.unit_position[t1];
+    const bool same = unit0 == unit1;
+    if (same && position0 < position1) return 1;
+    const bool tied = (f[1] & kTieBit) != 0;
+    out[0] = t0;
+    out[1] = t1 | (tied ? kTieBit : 0);
+    units[0] = uint16_t(unit0);
+    units[1] = uint16_t(unit1 | (same ? kUnitRepeatBit : 0) | (tied ? kUnitTieBit : 0));
+    return 2;
+}
+
 // The deduplicated unit lists of one node, kept per length (each length's lists in order of first
 // appearance): the node stores them shortest first without a sort. Which list a pixel joins
 // never depends on the hash: a list's content has one slot, and grow() reinserts each length's
@@ -388,8 +410,9 @@ KeptNode keep_fragments(uint64_t visible, uint64_t single, const uint32_t* start
             if (pending) pending = s.units.data();
         }
         uint16_t* units = s.units.data() + (pending == s.units.data() ? s.units.size() / 2 : 0);
-        const uint32_t kept = reduce_pixel(fragments + starts[p], n, partition, s.reduced.data(), s.kept_unit.data(),
-                                           s.kept_position.data(), units, repeated);
+        const uint32_t kept = n == 2 ? reduce_pair(fragments + starts[p], partition, s.reduced.data(), units, repeated)
+                                     : reduce_pixel(fragments + starts[p], n, partition, s.reduced.data(),
+                                                    s.kept_unit.data(), s.kept_position.data(), units, repeated);
         if (kept < 2) {
             ++node.single;  // only the nearest is left: it passes under every order, nothing else does
             continue;

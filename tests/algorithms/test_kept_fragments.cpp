@@ -258,6 +258,24 @@ TEST(KeptFragments, ListsOfEveryLengthScoreAsThePerTriangleListsForAnyOrderCount
     }
 }
 
+// A list naming a triangle the partition does not have is refused, whichever of its entries it is
+// and whatever its length (lists of two take a path of their own).
+TEST(KeptFragments, ATriangleBeyondThePartitionIsRefused) {
+    const UnitPartition p = runs({2, 1});  // triangles 0, 1, 2
+    const std::vector<std::vector<uint32_t>> bad = {{0, 3}, {3, 0}, {1, 2 | kTie, 7}, {9, 0, 1}, {0, 1, 2, 3}};
+    for (const auto& pixel : bad) {
+        Lists l;
+        l.pixel({0, 1});
+        l.pixel(pixel);
+        try {
+            keep(l.node(0), p);
+            ADD_FAILURE() << "accepted a list of " << pixel.size();
+        } catch (const InvalidInput& e) {
+            EXPECT_NE(std::string(e.what()).find("but the partition has 3"), std::string::npos) << e.what();
+        }
+    }
+}
+
 TEST(KeptFragments, AnOrderThatSplitsAUnitIsRefused) {
     const UnitPartition p = runs({2, 1});
     const std::vector<uint32_t> faces = {0, 2, 1};  // unit 0 split by unit 1

@@ -271,7 +271,8 @@ constexpr LaneCompaction kLaneCompaction;
 // emit_box's float(z_row + dzdx · double(px)), the same multiply, add and conversion (to nearest,
 // no FMA). The covered lanes are packed to the front (a lane permutation) and stored to the three
 // arrays with one 16-byte store each: the fragments of emit_box, in its order. Up to 3 slots past
-// the fragments are written too (reserved).
+// the fragments are written too (reserved). A box at most 4 pixels wide (most of them) takes one
+// group a row without an inner loop: the same lanes, so the same values.
 __attribute__((target("avx2"))) void emit_box_avx2(const double (&e_first)[3], const double (&step_x)[3],
                                                    const double (&step_y)[3], double dzdx, double dzdy, double z_origin,
                                                    const TriangleBox& box, uint32_t triangle, unsigned resolution,
@@ -293,6 +294,38 @@ __attribute__((target("avx2"))) void emit_box_avx2(const double (&e_first)[3], c
     const __m256d slope = _mm256_set1_pd(dzdx), last = _mm256_set1_pd(double(px1)), zero = _mm256_setzero_pd();
     const __m128 one_f = _mm_set1_ps(1.0f), zero_f = _mm_setzero_ps();
     const __m128i triangles = _mm_set1_epi32(int32_t(triangle));
+    if (px1 - px0 < 4) {  // a box at most 4 pixels wide (most drawn boxes): one group a row, no inner loop
+        const __m256d x = _mm256_add_pd(_mm256_set1_pd(double(px0)), lane);
+        const __m256d in_box = _mm256_cmp_pd(x, last, _CMP_LE_OQ);
+        const __m256d slope_x = _mm256_mul_pd(slope, x);
+        __m256d a0 = _mm256_add_pd(_mm256_set1_pd(e_row[0]), lane_step[0]);
+        __m256d a1 = _mm256_add_pd(_mm256_set1_pd(e_row[1]), lane_step[1]);
+        __m256d a2 = _mm256_add_pd(_mm256_set1_pd(e_row[2]), lane_step[2]);
+        const __m256d row_step0 = _mm256_set1_pd(step_y[0]), row_step1 = _mm256_set1_pd(step_y[1]),
+                      row_step2 = _mm256_set1_pd(step_y[2]);
+        for (int64_t py = py0; py <= py1; ++py) {
+            const __m256d z_row = _mm256_set1_pd(z_origin + dzdy * double(py));
+            const uint32_t row = uint32_t(py * resolution);
+            const __m256d covered =
+                _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(a0, zero, _CMP_GE_OQ), _mm256_cmp_pd(a1, zero, _CMP_GE_OQ)),
+                              _mm256_and_pd(_mm256_cmp_pd(a2, zero, _CMP_GE_OQ), in_box));
+            const __m128 depth = _mm256_cvtpd_ps(_mm256_add_pd(z_row, slope_x));
+            const __m128 in_range = _mm_and_ps(_mm_cmplt_ps(depth, one_f), _mm_cmpge_ps(depth, zero_f));
+            const int mask = _mm256_movemask_pd(covered) & _mm_movemask_ps(in_range);
+            const __m128i order = _mm_load_si128(reinterpret_cast<const __m128i*>(kLaneCompaction.lanes[mask]));
+            const __m128i pixels = _mm_add_epi32(_mm_set1_epi32(int32_t(row + uint32_t(px0))), lane_index);
+            _mm_storeu_ps(reinterpret_cast<float*>(out_pixel + count),
+                          _mm_permutevar_ps(_mm_castsi128_ps(pixels), order));
+            _mm_storeu_si128(reinterpret_cast<__m128i*>(out_triangle + count), triangles);
+            _mm_storeu_ps(out_depth + count, _mm_permutevar_ps(depth, order));
+            count += kLaneCompaction.count[mask];
+            a0 = _mm256_add_pd(a0, row_step0);
+            a1 = _mm256_add_pd(a1, row_step1);
+            a2 = _mm256_add_pd(a2, row_step2);
+        }
+        sink.count = count;
+        return;
+    }
     for (int64_t py = py0; py <= py1; ++py) {
         const __m256d z_row = _mm256_set1_pd(z_origin + dzdy * double(py));
         const uint32_t row = uint32_t(py * resolution);

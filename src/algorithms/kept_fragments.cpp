@@ -115,6 +115,38 @@ ANIMORDER_KEPT_INLINE uint32_t reduce_pair(const uint32_t* f, const UnitPartitio
     return 2;
 }
 
+// reduce_pixel for a list of three fragments, without its loops or branches on the data. The last
+// fragment's nearer fragments of its unit drawn first dominate it whether or not they are kept
+// themselves (one that is dropped is dominated by a still nearer one of the unit, drawn earlier
+// still); its repeat flag counts the kept ones only.
+ANIMORDER_KEPT_INLINE uint32_t reduce_triple(const uint32_t* f, const UnitPartition& partition, uint32_t* out,
+                                             uint16_t* units, bool& repeated) {
+    const size_t triangles = partition.unit_of_triangle.size();
+    const uint32_t t0 = f[0] & kTriangleMask, t1 = f[1] & kTriangleMask, t2 = f[2] & kTriangleMask;
+    if (t0 >= triangles || t1 >= triangles || t2 >= triangles)
+        throw InvalidInput("kept fragments: triangle " +
+                           std::to_string(t0 >= triangles ? t0 : t1 >= triangles ? t1 : t2) +
+                           ", but the partition has " + std::to_string(triangles));
+    const auto [unit0, position0] = partition.unit_position[t0];
+    const auto [unit1, position1] = partition.unit_position[t1];
+    const auto [unit2, position2] = partition.unit_position[t2];
+    const bool same10 = unit1 == unit0, same20 = unit2 == unit0, same21 = unit2 == unit1;
+    const bool drop1 = same10 && position0 < position1;
+    const bool drop2 = (same20 && position0 < position2) || (same21 && position1 < position2);
+    const bool tie1 = (f[1] & kTieBit) != 0;
+    const bool tie2 = (f[2] & kTieBit) != 0 && (!drop1 || tie1);  // at the last kept entry's depth
+    const uint32_t repeats2 = uint32_t(same20) + uint32_t(same21 && !drop1);
+    repeated = !drop2 && repeats2 > 1;
+    out[0] = t0;
+    units[0] = uint16_t(unit0);
+    out[1] = t1 | (tie1 ? kTieBit : 0);
+    units[1] = uint16_t(unit1 | (same10 ? kUnitRepeatBit : 0) | (tie1 ? kUnitTieBit : 0));
+    const uint32_t slot = drop1 ? 1 : 2;  // the last fragment after the kept second one, or in its place
+    out[slot] = t2 | (tie2 ? kTieBit : 0);
+    units[slot] = uint16_t(unit2 | (repeats2 ? kUnitRepeatBit : 0) | (tie2 ? kUnitTieBit : 0));
+    return 3 - uint32_t(drop1) - uint32_t(drop2);
+}
+
 // The deduplicated unit lists of one node, kept per length (each length's lists in order of first
 // appearance): the node stores them shortest first without a sort. Which list a pixel joins
 // never depends on the hash: a list's content has one slot, and grow() reinserts each length's
@@ -410,9 +442,12 @@ KeptNode keep_fragments(uint64_t visible, uint64_t single, const uint32_t* start
             if (pending) pending = s.units.data();
         }
         uint16_t* units = s.units.data() + (pending == s.units.data() ? s.units.size() / 2 : 0);
-        const uint32_t kept = n == 2 ? reduce_pair(fragments + starts[p], partition, s.reduced.data(), units, repeated)
-                                     : reduce_pixel(fragments + starts[p], n, partition, s.reduced.data(),
-                                                    s.kept_unit.data(), s.kept_position.data(), units, repeated);
+        const uint32_t* f = fragments + starts[p];
+        const uint32_t kept =
+            n == 2   ? reduce_pair(f, partition, s.reduced.data(), units, repeated)
+            : n == 3 ? reduce_triple(f, partition, s.reduced.data(), units, repeated)
+                     : reduce_pixel(f, n, partition, s.reduced.data(), s.kept_unit.data(), s.kept_position.data(),
+                                    units, repeated);
         if (kept < 2) {
             ++node.single;  // only the nearest is left: it passes under every order, nothing else does
             continue;

@@ -128,6 +128,30 @@ TEST(KeptFragments, HandWorkedPixelsAreReducedAndShared) {
     expect_same_counts(l.node(5), k, p, all);
 }
 
+// A unit met three times of which the middle fragment is dropped (behind the nearest, drawn after
+// it) is met twice in what is kept: a unit list with a flagged second entry, not a list kept per
+// triangle; so is a unit met twice behind another one. Lists of three fragments take a path of
+// their own (checked: counting the dropped fragment as a repeat of the unit fails this test).
+TEST(KeptFragments, AUnitLeftTwiceAfterADropStaysAUnitList) {
+    const UnitPartition p = runs({2, 1, 3});  // units 0 {0,1}, 1 {2}, 2 {3,4,5}
+    Lists l;
+    l.pixel({4, 5, 3});  // 5 behind 4 (drawn after it): dropped; 3 drawn before 4: unit 2 twice
+    l.pixel({2, 4, 3});  // unit 1, then unit 2 twice (3 drawn first)
+    l.pixel({4, 5, 3, 2});  // the same as the first pixel, with unit 1 behind: the general path
+    const KeptNode k = keep(l.node(0), p);
+    EXPECT_EQ(k.triangle_lists, 0u);
+    std::vector<std::vector<uint32_t>> lists;
+    std::vector<uint32_t> scratch;
+    for_each_unit_list(k, p.unit_of_triangle.data(), p.unit_of_triangle.size(), scratch,
+                       [&](const uint32_t* u, uint32_t n, uint32_t) { lists.emplace_back(u, u + n); });
+    EXPECT_EQ(lists, (std::vector<std::vector<uint32_t>>{{2, 2}, {1, 2, 2}, {2, 2, 1}}));
+    std::vector<uint32_t> order = {0, 1, 2};
+    std::vector<std::vector<uint32_t>> all;
+    do all.push_back(order);
+    while (std::next_permutation(order.begin(), order.end()));
+    expect_same_counts(l.node(0), k, p, all);
+}
+
 TEST(KeptFragments, TiesStayGroupsWhenAFragmentBetweenIsDropped) {
     const UnitPartition p = runs({2, 1});  // unit 0 {0,1}, unit 1 {2}
     Lists l;

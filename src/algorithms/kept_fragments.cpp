@@ -27,6 +27,7 @@
 #include <cstring>
 #include <numeric>
 #include <string>
+#include <tuple>
 #include <type_traits>
 
 namespace animorder {
@@ -93,58 +94,48 @@ uint32_t reduce_pixel(const uint32_t* f, uint32_t n, const UnitPartition& partit
     return kept;
 }
 
-// reduce_pixel for a list of two fragments (half the multi-fragment pixels of a character), without
-// its loops: the farther fragment is dropped when the nearer one is of its unit and drawn first.
-ANIMORDER_KEPT_INLINE uint32_t reduce_pair(const uint32_t* f, const UnitPartition& partition, uint32_t* out,
-                                           uint16_t* units, bool& repeated) {
+// reduce_pixel for a list of N fragments (N a constant: the loops unrolled, no branch on the data;
+// nearly every multi-fragment pixel has 2 to 4). A fragment is tested against every nearer one,
+// dropped or not: a dropped one is dominated by a still nearer fragment of its unit drawn earlier
+// still, which then dominates this one too. Entries are written at the kept count whether or not
+// they stay (the next one overwrites a dropped one); the repeat flag counts kept entries only.
+template <uint32_t N>
+ANIMORDER_KEPT_INLINE uint32_t reduce_fixed(const uint32_t* f, const UnitPartition& partition, uint32_t* out,
+                                            uint16_t* units, bool& repeated) {
+    const size_t triangles = partition.unit_of_triangle.size();
+    uint32_t t[N], unit[N], position[N];
+    bool outside = false;
+    for (uint32_t j = 0; j < N; ++j) {
+        t[j] = f[j] & kTriangleMask;
+        outside |= t[j] >= triangles;
+    }
+    if (outside)
+        for (uint32_t j = 0; j < N; ++j)
+            if (t[j] >= triangles)
+                throw InvalidInput("kept fragments: triangle " + std::to_string(t[j]) + ", but the partition has " +
+                                   std::to_string(triangles));
+    for (uint32_t j = 0; j < N; ++j) std::tie(unit[j], position[j]) = partition.unit_position[t[j]];
+    bool kept_entry[N];
+    bool previous_at_kept_depth = true;  // as in reduce_pixel
+    uint32_t kept = 0;
     repeated = false;
-    const size_t triangles = partition.unit_of_triangle.size();
-    const uint32_t t0 = f[0] & kTriangleMask, t1 = f[1] & kTriangleMask;
-    if (t0 >= triangles || t1 >= triangles)
-        throw InvalidInput("kept fragments: triangle " + std::to_string(t0 >= triangles ? t0 : t1) +
-                           ", but the partition has " + std::to_string(triangles));
-    const auto [unit0, position0] = partition.unit_position[t0];
-    const auto [unit1, position1] = partition.unit_position[t1];
-    const bool same = unit0 == unit1;
-    if (same && position0 < position1) return 1;
-    const bool tied = (f[1] & kTieBit) != 0;
-    out[0] = t0;
-    out[1] = t1 | (tied ? kTieBit : 0);
-    units[0] = uint16_t(unit0);
-    units[1] = uint16_t(unit1 | (same ? kUnitRepeatBit : 0) | (tied ? kUnitTieBit : 0));
-    return 2;
-}
-
-// reduce_pixel for a list of three fragments, without its loops or branches on the data. The last
-// fragment's nearer fragments of its unit drawn first dominate it whether or not they are kept
-// themselves (one that is dropped is dominated by a still nearer one of the unit, drawn earlier
-// still); its repeat flag counts the kept ones only.
-ANIMORDER_KEPT_INLINE uint32_t reduce_triple(const uint32_t* f, const UnitPartition& partition, uint32_t* out,
-                                             uint16_t* units, bool& repeated) {
-    const size_t triangles = partition.unit_of_triangle.size();
-    const uint32_t t0 = f[0] & kTriangleMask, t1 = f[1] & kTriangleMask, t2 = f[2] & kTriangleMask;
-    if (t0 >= triangles || t1 >= triangles || t2 >= triangles)
-        throw InvalidInput("kept fragments: triangle " +
-                           std::to_string(t0 >= triangles ? t0 : t1 >= triangles ? t1 : t2) +
-                           ", but the partition has " + std::to_string(triangles));
-    const auto [unit0, position0] = partition.unit_position[t0];
-    const auto [unit1, position1] = partition.unit_position[t1];
-    const auto [unit2, position2] = partition.unit_position[t2];
-    const bool same10 = unit1 == unit0, same20 = unit2 == unit0, same21 = unit2 == unit1;
-    const bool drop1 = same10 && position0 < position1;
-    const bool drop2 = (same20 && position0 < position2) || (same21 && position1 < position2);
-    const bool tie1 = (f[1] & kTieBit) != 0;
-    const bool tie2 = (f[2] & kTieBit) != 0 && (!drop1 || tie1);  // at the last kept entry's depth
-    const uint32_t repeats2 = uint32_t(same20) + uint32_t(same21 && !drop1);
-    repeated = !drop2 && repeats2 > 1;
-    out[0] = t0;
-    units[0] = uint16_t(unit0);
-    out[1] = t1 | (tie1 ? kTieBit : 0);
-    units[1] = uint16_t(unit1 | (same10 ? kUnitRepeatBit : 0) | (tie1 ? kUnitTieBit : 0));
-    const uint32_t slot = drop1 ? 1 : 2;  // the last fragment after the kept second one, or in its place
-    out[slot] = t2 | (tie2 ? kTieBit : 0);
-    units[slot] = uint16_t(unit2 | (repeats2 ? kUnitRepeatBit : 0) | (tie2 ? kUnitTieBit : 0));
-    return 3 - uint32_t(drop1) - uint32_t(drop2);
+    for (uint32_t j = 0; j < N; ++j) {
+        const bool tied = j > 0 && (f[j] & kTieBit) && previous_at_kept_depth;
+        bool dominated = false;
+        uint32_t same_unit = 0;
+        for (uint32_t i = 0; i < j; ++i) {
+            const bool same = unit[i] == unit[j];
+            dominated |= same && position[i] < position[j];
+            same_unit += same && kept_entry[i];
+        }
+        kept_entry[j] = !dominated;
+        previous_at_kept_depth = dominated ? tied : true;
+        repeated |= !dominated && same_unit > 1;
+        out[kept] = t[j] | (tied ? kTieBit : 0);
+        units[kept] = uint16_t(unit[j] | (same_unit ? kUnitRepeatBit : 0) | (tied ? kUnitTieBit : 0));
+        kept += !dominated;
+    }
+    return kept;
 }
 
 // The deduplicated unit lists of one node, kept per length (each length's lists in order of first
@@ -443,11 +434,13 @@ KeptNode keep_fragments(uint64_t visible, uint64_t single, const uint32_t* start
         }
         uint16_t* units = s.units.data() + (pending == s.units.data() ? s.units.size() / 2 : 0);
         const uint32_t* f = fragments + starts[p];
+        uint32_t* reduced = s.reduced.data();
         const uint32_t kept =
-            n == 2   ? reduce_pair(f, partition, s.reduced.data(), units, repeated)
-            : n == 3 ? reduce_triple(f, partition, s.reduced.data(), units, repeated)
-                     : reduce_pixel(f, n, partition, s.reduced.data(), s.kept_unit.data(), s.kept_position.data(),
-                                    units, repeated);
+            n == 2   ? reduce_fixed<2>(f, partition, reduced, units, repeated)
+            : n == 3 ? reduce_fixed<3>(f, partition, reduced, units, repeated)
+            : n == 4 ? reduce_fixed<4>(f, partition, reduced, units, repeated)
+                     : reduce_pixel(f, n, partition, reduced, s.kept_unit.data(), s.kept_position.data(), units,
+                                    repeated);
         if (kept < 2) {
             ++node.single;  // only the nearest is left: it passes under every order, nothing else does
             continue;

@@ -130,8 +130,8 @@ TEST(KeptFragments, HandWorkedPixelsAreReducedAndShared) {
 
 // A unit met three times of which the middle fragment is dropped (behind the nearest, drawn after
 // it) is met twice in what is kept: a unit list with a flagged second entry, not a list kept per
-// triangle; so is a unit met twice behind another one. Lists of three fragments take a path of
-// their own (checked: counting the dropped fragment as a repeat of the unit fails this test).
+// triangle; so is a unit met twice behind another one. Lists of two to four fragments take a path
+// of their own (checked: counting the dropped fragment as a repeat of the unit fails this test).
 TEST(KeptFragments, AUnitLeftTwiceAfterADropStaysAUnitList) {
     const UnitPartition p = runs({2, 1, 3});  // units 0 {0,1}, 1 {2}, 2 {3,4,5}
     Lists l;
@@ -283,7 +283,7 @@ TEST(KeptFragments, ListsOfEveryLengthScoreAsThePerTriangleListsForAnyOrderCount
 }
 
 // A list naming a triangle the partition does not have is refused, whichever of its entries it is
-// and whatever its length (lists of two take a path of their own).
+// and whatever its length (lists of two to four take a path of their own).
 TEST(KeptFragments, ATriangleBeyondThePartitionIsRefused) {
     const UnitPartition p = runs({2, 1});  // triangles 0, 1, 2
     const std::vector<std::vector<uint32_t>> bad = {{0, 3}, {3, 0}, {1, 2 | kTie, 7}, {9, 0, 1}, {0, 1, 2, 3}};

@@ -759,9 +759,9 @@ constexpr int32_t kSpecialVertex = int32_t(1) << 30;
 // unclipped: int32 arithmetic over arrays that the compiler vectorises. keep[i] is non-zero
 // exactly when the bounding box, clamped to the viewport, holds a pixel centre.
 //
-// It also drops from `keep` the pixel-sized triangles that cover none of their box's centres:
-// about half the drawn triangles of a character whose triangles are that small, which would be
-// set up only to emit nothing. A triangle takes this test when its box has at most 2 × 2 pixels and
+// It also drops from `keep` the pixel-sized triangles that cover none of their box's centres (on
+// a character whose triangles are that small, many of the drawn ones), which would be set up only
+// to emit nothing. A triangle takes this test when its box has at most 2 × 2 pixels and
 // its corners lie within 4 pixels of each other; the test is BatchSetup::compute's edge functions
 // at the box's (up to) four centres, corners in positive order (0, 2, 1 for a front face, else 0,
 // 1, 2), in int32 lanes: every difference is then below 2^11 in magnitude, every product below 2^21,

@@ -264,6 +264,28 @@ struct LaneCompaction {
 };
 constexpr LaneCompaction kLaneCompaction;
 
+// One group of four pixels in the AVX2 copy: the lanes whose three edge values are >= 0, that lie
+// in the box and whose depth (z, rounded to float) lies in [0, 1), packed to the front and stored
+// at `count` (one 16-byte store per array, whatever the count); returns the new count.
+__attribute__((target("avx2"))) ANIMORDER_INLINE size_t emit_group_avx2(__m256d a0, __m256d a1, __m256d a2,
+                                                                        __m256d in_box, __m256d z, __m128i pixels,
+                                                                        __m128i triangles, FragmentSink& sink,
+                                                                        size_t count) {
+    const __m256d zero = _mm256_setzero_pd();
+    const __m256d covered = _mm256_and_pd(
+        _mm256_and_pd(_mm256_cmp_pd(a0, zero, _CMP_GE_OQ), _mm256_cmp_pd(a1, zero, _CMP_GE_OQ)),
+        _mm256_and_pd(_mm256_cmp_pd(a2, zero, _CMP_GE_OQ), in_box));
+    const __m128 depth = _mm256_cvtpd_ps(z);
+    const __m128 in_range = _mm_and_ps(_mm_cmplt_ps(depth, _mm_set1_ps(1.0f)), _mm_cmpge_ps(depth, _mm_setzero_ps()));
+    const int mask = _mm256_movemask_pd(covered) & _mm_movemask_ps(in_range);
+    const __m128i order = _mm_load_si128(reinterpret_cast<const __m128i*>(kLaneCompaction.lanes[mask]));
+    _mm_storeu_ps(reinterpret_cast<float*>(sink.pixel.data() + count),
+                  _mm_permutevar_ps(_mm_castsi128_ps(pixels), order));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(sink.triangle.data() + count), triangles);
+    _mm_storeu_ps(sink.depth.data() + count, _mm_permutevar_ps(depth, order));
+    return count + kLaneCompaction.count[mask];
+}
+
 // emit_box in the AVX2 copy, from BatchSetup's doubles (no conversion to int64): 4 pixels of a row
 // at a time, in double lanes. Exact: the edge values e + k·step_x + r·step_y are integers below
 // 2^53 in magnitude (BatchSetup's bound plus at most 2 · 2^14 · 2^33), so double holds them, sums
@@ -280,9 +302,6 @@ __attribute__((target("avx2"))) void emit_box_avx2(const double (&e_first)[3], c
     const int64_t px0 = box.px0, px1 = box.px1, py0 = box.py0, py1 = box.py1;
     double e_row[3] = {e_first[0], e_first[1], e_first[2]};
     sink.reserve_more(size_t(px1 - px0 + 1) * size_t(py1 - py0 + 1) + 4);
-    uint32_t* out_pixel = sink.pixel.data();
-    uint32_t* out_triangle = sink.triangle.data();
-    float* out_depth = sink.depth.data();
     size_t count = sink.count;
     const __m256d lane = _mm256_set_pd(3.0, 2.0, 1.0, 0.0);
     const __m128i lane_index = _mm_set_epi32(3, 2, 1, 0);
@@ -291,8 +310,7 @@ __attribute__((target("avx2"))) void emit_box_avx2(const double (&e_first)[3], c
         lane_step[i] = _mm256_mul_pd(lane, _mm256_set1_pd(step_x[i]));
         group_step[i] = _mm256_set1_pd(4.0 * step_x[i]);
     }
-    const __m256d slope = _mm256_set1_pd(dzdx), last = _mm256_set1_pd(double(px1)), zero = _mm256_setzero_pd();
-    const __m128 one_f = _mm_set1_ps(1.0f), zero_f = _mm_setzero_ps();
+    const __m256d slope = _mm256_set1_pd(dzdx), last = _mm256_set1_pd(double(px1));
     const __m128i triangles = _mm_set1_epi32(int32_t(triangle));
     if (px1 - px0 < 4) {  // a box at most 4 pixels wide (most drawn boxes): one group a row, no inner loop
         const __m256d x = _mm256_add_pd(_mm256_set1_pd(double(px0)), lane);
@@ -306,19 +324,8 @@ __attribute__((target("avx2"))) void emit_box_avx2(const double (&e_first)[3], c
         for (int64_t py = py0; py <= py1; ++py) {
             const __m256d z_row = _mm256_set1_pd(z_origin + dzdy * double(py));
             const uint32_t row = uint32_t(py * resolution);
-            const __m256d covered =
-                _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(a0, zero, _CMP_GE_OQ), _mm256_cmp_pd(a1, zero, _CMP_GE_OQ)),
-                              _mm256_and_pd(_mm256_cmp_pd(a2, zero, _CMP_GE_OQ), in_box));
-            const __m128 depth = _mm256_cvtpd_ps(_mm256_add_pd(z_row, slope_x));
-            const __m128 in_range = _mm_and_ps(_mm_cmplt_ps(depth, one_f), _mm_cmpge_ps(depth, zero_f));
-            const int mask = _mm256_movemask_pd(covered) & _mm_movemask_ps(in_range);
-            const __m128i order = _mm_load_si128(reinterpret_cast<const __m128i*>(kLaneCompaction.lanes[mask]));
             const __m128i pixels = _mm_add_epi32(_mm_set1_epi32(int32_t(row + uint32_t(px0))), lane_index);
-            _mm_storeu_ps(reinterpret_cast<float*>(out_pixel + count),
-                          _mm_permutevar_ps(_mm_castsi128_ps(pixels), order));
-            _mm_storeu_si128(reinterpret_cast<__m128i*>(out_triangle + count), triangles);
-            _mm_storeu_ps(out_depth + count, _mm_permutevar_ps(depth, order));
-            count += kLaneCompaction.count[mask];
+            count = emit_group_avx2(a0, a1, a2, in_box, _mm256_add_pd(z_row, slope_x), pixels, triangles, sink, count);
             a0 = _mm256_add_pd(a0, row_step0);
             a1 = _mm256_add_pd(a1, row_step1);
             a2 = _mm256_add_pd(a2, row_step2);
@@ -334,19 +341,9 @@ __attribute__((target("avx2"))) void emit_box_avx2(const double (&e_first)[3], c
         __m256d a2 = _mm256_add_pd(_mm256_set1_pd(e_row[2]), lane_step[2]);
         for (int64_t px = px0; px <= px1; px += 4) {
             const __m256d x = _mm256_add_pd(_mm256_set1_pd(double(px)), lane);
-            const __m256d covered =
-                _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(a0, zero, _CMP_GE_OQ), _mm256_cmp_pd(a1, zero, _CMP_GE_OQ)),
-                              _mm256_and_pd(_mm256_cmp_pd(a2, zero, _CMP_GE_OQ), _mm256_cmp_pd(x, last, _CMP_LE_OQ)));
-            const __m128 depth = _mm256_cvtpd_ps(_mm256_add_pd(z_row, _mm256_mul_pd(slope, x)));
-            const __m128 in_range = _mm_and_ps(_mm_cmplt_ps(depth, one_f), _mm_cmpge_ps(depth, zero_f));
-            const int mask = _mm256_movemask_pd(covered) & _mm_movemask_ps(in_range);
-            const __m128i order = _mm_load_si128(reinterpret_cast<const __m128i*>(kLaneCompaction.lanes[mask]));
             const __m128i pixels = _mm_add_epi32(_mm_set1_epi32(int32_t(row + uint32_t(px))), lane_index);
-            _mm_storeu_ps(reinterpret_cast<float*>(out_pixel + count),
-                          _mm_permutevar_ps(_mm_castsi128_ps(pixels), order));
-            _mm_storeu_si128(reinterpret_cast<__m128i*>(out_triangle + count), triangles);
-            _mm_storeu_ps(out_depth + count, _mm_permutevar_ps(depth, order));
-            count += kLaneCompaction.count[mask];
+            count = emit_group_avx2(a0, a1, a2, _mm256_cmp_pd(x, last, _CMP_LE_OQ),
+                                    _mm256_add_pd(z_row, _mm256_mul_pd(slope, x)), pixels, triangles, sink, count);
             a0 = _mm256_add_pd(a0, group_step[0]);
             a1 = _mm256_add_pd(a1, group_step[1]);
             a2 = _mm256_add_pd(a2, group_step[2]);

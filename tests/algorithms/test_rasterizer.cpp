@@ -593,6 +593,21 @@ void expect_same_fragments(const std::vector<std::tuple<uint32_t, uint32_t, floa
     }
 }
 
+// Both copies of the per-node code (the portable one and, where the CPU has it, the AVX2 one) draw
+// exactly the expected fragments.
+void expect_both_copies_draw(const std::vector<float>& clip, const std::vector<uint32_t>& ib,
+                             const std::vector<uint8_t>& modes, unsigned resolution,
+                             const std::vector<std::tuple<uint32_t, uint32_t, float>>& expected,
+                             const std::string& what) {
+    for (bool simd : {false, true}) {
+        if (simd && !NodeRasterizer::simd_available()) continue;
+        NodeRasterizer r;
+        r.set_simd(simd);
+        r.rasterize(clip.data(), clip.size() / 4, ib.data(), ib.size(), resolution, modes.data());
+        expect_same_fragments(engine_fragments(r), expected, what + "simd " + std::to_string(simd));
+    }
+}
+
 }  // namespace
 
 // Every fragment (pixel, triangle, depth bits) and its order, against the plain reference, on
@@ -645,14 +660,7 @@ TEST(Rasterizer, FragmentsEqualAPlainPerPixelReference) {
             add(p, mode);
         }
         const auto expected = reference_fragments(clip, ib, modes, resolution);
-        for (bool simd : {false, true}) {
-            if (simd && !NodeRasterizer::simd_available()) continue;
-            NodeRasterizer r;
-            r.set_simd(simd);
-            r.rasterize(clip.data(), clip.size() / 4, ib.data(), ib.size(), resolution, modes.data());
-            expect_same_fragments(engine_fragments(r), expected,
-                                  "resolution " + std::to_string(resolution) + " simd " + std::to_string(simd));
-        }
+        expect_both_copies_draw(clip, ib, modes, resolution, expected, "resolution " + std::to_string(resolution) + " ");
         EXPECT_GT(expected.size(), 200u);  // the scene draws something
     }
 }
@@ -696,13 +704,7 @@ TEST(Rasterizer, SmallAndWideBoxesEqualThePlainReference) {
         near_zero += std::get<2>(f) < 0.001f;
         near_one += std::get<2>(f) > 0.999f;
     }
-    for (bool simd : {false, true}) {
-        if (simd && !NodeRasterizer::simd_available()) continue;
-        NodeRasterizer r;
-        r.set_simd(simd);
-        r.rasterize(clip.data(), clip.size() / 4, ib.data(), ib.size(), resolution, modes.data());
-        expect_same_fragments(engine_fragments(r), expected, "simd " + std::to_string(simd));
-    }
+    expect_both_copies_draw(clip, ib, modes, resolution, expected, "");
     EXPECT_GT(expected.size(), 1000u) << near_zero << " " << near_one;
     EXPECT_GT(near_zero, 5u);
     EXPECT_GT(near_one, 5u);
@@ -763,13 +765,7 @@ TEST(Rasterizer, SmallBoxTestDropsOnlyTrianglesThatCoverNothing) {
     }
     const auto far_expected = reference_fragments(far_clip, far_ib, far_modes, large);
     EXPECT_GT(far_expected.size(), 50u);
-    for (bool simd : {false, true}) {
-        if (simd && !NodeRasterizer::simd_available()) continue;
-        NodeRasterizer r;
-        r.set_simd(simd);
-        r.rasterize(far_clip.data(), far_clip.size() / 4, far_ib.data(), far_ib.size(), large, far_modes.data());
-        expect_same_fragments(engine_fragments(r), far_expected, "far corners, simd " + std::to_string(simd));
-    }
+    expect_both_copies_draw(far_clip, far_ib, far_modes, large, far_expected, "far corners, ");
 
     const auto expected = reference_fragments(clip, ib, modes, resolution);
     // The scene has both kinds of pixel-sized triangle: those that cover a centre and those that do not.
@@ -778,13 +774,7 @@ TEST(Rasterizer, SmallBoxTestDropsOnlyTrianglesThatCoverNothing) {
     const size_t empty = size_t(std::count(per_triangle.begin(), per_triangle.end(), 0u));
     EXPECT_GT(empty, 1000u);
     EXPECT_GT(per_triangle.size() - empty, 1000u);
-    for (bool simd : {false, true}) {
-        if (simd && !NodeRasterizer::simd_available()) continue;
-        NodeRasterizer r;
-        r.set_simd(simd);
-        r.rasterize(clip.data(), clip.size() / 4, ib.data(), ib.size(), resolution, modes.data());
-        expect_same_fragments(engine_fragments(r), expected, "simd " + std::to_string(simd));
-    }
+    expect_both_copies_draw(clip, ib, modes, resolution, expected, "");
 }
 
 // Clipped triangles (crossing the near plane or the guard band) among unclipped ones: each

@@ -71,7 +71,8 @@ struct KeepScratch {
     };
     std::vector<Lists> lists;
     std::vector<uint8_t> used_lengths;
-    std::vector<uint32_t> reduced, kept_unit, kept_position;
+    std::vector<uint32_t> reduced, entry_unit, entry_position;  // a pixel's entries, as reduced
+    std::vector<uint8_t> entry_kept;
     std::vector<uint16_t> units;
     std::vector<uint32_t> triangle_lists;
 };

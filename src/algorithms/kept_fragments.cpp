@@ -53,76 +53,44 @@ uint64_t hash_list(uint64_t key, const uint16_t* e, size_t n) {
     return h ^ (h >> 29);
 }
 
-// Drops the fragments of reduction 1 from one pixel's list into `out` (tie bits recomputed: an
-// entry is tied when its depth equals the previous kept entry's) and returns how many are kept;
-// kept_unit and kept_position hold the kept entries' unit and position, units their unit list
-// entries (unit | kUnitTieBit when tied, | kUnitRepeatBit for the unit's second entry; each array
-// at least n long). Sets `repeated` when a unit still appears three times.
-uint32_t reduce_pixel(const uint32_t* f, uint32_t n, const UnitPartition& partition, uint32_t* out, uint32_t* kept_unit,
-                      uint32_t* kept_position, uint16_t* units, bool& repeated) {
-    repeated = false;
+// Drops the fragments of reduction 1 from one pixel's list of n fragments into `out` (tie bits
+// recomputed: an entry is tied when its depth equals the previous kept entry's) and returns how many
+// are kept; `units` gets their unit list entries (unit | kUnitTieBit when tied, | kUnitRepeatBit
+// for the unit's second entry). Sets `repeated` when a unit still appears three times. `out` and
+// `units` need n entries: an entry is written at the kept count whether or not it stays (the next
+// one overwrites a dropped one).
+//
+// A fragment is tested against every nearer one, dropped or not: a dropped one is dominated by a
+// still nearer fragment of its unit drawn earlier still, which then dominates this one too. The
+// repeat flag counts kept entries only. N > 0 is n known at compile time (nearly every
+// multi-fragment pixel has 2 to 4): the loops are unrolled, no branch on the data, and the
+// entries' units, positions and kept flags live in local arrays; N = 0 takes any n, with those in
+// the scratch arrays (each at least n long).
+template <uint32_t N>
+ANIMORDER_KEPT_INLINE uint32_t reduce_list(const uint32_t* f, uint32_t n, const UnitPartition& partition,
+                                           uint32_t* out, uint16_t* units, KeepScratch& scratch, bool& repeated) {
+    const uint32_t count = N ? N : n;
     const size_t triangles = partition.unit_of_triangle.size();
-    const std::pair<uint32_t, uint32_t>* unit_position = partition.unit_position.data();
+    uint32_t local_unit[N ? N : 1], local_position[N ? N : 1];
+    uint8_t local_kept[N ? N : 1];
+    uint32_t* unit = N ? local_unit : scratch.entry_unit.data();
+    uint32_t* position = N ? local_position : scratch.entry_position.data();
+    uint8_t* kept_entry = N ? local_kept : scratch.entry_kept.data();
+    bool outside = false;
+    for (uint32_t j = 0; j < count; ++j) outside |= (f[j] & kTriangleMask) >= triangles;
+    if (outside)
+        for (uint32_t j = 0; j < count; ++j)
+            if ((f[j] & kTriangleMask) >= triangles)
+                throw InvalidInput("kept fragments: triangle " + std::to_string(f[j] & kTriangleMask) +
+                                   ", but the partition has " + std::to_string(triangles));
+    for (uint32_t j = 0; j < count; ++j) std::tie(unit[j], position[j]) = partition.unit_position[f[j] & kTriangleMask];
     bool previous_at_kept_depth = true;  // the previous fragment's depth equals the last kept one's
     uint32_t kept = 0;
-    for (uint32_t j = 0; j < n; ++j) {
-        const uint32_t t = f[j] & kTriangleMask;
-        if (t >= triangles)
-            throw InvalidInput("kept fragments: triangle " + std::to_string(t) + ", but the partition has " +
-                               std::to_string(triangles));
-        const bool tied = j > 0 && (f[j] & kTieBit) && previous_at_kept_depth;
-        const auto [unit, position] = unit_position[t];
-        bool dominated = false;
-        uint32_t same_unit = 0;  // nearer entries of this unit, all drawn after it (else dominated)
-        for (uint32_t i = 0; i < kept; ++i) {
-            const bool same = kept_unit[i] == unit;
-            same_unit += same;
-            dominated |= same && kept_position[i] < position;
-        }
-        if (dominated) {
-            previous_at_kept_depth = tied;
-            continue;
-        }
-        repeated |= same_unit > 1;
-        out[kept] = t | (tied ? kTieBit : 0);
-        units[kept] = uint16_t(unit | (same_unit ? kUnitRepeatBit : 0) | (tied ? kUnitTieBit : 0));
-        kept_unit[kept] = unit;
-        kept_position[kept] = position;
-        ++kept;
-        previous_at_kept_depth = true;
-    }
-    return kept;
-}
-
-// reduce_pixel for a list of N fragments (N a constant: the loops unrolled, no branch on the data;
-// nearly every multi-fragment pixel has 2 to 4). A fragment is tested against every nearer one,
-// dropped or not: a dropped one is dominated by a still nearer fragment of its unit drawn earlier
-// still, which then dominates this one too. Entries are written at the kept count whether or not
-// they stay (the next one overwrites a dropped one); the repeat flag counts kept entries only.
-template <uint32_t N>
-ANIMORDER_KEPT_INLINE uint32_t reduce_fixed(const uint32_t* f, const UnitPartition& partition, uint32_t* out,
-                                            uint16_t* units, bool& repeated) {
-    const size_t triangles = partition.unit_of_triangle.size();
-    uint32_t t[N], unit[N], position[N];
-    bool outside = false;
-    for (uint32_t j = 0; j < N; ++j) {
-        t[j] = f[j] & kTriangleMask;
-        outside |= t[j] >= triangles;
-    }
-    if (outside)
-        for (uint32_t j = 0; j < N; ++j)
-            if (t[j] >= triangles)
-                throw InvalidInput("kept fragments: triangle " + std::to_string(t[j]) + ", but the partition has " +
-                                   std::to_string(triangles));
-    for (uint32_t j = 0; j < N; ++j) std::tie(unit[j], position[j]) = partition.unit_position[t[j]];
-    bool kept_entry[N];
-    bool previous_at_kept_depth = true;  // as in reduce_pixel
-    uint32_t kept = 0;
     repeated = false;
-    for (uint32_t j = 0; j < N; ++j) {
+    for (uint32_t j = 0; j < count; ++j) {
         const bool tied = j > 0 && (f[j] & kTieBit) && previous_at_kept_depth;
         bool dominated = false;
-        uint32_t same_unit = 0;
+        uint32_t same_unit = 0;  // kept nearer entries of this unit, all drawn after it (else dominated)
         for (uint32_t i = 0; i < j; ++i) {
             const bool same = unit[i] == unit[j];
             dominated |= same && position[i] < position[j];
@@ -131,7 +99,7 @@ ANIMORDER_KEPT_INLINE uint32_t reduce_fixed(const uint32_t* f, const UnitPartiti
         kept_entry[j] = !dominated;
         previous_at_kept_depth = dominated ? tied : true;
         repeated |= !dominated && same_unit > 1;
-        out[kept] = t[j] | (tied ? kTieBit : 0);
+        out[kept] = (f[j] & kTriangleMask) | (tied ? kTieBit : 0);
         units[kept] = uint16_t(unit[j] | (same_unit ? kUnitRepeatBit : 0) | (tied ? kUnitTieBit : 0));
         kept += !dominated;
     }
@@ -423,8 +391,9 @@ KeptNode keep_fragments(uint64_t visible, uint64_t single, const uint32_t* start
         const uint32_t n = starts[p + 1] - starts[p];
         if (s.reduced.size() < n) {
             s.reduced.resize(n);
-            s.kept_unit.resize(n);
-            s.kept_position.resize(n);
+            s.entry_unit.resize(n);
+            s.entry_position.resize(n);
+            s.entry_kept.resize(n);
         }
         if (s.units.size() < 2 * std::max<size_t>(n, 4)) {
             std::vector<uint16_t> units(2 * std::max<size_t>(n, 4));
@@ -435,12 +404,10 @@ KeptNode keep_fragments(uint64_t visible, uint64_t single, const uint32_t* start
         uint16_t* units = s.units.data() + (pending == s.units.data() ? s.units.size() / 2 : 0);
         const uint32_t* f = fragments + starts[p];
         uint32_t* reduced = s.reduced.data();
-        const uint32_t kept =
-            n == 2   ? reduce_fixed<2>(f, partition, reduced, units, repeated)
-            : n == 3 ? reduce_fixed<3>(f, partition, reduced, units, repeated)
-            : n == 4 ? reduce_fixed<4>(f, partition, reduced, units, repeated)
-                     : reduce_pixel(f, n, partition, reduced, s.kept_unit.data(), s.kept_position.data(), units,
-                                    repeated);
+        const uint32_t kept = n == 2   ? reduce_list<2>(f, n, partition, reduced, units, s, repeated)
+                              : n == 3 ? reduce_list<3>(f, n, partition, reduced, units, s, repeated)
+                              : n == 4 ? reduce_list<4>(f, n, partition, reduced, units, s, repeated)
+                                       : reduce_list<0>(f, n, partition, reduced, units, s, repeated);
         if (kept < 2) {
             ++node.single;  // only the nearest is left: it passes under every order, nothing else does
             continue;

@@ -357,42 +357,30 @@ __attribute__((target("avx2"))) void emit_box_avx2(const double (&e_first)[3], c
 
 // emit_small_box in the AVX2 copy: the box's four pixels are the four lanes (x0 y0, x1 y0, x0 y1,
 // x1 y1, emit_small_box's order), edge values e, e + sx, e + sy, e + sx + sy (integers below 2^53:
-// exact in double), depths emit_small_box's float(z_row + dzdx · x), then packed and stored as in
-// emit_box_avx2. Takes BatchSetup's doubles as they are: no conversion to int64.
+// exact in double), depths emit_small_box's float(z_row + dzdx · x), the lanes past the box masked,
+// then one emit_group_avx2. Takes BatchSetup's doubles as they are: no conversion to int64.
 __attribute__((target("avx2"))) inline void emit_small_box_avx2(const double (&e)[3], const double (&step_x)[3],
                                                                 const double (&step_y)[3], double dzdx, double dzdy,
                                                                 double z_origin, const TriangleBox& box,
                                                                 uint32_t triangle, unsigned resolution,
                                                                 FragmentSink& sink) {
     sink.reserve_more(4);
-    const size_t count = sink.count;
     const double x0 = double(box.px0), x1 = x0 + 1.0;
     const double z_row0 = z_origin + dzdy * double(box.py0), z_row1 = z_origin + dzdy * double(box.py0 + 1);
-    const __m256d zero = _mm256_setzero_pd();
     const __m256d a0 =
         _mm256_add_pd(_mm256_set1_pd(e[0]), _mm256_set_pd(step_x[0] + step_y[0], step_y[0], step_x[0], 0.0));
     const __m256d a1 =
         _mm256_add_pd(_mm256_set1_pd(e[1]), _mm256_set_pd(step_x[1] + step_y[1], step_y[1], step_x[1], 0.0));
     const __m256d a2 =
         _mm256_add_pd(_mm256_set1_pd(e[2]), _mm256_set_pd(step_x[2] + step_y[2], step_y[2], step_x[2], 0.0));
-    const __m256d covered =
-        _mm256_and_pd(_mm256_cmp_pd(a0, zero, _CMP_GE_OQ),
-                      _mm256_and_pd(_mm256_cmp_pd(a1, zero, _CMP_GE_OQ), _mm256_cmp_pd(a2, zero, _CMP_GE_OQ)));
     const __m256d x = _mm256_set_pd(x1, x0, x1, x0), z_row = _mm256_set_pd(z_row1, z_row1, z_row0, z_row0);
-    const __m128 depth = _mm256_cvtpd_ps(_mm256_add_pd(z_row, _mm256_mul_pd(_mm256_set1_pd(dzdx), x)));
-    const __m128 in_range = _mm_and_ps(_mm_cmplt_ps(depth, _mm_set1_ps(1.0f)), _mm_cmpge_ps(depth, _mm_setzero_ps()));
     const bool wide = box.px1 > box.px0, tall = box.py1 > box.py0;
-    const int in_box = 1 | int(wide) << 1 | int(tall) << 2 | int(wide && tall) << 3;
-    const int mask = _mm256_movemask_pd(covered) & _mm_movemask_ps(in_range) & in_box;
-    const __m128i order = _mm_load_si128(reinterpret_cast<const __m128i*>(kLaneCompaction.lanes[mask]));
+    const __m256d in_box = _mm256_castsi256_pd(_mm256_set_epi64x(wide && tall ? -1 : 0, tall ? -1 : 0, wide ? -1 : 0, -1));
     const uint32_t row = uint32_t(box.py0 * resolution) + uint32_t(box.px0);
     const __m128i pixels =
         _mm_add_epi32(_mm_set1_epi32(int32_t(row)), _mm_set_epi32(int32_t(resolution + 1), int32_t(resolution), 1, 0));
-    _mm_storeu_ps(reinterpret_cast<float*>(sink.pixel.data() + count),
-                  _mm_permutevar_ps(_mm_castsi128_ps(pixels), order));
-    _mm_storeu_si128(reinterpret_cast<__m128i*>(sink.triangle.data() + count), _mm_set1_epi32(int32_t(triangle)));
-    _mm_storeu_ps(sink.depth.data() + count, _mm_permutevar_ps(depth, order));
-    sink.count = count + kLaneCompaction.count[mask];
+    sink.count = emit_group_avx2(a0, a1, a2, in_box, _mm256_add_pd(z_row, _mm256_mul_pd(_mm256_set1_pd(dzdx), x)),
+                                 pixels, _mm_set1_epi32(int32_t(triangle)), sink, sink.count);
 }
 #endif
 

@@ -8,9 +8,10 @@
 //
 //   build/bench/bench_raster ../shared/data/glb-xbot/Xbot.glb
 //   build/bench/bench_raster ../shared/data/mixamo-ganfaul/Ganfaul.gltf --clip Idle [--keyframes 4] [--repeat 2]
-//   ... --simd 0: the rasteriser's portable copy even where the CPU has AVX2
-//   ... --simd both: the portable copy, then the AVX2 copy (where the CPU has it) in the same run,
-//       with their ratio and whether their hashes agree
+//   ... --simd 0|1|2: at most the rasteriser's portable, AVX2 or AVX-512 copy (NodeRasterizer::Copy;
+//       default: the widest this CPU runs, what the pipeline runs, marked "(default)")
+//   ... --simd all: every copy this CPU runs, narrowest first, in the same run, with each wide
+//       copy's speed against the portable one's and whether their hashes agree
 #include "animorder/camera.h"
 #include "animorder/kept_fragments.h"
 #include "animorder/load.h"
@@ -57,12 +58,14 @@ struct Hash {
 int main(int argc, char** argv) try {
     if (argc < 2) {
         std::fprintf(stderr,
-                     "usage: bench_raster CHARACTER [--clip NAME] [--keyframes N] [--repeat N] [--simd 0|1|both]\n");
+                     "usage: bench_raster CHARACTER [--clip NAME] [--keyframes N] [--repeat N] [--simd 0|1|2|all]\n");
         return 1;
     }
     std::vector<std::string> clips;
     size_t keyframe_samples = 4, repeats = 2;
-    std::vector<bool> copies = {true};  // the rasteriser's copies to time: AVX2 allowed or not
+    using Copy = NodeRasterizer::Copy;
+    const Copy widest = NodeRasterizer::widest_copy();
+    std::vector<Copy> copies = {widest};  // the rasteriser's copies to time
     for (int i = 2; i + 1 < argc; i += 2) {
         if (!std::strcmp(argv[i], "--clip"))
             clips.push_back(argv[i + 1]);
@@ -70,9 +73,13 @@ int main(int argc, char** argv) try {
             keyframe_samples = std::strtoul(argv[i + 1], nullptr, 10);
         else if (!std::strcmp(argv[i], "--repeat"))
             repeats = std::strtoul(argv[i + 1], nullptr, 10);
-        else if (!std::strcmp(argv[i], "--simd"))
-            copies = !std::strcmp(argv[i + 1], "both") ? std::vector<bool>{false, true}
-                                                       : std::vector<bool>{std::strcmp(argv[i + 1], "0") != 0};
+        else if (!std::strcmp(argv[i], "--simd") && !std::strcmp(argv[i + 1], "all")) {
+            copies.clear();
+            for (const Copy c : {Copy::Portable, Copy::Avx2, Copy::Avx512})
+                if (c <= widest) copies.push_back(c);
+        } else if (!std::strcmp(argv[i], "--simd") && std::strlen(argv[i + 1]) == 1 && argv[i + 1][0] >= '0' &&
+                   argv[i + 1][0] <= '2')
+            copies = {std::min(widest, Copy(argv[i + 1][0] - '0'))};
         else {
             std::fprintf(stderr, "bench_raster: unknown option %s\n", argv[i]);
             return 1;
@@ -117,9 +124,9 @@ int main(int argc, char** argv) try {
     const std::vector<uint32_t> ranks1 = rank_tables(1), ranks5 = rank_tables(5);
     const std::vector<uint16_t> unit_ranks1 = make_unit_rank_table(ranks1.data(), 1, partition),
                                 unit_ranks5 = make_unit_rank_table(ranks5.data(), 5, partition);
-    const auto measure = [&](bool simd) {
+    const auto measure = [&](Copy copy) {
         NodeRasterizer rasterizer;
-        rasterizer.set_simd(simd);
+        rasterizer.set_copy(copy);
         KeepScratch scratch;
         double transform_s = 0, raster_s = 0, keep_s = 0, score1_s = 0, score5_s = 0, replay5_s = 0;
         Hash score_hash;  // the scores of the random unit orders
@@ -187,7 +194,7 @@ int main(int argc, char** argv) try {
                         triangle_lists += kept.triangle_lists;
                     }
                 }
-        std::printf("%s: ", simd && NodeRasterizer::simd_available() ? "AVX2 copy" : "portable copy");
+        std::printf("%s copy%s: ", NodeRasterizer::copy_name(copy), copy == widest ? " (default)" : "");
         std::printf(
             "%zu triangles, %zu nodes, %.0f fragments/node: transform %.3f ms/node, rasterize %.3f ms/node, "
             "keep %.3f ms/node (thread CPU time); output hash %016llx\n",
@@ -207,11 +214,11 @@ int main(int argc, char** argv) try {
         return Timing{1e3 * raster_s / double(nodes), hash.h};
     };
     std::vector<Timing> timings;
-    for (const bool simd : copies) timings.push_back(measure(simd));
-    if (timings.size() == 2 && NodeRasterizer::simd_available())
-        std::printf("rasterize: AVX2 copy %.2fx the portable copy's speed; hashes %s\n",
-                    timings[0].rasterize_ms / timings[1].rasterize_ms,
-                    timings[0].hash == timings[1].hash ? "equal" : "DIFFER");
+    for (const Copy copy : copies) timings.push_back(measure(copy));
+    for (size_t i = 1; i < timings.size() && copies[0] == Copy::Portable; ++i)
+        std::printf("rasterize: %s copy %.2fx the portable copy's speed; hashes %s\n",
+                    NodeRasterizer::copy_name(copies[i]), timings[0].rasterize_ms / timings[i].rasterize_ms,
+                    timings[0].hash == timings[i].hash ? "equal" : "DIFFER");
     return 0;
 } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_raster: %s\n", e.what());

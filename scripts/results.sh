@@ -227,8 +227,8 @@ fi
 # (the engine-ratio case is bench-overdraw.txt above).
 # The per-node cost on one thread (thread CPU time), the rasteriser's portable and AVX2 copies in one run.
 if [ -x "$BIN/bench/bench_raster" ]; then
-  step_stdout bench-raster-ganfaul-idle.txt "$BIN/bench/bench_raster" "$GANFAUL" --clip Idle --simd both
-  step_stdout bench-raster-xbot.txt "$BIN/bench/bench_raster" $DATA/glb-xbot/Xbot.glb --simd both
+  step_stdout bench-raster-ganfaul-idle.txt "$BIN/bench/bench_raster" "$GANFAUL" --clip Idle --simd all
+  step_stdout bench-raster-xbot.txt "$BIN/bench/bench_raster" $DATA/glb-xbot/Xbot.glb --simd all
 fi
 if [ -x "$BIN/bench/bench_scale" ]; then
   step_stdout bench-scale.txt "$BIN/bench/bench_scale" ganfaul-joint xbot-single clip60-single

@@ -39,11 +39,17 @@ public:
     void rasterize_validated(const float* clip_xyzw, size_t vertex_count, const uint32_t* indices, size_t index_count,
                              unsigned resolution, const uint8_t* modes = nullptr);
 
-    // Where the CPU has AVX2 (simd_available), rasterize runs a copy of its per-node code compiled
-    // for it: the same operations in the same order, so the same bits. set_simd(false) makes this
-    // instance run the portable copy (tests compare the two).
-    static bool simd_available();
-    void set_simd(bool allowed);
+    // The per-node code is compiled in up to three copies, each doing the same operations in the
+    // same order, so each giving the same bits: portable (SSE2 on x86-64); AVX2, where the CPU
+    // has it; AVX-512, the AVX2 copy compiled with AVX-512 (F, VL, BW, DQ) allowed at the same
+    // 256-bit vector width (more registers, mask registers, 64-bit integer lanes), where the CPU
+    // has that. rasterize runs the widest copy the CPU has, or at most the one set_copy names
+    // (tests compare them; benchmarks time each).
+    enum class Copy : uint8_t { Portable, Avx2, Avx512 };
+    static Copy widest_copy();           // the widest copy this CPU runs
+    static const char* copy_name(Copy);  // "portable", "AVX2", "AVX-512"
+    void set_copy(Copy widest);          // at most this copy from now on (default: widest_copy())
+    Copy copy() const;                   // the copy rasterize runs: set_copy's, or narrower where the CPU lacks it
 
     // Pixels covered by at least one fragment (what the depth buffer shows after any order).
     uint64_t visible_pixels() const;

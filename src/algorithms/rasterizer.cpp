@@ -35,10 +35,12 @@
 #include <cstring>
 #include <string>
 
-// The per-node code is compiled twice (rasterize_node below): portable (SSE2 on x86-64) and, on
-// x86 with GCC or Clang, for AVX2, run where the CPU has it (wider vectors for the batched
-// pre-pass and set-up). Both do the same IEEE operations in the same order (no FMA: AVX2 alone
-// does not allow contraction), so they give the same bits; test_rasterizer compares them.
+// The per-node code is compiled three times (rasterize_node below): portable (SSE2 on x86-64)
+// and, on x86 with GCC or Clang, for AVX2 (wider vectors for the batched pre-pass and set-up)
+// and for AVX-512 at 256-bit width (the AVX2 copy's source; the compiler's loops gain mask
+// registers, 32 vector registers and 64-bit integer lanes), each run where the CPU has it. All do
+// the same IEEE operations in the same order (no FMA: the build turns contraction off), so they
+// give the same bits; test_rasterizer compares them.
 #if (defined(__GNUC__) || defined(__clang__)) && (defined(__x86_64__) || defined(__i386__))
 #define ANIMORDER_RASTER_AVX2 1
 #include <immintrin.h>
@@ -107,7 +109,7 @@ struct BatchSetup {
 struct NodeRasterizer::State {
     unsigned resolution = 0;
     // Raw fragments, in rasterisation order, as three arrays (pixel, triangle, depth): the first
-    // raw_count entries are this node's. One array per field lets the AVX2 copy store a row's
+    // raw_count entries are this node's. One array per field lets the wide copies store a row's
     // covered pixels with a few vector stores. `sorted`, `gathered`: group_fragments' radix sort.
     std::vector<uint32_t> raw_pixel, raw_triangle;
     std::vector<float> raw_depth;
@@ -136,7 +138,7 @@ struct NodeRasterizer::State {
     std::vector<Snapped> snapped;
     std::vector<VertexRecord> vertices;
     std::vector<uint8_t> vertex_flags;
-    bool simd = true;                   // the AVX2 copy where the CPU has it (set_simd)
+    NodeRasterizer::Copy copy = NodeRasterizer::widest_copy();  // set_copy; never wider than the CPU runs
     std::vector<uint32_t> histogram;    // counting sort of the fragments by pixel
     std::vector<uint32_t> pixel_count;  // per pixel, zero between nodes (kPixelImageLimit pixels at most)
     std::vector<uint8_t> touched;       // per 64-pixel block, 1 when it has fragments; zero between nodes
@@ -264,7 +266,7 @@ struct LaneCompaction {
 };
 constexpr LaneCompaction kLaneCompaction;
 
-// One group of four pixels in the AVX2 copy: the lanes whose three edge values are >= 0, that lie
+// One group of four pixels in the wide (AVX2, AVX-512) copies: the lanes whose three edge values are >= 0, that lie
 // in the box and whose depth (z, rounded to float) lies in [0, 1), packed to the front and stored
 // at `count` (one 16-byte store per array, whatever the count); returns the new count.
 __attribute__((target("avx2"))) ANIMORDER_INLINE size_t emit_group_avx2(__m256d a0, __m256d a1, __m256d a2,
@@ -286,7 +288,7 @@ __attribute__((target("avx2"))) ANIMORDER_INLINE size_t emit_group_avx2(__m256d 
     return count + kLaneCompaction.count[mask];
 }
 
-// emit_box in the AVX2 copy, from BatchSetup's doubles (no conversion to int64): 4 pixels of a row
+// emit_box in the wide copies, from BatchSetup's doubles (no conversion to int64): 4 pixels of a row
 // at a time, in double lanes. Exact: the edge values e + k·step_x + r·step_y are integers below
 // 2^53 in magnitude (BatchSetup's bound plus at most 2 · 2^14 · 2^33), so double holds them, sums
 // included, and their signs decide coverage as in emit_box; the depth of a lane is
@@ -295,6 +297,7 @@ __attribute__((target("avx2"))) ANIMORDER_INLINE size_t emit_group_avx2(__m256d 
 // arrays with one 16-byte store each: the fragments of emit_box, in its order. Up to 3 slots past
 // the fragments are written too (reserved). A box at most 4 pixels wide (most of them) takes one
 // group a row without an inner loop: the same lanes, so the same values.
+template <NodeRasterizer::Copy>  // one instance a wide copy: each inlines its own
 __attribute__((target("avx2"))) void emit_box_avx2(const double (&e_first)[3], const double (&step_x)[3],
                                                    const double (&step_y)[3], double dzdx, double dzdy, double z_origin,
                                                    const TriangleBox& box, uint32_t triangle, unsigned resolution,
@@ -355,7 +358,7 @@ __attribute__((target("avx2"))) void emit_box_avx2(const double (&e_first)[3], c
     sink.count = count;
 }
 
-// emit_small_box in the AVX2 copy: the box's four pixels are the four lanes (x0 y0, x1 y0, x0 y1,
+// emit_small_box in the wide copies: the box's four pixels are the four lanes (x0 y0, x1 y0, x0 y1,
 // x1 y1, emit_small_box's order), edge values e, e + sx, e + sy, e + sx + sy (integers below 2^53:
 // exact in double), depths emit_small_box's float(z_row + dzdx · x), the lanes past the box masked,
 // then one emit_group_avx2. Takes BatchSetup's doubles as they are: no conversion to int64.
@@ -511,7 +514,7 @@ void rasterize_clipped_triangle(const ClipVertex (&v)[3], uint32_t triangle, uns
 // the fragments of the other pixels are moved as (depth, triangle) keys, one 64-bit integer each:
 // a depth is a float in [0, 1), whose bits order as its values once −0 is made +0 (adding +0 does
 // that), so the keys compare as the pairs, and equal high halves are equal depths.
-void group_fragments_by_image(NodeRasterizer::State& s) {
+ANIMORDER_INLINE void group_fragments_by_image(NodeRasterizer::State& s) {
     const size_t n = s.raw_count;
     const uint32_t pixels = s.resolution * s.resolution;
     const size_t blocks = (size_t(pixels) + 63) / 64;
@@ -649,7 +652,7 @@ void group_fragments_by_image(NodeRasterizer::State& s) {
 // a loop over every pixel of the viewport). Each pixel with two or more fragments is then sorted
 // by depth into the compact list that scoring walks; a single-fragment pixel only counts, its
 // fragment passes under every order.
-void group_fragments(NodeRasterizer::State& s) {
+ANIMORDER_INLINE void group_fragments(NodeRasterizer::State& s) {
     const uint32_t image_pixels = s.resolution * s.resolution;
     if (image_pixels <= kPixelImageLimit) return group_fragments_by_image(s);
     const size_t n = s.raw_count;
@@ -795,12 +798,13 @@ ANIMORDER_INLINE void batch_box_test(size_t n, const int32_t* x0, const int32_t*
 
 #ifdef ANIMORDER_RASTER_AVX2
 // The vertex pass of rasterize_node (inside_all, project, the compact test, the record) for 8
-// vertices at a time in the AVX2 copy: the same float operations in the same order (a division,
+// vertices at a time in the wide copies: the same float operations in the same order (a division,
 // products and sums rounded one by one, no FMA), so the same bits. Returns how many vertices it
 // did (a multiple of 8); the scalar loop does the rest. round_half_away's int64(v ± 0.5f) is
 // taken as an int32 truncation where |v ± 0.5f| < 2^30 (the same integer) and the compact test
 // as there: X compact iff |t| < 2^24 (t = v ± 0.5f; floats at 2^23 and above are integers), Y
 // compact iff top_row − trunc(t) lies inside ±2^24; NaN compares false (not compact).
+template <NodeRasterizer::Copy>  // one instance a wide copy: each inlines its own
 __attribute__((target("avx2"))) size_t project_vertices_avx2(const ClipVertex* cv, size_t count, unsigned resolution,
                                                              NodeRasterizer::State::Snapped* snapped,
                                                              NodeRasterizer::State::VertexRecord* out, uint8_t* flags) {
@@ -889,6 +893,8 @@ void rasterize_node_portable(NodeRasterizer::State& s, const float* clip_xyzw, s
 #ifdef ANIMORDER_RASTER_AVX2
 void rasterize_node_avx2(NodeRasterizer::State& s, const float* clip_xyzw, size_t vertex_count, const uint32_t* indices,
                          size_t index_count, unsigned resolution, const uint8_t* modes);
+void rasterize_node_avx512(NodeRasterizer::State& s, const float* clip_xyzw, size_t vertex_count,
+                           const uint32_t* indices, size_t index_count, unsigned resolution, const uint8_t* modes);
 #endif
 }  // namespace
 
@@ -905,32 +911,50 @@ void NodeRasterizer::rasterize_validated(const float* clip_xyzw, size_t vertex_c
     State& s = *state_;
     s.resolution = resolution;
 #ifdef ANIMORDER_RASTER_AVX2
-    if (s.simd && simd_available())
+    if (s.copy == Copy::Avx512)
+        return rasterize_node_avx512(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes);
+    if (s.copy == Copy::Avx2)
         return rasterize_node_avx2(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes);
 #endif
     rasterize_node_portable(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes);
 }
 
-bool NodeRasterizer::simd_available() {
+NodeRasterizer::Copy NodeRasterizer::widest_copy() {
 #ifdef ANIMORDER_RASTER_AVX2
-    static const bool avx2 = __builtin_cpu_supports("avx2");
-    return avx2;
+    static const Copy widest = [] {
+        if (!__builtin_cpu_supports("avx2")) return Copy::Portable;
+        const bool avx512 = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+                            __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq");
+        return avx512 ? Copy::Avx512 : Copy::Avx2;
+    }();
+    return widest;
 #else
-    return false;
+    return Copy::Portable;
 #endif
 }
 
-void NodeRasterizer::set_simd(bool allowed) { state_->simd = allowed; }
+const char* NodeRasterizer::copy_name(Copy copy) {
+    switch (copy) {
+        case Copy::Avx2: return "AVX2";
+        case Copy::Avx512: return "AVX-512";
+        default: return "portable";
+    }
+}
+
+void NodeRasterizer::set_copy(Copy widest) { state_->copy = std::min(widest, widest_copy()); }
+NodeRasterizer::Copy NodeRasterizer::copy() const { return state_->copy; }
 
 namespace {
 
 // One node after the checks: project the vertices, pre-pass and set up the triangles in
-// batches, draw them, group the fragments. Inlined into the two copies below; kAvx2: the AVX2
-// copy, whose large boxes take emit_box_avx2.
-template <bool kAvx2>
+// batches, draw them, group the fragments (group_fragments inlined too, so each copy compiles it
+// for its own instructions). Inlined into the three copies below; kAvx2: the AVX2 and AVX-512
+// copies, whose boxes take the emit_*_avx2 paths.
+template <NodeRasterizer::Copy kCopy>
 ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip_xyzw, size_t vertex_count,
                                      const uint32_t* indices, size_t index_count, unsigned resolution,
                                      const uint8_t* modes) {
+    constexpr bool kAvx2 = kCopy != NodeRasterizer::Copy::Portable;
     const ClipVertex* cv = reinterpret_cast<const ClipVertex*>(clip_xyzw);
     s.snapped.resize(vertex_count);
     s.vertices.resize(vertex_count);
@@ -938,8 +962,8 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
     size_t first_vertex = 0;
 #ifdef ANIMORDER_RASTER_AVX2
     if constexpr (kAvx2)
-        first_vertex = project_vertices_avx2(cv, vertex_count, resolution, s.snapped.data(), s.vertices.data(),
-                                             s.vertex_flags.data());
+        first_vertex = project_vertices_avx2<kCopy>(cv, vertex_count, resolution, s.snapped.data(), s.vertices.data(),
+                                                    s.vertex_flags.data());
 #endif
     for (size_t v = first_vertex; v < vertex_count; ++v) {
         if (!inside_all(cv[v])) {
@@ -1051,8 +1075,8 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
                         emit_small_box_avx2(e, sx, sy, setup.dzdx[j], setup.dzdy[j], setup.z_origin[j], box,
                                             uint32_t(t), resolution, sink);
                     else
-                        emit_box_avx2(e, sx, sy, setup.dzdx[j], setup.dzdy[j], setup.z_origin[j], box, uint32_t(t),
-                                      resolution, sink);
+                        emit_box_avx2<kCopy>(e, sx, sy, setup.dzdx[j], setup.dzdy[j], setup.z_origin[j], box,
+                                             uint32_t(t), resolution, sink);
                     continue;
                 }
 #endif
@@ -1086,7 +1110,7 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
 
 void rasterize_node_portable(NodeRasterizer::State& s, const float* clip_xyzw, size_t vertex_count,
                              const uint32_t* indices, size_t index_count, unsigned resolution, const uint8_t* modes) {
-    rasterize_node<false>(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes);
+    rasterize_node<NodeRasterizer::Copy::Portable>(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes);
 }
 
 #ifdef ANIMORDER_RASTER_AVX2
@@ -1094,7 +1118,15 @@ __attribute__((target("avx2"))) void rasterize_node_avx2(NodeRasterizer::State& 
                                                          size_t vertex_count, const uint32_t* indices,
                                                          size_t index_count, unsigned resolution,
                                                          const uint8_t* modes) {
-    rasterize_node<true>(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes);
+    rasterize_node<NodeRasterizer::Copy::Avx2>(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes);
+}
+
+// The AVX2 copy's source compiled with AVX-512 allowed; GCC keeps its loops at 256-bit vectors
+// (its default width for these targets), so no 512-bit clock penalty where a CPU has one.
+__attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) void rasterize_node_avx512(
+    NodeRasterizer::State& s, const float* clip_xyzw, size_t vertex_count, const uint32_t* indices, size_t index_count,
+    unsigned resolution, const uint8_t* modes) {
+    rasterize_node<NodeRasterizer::Copy::Avx512>(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes);
 }
 #endif
 
@@ -1127,7 +1159,7 @@ void replay_all(uint64_t* passed, const uint32_t* starts, size_t pixels, const u
 }
 
 #ifdef ANIMORDER_RASTER_AVX2
-// replay_all in the AVX2 copy: the K orders are K lanes of one 8-lane vector (a masked load reads a
+// replay_all in the wide copies: the K orders are K lanes of one 8-lane vector (a masked load reads a
 // fragment's K ranks; ranks are below 2^31, so signed compares order them). A list of at most 4
 // fragments without equal depths (nearly all) takes 4 steps without a branch, a shorter one
 // repeating its last fragment (which can neither pass nor lower the minimum); longer untied lists
@@ -1176,7 +1208,7 @@ __attribute__((target("avx2"))) void replay_all_avx2(uint64_t* passed, const uin
 void replay_all_any(uint64_t* passed, const uint32_t* starts, size_t pixels, const uint32_t* fragments,
                     const uint32_t* ranks, size_t order_count, bool simd) {
 #ifdef ANIMORDER_RASTER_AVX2
-    if (simd && NodeRasterizer::simd_available()) switch (order_count) {
+    if (simd && NodeRasterizer::widest_copy() != NodeRasterizer::Copy::Portable) switch (order_count) {
             case 1: return replay_all_avx2<1>(passed, starts, pixels, fragments, ranks);
             case 2: return replay_all_avx2<2>(passed, starts, pixels, fragments, ranks);
             case 3: return replay_all_avx2<3>(passed, starts, pixels, fragments, ranks);
@@ -1236,7 +1268,8 @@ void score_fragments(uint64_t* passed, const NodeFragments& node, const uint32_t
 void NodeRasterizer::score(uint64_t* passed, const uint32_t* ranks, size_t order_count) const {
     const State& s = *state_;
     for (size_t o = 0; o < order_count; ++o) passed[o] = s.single;  // a lone fragment always passes
-    replay_all_any(passed, s.multi_start.data(), s.multi_count, s.multi_fragment.data(), ranks, order_count, s.simd);
+    replay_all_any(passed, s.multi_start.data(), s.multi_count, s.multi_fragment.data(), ranks, order_count,
+                   s.copy != Copy::Portable);
 }
 
 std::vector<uint32_t> NodeRasterizer::passed_per_pixel(const uint32_t* ranks, size_t order_count,

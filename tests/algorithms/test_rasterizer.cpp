@@ -26,6 +26,16 @@ using namespace animorder;
 
 namespace {
 
+using Copy = NodeRasterizer::Copy;
+
+// The copies of the per-node code this CPU runs, narrowest (portable) first.
+std::vector<Copy> copies_here() {
+    std::vector<Copy> copies;
+    for (const Copy c : {Copy::Portable, Copy::Avx2, Copy::Avx512})
+        if (c <= NodeRasterizer::widest_copy()) copies.push_back(c);
+    return copies;
+}
+
 // A scene in clip space with w = 1 (orthographic): x, y, z are NDC.
 struct Scene {
     std::vector<float> clip;
@@ -211,8 +221,8 @@ uint64_t brute_force_passed(const NodeRasterizer& r, const std::vector<uint32_t>
 }
 }  // namespace
 
-// Both copies (portable and AVX2), 1 to 9 orders at once (the AVX2 copy has one vector lane per
-// order up to 8, then the generic replay), against a z-buffer drawing each order; on the bundled
+// Every copy the CPU runs (portable, AVX2, AVX-512), 1 to 9 orders at once (the wide copies have
+// one vector lane per order up to 8, then the generic replay), against a z-buffer drawing each order; on the bundled
 // character and on a copy with every seventh triangle drawn twice (equal depths: ties).
 TEST(Rasterizer, ScoringManyOrdersEqualsDrawingEachOrderWithAZBuffer) {
     AnimatedMesh doubled = make_procedural_character();
@@ -246,11 +256,11 @@ TEST(Rasterizer, ScoringManyOrdersEqualsDrawingEachOrderWithAZBuffer) {
                 transform_to_clip(clip.data(), mesh.keyframe(k), mesh.vertex_count, &framing.centres[3 * k],
                                   node_view_projection(&dirs[3 * v], framing.radius));
                 std::vector<uint64_t> want(orders.size());
-                for (const bool simd : {false, true}) {
+                for (const Copy copy : copies_here()) {
                     NodeRasterizer r;
-                    r.set_simd(simd);
+                    r.set_copy(copy);
                     r.rasterize(clip.data(), mesh.vertex_count, mesh.indices.data(), mesh.indices.size(), 128);
-                    if (!simd) {
+                    if (copy == Copy::Portable) {
                         for (size_t o = 0; o < orders.size(); ++o) want[o] = brute_force_passed(r, orders[o]);
                         const NodeRasterizer::FragmentLists l = r.fragment_lists();
                         for (size_t m = 0; m < l.pixels; ++m) {
@@ -263,8 +273,9 @@ TEST(Rasterizer, ScoringManyOrdersEqualsDrawingEachOrderWithAZBuffer) {
                         std::vector<uint64_t> passed(c);
                         r.score(passed.data(), ranks[c].data(), c);
                         for (size_t o = 0; o < c; ++o) {
-                            EXPECT_EQ(passed[o], want[o]) << "view " << v << " keyframe " << k << " order " << o
-                                                          << " of " << c << (simd ? ", AVX2 copy" : ", portable copy");
+                            EXPECT_EQ(passed[o], want[o])
+                                << "view " << v << " keyframe " << k << " order " << o << " of " << c << ", "
+                                << NodeRasterizer::copy_name(copy) << " copy";
                             EXPECT_GE(passed[o], r.visible_pixels());
                             EXPECT_LE(passed[o], r.fragments());
                         }
@@ -279,7 +290,7 @@ TEST(Rasterizer, ScoringManyOrdersEqualsDrawingEachOrderWithAZBuffer) {
 }
 
 // score_fragments on made-up lists of 2 to 12 fragments with equal depths anywhere in them
-// (also only past the fourth fragment, where the AVX2 copy's short-list path ends), 1 to 9
+// (also only past the fourth fragment, where the wide copies' short-list path ends), 1 to 9
 // orders, against drawing each order into one z-buffer entry per pixel.
 TEST(Rasterizer, ScoringListsWithTiesAnywhereEqualsAZBuffer) {
     std::mt19937 rng(5);
@@ -593,18 +604,17 @@ void expect_same_fragments(const std::vector<std::tuple<uint32_t, uint32_t, floa
     }
 }
 
-// Both copies of the per-node code (the portable one and, where the CPU has it, the AVX2 one) draw
-// exactly the expected fragments.
-void expect_both_copies_draw(const std::vector<float>& clip, const std::vector<uint32_t>& ib,
+// Every copy of the per-node code the CPU runs (portable, AVX2, AVX-512) draws exactly the
+// expected fragments.
+void expect_every_copy_draws(const std::vector<float>& clip, const std::vector<uint32_t>& ib,
                              const std::vector<uint8_t>& modes, unsigned resolution,
                              const std::vector<std::tuple<uint32_t, uint32_t, float>>& expected,
                              const std::string& what) {
-    for (bool simd : {false, true}) {
-        if (simd && !NodeRasterizer::simd_available()) continue;
+    for (const Copy copy : copies_here()) {
         NodeRasterizer r;
-        r.set_simd(simd);
+        r.set_copy(copy);
         r.rasterize(clip.data(), clip.size() / 4, ib.data(), ib.size(), resolution, modes.data());
-        expect_same_fragments(engine_fragments(r), expected, what + "simd " + std::to_string(simd));
+        expect_same_fragments(engine_fragments(r), expected, what + NodeRasterizer::copy_name(copy) + " copy");
     }
 }
 
@@ -613,8 +623,8 @@ void expect_both_copies_draw(const std::vector<float>& clip, const std::vector<u
 // Every fragment (pixel, triangle, depth bits) and its order, against the plain reference, on
 // triangles meant to hit the engine's special cases: random ones of all sizes, tiny ones inside
 // one pixel box, slivers, corners on pixel centres (fill rule), double-sided back faces, skipped
-// ones, and more triangles than one batch of the pre-pass. Both copies of the per-node code (the
-// portable one and, where the CPU has it, the AVX2 one) are checked.
+// ones, and more triangles than one batch of the pre-pass. Every copy of the per-node code (the
+// portable one and, where the CPU has them, the AVX2 and AVX-512 ones) are checked.
 TEST(Rasterizer, FragmentsEqualAPlainPerPixelReference) {
     std::mt19937 rng(19);
     std::uniform_real_distribution<float> any(-1.0f, 1.0f), depth(-0.9f, 0.9f), small(-0.02f, 0.02f);
@@ -660,13 +670,14 @@ TEST(Rasterizer, FragmentsEqualAPlainPerPixelReference) {
             add(p, mode);
         }
         const auto expected = reference_fragments(clip, ib, modes, resolution);
-        expect_both_copies_draw(clip, ib, modes, resolution, expected, "resolution " + std::to_string(resolution) + " ");
+        expect_every_copy_draws(clip, ib, modes, resolution, expected,
+                                "resolution " + std::to_string(resolution) + " ");
         EXPECT_GT(expected.size(), 200u);  // the scene draws something
     }
 }
 
 // The per-box paths of both copies against the plain reference: boxes of 1 × 1, 1 × 2, 2 × 1 and
-// 2 × 2 pixels (the AVX2 copy's one-vector path), and boxes 3 to 10 pixels wide (its 4-pixel groups:
+// 2 × 2 pixels (the wide copies' one-vector path), and boxes 3 to 10 pixels wide (its 4-pixel groups:
 // one group, two, three, with masked lanes past the box), mixed in one batch; boxes cut by the
 // viewport's edges; both faces; depths at and next to 0 and 1 (some fragments round to depth 1
 // and are dropped).
@@ -704,7 +715,7 @@ TEST(Rasterizer, SmallAndWideBoxesEqualThePlainReference) {
         near_zero += std::get<2>(f) < 0.001f;
         near_one += std::get<2>(f) > 0.999f;
     }
-    expect_both_copies_draw(clip, ib, modes, resolution, expected, "");
+    expect_every_copy_draws(clip, ib, modes, resolution, expected, "");
     EXPECT_GT(expected.size(), 1000u) << near_zero << " " << near_one;
     EXPECT_GT(near_zero, 5u);
     EXPECT_GT(near_one, 5u);
@@ -765,7 +776,7 @@ TEST(Rasterizer, SmallBoxTestDropsOnlyTrianglesThatCoverNothing) {
     }
     const auto far_expected = reference_fragments(far_clip, far_ib, far_modes, large);
     EXPECT_GT(far_expected.size(), 50u);
-    expect_both_copies_draw(far_clip, far_ib, far_modes, large, far_expected, "far corners, ");
+    expect_every_copy_draws(far_clip, far_ib, far_modes, large, far_expected, "far corners, ");
 
     const auto expected = reference_fragments(clip, ib, modes, resolution);
     // The scene has both kinds of pixel-sized triangle: those that cover a centre and those that do not.
@@ -774,7 +785,7 @@ TEST(Rasterizer, SmallBoxTestDropsOnlyTrianglesThatCoverNothing) {
     const size_t empty = size_t(std::count(per_triangle.begin(), per_triangle.end(), 0u));
     EXPECT_GT(empty, 1000u);
     EXPECT_GT(per_triangle.size() - empty, 1000u);
-    expect_both_copies_draw(clip, ib, modes, resolution, expected, "");
+    expect_every_copy_draws(clip, ib, modes, resolution, expected, "");
 }
 
 // Clipped triangles (crossing the near plane or the guard band) among unclipped ones: each
@@ -872,12 +883,12 @@ TEST(Rasterizer, GroupedListsEqualASortOfTheRawFragments) {
     }
 }
 
-// The AVX2 copy of the per-node code against the portable one, bit for bit: every raw fragment
+// The wide copies of the per-node code (AVX2, AVX-512) against the portable one, bit for bit: every raw fragment
 // (pixel, triangle, depth bits, in order) and the grouped lists, on the bundled character from
 // 42 directions at two keyframes (small triangles, the common case) at 64² and 256², with a
 // wide near-plane-crossing triangle added (the exact paths).
-TEST(Rasterizer, Avx2CopyGivesThePortableBits) {
-    if (!NodeRasterizer::simd_available()) GTEST_SKIP() << "this CPU has no AVX2: only the portable copy runs";
+TEST(Rasterizer, WideCopiesGiveThePortableBits) {
+    if (copies_here().size() < 2) GTEST_SKIP() << "this CPU has no AVX2: only the portable copy runs";
     const AnimatedMesh mesh = make_procedural_character();
     const Framing framing = frame_animated_mesh(mesh);
     const std::vector<float> dirs = icosphere_directions(1);
@@ -896,29 +907,39 @@ TEST(Rasterizer, Avx2CopyGivesThePortableBits) {
                                   node_view_projection(&dirs[3 * v], framing.radius));
                 const float wide[12] = {-3.0f, -0.5f, -2.0f, 1.0f, 3.0f, 0.2f, 0.5f, 1.0f, 0.1f, 2.5f, 0.9f, 1.0f};
                 std::copy(wide, wide + 12, clip.end() - 12);
-                NodeRasterizer portable, simd;
-                portable.set_simd(false);
+                NodeRasterizer portable;
+                portable.set_copy(Copy::Portable);
                 portable.rasterize(clip.data(), mesh.vertex_count + 3, ib.data(), ib.size(), resolution, modes.data());
-                simd.rasterize(clip.data(), mesh.vertex_count + 3, ib.data(), ib.size(), resolution, modes.data());
-                const auto a = engine_fragments(portable), b = engine_fragments(simd);
-                ASSERT_EQ(a.size(), b.size()) << "view " << v;
-                for (size_t f = 0; f < a.size(); ++f) {
-                    ASSERT_EQ(std::get<0>(a[f]), std::get<0>(b[f])) << "view " << v << " fragment " << f;
-                    ASSERT_EQ(std::get<1>(a[f]), std::get<1>(b[f])) << "view " << v << " fragment " << f;
-                    ASSERT_EQ(std::memcmp(&std::get<2>(a[f]), &std::get<2>(b[f]), 4), 0)
-                        << "view " << v << " fragment " << f;
+                const auto a = engine_fragments(portable);
+                const NodeFragments ga = portable.export_fragments();
+                for (const Copy copy : copies_here()) {
+                    if (copy == Copy::Portable) continue;
+                    NodeRasterizer wide_copy;
+                    wide_copy.set_copy(copy);
+                    wide_copy.rasterize(clip.data(), mesh.vertex_count + 3, ib.data(), ib.size(), resolution,
+                                        modes.data());
+                    const std::string what =
+                        std::string(NodeRasterizer::copy_name(copy)) + " copy, view " + std::to_string(v);
+                    const auto b = engine_fragments(wide_copy);
+                    ASSERT_EQ(a.size(), b.size()) << what;
+                    for (size_t f = 0; f < a.size(); ++f) {
+                        ASSERT_EQ(std::get<0>(a[f]), std::get<0>(b[f])) << what << " fragment " << f;
+                        ASSERT_EQ(std::get<1>(a[f]), std::get<1>(b[f])) << what << " fragment " << f;
+                        ASSERT_EQ(std::memcmp(&std::get<2>(a[f]), &std::get<2>(b[f]), 4), 0)
+                            << what << " fragment " << f;
+                    }
+                    const NodeFragments gb = wide_copy.export_fragments();
+                    ASSERT_EQ(ga.visible, gb.visible) << what;
+                    ASSERT_EQ(ga.single, gb.single) << what;
+                    ASSERT_EQ(ga.starts, gb.starts) << what;
+                    ASSERT_EQ(ga.fragments, gb.fragments) << what;
+                    compared += a.size();
                 }
-                const NodeFragments ga = portable.export_fragments(), gb = simd.export_fragments();
-                ASSERT_EQ(ga.visible, gb.visible);
-                ASSERT_EQ(ga.single, gb.single);
-                ASSERT_EQ(ga.starts, gb.starts);
-                ASSERT_EQ(ga.fragments, gb.fragments);
-                compared += a.size();
             }
     EXPECT_GT(compared, 100000u);  // the views draw the character
 }
 
-// The AVX2 copy's vertex pass (8 vertices at a time) against the portable one's (one at a time),
+// The wide copies' vertex pass (8 vertices at a time) against the portable one's (one at a time),
 // bit for bit, on vertices chosen to hit its branches: inside and outside each clip plane and the
 // guard band (and exactly on them), w negative, tiny and huge, subpixel coordinates exactly
 // half-way between two integers (rounding half away from zero), −0, resolutions whose half is not
@@ -927,8 +948,8 @@ TEST(Rasterizer, Avx2CopyGivesThePortableBits) {
 // among them, so that most vertices are drawn. Fails when a record (snapped X, Y, the depth
 // plane's x, y, z) differs: fragments then move, change depth or go (checked: rounding ties to
 // even, or x · (1/w · half) for (x · 1/w) · half, fail it).
-TEST(Rasterizer, Avx2VertexPassGivesThePortableBits) {
-    if (!NodeRasterizer::simd_available()) GTEST_SKIP() << "this CPU has no AVX2: only the portable copy runs";
+TEST(Rasterizer, WideVertexPassGivesThePortableBits) {
+    if (copies_here().size() < 2) GTEST_SKIP() << "this CPU has no AVX2: only the portable copy runs";
     std::mt19937 rng(20261125);
     std::uniform_real_distribution<float> unit(-1.0f, 1.0f), small(-0.02f, 0.02f);
     const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
@@ -970,14 +991,19 @@ TEST(Rasterizer, Avx2VertexPassGivesThePortableBits) {
             for (uint32_t v = 0; v + 2 < vertices; ++v) ib.insert(ib.end(), {v + 2, v + 1, v});  // back faces too
             std::vector<uint8_t> modes(ib.size() / 3, 0);
             for (size_t t = 0; t < modes.size(); t += 2) modes[t] = kDrawBothFaces;
-            NodeRasterizer portable, simd;
-            portable.set_simd(false);
+            NodeRasterizer portable;
+            portable.set_copy(Copy::Portable);
             portable.rasterize(clip.data(), vertices, ib.data(), ib.size(), resolution, modes.data());
-            simd.rasterize(clip.data(), vertices, ib.data(), ib.size(), resolution, modes.data());
-            const std::string what =
-                "resolution " + std::to_string(resolution) + ", " + std::to_string(vertices) + " vertices";
             const auto expected = engine_fragments(portable);
-            expect_same_fragments(engine_fragments(simd), expected, what);
+            for (const Copy copy : copies_here()) {
+                if (copy == Copy::Portable) continue;
+                NodeRasterizer wide_copy;
+                wide_copy.set_copy(copy);
+                wide_copy.rasterize(clip.data(), vertices, ib.data(), ib.size(), resolution, modes.data());
+                expect_same_fragments(engine_fragments(wide_copy), expected,
+                                      std::string(NodeRasterizer::copy_name(copy)) + " copy, resolution " +
+                                          std::to_string(resolution) + ", " + std::to_string(vertices) + " vertices");
+            }
             fragments += expected.size();
         }
     }

@@ -29,6 +29,9 @@
 #include <string>
 #include <tuple>
 #include <type_traits>
+#ifdef __SSE2__
+#include <emmintrin.h>
+#endif
 
 namespace animorder {
 namespace {
@@ -261,6 +264,16 @@ typedef int16_t I16x8 __attribute__((vector_size(16)));
 typedef uint16_t U16x8 __attribute__((vector_size(16)));
 typedef uint32_t U32x4 __attribute__((vector_size(16)));
 
+// The lane-wise minimum: one instruction on x86 (SSE2's pminsw), which the compiler does not find
+// in the portable form.
+ANIMORDER_KEPT_INLINE I16x8 lane_min(I16x8 a, I16x8 b) {
+#ifdef __SSE2__
+    return I16x8(_mm_min_epi16(__m128i(a), __m128i(b)));
+#else
+    return a < b ? a : b;
+#endif
+}
+
 // 2 to 8 orders side by side, one vector lane each (rows of 8 ranks ^ 0x8000: signed compares
 // order them as the ranks), list by list. The replay is replay_list's: an entry passes iff its
 // rank beats the running minimum and nothing of its own tie group passed before it. A list
@@ -280,11 +293,21 @@ void score_unit_lists_k(uint64_t* passed, const KeptNode& node, const uint16_t* 
         return r;
     };
     U32x4 low = {}, high = {};
+    // low, high += passes × weight, lane by lane (16 × 16 → 32 bits): on x86 the two 16-bit halves
+    // of each product (SSE2 has no 32-bit multiply; its emulation costs twice as much), else
+    // widened and multiplied.
     const auto add = [&](I16x8 passes, uint32_t weight) {
+#ifdef __SSE2__
+        const __m128i p = __m128i(passes), w = _mm_set1_epi16(int16_t(uint16_t(weight)));
+        const __m128i product_low = _mm_mullo_epi16(p, w), product_high = _mm_mulhi_epu16(p, w);
+        low += U32x4(_mm_unpacklo_epi16(product_low, product_high));
+        if constexpr (K > 4) high += U32x4(_mm_unpackhi_epi16(product_low, product_high));
+#else
         const U32x4 w = U32x4{} + weight;
         const U16x8 p = U16x8(passes);
         low += U32x4(__builtin_shufflevector(p, U16x8{}, 0, 8, 1, 9, 2, 10, 3, 11)) * w;
         if constexpr (K > 4) high += U32x4(__builtin_shufflevector(p, U16x8{}, 4, 12, 5, 13, 6, 14, 7, 15)) * w;
+#endif
     };
     // Any list, ties or not: replay_list's rule entry by entry.
     const auto general = [&](const uint16_t* f, uint32_t n) {
@@ -294,7 +317,7 @@ void score_unit_lists_k(uint64_t* passed, const KeptNode& node, const uint16_t* 
             if (j == 0 || !(f[j] & kUnitTieBit)) before = running;
             const I16x8 below = r < running;
             passes -= below & (running == before);
-            running ^= (running ^ r) & below;
+            running = lane_min(running, r);
         }
         return passes;
     };
@@ -314,7 +337,7 @@ void score_unit_lists_k(uint64_t* passed, const KeptNode& node, const uint16_t* 
                 const I16x8 r = row(e[j]);
                 const I16x8 below = r < running;
                 passes -= below;
-                running ^= (running ^ r) & below;
+                running = lane_min(running, r);
             }
             add(passes, weights[list]);
         }

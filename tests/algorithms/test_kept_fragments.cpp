@@ -282,6 +282,39 @@ TEST(KeptFragments, ListsOfEveryLengthScoreAsThePerTriangleListsForAnyOrderCount
     }
 }
 
+// Weights of 2^15 and more (scoring multiplies 16-bit pass counts by 16-bit weights; a signed
+// high half would make them negative) and past 65535 (a second copy of the list): 70,000 pixels
+// see units 0, 1, 2 nearest first and 40,000 see units 2, 1, 0. Drawn 0, 1, 2 the first pass once
+// and the second three times: 70,000 + 120,000; drawn 2, 1, 0 the other way round, 210,000 +
+// 40,000; drawn 1, 0, 2, 2 · 70,000 + 2 · 40,000. Scored with 1 to 8 orders at once (one order in
+// scalar code, 2 to 4 in the low half of the vector lanes, 5 to 8 in both).
+TEST(KeptFragments, HeavyWeightsScoreExactly) {
+    const UnitPartition p = runs({1, 1, 1});
+    Lists l;
+    for (int i = 0; i < 70000; ++i) l.pixel({0, 1, 2});
+    for (int i = 0; i < 40000; ++i) l.pixel({2, 1, 0});
+    const NodeFragments full = l.node(0);
+    const KeptNode k = keep(full, p);
+    EXPECT_EQ(k.unit_lists, 3u);  // 65,535 + 4,465 copies of the first list, one of the second
+    const std::vector<std::vector<uint32_t>> base = {{0, 1, 2}, {2, 1, 0}, {1, 0, 2}};
+    const uint64_t expected[3] = {190000, 250000, 220000};
+    for (size_t count = 1; count <= 8; ++count) {
+        std::vector<std::vector<uint32_t>> orders;
+        for (size_t o = 0; o < count; ++o) orders.push_back(base[o % 3]);
+        SCOPED_TRACE(std::to_string(count) + " orders");
+        expect_same_counts(full, k, p, orders);
+        std::vector<std::vector<uint32_t>> faces;
+        std::vector<const uint32_t*> pointers;
+        for (const auto& o : orders) faces.push_back(face_order(p, o));
+        for (const auto& f : faces) pointers.push_back(f.data());
+        const std::vector<uint32_t> ranks = make_rank_table(pointers, 3);
+        const std::vector<uint16_t> unit_ranks = make_unit_rank_table(ranks.data(), count, p);
+        std::vector<uint64_t> got(count);
+        score_kept(got.data(), k, unit_ranks.data(), ranks.data(), count);
+        for (size_t o = 0; o < count; ++o) EXPECT_EQ(got[o], expected[o % 3]) << "order " << o;
+    }
+}
+
 // A list naming a triangle the partition does not have is refused, whichever of its entries it is
 // and whatever its length (lists of two to four take a path of their own).
 TEST(KeptFragments, ATriangleBeyondThePartitionIsRefused) {

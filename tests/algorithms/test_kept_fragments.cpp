@@ -69,9 +69,9 @@ std::vector<uint32_t> face_order(const UnitPartition& p, const std::vector<uint3
     return faces;
 }
 
-// Both forms scored with the same orders must agree.
-void expect_same_counts(const NodeFragments& full, const KeptNode& kept, const UnitPartition& p,
-                        const std::vector<std::vector<uint32_t>>& unit_orders) {
+// Both forms scored with the same orders must agree; returns the kept form's counts.
+std::vector<uint64_t> expect_same_counts(const NodeFragments& full, const KeptNode& kept, const UnitPartition& p,
+                                         const std::vector<std::vector<uint32_t>>& unit_orders) {
     std::vector<std::vector<uint32_t>> faces;
     std::vector<const uint32_t*> pointers;
     for (const auto& o : unit_orders) faces.push_back(face_order(p, o));
@@ -83,6 +83,7 @@ void expect_same_counts(const NodeFragments& full, const KeptNode& kept, const U
     score_kept(got.data(), kept, unit_ranks.data(), ranks.data(), faces.size());
     EXPECT_EQ(got, expected);
     EXPECT_EQ(kept.visible, full.visible);
+    return got;
 }
 
 KeptNode keep(const NodeFragments& n, const UnitPartition& p) {
@@ -302,15 +303,7 @@ TEST(KeptFragments, HeavyWeightsScoreExactly) {
         std::vector<std::vector<uint32_t>> orders;
         for (size_t o = 0; o < count; ++o) orders.push_back(base[o % 3]);
         SCOPED_TRACE(std::to_string(count) + " orders");
-        expect_same_counts(full, k, p, orders);
-        std::vector<std::vector<uint32_t>> faces;
-        std::vector<const uint32_t*> pointers;
-        for (const auto& o : orders) faces.push_back(face_order(p, o));
-        for (const auto& f : faces) pointers.push_back(f.data());
-        const std::vector<uint32_t> ranks = make_rank_table(pointers, 3);
-        const std::vector<uint16_t> unit_ranks = make_unit_rank_table(ranks.data(), count, p);
-        std::vector<uint64_t> got(count);
-        score_kept(got.data(), k, unit_ranks.data(), ranks.data(), count);
+        const std::vector<uint64_t> got = expect_same_counts(full, k, p, orders);
         for (size_t o = 0; o < count; ++o) EXPECT_EQ(got[o], expected[o % 3]) << "order " << o;
     }
 }

@@ -17,9 +17,13 @@ public:
 };
 
 // Throws OutputError unless every output path can be written as a new or replaced file: its folder
-// exists, it is not a folder, it is not (after resolving links) one of `inputs`, and no two
-// outputs are the same file. Call it before any long work, so a bad path fails at once.
+// exists, it is not a folder, its name leaves room for its temporary's, it is not (after
+// resolving links) one of `inputs`, and no two outputs are the same file. Call it before any long work, so a bad path fails at once.
 void check_output_paths(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs);
+
+// Throws OutputError when `stem`, a name that a run's outputs extend (OUT → OUT.animorder.bin),
+// names a folder instead: empty, ending in '/', ending in "." or "..", or an existing folder.
+void check_output_stem(const std::string& stem);
 
 // The outputs of one run. add() writes each to a temporary beside its target; commit() renames
 // them all into place. If any add() or the commit fails, or the set is destroyed uncommitted,

@@ -29,12 +29,29 @@ struct LoadOptions {
     // are sampled, so that select_clips names the file's clips in its error); other formats
     // sample every clip. Callers still call select_clips for the order and the error.
     std::vector<std::string> clips;
+    // When set, receives every file the load read: files_load_reads' and the side files an
+    // importer opened as it read (an OBJ's .mtl), each once, in the order first read.
+    std::vector<std::string>* files_read = nullptr;
 };
 
 // By extension: .gltf/.glb → load_gltf (gltf_loader.h), .md2 → load_md2, .iqm → load_iqm (no
 // clip files), anything else → load_assimp. A folder in
-// clip_files stands for the files in it, in name order.
+// clip_files stands for the files in it, in name order. Throws LoadError when a file it would
+// read exists but is not a regular file (require_regular_files).
 AnimatedMesh load_character(const std::string& path, const std::vector<std::string>& clip_files = {},
                             const LoadOptions& options = {});
+
+// The files load_character(path, clip_files) reads, as far as they are known before loading: the
+// file; for .gltf/.glb its external buffers and images, by URI, resolved as the glTF loader
+// resolves them (percent-decoded, '+' a space, joined to the file's folder; data: URIs are
+// inside the file); each clip file, and the files of each clip folder in name order. Not the side
+// files an assimp format may open as it reads (an OBJ's .mtl). Reads only the glTF's JSON, from a
+// regular file; a file it cannot parse lists no external file (loading it says what is wrong).
+std::vector<std::string> files_load_reads(const std::string& path, const std::vector<std::string>& clip_files = {});
+
+// Throws LoadError when a file of files_load_reads(path, clip_files) exists but is not a regular
+// file: a FIFO or a device (a glTF buffer URI of /dev/zero) would never end, a folder is no file.
+// Missing files are left to the loaders, which name them.
+void require_regular_files(const std::string& path, const std::vector<std::string>& clip_files = {});
 
 }  // namespace animorder

@@ -32,6 +32,7 @@
 #include "checked_size.h"
 #include "isolated_import.h"
 
+#include <assimp/DefaultIOSystem.h>
 #include <assimp/GltfMaterial.h>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
@@ -99,8 +100,30 @@ void flatten(const aiNode* root, Flat& flat) {
     }
 }
 
-const aiScene* import(Assimp::Importer& importer, const std::string& path) {
+// Assimp's file access, but only to regular files: a side file an importer opens as it reads (an
+// OBJ's mtllib, say) that is a FIFO or a device would never end; for assimp it is then missing.
+// Every file opened is added to `opened` (once).
+class RegularFilesOnly : public Assimp::DefaultIOSystem {
+public:
+    explicit RegularFilesOnly(std::vector<std::string>& opened) : opened_(opened) {}
+    bool Exists(const char* file) const override { return regular(file) && DefaultIOSystem::Exists(file); }
+    Assimp::IOStream* Open(const char* file, const char* mode) override {
+        Assimp::IOStream* stream = regular(file) ? DefaultIOSystem::Open(file, mode) : nullptr;
+        if (stream && std::find(opened_.begin(), opened_.end(), file) == opened_.end()) opened_.push_back(file);
+        return stream;
+    }
+
+private:
+    std::vector<std::string>& opened_;
+    static bool regular(const char* file) {
+        std::error_code error;
+        return file && std::filesystem::is_regular_file(file, error);
+    }
+};
+
+const aiScene* import(Assimp::Importer& importer, const std::string& path, std::vector<std::string>& opened) {
     if (!std::filesystem::exists(path)) throw LoadError(path + ": cannot open file");
+    importer.SetIOHandler(new RegularFilesOnly(opened));  // the importer owns it
     importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
     const aiScene* scene =
         importer.ReadFile(path, aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_JoinIdenticalVertices |
@@ -116,10 +139,11 @@ const aiScene* import(Assimp::Importer& importer, const std::string& path) {
 // The whole load, in the child process of load_assimp: reading(i) before reading file i (0: the
 // character, 1..: clip_files).
 AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::string>& clip_files,
-                              const LoadOptions& options, const io::ReadingFile& reading) {
+                              const LoadOptions& options, const io::ChildContext& child) {
+    const io::ReadingFile& reading = child.reading;
     reading(0);
     Assimp::Importer importer;
-    const aiScene* scene = import(importer, path);
+    const aiScene* scene = import(importer, path, child.opened);
     Flat flat;
     flatten(scene->mRootNode, flat);
 
@@ -217,7 +241,7 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
         const std::string& file = clip_files[i];
         reading(i + 1);
         clip_importers.push_back(std::make_unique<Assimp::Importer>());
-        const aiScene* clip_scene = import(*clip_importers.back(), file);
+        const aiScene* clip_scene = import(*clip_importers.back(), file, child.opened);
         if (clip_scene->mNumAnimations == 0) throw LoadError(file + ": has no animation");
         for (unsigned a = 0; a < clip_scene->mNumAnimations; ++a) {
             const aiAnimation* anim = clip_scene->mAnimations[a];
@@ -415,8 +439,8 @@ AnimatedMesh load_assimp(const std::string& path, const std::vector<std::string>
     if (!std::filesystem::exists(path)) throw LoadError(path + ": cannot open file");
     std::vector<std::string> files{path};
     files.insert(files.end(), clip_files.begin(), clip_files.end());
-    return io::load_isolated(files, options, [&](const io::ReadingFile& reading) {
-        return load_assimp_here(path, clip_files, options, reading);
+    return io::load_isolated(files, options, [&](const io::ChildContext& child) {
+        return load_assimp_here(path, clip_files, options, child);
     });
 }
 

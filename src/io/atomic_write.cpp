@@ -27,14 +27,24 @@ bool same_file(const std::string& a, const std::string& b) {
     return resolved(a) == resolved(b);
 }
 
+// What a temporary adds to its target's name: "." before, ".tmp" or ".old" and a process id after.
+constexpr size_t kTemporaryExtra = 1 + 4 + 10;
+
 void check_writable_target(const std::string& path) {
     const fs::path target(path);
     if (path.empty()) throw OutputError("an output path is empty");
     if (fs::is_directory(target)) throw OutputError(path + ": is a directory, expected a file name");
     const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
-    if (!fs::is_directory(folder)) throw OutputError(path + ": folder " + folder.string() + " does not exist");
+    if (!fs::is_directory(folder))
+        throw OutputError(path + ": folder " + folder.string() +
+                          (fs::exists(folder) ? " is not a folder" : " does not exist"));
     if (::access(folder.c_str(), W_OK | X_OK) != 0)
         throw OutputError(path + ": folder " + folder.string() + " is not writable");
+    const long name_max = ::pathconf(folder.c_str(), _PC_NAME_MAX);
+    const size_t limit = name_max > 0 ? size_t(name_max) : 255;
+    if (target.filename().string().size() + kTemporaryExtra > limit)
+        throw OutputError(path + ": the file name is too long (at most " + std::to_string(limit - kTemporaryExtra) +
+                          " bytes here, so that its temporary fits)");
 }
 
 std::string temporary_name(const fs::path& target, const char* kind) {
@@ -44,6 +54,15 @@ std::string temporary_name(const fs::path& target, const char* kind) {
 }
 
 }  // namespace
+
+void check_output_stem(const std::string& stem) {
+    const fs::path path(stem);
+    const std::string last = path.filename().string();
+    std::error_code error;
+    if (stem.empty() || last.empty() || last == "." || last == ".." || fs::is_directory(path, error))
+        throw OutputError((stem.empty() ? std::string("an output name") : stem) +
+                          ": names a folder; give a file name the outputs extend (e.g. out/hero)");
+}
 
 void check_output_paths(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs) {
     for (size_t i = 0; i < outputs.size(); ++i) {
@@ -95,6 +114,7 @@ void OutputSet::commit() {
         if (!fs::exists(p.target)) continue;
         const std::string backup = temporary_name(p.target, "old");
         fs::rename(p.target, backup, error);
+        if (error == std::errc::no_such_file_or_directory) continue;  // gone meanwhile: nothing to keep
         if (error) roll_back(p.target + ": cannot replace: " + error.message());
         backups.emplace_back(p.target, backup);
     }

@@ -33,8 +33,9 @@ inline int append_buffer_view(tinygltf::Model& model, const void* data, size_t b
 }
 
 // The glTF file at `path` (binary when it starts with "glTF"), images left undecoded; LoadError
-// when it is no readable glTF 2.0 file.
+// when it is no readable glTF 2.0 file, or it or a file it references is no regular file.
 inline tinygltf::Model read_model(const std::string& path) {
+    require_regular_files(path);
     tinygltf::Model model;
     tinygltf::TinyGLTF loader;
     loader.SetImageLoader([](tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*,

@@ -128,7 +128,7 @@ private:
     std::string buf_;
 };
 
-void write_mesh(Writer& w, const AnimatedMesh& m) {
+void write_mesh(Writer& w, const AnimatedMesh& m, const std::vector<std::string>& opened) {
     w.bytes(kMagic, sizeof kMagic);
     w.bytes("M", 1);
     w.str(m.name);
@@ -156,6 +156,8 @@ void write_mesh(Writer& w, const AnimatedMesh& m) {
     w.array(m.keyframe_positions);
     w.u64(m.joint_count);
     w.u64(m.morph_target_count);
+    w.u64(opened.size());
+    for (const std::string& file : opened) w.str(file);
     w.bytes(kEnd, sizeof kEnd);
     w.flush();
 }
@@ -169,7 +171,7 @@ void write_error(Writer& w, const std::string& message) {
 }
 
 [[noreturn]] void run_child(int data_fd, int log_fd, volatile uint64_t* reading_index, const std::string& path,
-                            const std::function<AnimatedMesh(const ReadingFile&)>& load) {
+                            const std::function<AnimatedMesh(const ChildContext&)>& load) {
     // Nothing the child (assimp, a sanitizer) prints reaches the user; the parent reads the log.
     ::dup2(log_fd, STDOUT_FILENO);
     ::dup2(log_fd, STDERR_FILENO);
@@ -177,8 +179,9 @@ void write_error(Writer& w, const std::string& message) {
     try {
         Writer w(data_fd);
         try {
-            const AnimatedMesh mesh = load([reading_index](size_t i) { *reading_index = i; });
-            write_mesh(w, mesh);
+            std::vector<std::string> opened;
+            const AnimatedMesh mesh = load({[reading_index](size_t i) { *reading_index = i; }, opened});
+            write_mesh(w, mesh, opened);
         } catch (const WriteFailed&) {
             throw;
         } catch (const std::bad_alloc&) {
@@ -270,7 +273,8 @@ private:
     const std::string& file_;
 };
 
-AnimatedMesh read_mesh(Reader& r, const std::string& path, const LoadOptions& options) {
+AnimatedMesh read_mesh(Reader& r, const std::string& path, const LoadOptions& options,
+                       std::vector<std::string>& opened) {
     AnimatedMesh m;
     m.name = r.str();
     m.vertex_count = r.u64();
@@ -306,6 +310,8 @@ AnimatedMesh read_mesh(Reader& r, const std::string& path, const LoadOptions& op
     r.array(m.keyframe_positions, floats);
     m.joint_count = r.u64();
     m.morph_target_count = r.u64();
+    opened.resize(r.count(8));  // each at least its length
+    for (std::string& file : opened) file = r.str();
     r.expect(kEnd);
     if (!r.at_end()) r.bad("bytes after the mesh");
     try {
@@ -344,7 +350,7 @@ std::string last_words(int log_fd) {
 }  // namespace
 
 AnimatedMesh load_isolated(const std::vector<std::string>& files, const LoadOptions& options,
-                           const std::function<AnimatedMesh(const ReadingFile& reading)>& load) {
+                           const std::function<AnimatedMesh(const ChildContext& child)>& load) {
     if (files.empty()) throw LoadError("(no file): nothing to read");
     const std::string& path = files[0];
     const Fd data(::memfd_create("animorder-child-mesh", MFD_CLOEXEC));
@@ -401,7 +407,13 @@ AnimatedMesh load_isolated(const std::vector<std::string>& files, const LoadOpti
         throw LoadError(path + ": " + message);
     }
     if (kind != 'M') r.bad("an unknown answer");
-    return read_mesh(r, path, options);
+    std::vector<std::string> opened;
+    AnimatedMesh mesh = read_mesh(r, path, options, opened);
+    if (options.files_read)
+        for (const std::string& file : opened)
+            if (std::find(options.files_read->begin(), options.files_read->end(), file) == options.files_read->end())
+                options.files_read->push_back(file);
+    return mesh;
 }
 
 }  // namespace animorder::io

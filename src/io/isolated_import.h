@@ -15,6 +15,13 @@ namespace animorder::io {
 // blamed on the right file.
 using ReadingFile = std::function<void(size_t)>;
 
+// What the child's loader gets: reading(i) before it reads files[i], and `opened`, to which it
+// adds every file it opens (passed back with the mesh).
+struct ChildContext {
+    ReadingFile reading;
+    std::vector<std::string>& opened;
+};
+
 // Runs load(reading) in a forked child and returns the AnimatedMesh it produced. files[0] is
 // the character (the file errors are about when nothing better is known), the rest are the
 // clip files the loader reads. The child passes the mesh back through an in-memory file
@@ -26,8 +33,9 @@ using ReadingFile = std::function<void(size_t)>;
 //    followed by the last meaningful line the child wrote to stderr, if any;
 //  - the child exiting non-zero (AddressSanitizer does this after a report): "FILE: assimp
 //    crashed reading it (exit code N)" and the same stderr line.
-// The child's stdout and stderr are captured, never shown.
+// The child's stdout and stderr are captured, never shown. The files the child opened are added
+// to options.files_read (when set) if not there already.
 AnimatedMesh load_isolated(const std::vector<std::string>& files, const LoadOptions& options,
-                           const std::function<AnimatedMesh(const ReadingFile& reading)>& load);
+                           const std::function<AnimatedMesh(const ChildContext& child)>& load);
 
 }  // namespace animorder::io

@@ -8,14 +8,27 @@
 #include "animorder/iqm_loader.h"
 #include "animorder/md2_loader.h"
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <cctype>
+#include <cstdint>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 
 namespace animorder {
+namespace {
 
-AnimatedMesh load_character(const std::string& path, const std::vector<std::string>& clip_files,
-                            const LoadOptions& options) {
+std::string lower_extension(const std::string& path) {
+    std::string extension = std::filesystem::path(path).extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char ch) { return char(std::tolower(ch)); });
+    return extension;
+}
+
+// A clip folder stands for its regular files, in name order.
+std::vector<std::string> expand_clip_files(const std::vector<std::string>& clip_files) {
     std::vector<std::string> files;
     for (const std::string& c : clip_files) {
         if (std::filesystem::is_directory(c)) {
@@ -29,9 +42,133 @@ AnimatedMesh load_character(const std::string& path, const std::vector<std::stri
             files.push_back(c);
         }
     }
-    std::string extension = std::filesystem::path(path).extension().string();
-    std::transform(extension.begin(), extension.end(), extension.begin(),
-                   [](unsigned char ch) { return char(std::tolower(ch)); });
+    return files;
+}
+
+// The JSON text of a glTF (.gltf: the file; .glb: its first chunk, which must be JSON); empty
+// when the file is not a regular file, its sizes do not hold or the text exceeds 1 GiB.
+constexpr uint64_t kMaxJsonBytes = uint64_t(1) << 30;
+std::string gltf_json_text(const std::string& path) {
+    std::error_code error;
+    if (!std::filesystem::is_regular_file(path, error)) return {};
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return {};
+    const uint64_t size = std::filesystem::file_size(path, error);
+    if (error) return {};
+    char header[20] = {};
+    in.read(header, sizeof header);
+    if (in.gcount() >= 4 && std::memcmp(header, "glTF", 4) == 0) {
+        if (in.gcount() < 20) return {};
+        uint32_t length = 0;
+        std::memcpy(&length, header + 12, 4);  // chunk 0: length, type "JSON", then the text
+        if (std::memcmp(header + 16, "JSON", 4) != 0 || uint64_t(length) > size - 20 || length > kMaxJsonBytes)
+            return {};
+        std::string text(length, '\0');
+        in.read(text.data(), std::streamsize(length));
+        return in.gcount() == std::streamsize(length) ? text : std::string();
+    }
+    if (size > kMaxJsonBytes) return {};
+    std::string text(size_t(size), '\0');
+    in.seekg(0);
+    in.read(text.data(), std::streamsize(size));
+    return in.gcount() == std::streamsize(size) ? text : std::string();
+}
+
+// tinygltf's urldecode: '+' is a space, %XY the byte XY (a digit that is not hex counts 0).
+std::string decode_uri(const std::string& uri) {
+    const auto hex = [](unsigned char c) -> unsigned {
+        return c >= '0' && c <= '9'   ? c - '0'
+               : c >= 'a' && c <= 'f' ? c - 'a' + 10
+               : c >= 'A' && c <= 'F' ? c - 'A' + 10
+                                      : 0;
+    };
+    std::string out;
+    for (size_t i = 0; i < uri.size(); ++i) {
+        if (uri[i] == '+') {
+            out += ' ';
+        } else if (uri[i] == '%' && uri.size() > i + 2) {
+            out += char(hex(uri[i + 1]) << 4 | hex(uri[i + 2]));
+            i += 2;
+        } else {
+            out += uri[i];
+        }
+    }
+    return out;
+}
+
+// tinygltf's GetBaseDir and JoinPath: the text before the last '/' or '\\', and "a/b" (a alone
+// when b is empty; no second '/' when a ends in one).
+std::string join_to_folder_of(const std::string& file, const std::string& name) {
+    const size_t slash = file.find_last_of("/\\");
+    const std::string folder = slash == std::string::npos ? std::string() : file.substr(0, slash);
+    if (folder.empty()) return name;
+    return folder.back() == '/' ? folder + name : folder + "/" + name;
+}
+
+std::vector<std::string> gltf_external_files(const std::string& path) {
+    std::vector<std::string> files;
+    const std::string text = gltf_json_text(path);
+    if (text.empty()) return files;
+    const nlohmann::json doc = nlohmann::json::parse(text, nullptr, false);
+    if (!doc.is_object()) return files;
+    for (const char* list : {"buffers", "images"}) {
+        const auto entries = doc.find(list);
+        if (entries == doc.end() || !entries->is_array()) continue;
+        for (const nlohmann::json& entry : *entries) {
+            if (!entry.is_object()) continue;
+            const auto uri = entry.find("uri");
+            if (uri == entry.end() || !uri->is_string()) continue;
+            const std::string& u = uri->get_ref<const std::string&>();
+            if (u.rfind("data:", 0) == 0) continue;  // embedded
+            files.push_back(join_to_folder_of(path, decode_uri(u)));
+        }
+    }
+    return files;
+}
+
+}  // namespace
+
+std::vector<std::string> files_load_reads(const std::string& path, const std::vector<std::string>& clip_files) {
+    std::vector<std::string> files = {path};
+    const std::string extension = lower_extension(path);
+    if (extension == ".gltf" || extension == ".glb") {
+        const std::vector<std::string> external = gltf_external_files(path);
+        files.insert(files.end(), external.begin(), external.end());
+    }
+    std::error_code error;
+    for (const std::string& c : clip_files) {
+        if (!std::filesystem::is_directory(c, error)) {
+            files.push_back(c);
+            continue;
+        }
+        const std::vector<std::string> inside = expand_clip_files({c});
+        files.insert(files.end(), inside.begin(), inside.end());
+    }
+    return files;
+}
+
+void require_regular_files(const std::string& path, const std::vector<std::string>& clip_files) {
+    // A FIFO or a device (a glTF buffer named /dev/zero, say) would never end: only regular files
+    // are read. A missing one is left to its loader, which names it.
+    for (const std::string& file : files_load_reads(path, clip_files)) {
+        std::error_code error;
+        const std::filesystem::file_status status = std::filesystem::status(file, error);
+        if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status))
+            throw LoadError(path + (file == path ? ": is " : ": reads " + file + ", which is ") +
+                            (std::filesystem::is_directory(status) ? "a folder" : "not a regular file"));
+    }
+}
+
+AnimatedMesh load_character(const std::string& path, const std::vector<std::string>& clip_files,
+                            const LoadOptions& options) {
+    require_regular_files(path, clip_files);
+    if (options.files_read) {
+        for (const std::string& file : files_load_reads(path, clip_files))
+            if (std::find(options.files_read->begin(), options.files_read->end(), file) == options.files_read->end())
+                options.files_read->push_back(file);
+    }
+    const std::vector<std::string> files = expand_clip_files(clip_files);
+    const std::string extension = lower_extension(path);
     if (extension == ".gltf" || extension == ".glb" || extension == ".md2" || extension == ".iqm") {
         if (!files.empty())
             throw LoadError(path + ": clip files apply to assimp formats (this file carries its clips)");

@@ -10,6 +10,7 @@
 #include "support/require.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -560,4 +561,68 @@ TEST(GltfCharacters, DoubleSidedMaterialsOfSharedData) {
             EXPECT_EQ(p.alpha_mode, AlphaMode::Opaque) << p.name;
         }
     }
+}
+
+// files_load_reads lists what the loader will read, resolved as tinygltf resolves it: the files
+// here are read by loading the same glTF (every listed buffer is one the load needs), and the
+// spellings are worked out by hand from the URIs ('+' a space, %XY a byte, data: URIs inside).
+TEST_F(GltfLoader, TheFilesALoadReadsAreListedAsTheLoaderResolvesThem) {
+    Gltf g = skinned_bar();
+    fs::create_directories(dir_ / "sub");
+    write("sub/a b.bin", g.bin);
+    g.doc["buffers"] = json::array({{{"byteLength", g.bin.size()}, {"uri", "sub/a%20b.bin"}}});
+    g.doc["images"] =
+        json::array({{{"uri", "tex+1.png"}}, {{"uri", "data:image/png;base64,AAAA"}}, {{"uri", "c%2Bd.png"}}});
+    const std::string gltf = write("x.gltf", g.doc.dump());
+    const std::string folder = dir_.string();
+    const std::vector<std::string> expected = {gltf, folder + "/sub/a b.bin", folder + "/tex 1.png",
+                                               folder + "/c+d.png"};
+    EXPECT_EQ(files_load_reads(gltf), expected);
+    std::vector<std::string> read;
+    LoadOptions options;
+    options.files_read = &read;
+    EXPECT_EQ(load_character(gltf, {}, options).triangle_count(), 2u);  // the decoded buffer is the one it read
+    EXPECT_EQ(read, expected);
+
+    // A GLB's JSON chunk is read the same way; a chunk length past the end lists no external file.
+    const std::string text = g.doc.dump();
+    auto glb = [&](uint32_t chunk_length) {
+        std::string bytes = "glTF";
+        const uint32_t header[4] = {2, uint32_t(20 + text.size()), chunk_length, 0x4E4F534Au};  // "JSON"
+        bytes.append(reinterpret_cast<const char*>(header), sizeof header);
+        return bytes + text;
+    };
+    const std::string good = write("y.glb", glb(uint32_t(text.size())));
+    EXPECT_EQ(files_load_reads(good),
+              (std::vector<std::string>{good, folder + "/sub/a b.bin", folder + "/tex 1.png", folder + "/c+d.png"}));
+    const std::string lying = write("z.glb", glb(uint32_t(text.size() + 1)));
+    EXPECT_EQ(files_load_reads(lying), std::vector<std::string>{lying});
+    EXPECT_EQ(files_load_reads(write("junk.gltf", "{not json")),
+              std::vector<std::string>{(dir_ / "junk.gltf").string()});
+}
+
+// A file that never ends (a FIFO, a device) is refused at once, not read: as the character, as a
+// glTF buffer URI (relative or absolute), and by the writers' read_model path (check, reapply).
+TEST_F(GltfLoader, FilesThatAreNotRegularAreRefusedWithoutReadingThem) {
+    const std::string fifo = (dir_ / "pipe.bin").string();
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    Gltf g = skinned_bar();
+    g.doc["buffers"] = json::array({{{"byteLength", 12}, {"uri", "pipe.bin"}}});
+    const std::string path = write("fifo.gltf", g.doc.dump());
+    test::expect_one_line_load_error(path, "reads " + fifo + ", which is not a regular file",
+                                     [&] { load_character(path); });
+    EXPECT_THROW(require_regular_files(path), LoadError);
+    // An absolute URI from a glTF named without a folder is taken as it is (tinygltf joins it to
+    // an empty folder): /dev/zero.
+    g.doc["buffers"] = json::array({{{"byteLength", 12}, {"uri", "/dev/zero"}}});
+    write("zero.gltf", g.doc.dump());
+    const fs::path before = fs::current_path();
+    fs::current_path(dir_);
+    test::expect_one_line_load_error("zero.gltf", "reads /dev/zero, which is not a regular file",
+                                     [&] { load_character("zero.gltf"); });
+    fs::current_path(before);
+    const std::string glb = (dir_ / "pipe.glb").string();
+    ASSERT_EQ(::mkfifo(glb.c_str(), 0600), 0);
+    test::expect_one_line_load_error(glb, "is not a regular file", [&] { load_character(glb); });
+    test::expect_one_line_load_error(fifo, "is not a regular file", [&] { load_character(fifo); });
 }

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #include <chrono>
@@ -347,4 +348,177 @@ TEST_F(Batch, AChangedInputFileRerunsItsItemAndAGltfItemWritesTheGltf) {
     }
     const test::Outcome changed = run("batch -q" + kEval + " " + manifest());
     EXPECT_NE(changed.out.find("2 items: 1 done, 1 up to date"), std::string::npos) << changed.out << changed.err;
+}
+
+namespace {
+
+// `animorder ARGS` run from `folder` (relative manifests), a hang turned into exit 124.
+test::Outcome run_from(const fs::path& folder, const std::string& args, const fs::path& scratch) {
+    return test::run_captured("cd '" + folder.string() + "' && timeout 120 " + std::string(ANIMORDER_EXE) + " " + args,
+                              scratch);
+}
+
+// A one-triangle glTF whose buffer (36 bytes: triangle_bytes) is the file `uri` names.
+std::string triangle_gltf(const std::string& uri) {
+    return nlohmann::json{{"asset", {{"version", "2.0"}}},
+                          {"scene", 0},
+                          {"scenes", {{{"nodes", {0}}}}},
+                          {"nodes", {{{"mesh", 0}}}},
+                          {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}}}}}}}}},
+                          {"accessors",
+                           {{{"bufferView", 0},
+                             {"componentType", 5126},
+                             {"count", 3},
+                             {"type", "VEC3"},
+                             {"min", {0, 0, 0}},
+                             {"max", {1, 1, 1}}}}},
+                          {"bufferViews", {{{"buffer", 0}, {"byteLength", 36}}}},
+                          {"buffers", {{{"byteLength", 36}, {"uri", uri}}}}}
+        .dump();
+}
+
+std::string triangle_bytes(float z) {
+    const float corners[9] = {0, 0, 0, 1, 0, 0, 0, 1, z};
+    return std::string(reinterpret_cast<const char*>(corners), sizeof corners);
+}
+
+}  // namespace
+
+// Files that would never end (a FIFO, /dev/zero as a glTF buffer) fail their item at once, and a
+// glTF's external buffer is an input that no output may replace, in batch as in optimize.
+TEST_F(Batch, HostileFilesNeitherHangTheRunNorGetReplaced) {
+    write("zero.gltf", triangle_gltf("/dev/zero"));  // from a glTF named without a folder: /dev/zero itself
+    ASSERT_EQ(::mkfifo(path("pipe.glb").c_str(), 0600), 0);
+    ASSERT_EQ(::mkfifo(path("pipe.mtl").c_str(), 0600), 0);
+    write("tri.obj", "mtllib pipe.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");  // the material file a FIFO: skipped
+    write("m.json", R"({"items": [
+      {"name": "zero", "input": "zero.gltf", "method": "original", "output": "out/zero"},
+      {"name": "pipe", "input": "pipe.glb", "method": "original", "output": "out/pipe"},
+      {"name": "obj", "input": "tri.obj", "method": "original", "output": "out/obj"}
+    ]})");
+    for (const char* mode : {"", " --merge"}) {
+        const test::Outcome o = run_from(dir_, std::string("batch -q --eval-views 0 m.json") + mode, dir_);
+        EXPECT_EQ(o.exit_code, 3) << mode << o.err;  // two items failed (merge: their errors are recorded)
+    }
+    const nlohmann::json summary = nlohmann::json::parse(test::slurp(path("m.summary.json")));
+    ASSERT_EQ(summary["items"].size(), 3u);
+    EXPECT_EQ(summary["items"][0]["status"], "failed");
+    EXPECT_NE(summary["items"][0]["error"].get<std::string>().find("reads /dev/zero, which is not a regular file"),
+              std::string::npos)
+        << summary["items"][0];
+    EXPECT_EQ(summary["items"][1]["status"], "failed");
+    EXPECT_NE(summary["items"][1]["error"].get<std::string>().find("not a regular file"), std::string::npos);
+    EXPECT_EQ(summary["items"][2]["status"], "ok");
+    EXPECT_EQ(summary["items"][2]["triangles"], 1);
+
+    // A buffer named like an output: refused before any work, by batch and by optimize.
+    write("s.animorder.bin", triangle_bytes(0));
+    write("s.gltf", triangle_gltf("s.animorder.bin"));
+    write("m.json", R"({"items": [{"input": "s.gltf", "method": "original", "output": "s.glb"}]})");
+    const test::Outcome batch = run_from(dir_, "batch -q --eval-views 0 m.json", dir_);
+    EXPECT_EQ(batch.exit_code, 1);
+    EXPECT_NE(batch.err.find("s.animorder.bin: is an input of this run"), std::string::npos) << batch.err;
+    const test::Outcome optimize = run_from(dir_, "optimize -q --method original s.gltf -o s.glb", dir_);
+    EXPECT_EQ(optimize.exit_code, 1);
+    EXPECT_NE(optimize.err.find("s.animorder.bin: is an input of this run"), std::string::npos) << optimize.err;
+    EXPECT_EQ(test::slurp(path("s.animorder.bin")), triangle_bytes(0));
+    EXPECT_FALSE(fs::exists(path("s.glb")));
+}
+
+// The stamp covers what the loader reads: a percent-encoded buffer URI's file, and an OBJ's
+// material file (known only once assimp has opened it: the report lists it with its digest; a
+// blended material changes static-sander07's buffer, which sorts blended primitives apart).
+TEST_F(Batch, AChangedBufferOrMaterialFileRerunsItsItem) {
+    write("my buf.bin", triangle_bytes(0));
+    write("tri.gltf", triangle_gltf("my%20buf.bin"));
+    write("quad.mtl", "newmtl skin\nKd 1 0 0\nd 1\n");
+    write("quad.obj", "mtllib quad.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nusemtl skin\nf 1 2 3\nf 2 4 3\n");
+    write("m.json", R"({"items": [
+      {"name": "tri", "input": "tri.gltf", "method": "original", "output": "out/tri"},
+      {"name": "quad", "input": "quad.obj", "method": "static-sander07", "output": "out/quad"}
+    ]})");
+    const std::string batch = "batch -q --eval-views 0 --no-timings " + manifest();
+    ASSERT_EQ(run(batch).exit_code, 0);
+    const nlohmann::json report = nlohmann::json::parse(test::slurp(path("out/quad.animorder.report.json")));
+    ASSERT_EQ(report["batch"]["side_files"].size(), 1u) << report["batch"];
+    EXPECT_EQ(report["batch"]["side_files"][0]["file"], "../quad.mtl");
+    EXPECT_NE(run(batch).out.find("0 done, 2 up to date"), std::string::npos);
+
+    write("my buf.bin", triangle_bytes(0.5f));
+    EXPECT_NE(run(batch).out.find("2 items: 1 done, 1 up to date"), std::string::npos);
+    const std::string opaque = test::slurp(path("out/quad.animorder.bin"));
+    write("quad.mtl", "newmtl skin\nKd 1 0 0\nd 0.5\n");  // now blended: the sidecar flags it
+    EXPECT_NE(run(batch).out.find("2 items: 1 done, 1 up to date"), std::string::npos);
+    EXPECT_NE(test::slurp(path("out/quad.animorder.bin")), opaque);
+}
+
+// A manifest reached by another spelling of its path, a report edited by hand, a folder named
+// like a clip in the current folder, and another thread count change nothing.
+TEST_F(Batch, SpellingsEditsAndThreadCountsDoNotChangeWhatIsUpToDate) {
+    fs::create_directories(path("lib/out"));
+    std::ofstream(path("lib/m.json")) << R"({"items": [
+      {"name": "walk", "clips": ["walk"], "options": "-k 2 --views 12 --resolution 32 --max-iterations 2", "output": "out/walk"}
+    ]})";
+    const std::string flags = "-q --no-timings --eval-views 1 --eval-resolution 32 ";
+    ASSERT_EQ(run_from(dir_, "batch " + flags + "lib/m.json", dir_).exit_code, 0);
+    EXPECT_EQ(run_from(dir_, "batch " + flags + "--merge ./lib/m.json", dir_).exit_code, 0);
+    EXPECT_NE(run_from(path("lib"), "batch " + flags + "m.json", dir_).out.find("0 done, 1 up to date"),
+              std::string::npos);
+    EXPECT_NE(run("batch " + flags + path("lib/m.json").string()).out.find("0 done, 1 up to date"), std::string::npos);
+
+    fs::create_directories(path("walk"));  // a folder named like the clip, where the run starts
+    const test::Outcome clip = run_from(dir_, "batch " + flags + "--force lib/m.json", dir_);
+    EXPECT_EQ(clip.exit_code, 0) << clip.err;
+
+    std::ofstream(path("lib/out/walk.animorder.report.json")) << R"({"batch": {"stamp": 5}})";
+    std::ofstream(path("lib/out/walk.animorder.error.json")) << R"({"stamp": 7, "error": null})";
+    const test::Outcome edited = run_from(dir_, "batch " + flags + "lib/m.json", dir_);
+    EXPECT_EQ(edited.exit_code, 0) << edited.err;
+    EXPECT_NE(edited.out.find("1 done, 0 up to date"), std::string::npos) << edited.out;
+
+    std::map<std::string, std::string> files[2];
+    for (int t = 0; t < 2; ++t) {
+        ASSERT_EQ(run_from(dir_, "batch " + flags + "--force --threads " + std::to_string(t + 1) + " lib/m.json", dir_)
+                      .exit_code,
+                  0);
+        for (const auto& e : fs::directory_iterator(path("lib/out")))
+            files[t][e.path().filename().string()] = test::slurp(e.path());
+    }
+    EXPECT_EQ(files[0], files[1]);
+}
+
+// Manifest mistakes found before any work, each one line: text the JSON reports cannot hold, an
+// output naming a folder, files named inside "options", a key or a column given twice, a name too
+// long for its temporary; while a CSV's byte order mark and spaces around its fields are fine.
+TEST_F(Batch, ManifestMistakesAreRefusedBeforeAnyWork) {
+    const std::string long_name(230, 'x');
+    const std::vector<std::pair<std::string, std::string>> bad = {
+        {"m.csv", "name,method,output\nok,original,out/ok\ncaf\xe9,original,out/cafe\n"},
+        {"m.json", R"({"items": [{"method": "original", "output": "out/"}]})"},
+        {"m.json", R"({"items": [{"method": "original", "output": "."}]})"},
+        {"m.json", R"({"items": [{"method": "original", "options": "chars/Fox.glb", "output": "out/a"}]})"},
+        {"m.json", R"({"items": [{"method": "original", "options": "--clip walk", "output": "out/a"}]})"},
+        {"m.json", R"({"items": [{"method": "original", "options": "--help", "output": "out/a"}]})"},
+        {"m.json", R"({"items": [{"method": "original", "output": "out/a", "output": "out/b"}]})"},
+        {"m.csv", "method,output,method\noriginal,out/a,single\n"},
+        {"m.json", R"({"items": [{"method": "original", "output": "out/)" + long_name + R"("}]})"}};
+    for (const auto& [name, text] : bad) {
+        write(name, text);
+        const test::Outcome o = run("batch -q --eval-views 0 " + path(name).string());
+        EXPECT_EQ(o.exit_code, 1) << text;
+        EXPECT_EQ(test::line_count(o.err), 1u) << text << "\n" << o.err;
+        EXPECT_TRUE(outputs().empty()) << text;
+        fs::remove(path(name));
+    }
+    write("m.json", R"({"items": [{"method": "original", "output": "out/a"}]})");
+    for (const char* options : {"--summary out/", "--shard env/0", "--summary /dev/null/x"}) {
+        const test::Outcome o = run("batch -q --eval-views 0 " + std::string(options) + " " + manifest());
+        EXPECT_EQ(o.exit_code, 1) << options;
+        EXPECT_EQ(test::line_count(o.err), 1u) << options << "\n" << o.err;
+    }
+    EXPECT_TRUE(outputs().empty());
+    write("m.csv", "\xEF\xBB\xBFmethod , output\n original , out/a \n");
+    const test::Outcome bom = run("batch -q --eval-views 0 " + path("m.csv").string());
+    EXPECT_EQ(bom.exit_code, 0) << bom.err;
+    EXPECT_TRUE(fs::exists(path("out/a.animorder.bin")));
 }

@@ -3,9 +3,11 @@
 // Each item of the manifest is one optimize run (the same library call as `animorder optimize`,
 // optimize.h) whose files — glTF, sidecar, sidecar description and the item report
 // OUT.animorder.report.json — appear together or not at all (OutputSet). The item report holds
-// the item's stamp: a SHA-256 (nettle) of the tool version, the item's resolved options and the
-// bytes of every file it reads. An item whose report carries the stamp it would have now, with
-// every output present, is up to date and skipped; so a run killed at any moment and started
+// the item's stamp: a SHA-256 (nettle) of the tool version, the item's resolved options, its paths
+// as the manifest writes them and the bytes of every file it reads as known before loading, plus
+// the side files the importer opened (an OBJ's .mtl), each with its digest. An item whose report
+// carries the stamp it would have now, with its side files unchanged and every output present,
+// is up to date and skipped; so a run killed at any moment and started
 // again redoes only the items it had not finished, and a changed option or input re-runs only the
 // items it affects. A failing item leaves OUT.animorder.error.json (its stamp and the error) and
 // the batch goes on. `--shard I/N` runs items i with i % N == I; the summary (SUMMARY.json and
@@ -58,6 +60,10 @@ struct ManifestItem {
     std::string method;              // empty: optimize's default
     std::vector<std::string> options;
     std::string output;  // resolved against the manifest's folder
+    // The paths as the manifest writes them: what the stamp hashes, so that it does not depend on
+    // how the manifest's own path was spelled, nor on the current folder.
+    std::string input_as_written, output_as_written;
+    std::vector<std::string> clips_as_written;
 };
 
 // Items' relative paths are relative to the manifest's folder, so a manifest moves with its data.
@@ -73,12 +79,30 @@ std::vector<std::string> split_words(const std::string& text) {
     return words;
 }
 
-std::string read_text(const std::string& path) {
+// A manifest or a report: a regular file of at most kMaxTextBytes (a FIFO or a device would never end).
+constexpr uintmax_t kMaxTextBytes = uintmax_t(1) << 30;
+std::string read_text(const std::string& path, const char* what) {
+    std::error_code error;
+    if (fs::is_directory(path, error)) throw std::runtime_error(path + ": is a folder, not " + what);
+    if (!fs::is_regular_file(path, error))
+        throw std::runtime_error(path + (fs::exists(path, error) ? ": is not a regular file" : ": does not exist") +
+                                 " (expected " + what + ")");
+    if (fs::file_size(path, error) > kMaxTextBytes)
+        throw std::runtime_error(path + ": larger than 1 GiB, too large for " + what);
     std::ifstream in(path, std::ios::binary);
-    if (!in) throw std::runtime_error(path + ": cannot read the manifest");
+    if (!in) throw std::runtime_error(path + ": cannot read " + what);
     std::stringstream ss;
     ss << in.rdbuf();
     return ss.str();
+}
+
+// Text that the JSON reports can hold: valid UTF-8 (a report names items and paths).
+void require_utf8(const std::string& text, const std::string& where) {
+    try {
+        (void)json(text).dump();
+    } catch (const json::exception&) {
+        throw std::runtime_error(where + " is not valid UTF-8 (the reports are JSON)");
+    }
 }
 
 // "options" as a string of optimize arguments, a list of them, or an object {"lambda": 3, "joint": true}.
@@ -100,6 +124,10 @@ std::vector<std::string> options_from_json(const json& value, const std::string&
                 if (it.value().get<bool>()) out.push_back(flag);
             } else if (it.value().is_string()) {
                 out.insert(out.end(), {flag, it.value().get<std::string>()});
+            } else if (it.value().is_number_float() &&
+                       std::nearbyint(it.value().get<double>()) == it.value().get<double>() &&
+                       std::fabs(it.value().get<double>()) < 9e15) {  // 3.0 → "3", for integer options
+                out.insert(out.end(), {flag, std::to_string(int64_t(it.value().get<double>()))});
             } else if (it.value().is_number()) {
                 out.insert(out.end(), {flag, it.value().dump()});
             } else {
@@ -113,11 +141,27 @@ std::vector<std::string> options_from_json(const json& value, const std::string&
 
 std::vector<ManifestItem> parse_json_manifest(const std::string& text, const std::string& path) {
     json doc;
+    // The parser keeps the last of two equal keys; a manifest that says one thing twice is refused.
+    std::vector<std::vector<std::string>> keys;  // the keys of each object being parsed
+    std::string duplicate;
+    const json::parser_callback_t no_duplicate_keys = [&](int, json::parse_event_t event, json& parsed) {
+        if (event == json::parse_event_t::object_start) keys.emplace_back();
+        if (event == json::parse_event_t::object_end && !keys.empty()) keys.pop_back();
+        if (event == json::parse_event_t::key && !keys.empty()) {
+            const std::string key = parsed.get<std::string>();
+            if (std::find(keys.back().begin(), keys.back().end(), key) != keys.back().end() && duplicate.empty())
+                duplicate = key;
+            keys.back().push_back(key);
+        }
+        return true;
+    };
     try {
-        doc = json::parse(text);
+        doc = json::parse(text, no_duplicate_keys);
     } catch (const json::exception& e) {
         throw std::runtime_error(path + ": not valid JSON: " + e.what());
     }
+    if (!duplicate.empty())
+        throw std::runtime_error(path + ": the key \"" + duplicate + "\" appears twice in one object");
     const json* list = &doc;
     if (doc.is_object()) {
         if (!doc.contains("items")) throw std::runtime_error(path + ": a JSON manifest needs an \"items\" list");
@@ -191,15 +235,23 @@ std::vector<std::string> csv_record(const std::string& text, size_t& pos, const 
     return fields;
 }
 
+void trim(std::string& text) {
+    text.erase(0, text.find_first_not_of(" \t"));
+    text.erase(text.find_last_not_of(" \t") + 1);
+}
+
+// Fields are trimmed of spaces and tabs; a UTF-8 byte order mark before the header is skipped.
 std::vector<ManifestItem> parse_csv_manifest(const std::string& text, const std::string& path) {
-    size_t pos = 0;
+    size_t pos = text.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;
     std::vector<std::string> header = csv_record(text, pos, path + ": line 1");
-    for (std::string& h : header) {
-        h.erase(0, h.find_first_not_of(" \t"));
-        h.erase(h.find_last_not_of(" \t") + 1);
+    for (size_t i = 0; i < header.size(); ++i) {
+        std::string& h = header[i];
+        trim(h);
         if (h != "name" && h != "input" && h != "clips" && h != "method" && h != "options" && h != "output")
             throw std::runtime_error(path + ": line 1: unknown column \"" + h +
                                      "\" (known: name, input, clips, method, options, output)");
+        if (std::find(header.begin(), header.begin() + long(i), h) != header.begin() + long(i))
+            throw std::runtime_error(path + ": line 1: the column \"" + h + "\" appears twice");
     }
     std::vector<ManifestItem> items;
     for (size_t line = 2; pos < text.size(); ++line) {
@@ -211,7 +263,8 @@ std::vector<ManifestItem> parse_csv_manifest(const std::string& text, const std:
                                      std::to_string(header.size()));
         ManifestItem item;
         for (size_t f = 0; f < header.size(); ++f) {
-            const std::string& v = fields[f];
+            std::string v = fields[f];
+            trim(v);
             if (header[f] == "name")
                 item.name = v;
             else if (header[f] == "input")
@@ -224,8 +277,10 @@ std::vector<ManifestItem> parse_csv_manifest(const std::string& text, const std:
                 item.options = split_words(v);
             else if (header[f] == "clips") {
                 std::stringstream list(v);
-                for (std::string c; std::getline(list, c, ';');)
-                    if (!split_words(c).empty()) item.clips.push_back(c);
+                for (std::string c; std::getline(list, c, ';');) {
+                    trim(c);
+                    if (!c.empty()) item.clips.push_back(c);
+                }
             }
         }
         items.push_back(item);
@@ -234,7 +289,7 @@ std::vector<ManifestItem> parse_csv_manifest(const std::string& text, const std:
 }
 
 std::vector<ManifestItem> read_manifest(const std::string& path) {
-    const std::string text = read_text(path);
+    const std::string text = read_text(path, "a manifest");
     const std::string ext = fs::path(path).extension().string();
     std::vector<ManifestItem> items;
     if (ext == ".csv")
@@ -248,13 +303,26 @@ std::vector<ManifestItem> read_manifest(const std::string& path) {
     const fs::path base = fs::path(path).parent_path();
     for (size_t i = 0; i < items.size(); ++i) {
         ManifestItem& item = items[i];
-        if (item.output.empty())
-            throw std::runtime_error(path + ": item " + std::to_string(i + 1) + " has no \"output\"");
+        const std::string where = path + ": item " + std::to_string(i + 1);
+        if (item.output.empty()) throw std::runtime_error(where + " has no \"output\"");
         if (item.name.empty()) item.name = item.output;
+        require_utf8(item.name, where + ": the name");
+        require_utf8(item.input, where + ": the input");
+        require_utf8(item.output, where + ": the output");
+        for (const std::string& c : item.clips) require_utf8(c, where + ": a clip");
+        for (const std::string& o : item.options) require_utf8(o, where + ": an option");
+        item.input_as_written = item.input;
+        item.output_as_written = item.output;
+        item.clips_as_written = item.clips;
         item.input = resolve(base, item.input);
         item.output = resolve(base, item.output);
-        for (std::string& c : item.clips)  // a clip file or folder beside the manifest, else a clip name
-            if (!base.empty() && !fs::path(c).is_absolute() && fs::exists(base / c)) c = (base / c).string();
+        // A clip file or folder beside the manifest (or absolute), made absolute: optimize then
+        // takes an absolute clip as a file and any other as a clip name, whatever the current folder.
+        for (std::string& c : item.clips) {
+            std::error_code error;
+            const fs::path beside = fs::path(c).is_absolute() ? fs::path(c) : base / c;
+            if (fs::exists(beside, error)) c = fs::absolute(beside, error).lexically_normal().string();
+        }
     }
     return items;
 }
@@ -277,25 +345,32 @@ std::string stem_of(const std::string& output) {
 PlannedItem plan_item(const ManifestItem& item, size_t index, const BatchOptions& batch, const ItemParser& parse) {
     PlannedItem p;
     p.item = item;
-    std::vector<std::string> args;
+    const std::string label = "item " + std::to_string(index + 1) + " (" + item.name + ")";
+    // The item's own fields first, its options last (so an option missing its value says so).
+    std::vector<std::string> args = {"-o", item.output};
     if (!item.input.empty()) args.push_back(item.input);
     for (const std::string& c : item.clips) args.insert(args.end(), {"--clip", c});
     if (!item.method.empty()) args.insert(args.end(), {"--method", item.method});
     for (const std::string& o : item.options) {
         if (o == "-o" || o == "-r" || o.rfind("--output", 0) == 0 || o.rfind("--report", 0) == 0)
-            throw std::runtime_error("item " + std::to_string(index + 1) + " (" + item.name + "): option " + o +
-                                     ": batch names the outputs (use the item's \"output\")");
+            throw std::runtime_error(label + ": option " + o + ": batch names the outputs (use the item's \"output\")");
+        if (o == "--clip" || o.rfind("--clip=", 0) == 0)
+            throw std::runtime_error(label + ": option " + o +
+                                     ": use the item's \"clips\" (resolved against the manifest's folder)");
         args.push_back(o);
     }
-    args.insert(args.end(), {"-o", item.output});
     try {
         p.options = parse(args);
+        if (p.options.common.input != item.input)
+            throw std::runtime_error("the options name a file (" + p.options.common.input +
+                                     "): give it as the item's \"input\" (resolved against the manifest's folder)");
+        p.options.common.clip_files_absolute = true;
         if (batch.quiet) p.options.common.quiet = true;
         p.options.methods.settings.clustering.threads = batch.threads;
         p.options.report_path = stem_of(item.output) + ".animorder.report.json";
         p.plan = plan_optimize(p.options);
     } catch (const std::exception& e) {
-        throw std::runtime_error("item " + std::to_string(index + 1) + " (" + item.name + "): " + e.what());
+        throw std::runtime_error(label + ": " + e.what());
     }
     p.report = p.options.report_path;
     p.error = stem_of(item.output) + ".animorder.error.json";
@@ -310,9 +385,13 @@ public:
         sha256_update(&ctx_, sizeof n, reinterpret_cast<const uint8_t*>(&n));
         sha256_update(&ctx_, text.size(), reinterpret_cast<const uint8_t*>(text.data()));
     }
-    // A file's bytes; a file that cannot be read hashes as its error (the item will fail to load it).
+    // A file's name and bytes (never its folder: a library moved whole keeps its stamps). A path
+    // that is no regular file (missing, a folder, a FIFO or a device, which would never end)
+    // hashes as that: the item then fails to load it.
     void add_file(const fs::path& path) {
         add("file:" + path.filename().string());
+        std::error_code error;
+        if (!fs::is_regular_file(path, error)) return add(fs::exists(path, error) ? "not a regular file" : "missing");
         std::ifstream in(path, std::ios::binary);
         if (!in) return add("unreadable");
         std::vector<char> block(1 << 16);
@@ -338,57 +417,22 @@ private:
     sha256_ctx ctx_;
 };
 
-// A file or folder the item reads, with what it references: a .gltf's external buffers and images,
-// a folder's files (sorted, recursively).
-void hash_input(Sha256& hash, const std::string& path) {
-    std::error_code error;
-    if (fs::is_directory(path, error)) {
-        std::vector<fs::path> files;
-        for (auto it = fs::recursive_directory_iterator(path, error);
-             !error && it != fs::recursive_directory_iterator(); it.increment(error))
-            if (it->is_regular_file(error)) files.push_back(it->path());
-        std::sort(files.begin(), files.end());
-        hash.add("folder:" + std::to_string(files.size()));
-        for (const fs::path& f : files) {
-            hash.add(fs::relative(f, path, error).string());
-            hash.add_file(f);
-        }
-        return;
-    }
-    hash.add_file(path);
-    if (fs::path(path).extension() != ".gltf") return;
-    try {
-        const nlohmann::json doc = nlohmann::json::parse(read_text(path));
-        for (const char* list : {"buffers", "images"})
-            if (doc.contains(list) && doc[list].is_array())
-                for (const nlohmann::json& entry : doc[list])
-                    if (entry.is_object() && entry.contains("uri") && entry["uri"].is_string()) {
-                        const std::string uri = entry["uri"].get<std::string>();
-                        if (uri.rfind("data:", 0) == 0) continue;  // embedded: hashed with the file
-                        hash.add("uri:" + uri);
-                        hash.add_file(fs::path(path).parent_path() / uri);
-                    }
-    } catch (const std::exception&) {
-        hash.add("unparsed");  // the loader will say what is wrong
-    }
-}
-
-// The stamp of an item: everything its outputs depend on (not --threads, which changes nothing).
+// The stamp of an item: everything its outputs depend on (not --threads, which changes nothing):
+// the tool version, the settings, the manifest's spellings of its paths, and the bytes of every
+// file it reads as far as known before loading (OptimizePlan::inputs: the character, a glTF's
+// external buffers and images, clip files, the files of clip folders).
 std::string item_stamp(const PlannedItem& p, const BatchOptions& batch) {
     Sha256 hash;
-    hash.add("animorder batch stamp 1");
+    hash.add("animorder batch stamp 2");
     hash.add(ANIMORDER_VERSION);
     hash.add(optimize_settings_json(p.options, p.plan, false).dump());
     hash.add("max_memory:" + std::to_string(p.options.common.max_memory));
-    hash.add("input:" + p.options.common.input);
-    hash.add("output:" + p.options.output);
+    hash.add("input:" + p.item.input_as_written);
+    hash.add("output:" + p.item.output_as_written);
+    for (const std::string& c : p.item.clips_as_written) hash.add("clip:" + c);
     hash.add("eval:" + std::to_string(batch.eval_views) + "/" + std::to_string(batch.eval_resolution) +
              (batch.no_timings ? "/no-timings" : ""));
-    if (!p.options.common.input.empty()) hash_input(hash, p.options.common.input);
-    for (const std::string& c : p.options.common.clips) {
-        hash.add("clip:" + c);
-        if (fs::exists(c)) hash_input(hash, c);
-    }
+    for (const std::string& file : p.plan.inputs) hash.add_file(file);
     return hash.hex();
 }
 
@@ -396,32 +440,77 @@ json read_json_file(const std::string& path) {
     std::error_code error;
     if (!fs::is_regular_file(path, error)) return json();
     try {
-        return json::parse(read_text(path));
+        return json::parse(read_text(path, "a report"));
     } catch (const std::exception&) {
         return json();  // unreadable: as if absent
     }
 }
 
-// The item's report when it is up to date: its stamp matches and every output is there.
+// object[key] when it is a string, else "" (a report edited by hand is stale, never an error).
+std::string string_at(const json& object, const char* key) {
+    if (!object.is_object()) return "";
+    const auto it = object.find(key);
+    return it != object.end() && it->is_string() ? it->get<std::string>() : "";
+}
+
+// A file's name and bytes, hashed.
+std::string file_digest(const fs::path& path) {
+    Sha256 hash;
+    hash.add_file(path);
+    return hash.hex();
+}
+
+fs::path folder_of(const std::string& path) {
+    const fs::path p(path);
+    return p.has_parent_path() ? p.parent_path() : fs::path(".");
+}
+
+// The files loading read beyond the stamp's (an OBJ's .mtl: only the importer knows them), each
+// with its path from the report's folder and its digest, for the report's "side_files".
+json side_files(const PlannedItem& p, const std::vector<std::string>& files_read) {
+    json list = json::array();
+    std::error_code error;
+    for (const std::string& file : files_read) {
+        const bool known = std::any_of(p.plan.inputs.begin(), p.plan.inputs.end(), [&](const std::string& input) {
+            return fs::weakly_canonical(input, error) == fs::weakly_canonical(file, error);
+        });
+        if (known) continue;
+        const fs::path from_report = fs::relative(file, folder_of(p.report), error);
+        list.push_back(
+            {{"file", (error ? fs::absolute(file) : from_report).generic_string()}, {"sha256", file_digest(file)}});
+    }
+    return list;
+}
+
+// The item's report when it is up to date: its stamp matches, every output is there and every
+// side file it lists still has its digest.
 json current_report(const PlannedItem& p, const std::string& stamp) {
     json report = read_json_file(p.report);
-    if (!report.is_object() || !report.contains("batch") || !report["batch"].is_object() ||
-        report["batch"].value("stamp", "") != stamp)
-        return json();
+    if (!report.is_object() || !report.contains("batch") || string_at(report["batch"], "stamp") != stamp) return json();
     std::error_code error;
     for (const std::string& out : p.plan.outputs)
         if (!fs::is_regular_file(out, error)) return json();
+    const json& batch = report["batch"];
+    const auto side = batch.find("side_files");
+    if (side != batch.end()) {
+        if (!side->is_array()) return json();
+        for (const json& entry : *side) {
+            const std::string file = string_at(entry, "file");
+            if (file.empty() || string_at(entry, "sha256") != file_digest(folder_of(p.report) / file)) return json();
+        }
+    }
     return report;
 }
 
-// Wall times out (--no-timings): every key of seconds set to null, wherever it is.
+// Wall times out (--no-timings): every key of seconds set to null, wherever it is, and the thread
+// count they ran with (settings.threads), which changes nothing else.
 void drop_timings(json& value) {
     if (value.is_array())
         for (json& v : value) drop_timings(v);
     if (!value.is_object()) return;
     for (auto it = value.begin(); it != value.end(); ++it) {
         const std::string& k = it.key();
-        if (k == "time_s" || k == "timings_s" || k == "stages_s" || k.rfind("seconds", 0) == 0)
+        if (k == "time_s" || k == "timings_s" || k == "stages_s" || k == "threads" || k.rfind("seconds", 0) == 0)
             it.value() = nullptr;
         else
             drop_timings(it.value());
@@ -457,7 +546,9 @@ json number_or_null(double v, bool have) { return have ? json(v) : json(nullptr)
 // Runs one item into one OutputSet (the report, with its stamp, last): all files or none.
 void run_item(const PlannedItem& p, const std::string& stamp, const BatchOptions& batch) {
     const Clock::time_point start = Clock::now();
-    remove_stale_temporaries(p.plan.outputs);
+    std::vector<std::string> files_of_item = p.plan.outputs;
+    files_of_item.push_back(p.error);
+    remove_stale_temporaries(files_of_item);
     OutputSet files;
     OptimizeProduct product = produce_optimize(p.options, p.plan, files);
     const AnimatedMesh& mesh = product.mesh;
@@ -494,6 +585,7 @@ void run_item(const PlannedItem& p, const std::string& stamp, const BatchOptions
                        {"eval_views", batch.eval_views},
                        {"eval_resolution", batch.eval_resolution},
                        {"index_bytes_added", uint64_t(buffers > 0 ? buffers - 1 : 0) * mesh.indices.size() * 4},
+                       {"side_files", side_files(p, product.files_read)},
                        {"time_s", std::chrono::duration<double>(Clock::now() - start).count()}};
     if (batch.no_timings) drop_timings(report);
     files.add(p.report, report_text(report));
@@ -507,8 +599,8 @@ void run_item(const PlannedItem& p, const std::string& stamp, const BatchOptions
 
 json summary_row(const PlannedItem& p, const std::string& stamp) {
     json row = {{"name", p.item.name},
-                {"input", p.options.common.input.empty() ? "(bundled)" : p.options.common.input},
-                {"output", p.item.output},
+                {"input", p.item.input_as_written.empty() ? "(bundled)" : p.item.input_as_written},
+                {"output", p.item.output_as_written},
                 {"method", method_name(p.plan.method)}};
     const json report = current_report(p, stamp);
     if (report.is_object()) {
@@ -521,13 +613,13 @@ json summary_row(const PlannedItem& p, const std::string& stamp) {
         return row;
     }
     const json failure = read_json_file(p.error);
-    const bool failed = failure.is_object() && failure.value("stamp", "") == stamp;
+    const bool failed = string_at(failure, "stamp") == stamp;
     for (const char* key : {"triangles", "clips", "buffers", "acmr_before", "acmr_after", "ovr_before", "ovr_after",
                             "index_bytes_added", "time_s"})
         row[key] = nullptr;
     row["status"] = failed ? "failed" : "missing";
     row["error"] =
-        failed ? failure.value("error", "") : "no up-to-date result (not run yet, or its inputs or options changed)";
+        failed ? string_at(failure, "error") : "no up-to-date result (not run yet, or its inputs or options changed)";
     return row;
 }
 
@@ -582,6 +674,7 @@ int write_summary(const std::vector<PlannedItem>& items, const std::vector<std::
     summary["failed"] = failed;
     summary["missing"] = missing;
     summary["items"] = rows;
+    remove_stale_temporaries({stem + ".json", stem + ".md"});
     OutputSet files;
     files.add(stem + ".json", report_text(summary));
     files.add(stem + ".md", summary_markdown(summary));
@@ -604,19 +697,23 @@ std::pair<size_t, size_t> parse_shard(const std::string& text) {
     if (slash == std::string::npos) throw std::runtime_error("--shard " + text + ": expected I/N (or env/N)");
     std::string index = text.substr(0, slash);
     const size_t count = number(text.substr(slash + 1), "N");
+    if (count == 0) throw std::runtime_error("--shard " + text + ": N must be at least 1");
     if (index == "env") {
         const char* k8s = std::getenv("JOB_COMPLETION_INDEX");
         const char* slurm = std::getenv("SLURM_ARRAY_TASK_ID");
-        if (k8s && *k8s)
-            index = k8s;
-        else if (slurm && *slurm)
-            index = slurm;
-        else
+        const char* variable = k8s && *k8s ? "JOB_COMPLETION_INDEX" : slurm && *slurm ? "SLURM_ARRAY_TASK_ID" : nullptr;
+        if (!variable)
             throw std::runtime_error("--shard env/N: neither JOB_COMPLETION_INDEX nor SLURM_ARRAY_TASK_ID is set");
+        index = std::getenv(variable);
+        const bool digits = !index.empty() && index.size() <= 9 && std::all_of(index.begin(), index.end(), [](char c) {
+            return std::isdigit(uint8_t(c)) != 0;
+        });
+        if (!digits || size_t(std::stoul(index)) >= count)
+            throw std::runtime_error("--shard " + text + ": " + variable + "=" + index +
+                                     " is not a shard index from 0 to " + std::to_string(count - 1));
     }
     const size_t i = number(index, "I");
-    if (count == 0 || i >= count)
-        throw std::runtime_error("--shard " + text + ": needs 0 <= I < N (I = " + index + ")");
+    if (i >= count) throw std::runtime_error("--shard " + text + ": needs 0 <= I < N (I = " + index + ")");
     return {i, count};
 }
 
@@ -638,6 +735,7 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
         const fs::path m(batch.manifest);
         summary = (m.parent_path() / m.stem()).string() + ".summary";
     }
+    check_output_stem(summary);
     std::vector<std::string> outputs = {summary + ".json", summary + ".md"}, inputs = {batch.manifest};
     for (const PlannedItem& p : items) {
         outputs.insert(outputs.end(), p.plan.outputs.begin(), p.plan.outputs.end());

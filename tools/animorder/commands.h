@@ -19,6 +19,9 @@ struct CommonOptions {
     std::string input;               // empty: the bundled procedural character
     bool quiet = false;              // no progress on stderr
     std::vector<std::string> clips;  // --clip: only these clips (all when empty), or clip files
+    // batch: a clip is a file iff its path is absolute (the manifest's clip files are resolved so),
+    // whatever the current folder holds; otherwise a clip is a file iff it exists (clip_is_file).
+    bool clip_files_absolute = false;
     unsigned cache_size = kDefaultCacheSize;
     size_t max_memory = LoadOptions{}.max_keyframe_bytes;  // --max-memory: the loading budget in bytes
 };

@@ -30,9 +30,14 @@ std::function<void(size_t, size_t)> progress_printer(const CommonOptions& common
     };
 }
 
-AnimatedMesh load_animated_input(const CommonOptions& common, std::string& input_name) {
+bool clip_is_file(const CommonOptions& common, const std::string& clip) {
+    return common.clip_files_absolute ? std::filesystem::path(clip).is_absolute() : std::filesystem::exists(clip);
+}
+
+AnimatedMesh load_animated_input(const CommonOptions& common, std::string& input_name,
+                                 std::vector<std::string>* files_read) {
     std::vector<std::string> clip_files, clip_names;
-    for (const std::string& c : common.clips) (std::filesystem::exists(c) ? clip_files : clip_names).push_back(c);
+    for (const std::string& c : common.clips) (clip_is_file(common, c) ? clip_files : clip_names).push_back(c);
     AnimatedMesh mesh;
     if (common.input.empty()) {
         if (!clip_files.empty()) throw std::runtime_error("clip files need an input character file");
@@ -44,6 +49,7 @@ AnimatedMesh load_animated_input(const CommonOptions& common, std::string& input
         LoadOptions options;
         options.max_keyframe_bytes = common.max_memory;
         options.clips = clip_names;  // only these are sampled (select_clips below still picks and orders them)
+        options.files_read = files_read;
         mesh = load_character(common.input, clip_files, options);
         note(common, "loaded " + common.input + ": " + std::to_string(mesh.triangle_count()) + " triangles, " +
                          std::to_string(mesh.clips.size()) + " clips, " + std::to_string(mesh.keyframe_count()) +
@@ -53,8 +59,9 @@ AnimatedMesh load_animated_input(const CommonOptions& common, std::string& input
     return mesh;
 }
 
-AnimatedMesh load_drawable_input(const CommonOptions& common, std::string& input_name) {
-    AnimatedMesh mesh = load_animated_input(common, input_name);
+AnimatedMesh load_drawable_input(const CommonOptions& common, std::string& input_name,
+                                 std::vector<std::string>* files_read) {
+    AnimatedMesh mesh = load_animated_input(common, input_name, files_read);
     validate_animated_mesh(mesh);
     // A mesh with no area at its first keyframe has nothing to draw, so nothing to reorder.
     double area = 0;

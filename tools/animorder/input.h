@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace animorder::tool {
 
@@ -19,13 +20,19 @@ void note(const CommonOptions& common, const std::string& text);
 // A progress line on stderr that rewrites itself (at most two updates a second); none if --quiet.
 std::function<void(size_t, size_t)> progress_printer(const CommonOptions& common, const std::string& stage);
 
+// Whether a --clip value names a clip file or folder (else the name of a clip to keep).
+bool clip_is_file(const CommonOptions& common, const std::string& clip);
+
 // The input named on the command line (or the bundled character, saying so). --clip values that
 // exist on disk are clip files or folders (Mixamo style); the others name the clips to keep.
-AnimatedMesh load_animated_input(const CommonOptions& common, std::string& input_name);
+// files_read, when given, receives every file the load read (LoadOptions::files_read).
+AnimatedMesh load_animated_input(const CommonOptions& common, std::string& input_name,
+                                 std::vector<std::string>* files_read = nullptr);
 
 // load_animated_input's mesh, validated, and refused when it has nothing to draw (every
 // triangle of zero area at its first keyframe).
-AnimatedMesh load_drawable_input(const CommonOptions& common, std::string& input_name);
+AnimatedMesh load_drawable_input(const CommonOptions& common, std::string& input_name,
+                                 std::vector<std::string>* files_read = nullptr);
 
 // The library's settings for one method from the options (names of the k-means variants
 // parsed, --cache-size, log and progress lines on stderr labelled with the method's name).

@@ -129,6 +129,8 @@ animorder::tool::OptimizeOptions parse_batch_item(const std::vector<std::string>
     std::vector<std::string> reversed(args.rbegin(), args.rend());  // CLI11 takes them last first
     try {
         item.parse(reversed);
+    } catch (const CLI::Success&) {  // --help, --version: not an item's option
+        throw std::runtime_error("--help and --version are not options of an item");
     } catch (const CLI::ParseError& e) {
         throw std::runtime_error(e.what());
     }

@@ -25,6 +25,7 @@ double seconds_since(Clock::time_point start) { return std::chrono::duration<dou
 // The files `-o OUT` names: OUT.glb / OUT.gltf (only for glTF input), OUT.animorder.bin and .json.
 void output_paths(const OptimizeOptions& options, OptimizePlan& paths) {
     if (options.output.empty()) return;
+    check_output_stem(options.output);
     std::string stem = options.output;
     const std::string extension = std::filesystem::path(options.output).extension().string();
     if (extension == ".glb" || extension == ".gltf") {
@@ -39,13 +40,19 @@ void output_paths(const OptimizeOptions& options, OptimizePlan& paths) {
     paths.sidecar_json = stem + ".animorder.json";
 }
 
-// Every file this run reads: the character and the clip files or folders named by --clip.
+// Every file this run reads, as far as known before loading (files_load_reads): the character,
+// a glTF's external buffers and images, the clip files and the files of clip folders.
 std::vector<std::string> input_paths(const CommonOptions& common) {
-    std::vector<std::string> inputs;
-    if (!common.input.empty()) inputs.push_back(common.input);
+    std::vector<std::string> clip_files;
     for (const std::string& c : common.clips)
-        if (std::filesystem::exists(c)) inputs.push_back(c);
-    return inputs;
+        if (clip_is_file(common, c)) clip_files.push_back(c);
+    if (common.input.empty()) return clip_files;  // the bundled character takes none (loading says so)
+    try {
+        return files_load_reads(common.input, clip_files);
+    } catch (const LoadError&) {  // an empty clip folder: loading says so
+        clip_files.insert(clip_files.begin(), common.input);
+        return clip_files;
+    }
 }
 
 }  // namespace
@@ -68,7 +75,8 @@ nlohmann::ordered_json optimize_settings_json(const OptimizeOptions& options, co
                                        {"nehab_clusters", m.nehab_clusters},
                                        {"nehab_views", m.nehab_views},
                                        {"nehab_all_keyframes", m.nehab_all_keyframes},
-                                       {"blend_clusters", m.blend_clusters}};
+                                       {"blend_clusters", m.blend_clusters},
+                                       {"planar_units", m.measured_planar_units}};
     if (with_threads) settings["threads"] = m.clustering.threads;
     return settings;
 }
@@ -105,7 +113,8 @@ OptimizeProduct produce_optimize(const OptimizeOptions& options, const OptimizeP
     const OptimizePlan& paths = plan;
     std::string input_name;
     OptimizeProduct product;
-    product.mesh = load_drawable_input(options.common, input_name);
+    product.mesh = load_drawable_input(options.common, input_name, &product.files_read);
+    check_output_paths(plan.outputs, product.files_read);
     const AnimatedMesh& mesh = product.mesh;
     const double load_s = seconds_since(start);
     note(options.common, "loaded " + input_name + ": " + std::to_string(mesh.triangle_count()) + " triangles, " +

@@ -23,7 +23,7 @@ struct OptimizePlan {
     MethodSettings settings;
     std::string gltf, sidecar, sidecar_json;  // empty when not written
     std::vector<std::string> outputs;         // every file the run writes (the report included)
-    std::vector<std::string> inputs;          // every file or folder it reads
+    std::vector<std::string> inputs;          // every file it reads, as far as known before loading
 };
 
 // Validates the options (method, settings, output names) and names the outputs; touches no file.
@@ -36,13 +36,15 @@ nlohmann::ordered_json optimize_settings_json(const OptimizeOptions& options, co
 
 struct OptimizeProduct {
     AnimatedMesh mesh;
+    std::vector<std::string> files_read;  // every file loading read (side files included: an OBJ's .mtl)
     MethodResult run;
     VertexCacheStats before;
     nlohmann::ordered_json report;
 };
 
 // Loads the input, runs the method and adds the glTF / sidecar files of `plan` to `files`
-// (not the report, and without committing). Throws for any error.
+// (not the report, and without committing). Throws for any error, and before the method runs
+// when an output would replace a file that loading read (a side file plan_optimize cannot know).
 OptimizeProduct produce_optimize(const OptimizeOptions& options, const OptimizePlan& plan, OutputSet& files);
 
 }  // namespace animorder::tool

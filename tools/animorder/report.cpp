@@ -18,7 +18,11 @@ nlohmann::ordered_json cache_stats_json(const VertexCacheStats& stats) {
     return {{"acmr", stats.acmr}, {"atvr", stats.atvr}, {"misses", stats.misses}};
 }
 
-std::string report_text(const nlohmann::ordered_json& report) { return report.dump(2) + "\n"; }
+// A name or path that is not UTF-8 (Linux allows any bytes) is written with U+FFFD for the bad
+// bytes rather than failing after the work is done.
+std::string report_text(const nlohmann::ordered_json& report) {
+    return report.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n";
+}
 
 namespace {
 

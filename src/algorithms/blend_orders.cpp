@@ -22,6 +22,7 @@
 #include "animorder/measured_order.h"
 #include "animorder/overdraw.h"
 #include "animorder/rasterizer.h"
+#include "worker_threads.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -75,7 +76,7 @@ std::vector<BlendFragments> blend_fragments_of_nodes(const AnimatedMesh& mesh, c
         std::vector<float> clip;
     };
     tbb::enumerable_thread_specific<Worker> workers;
-    tbb::task_arena arena(threads ? int(threads) : tbb::this_task_arena::max_concurrency());
+    tbb::task_arena arena(worker_threads(threads));
     arena.execute([&] {
         tbb::parallel_for(tbb::blocked_range<size_t>(0, node_count, 1), [&](const tbb::blocked_range<size_t>& range) {
             Worker& w = workers.local();
@@ -188,7 +189,7 @@ BlendClustering cluster_blend_nodes(const AnimatedMesh& mesh, const Framing& fra
         throw InvalidInput("a clustering run's assignment does not cover its nodes");
     // Every node's transparent pass, once.
     const std::vector<BlendFragments> kept = blend_fragments_of_nodes(mesh, framing, run, resolution, threads);
-    tbb::task_arena arena(threads ? int(threads) : tbb::this_task_arena::max_concurrency());
+    tbb::task_arena arena(worker_threads(threads));
 
     BlendClustering best;
     for (const BlendFragments& f : kept) best.covered += f.covered;

@@ -29,6 +29,7 @@
 #include "animorder/overdraw.h"
 #include "animorder/rasterizer.h"
 #include "animorder/viewpoints.h"
+#include "worker_threads.h"
 
 #include <algorithm>
 #include <memory>
@@ -371,7 +372,7 @@ std::vector<size_t> measured_update_orders(const Nodes& nodes, const ClusteringS
     const Clock::time_point order_start = Clock::now();
     // The clusters' searches are independent: run side by side, each the same whatever the thread.
     std::vector<std::string> lines(nodes.k);
-    tbb::task_arena arena(settings.threads ? int(settings.threads) : tbb::this_task_arena::max_concurrency());
+    tbb::task_arena arena(worker_threads(settings.threads));
     arena.execute([&] {
         tbb::parallel_for(size_t(0), nodes.k, [&](size_t c) {
             if (sizes[c] == 0) return;
@@ -610,7 +611,7 @@ ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patc
     result.assignment.assign(nodes.count, UINT32_MAX);
     BestState best;
     MeasuredGraphs measured;
-    tbb::task_arena update_arena(settings.threads ? int(settings.threads) : tbb::this_task_arena::max_concurrency());
+    tbb::task_arena update_arena(worker_threads(settings.threads));
     for (size_t iteration = 0;; ++iteration) {
         ClusteringIteration log;
         const Clock::time_point assignment_start = Clock::now();

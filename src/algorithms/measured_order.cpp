@@ -18,6 +18,7 @@
 
 #include "animorder/invalid_input.h"
 #include "animorder/nehab06.h"
+#include "worker_threads.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -170,7 +171,7 @@ void MeasuredPairCounts::State::add_nodes(const Node* const* nodes, size_t node_
     const size_t units = counts.units;
     tbb::enumerable_thread_specific<PairCounts> tables([units] { return PairCounts(units); });
     tbb::enumerable_thread_specific<Scratch> scratch;
-    tbb::task_arena arena(threads ? int(threads) : tbb::this_task_arena::max_concurrency());
+    tbb::task_arena arena(worker_threads(threads));
     arena.execute([&] {
         tbb::parallel_for(tbb::blocked_range<size_t>(0, node_count, 4), [&](const tbb::blocked_range<size_t>& r) {
             PairCounts& table = tables.local();

@@ -41,6 +41,7 @@
 
 #include "fragment_encoding.h"
 #include "stopwatch.h"
+#include "worker_threads.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -208,7 +209,7 @@ public:
             kept_ = rasterize_nodes(positions_, vertex_count_, nodes_.framing, indices_, index_count_,
                                     nodes_.list.data(), nodes_.list.size(), settings_, kMaxKeptBytes);
     }
-    int threads() const { return settings_.threads ? int(settings_.threads) : tbb::this_task_arena::max_concurrency(); }
+    int threads() const { return worker_threads(settings_.threads); }
     size_t size() const { return nodes_.list.size(); }
 
     // The graph's pair sums over every node.

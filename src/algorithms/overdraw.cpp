@@ -13,6 +13,7 @@
 #include "animorder/rasterizer.h"
 #include "animorder/triangle_order.h"
 #include "animorder/viewpoints.h"
+#include "worker_threads.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -118,7 +119,7 @@ void score_nodes(uint64_t* visible, uint64_t* passed, const float* keyframe_posi
             progress.node_done();
         }
     };
-    const int threads = settings.threads ? int(settings.threads) : tbb::this_task_arena::max_concurrency();
+    const int threads = worker_threads(settings.threads);
     tbb::task_arena arena(threads);
     arena.execute([&] { tbb::parallel_for(tbb::blocked_range<size_t>(0, node_count, 1), body); });
 }
@@ -157,7 +158,7 @@ std::vector<NodeFragments> rasterize_nodes(const float* keyframe_positions, size
             progress.node_done();
         }
     };
-    const int threads = settings.threads ? int(settings.threads) : tbb::this_task_arena::max_concurrency();
+    const int threads = worker_threads(settings.threads);
     tbb::task_arena arena(threads);
     arena.execute([&] { tbb::parallel_for(tbb::blocked_range<size_t>(0, node_count, 1), body); });
     if (too_big) return {};
@@ -166,7 +167,7 @@ std::vector<NodeFragments> rasterize_nodes(const float* keyframe_positions, size
 
 void score_kept_nodes(uint64_t* visible, uint64_t* passed, const std::vector<NodeFragments>& nodes,
                       const uint32_t* ranks, size_t order_count, const ScoreSettings& settings) {
-    const int threads = settings.threads ? int(settings.threads) : tbb::this_task_arena::max_concurrency();
+    const int threads = worker_threads(settings.threads);
     tbb::task_arena arena(threads);
     arena.execute([&] {
         tbb::parallel_for(tbb::blocked_range<size_t>(0, nodes.size(), 64),
@@ -189,7 +190,7 @@ struct NodeCache::Worker {
 template <typename Body>
 void NodeCache::for_nodes(size_t count, size_t grain, Body&& body) const {
     tbb::enumerable_thread_specific<Worker> workers;
-    const int threads = settings_.threads ? int(settings_.threads) : tbb::this_task_arena::max_concurrency();
+    const int threads = worker_threads(settings_.threads);
     tbb::task_arena arena(threads);
     arena.execute([&] {
         tbb::parallel_for(tbb::blocked_range<size_t>(0, count, grain), [&](const tbb::blocked_range<size_t>& range) {

@@ -4,6 +4,7 @@
 // nodes — every keyframe of every clip × random views, R per clip — in parallel, deterministic.
 #pragma once
 
+#include "../algorithms/worker_threads.h"
 #include "animorder/animated_mesh.h"
 #include "animorder/evaluation.h"
 #include "animorder/invalid_input.h"
@@ -104,7 +105,7 @@ void for_each_evaluation_node(const AnimatedMesh& mesh, const Framing& all, cons
     const std::vector<float> directions = random_sphere_directions(settings.views, settings.seed);
     size_t total_nodes = 0, done_before = 0;
     for (const Clip& c : mesh.clips) total_nodes += c.keyframe_count * settings.views;
-    const int threads = settings.threads ? int(settings.threads) : tbb::this_task_arena::max_concurrency();
+    const int threads = worker_threads(settings.threads);
     tbb::task_arena arena(threads);
     std::mutex progress_mutex;
     for (size_t c = 0; c < mesh.clips.size(); ++c) {

@@ -91,6 +91,11 @@ TEST_F(Cli, QuietSilencesStderr) {
     ASSERT_EQ(o.exit_code, 0);
     EXPECT_EQ(o.err, "");
     EXPECT_NE(o.out.find("ACMR"), std::string::npos);
+    // More threads than cores: TBB gives no more (nothing changes) and, asked, would warn on stderr.
+    const test::Outcome threads =
+        run("optimize --quiet -k 2 --views 12 --resolution 32 --max-iterations 1 --threads 1000");
+    EXPECT_EQ(threads.exit_code, 0) << threads.err;
+    EXPECT_EQ(threads.err, "");
 }
 
 TEST_F(Cli, OptimizeWritesIndicesAndReport) {
@@ -420,9 +425,11 @@ TEST_F(CliOutputs, AllOutputsAppearTogether) {
 
 // Option errors from the parser read like every other error: one line, exit code 1.
 TEST_F(Cli, OptionRangeErrorsAreOneLineWithExitCodeOne) {
-    for (const char* args : {"optimize -k 0", "optimize -k 1000", "optimize --lambda -1", "optimize --lambda inf",
-                             "optimize --resolution 0", "evaluate --eval-views 0", "inspect --no-such-option",
-                             "optimize --max-memory 12"}) {
+    for (const char* args :
+         {"optimize -k 0", "optimize -k 1000", "optimize --lambda -1", "optimize --lambda inf",
+          "optimize --resolution 0", "evaluate --eval-views 0", "inspect --no-such-option", "optimize --max-memory 12",
+          "optimize --seed -1", "optimize --frame -2", "optimize --max-memory 99999999999999999999999",
+          "evaluate --eval-seed 1e3", "optimize --fragment-memory +5", "heatmap --frame x"}) {
         const test::Outcome o = run(args);
         EXPECT_EQ(o.exit_code, 1) << args;
         EXPECT_EQ(test::line_count(o.err), 1u) << args << " → " << o.err;

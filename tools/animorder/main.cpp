@@ -13,6 +13,21 @@
 
 namespace {
 
+// The text of an unsigned option: digits only (a sign would wrap "-1" around to 2^64 - 1) and a
+// value that fits in 64 bits (a larger one would be taken as the largest, silently).
+const CLI::Validator kWholeNumber(
+    [](std::string& text) -> std::string {
+        if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos)
+            return "must be a whole number of at least 0, not '" + text + "'";
+        try {
+            (void)std::stoull(text);
+        } catch (const std::out_of_range&) {
+            return text + " is larger than 2^64 - 1";
+        }
+        return "";
+    },
+    "UINT");
+
 void add_common(CLI::App& command, animorder::tool::CommonOptions& common) {
     command.add_option("input", common.input, "Input mesh (default: the bundled procedural character)");
     command.add_flag("-q,--quiet", common.quiet, "No progress or notes on stderr");
@@ -25,6 +40,7 @@ void add_common(CLI::App& command, animorder::tool::CommonOptions& common) {
         .add_option("--max-memory", common.max_memory,
                     "Loading budget in bytes for the sampled animation (keyframes x vertices x 12)")
         ->capture_default_str()
+        ->check(kWholeNumber)
         ->check(CLI::Range(size_t(1) << 20, std::numeric_limits<size_t>::max()));
 }
 
@@ -53,21 +69,26 @@ void add_method_options(CLI::App& command, animorder::tool::MethodOptions& optio
             .add_option("--views", options.view_list,
                         "single/joint: clustering viewpoints (12, 42, 162, 642); a list runs each value")
             ->delimiter(',')
-            ->capture_default_str();
+            ->capture_default_str()
+            ->check(kWholeNumber);
     } else {
         command.add_option("-l,--lambda", m.lambda, lambda_help)->capture_default_str()->check(CLI::Range(0.0, 1000.0));
         command.add_option("-k,--clusters", c.clusters, "single/joint: number of buffers k")
             ->capture_default_str()
             ->check(CLI::Range(size_t(1), size_t(255)));
         command.add_option("--views", c.views, "single/joint: clustering viewpoints (12, 42, 162, 642)")
-            ->capture_default_str();
+            ->capture_default_str()
+            ->check(kWholeNumber);
     }
     command.add_option("--frame", m.keyframe, "static methods: keyframe whose positions they sort with")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(kWholeNumber);
     command.add_option("--resolution", c.resolution, "single/joint/static-nehab06: clustering viewport in pixels")
         ->capture_default_str()
         ->check(CLI::Range(8u, 4096u));
-    command.add_option("--seed", c.seed, "single/joint: seed of the bootstrap viewpoints")->capture_default_str();
+    command.add_option("--seed", c.seed, "single/joint: seed of the bootstrap viewpoints")
+        ->capture_default_str()
+        ->check(kWholeNumber);
     command.add_option("--min-separation", c.min_separation_deg, "single/joint: degrees between bootstrap viewpoints")
         ->capture_default_str();
     command.add_option("--max-iterations", c.max_iterations, "single/joint: cap on k-means iterations")
@@ -86,7 +107,8 @@ void add_method_options(CLI::App& command, animorder::tool::MethodOptions& optio
         ->capture_default_str()
         ->check(CLI::Range(size_t(0), size_t(1) << 20));
     command.add_option("--nehab-views", m.nehab_views, "static-nehab06: measuring viewpoints (12, 42, 162, 642)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(kWholeNumber);
     command.add_flag("--nehab-all-keyframes", m.nehab_all_keyframes,
                      "static-nehab06: measure also at 8 keyframes spread over the clips (default: --frame only)");
     command.add_flag("--planar-units", m.measured_planar_units,
@@ -95,7 +117,8 @@ void add_method_options(CLI::App& command, animorder::tool::MethodOptions& optio
         .add_option("--fragment-memory", c.max_cache_bytes,
                     "single/joint/measured: bytes for the nodes' kept fragments; nodes beyond are rasterised again "
                     "each iteration (same result, slower)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(kWholeNumber);
     command.add_option("--threads", c.threads, "Worker threads (0: all cores)")
         ->capture_default_str()
         ->check(CLI::Range(0u, 1024u));
@@ -172,7 +195,8 @@ int main(int argc, char** argv) {
         ->capture_default_str()
         ->check(CLI::Range(1u, 8192u));
     evaluate_cmd->add_option("--eval-seed", evaluate.evaluation.seed, "Seed of the evaluation viewpoints")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(kWholeNumber);
     evaluate_cmd->add_option("-r,--report", evaluate.report_path, "Write the JSON report to this file");
     evaluate_cmd->add_option("--csv", evaluate.csv_path, "Write the table as CSV to this file");
     evaluate_cmd->add_flag(
@@ -193,7 +217,9 @@ int main(int argc, char** argv) {
     heatmap_cmd->add_option("--view", heatmap.view, "Direction from the character to the camera, x,y,z")
         ->delimiter(',')
         ->expected(3);
-    heatmap_cmd->add_option("--frame", heatmap.keyframe, "Keyframe (over all clips)")->capture_default_str();
+    heatmap_cmd->add_option("--frame", heatmap.keyframe, "Keyframe (over all clips)")
+        ->capture_default_str()
+        ->check(kWholeNumber);
     heatmap_cmd->add_option("--resolution", heatmap.resolution, "Image size in pixels")
         ->capture_default_str()
         ->check(CLI::Range(16u, 8192u));
@@ -250,7 +276,9 @@ int main(int argc, char** argv) {
         ->capture_default_str()
         ->check(CLI::Range(0u, 65535u));
     view_cmd->add_flag("!--no-open", view.open, "Do not start a browser; just print the address");
-    view_cmd->add_option("--seconds", view.seconds, "Stop serving after this many seconds (0: until interrupted)");
+    view_cmd->add_option("--seconds", view.seconds, "Stop serving after this many seconds (0: until interrupted)")
+        ->check(kWholeNumber)
+        ->check(CLI::Range(0u, 100000000u));
     view_cmd->add_option("--viewer-root", view.viewer_root,
                          "The folder holding viewer/ and js/ (default: the source tree)");
 
@@ -275,7 +303,8 @@ int main(int argc, char** argv) {
         ->capture_default_str()
         ->check(CLI::Range(0.0, 0.1));
     reapply_cmd->add_option("--max-memory", reapply.max_memory, "Loading budget in bytes for the sampled animation")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(kWholeNumber);
     reapply_cmd->add_flag("-q,--quiet", reapply.quiet, "No progress or notes on stderr");
 
     if (argc == 1) {  // no arguments: the basics, and where to look next (gltfpack style)

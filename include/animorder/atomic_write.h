@@ -21,6 +21,10 @@ public:
 // resolving links) one of `inputs`, and no two outputs are the same file. Call it before any long work, so a bad path fails at once.
 void check_output_paths(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs);
 
+// A key equal for two paths exactly when they name the same file: its device and inode when it
+// exists, else its path with links and "." / ".." resolved.
+std::string file_identity(const std::string& path);
+
 // Throws OutputError when `stem`, a name that a run's outputs extend (OUT → OUT.animorder.bin),
 // names a folder instead: empty, ending in '/', ending in "." or "..", or an existing folder.
 void check_output_stem(const std::string& stem);

@@ -30,7 +30,8 @@ struct LoadOptions {
     // sample every clip. Callers still call select_clips for the order and the error.
     std::vector<std::string> clips;
     // When set, receives every file the load read: files_load_reads' and the side files an
-    // importer opened as it read (an OBJ's .mtl), each once, in the order first read.
+    // importer opened or looked for as it read (an OBJ's .mtl, found or not), each once, in the
+    // order first met.
     std::vector<std::string>* files_read = nullptr;
 };
 
@@ -43,10 +44,12 @@ AnimatedMesh load_character(const std::string& path, const std::vector<std::stri
 
 // The files load_character(path, clip_files) reads, as far as they are known before loading: the
 // file; for .gltf/.glb its external buffers and images, by URI, resolved as the glTF loader
-// resolves them (percent-decoded, '+' a space, joined to the file's folder; data: URIs are
-// inside the file); each clip file, and the files of each clip folder in name order. Not the side
-// files an assimp format may open as it reads (an OBJ's .mtl). Reads only the glTF's JSON, from a
-// regular file; a file it cannot parse lists no external file (loading it says what is wrong).
+// resolves them (percent-decoded, '+' a space; beside the file, else in the current folder when
+// only there; empty URIs and the data URIs tinygltf decodes name no file); each clip file, and
+// the files of each clip folder in name order. Not the side files an assimp format may open as it
+// reads (an OBJ's .mtl). Reads only the glTF's JSON, from a regular file; a file it cannot parse
+// lists no external file (loading it says what is wrong). LoadError for a clip folder that cannot
+// be listed or is empty, or glTF JSON over 1 GiB.
 std::vector<std::string> files_load_reads(const std::string& path, const std::vector<std::string>& clip_files = {});
 
 // Throws LoadError when a file of files_load_reads(path, clip_files) exists but is not a regular

@@ -102,23 +102,25 @@ void flatten(const aiNode* root, Flat& flat) {
 
 // Assimp's file access, but only to regular files: a side file an importer opens as it reads (an
 // OBJ's mtllib, say) that is a FIFO or a device would never end; for assimp it is then missing.
-// Every file opened is added to `opened` (once).
+// Every file it looks for or opens goes to `looked_at` (once), found or not: a material file
+// missing today changes the mesh when it appears.
 class RegularFilesOnly : public Assimp::DefaultIOSystem {
 public:
-    explicit RegularFilesOnly(std::vector<std::string>& opened) : opened_(opened) {}
-    bool Exists(const char* file) const override { return regular(file) && DefaultIOSystem::Exists(file); }
+    explicit RegularFilesOnly(std::vector<std::string>& looked_at) : looked_at_(looked_at) {}
+    bool Exists(const char* file) const override { return note(file) && DefaultIOSystem::Exists(file); }
     Assimp::IOStream* Open(const char* file, const char* mode) override {
-        Assimp::IOStream* stream = regular(file) ? DefaultIOSystem::Open(file, mode) : nullptr;
-        if (stream && std::find(opened_.begin(), opened_.end(), file) == opened_.end()) opened_.push_back(file);
-        return stream;
+        return note(file) ? DefaultIOSystem::Open(file, mode) : nullptr;
     }
 
 private:
-    std::vector<std::string>& opened_;
-    static bool regular(const char* file) {
+    // Records the file; whether it is a regular file.
+    bool note(const char* file) const {
+        if (!file) return false;
+        if (std::find(looked_at_.begin(), looked_at_.end(), file) == looked_at_.end()) looked_at_.push_back(file);
         std::error_code error;
-        return file && std::filesystem::is_regular_file(file, error);
+        return std::filesystem::is_regular_file(file, error);
     }
+    std::vector<std::string>& looked_at_;
 };
 
 const aiScene* import(Assimp::Importer& importer, const std::string& path, std::vector<std::string>& opened) {

@@ -2,11 +2,14 @@
 // disk, renamed into place only when every file of the run is written.
 #include "animorder/atomic_write.h"
 
+#include <sys/stat.h>
 #include <unistd.h>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <unordered_map>
+#include <unordered_set>
 
 namespace animorder {
 namespace {
@@ -17,27 +20,24 @@ namespace fs = std::filesystem;
 // be resolved), so two spellings of one file compare equal.
 fs::path resolved(const std::string& path) {
     std::error_code error;
-    fs::path p = fs::weakly_canonical(fs::absolute(path), error);
+    fs::path p = fs::weakly_canonical(fs::absolute(path, error), error);
     return error ? fs::path(path) : p;
 }
 
-bool same_file(const std::string& a, const std::string& b) {
-    std::error_code error;
-    if (fs::exists(a, error) && fs::exists(b, error) && fs::equivalent(a, b, error)) return true;
-    return resolved(a) == resolved(b);
-}
+bool same_file(const std::string& a, const std::string& b) { return file_identity(a) == file_identity(b); }
 
 // What a temporary adds to its target's name: "." before, ".tmp" or ".old" and a process id after.
 constexpr size_t kTemporaryExtra = 1 + 4 + 10;
 
 void check_writable_target(const std::string& path) {
     const fs::path target(path);
+    std::error_code error;
     if (path.empty()) throw OutputError("an output path is empty");
-    if (fs::is_directory(target)) throw OutputError(path + ": is a directory, expected a file name");
+    if (fs::is_directory(target, error)) throw OutputError(path + ": is a directory, expected a file name");
     const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
-    if (!fs::is_directory(folder))
+    if (!fs::is_directory(folder, error))
         throw OutputError(path + ": folder " + folder.string() +
-                          (fs::exists(folder) ? " is not a folder" : " does not exist"));
+                          (fs::exists(folder, error) ? " is not a folder" : " does not exist"));
     if (::access(folder.c_str(), W_OK | X_OK) != 0)
         throw OutputError(path + ": folder " + folder.string() + " is not writable");
     const long name_max = ::pathconf(folder.c_str(), _PC_NAME_MAX);
@@ -55,6 +55,12 @@ std::string temporary_name(const fs::path& target, const char* kind) {
 
 }  // namespace
 
+std::string file_identity(const std::string& path) {
+    struct stat st {};
+    if (::stat(path.c_str(), &st) == 0) return "inode " + std::to_string(st.st_dev) + ":" + std::to_string(st.st_ino);
+    return "path " + resolved(path).string();
+}
+
 void check_output_stem(const std::string& stem) {
     const fs::path path(stem);
     const std::string last = path.filename().string();
@@ -65,15 +71,19 @@ void check_output_stem(const std::string& stem) {
 }
 
 void check_output_paths(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs) {
+    // Each path resolved once (a library's batch checks thousands against thousands).
+    std::unordered_set<std::string> input_files;
+    for (const std::string& input : inputs)
+        if (!input.empty()) input_files.insert(file_identity(input));
+    std::unordered_map<std::string, size_t> output_files;
     for (size_t i = 0; i < outputs.size(); ++i) {
         check_writable_target(outputs[i]);
-        for (const std::string& input : inputs)
-            if (!input.empty() && same_file(outputs[i], input))
-                throw OutputError(outputs[i] +
-                                  ": is an input of this run: refusing to overwrite the input; name another output");
-        for (size_t j = 0; j < i; ++j)
-            if (same_file(outputs[i], outputs[j]))
-                throw OutputError(outputs[i] + ": named twice as an output (" + outputs[j] + ")");
+        const std::string identity = file_identity(outputs[i]);
+        if (input_files.count(identity))
+            throw OutputError(outputs[i] +
+                              ": is an input of this run: refusing to overwrite the input; name another output");
+        const auto [first, added] = output_files.emplace(identity, i);
+        if (!added) throw OutputError(outputs[i] + ": named twice as an output (" + outputs[first->second] + ")");
     }
 }
 

@@ -6,6 +6,11 @@
 
 #include <tiny_gltf.h>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstddef>
 #include <cstdio>
 #include <filesystem>
@@ -32,12 +37,50 @@ inline int append_buffer_view(tinygltf::Model& model, const void* data, size_t b
     return int(model.bufferViews.size() - 1);
 }
 
+// tinygltf's file access, but to regular files only, checked on the open file (O_NONBLOCK, then
+// fstat): a FIFO or a device never ends, and a file swapped for one after a check must not hang
+// the read. For a missing or irregular file, FileExists is false (tinygltf then looks elsewhere or
+// says the file was not found).
+inline bool regular_file_exists(const std::string& path, void*) {
+    struct stat st {};
+    return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+}
+
+inline bool read_regular_file(std::vector<unsigned char>* out, std::string* error, const std::string& path, void*) {
+    const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    struct stat st {};
+    const bool regular = fd >= 0 && ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode);
+    size_t got = 0;
+    if (regular) {
+        out->resize(size_t(st.st_size));
+        while (got < out->size()) {
+            const ssize_t n = ::read(fd, out->data() + got, out->size() - got);
+            if (n < 0 && errno == EINTR) continue;
+            if (n <= 0) break;
+            got += size_t(n);
+        }
+    }
+    if (fd >= 0) ::close(fd);
+    const char* why = fd < 0               ? "cannot open"
+                      : !regular           ? "not a regular file"
+                      : got != out->size() ? "cannot read all of"
+                      : out->empty()       ? "empty file"
+                                           : nullptr;
+    if (why && error) *error += std::string(why) + " : " + path + "\n";
+    return !why;
+}
+
+inline tinygltf::FsCallbacks regular_file_callbacks() {
+    return {regular_file_exists, tinygltf::ExpandFilePath, read_regular_file, tinygltf::WriteWholeFile, nullptr};
+}
+
 // The glTF file at `path` (binary when it starts with "glTF"), images left undecoded; LoadError
 // when it is no readable glTF 2.0 file, or it or a file it references is no regular file.
 inline tinygltf::Model read_model(const std::string& path) {
     require_regular_files(path);
     tinygltf::Model model;
     tinygltf::TinyGLTF loader;
+    loader.SetFsCallbacks(regular_file_callbacks());
     loader.SetImageLoader([](tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*,
                              int, void*) { return true; },
                           nullptr);

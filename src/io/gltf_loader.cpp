@@ -16,6 +16,7 @@
 #include "animorder/skinning.h"
 
 #include "checked_size.h"
+#include "gltf_buffer.h"
 #include "transform.h"
 
 #include <tiny_gltf.h>
@@ -326,6 +327,7 @@ size_t channel_components(const Scene& s, size_t node, const std::string& path) 
 tinygltf::Model parse_file(const std::string& path) {
     tinygltf::Model model;
     tinygltf::TinyGLTF loader;
+    loader.SetFsCallbacks(io::regular_file_callbacks());  // a FIFO or a device is never opened
     loader.SetImageLoader([](tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*,
                              int, void*) { return true; },  // textures pass through untouched: never decoded
                           nullptr);

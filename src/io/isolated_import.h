@@ -16,7 +16,7 @@ namespace animorder::io {
 using ReadingFile = std::function<void(size_t)>;
 
 // What the child's loader gets: reading(i) before it reads files[i], and `opened`, to which it
-// adds every file it opens (passed back with the mesh).
+// adds every file it opens or looks for (passed back with the mesh).
 struct ChildContext {
     ReadingFile reading;
     std::vector<std::string>& opened;
@@ -33,8 +33,8 @@ struct ChildContext {
 //    followed by the last meaningful line the child wrote to stderr, if any;
 //  - the child exiting non-zero (AddressSanitizer does this after a report): "FILE: assimp
 //    crashed reading it (exit code N)" and the same stderr line.
-// The child's stdout and stderr are captured, never shown. The files the child opened are added
-// to options.files_read (when set) if not there already.
+// The child's stdout and stderr are captured, never shown. The files the child opened or looked
+// for are added to options.files_read (when set) if not there already.
 AnimatedMesh load_isolated(const std::vector<std::string>& files, const LoadOptions& options,
                            const std::function<AnimatedMesh(const ChildContext& child)>& load);
 

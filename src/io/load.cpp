@@ -8,6 +8,7 @@
 #include "animorder/iqm_loader.h"
 #include "animorder/md2_loader.h"
 
+#include <tiny_gltf.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -27,26 +28,33 @@ std::string lower_extension(const std::string& path) {
     return extension;
 }
 
-// A clip folder stands for its regular files, in name order.
+// A clip folder stands for its regular files, in name order. Filesystem errors (a link loop, a
+// folder that cannot be listed) are LoadErrors naming the path.
 std::vector<std::string> expand_clip_files(const std::vector<std::string>& clip_files) {
+    namespace fs = std::filesystem;
     std::vector<std::string> files;
     for (const std::string& c : clip_files) {
-        if (std::filesystem::is_directory(c)) {
-            std::vector<std::string> inside;
-            for (const auto& entry : std::filesystem::directory_iterator(c))
-                if (entry.is_regular_file()) inside.push_back(entry.path().string());
-            std::sort(inside.begin(), inside.end());
-            if (inside.empty()) throw LoadError(c + ": the clip folder is empty");
-            files.insert(files.end(), inside.begin(), inside.end());
-        } else {
+        std::error_code error;
+        if (!fs::is_directory(c, error)) {
             files.push_back(c);
+            continue;
         }
+        std::vector<std::string> inside;
+        for (fs::directory_iterator it(c, error); !error && it != fs::directory_iterator(); it.increment(error)) {
+            std::error_code entry_error;
+            if (it->is_regular_file(entry_error)) inside.push_back(it->path().string());
+        }
+        if (error) throw LoadError(c + ": cannot list the clip folder: " + error.message());
+        std::sort(inside.begin(), inside.end());
+        if (inside.empty()) throw LoadError(c + ": the clip folder is empty");
+        files.insert(files.end(), inside.begin(), inside.end());
     }
     return files;
 }
 
 // The JSON text of a glTF (.gltf: the file; .glb: its first chunk, which must be JSON); empty
-// when the file is not a regular file, its sizes do not hold or the text exceeds 1 GiB.
+// when the file is not a regular file or its sizes do not hold; a LoadError when the text exceeds
+// 1 GiB (its external files could not be known).
 constexpr uint64_t kMaxJsonBytes = uint64_t(1) << 30;
 std::string gltf_json_text(const std::string& path) {
     std::error_code error;
@@ -61,13 +69,13 @@ std::string gltf_json_text(const std::string& path) {
         if (in.gcount() < 20) return {};
         uint32_t length = 0;
         std::memcpy(&length, header + 12, 4);  // chunk 0: length, type "JSON", then the text
-        if (std::memcmp(header + 16, "JSON", 4) != 0 || uint64_t(length) > size - 20 || length > kMaxJsonBytes)
-            return {};
+        if (std::memcmp(header + 16, "JSON", 4) != 0 || uint64_t(length) > size - 20) return {};
+        if (length > kMaxJsonBytes) throw LoadError(path + ": its glTF JSON is larger than 1 GiB");
         std::string text(length, '\0');
         in.read(text.data(), std::streamsize(length));
         return in.gcount() == std::streamsize(length) ? text : std::string();
     }
-    if (size > kMaxJsonBytes) return {};
+    if (size > kMaxJsonBytes) throw LoadError(path + ": its glTF JSON is larger than 1 GiB");
     std::string text(size_t(size), '\0');
     in.seekg(0);
     in.read(text.data(), std::streamsize(size));
@@ -96,13 +104,22 @@ std::string decode_uri(const std::string& uri) {
     return out;
 }
 
-// tinygltf's GetBaseDir and JoinPath: the text before the last '/' or '\\', and "a/b" (a alone
-// when b is empty; no second '/' when a ends in one).
-std::string join_to_folder_of(const std::string& file, const std::string& name) {
-    const size_t slash = file.find_last_of("/\\");
-    const std::string folder = slash == std::string::npos ? std::string() : file.substr(0, slash);
+// tinygltf's JoinPath: "a/b" (b alone when a is empty; no second '/' when a ends in one).
+std::string join_path(const std::string& folder, const std::string& name) {
     if (folder.empty()) return name;
     return folder.back() == '/' ? folder + name : folder + "/" + name;
+}
+
+// The file tinygltf's FindFile takes for a decoded URI: the first of the glTF's folder (its
+// GetBaseDir: the text before the last '/' or '\\') and the current folder where the file exists,
+// else the first (missing: the loader says so).
+std::string find_file(const std::string& gltf, const std::string& name) {
+    const size_t slash = gltf.find_last_of("/\\");
+    const std::string beside = join_path(slash == std::string::npos ? std::string() : gltf.substr(0, slash), name);
+    std::error_code error;
+    if (std::filesystem::exists(beside, error)) return beside;
+    const std::string here = join_path(".", name);
+    return std::filesystem::exists(here, error) ? here : beside;
 }
 
 std::vector<std::string> gltf_external_files(const std::string& path) {
@@ -119,8 +136,10 @@ std::vector<std::string> gltf_external_files(const std::string& path) {
             const auto uri = entry.find("uri");
             if (uri == entry.end() || !uri->is_string()) continue;
             const std::string& u = uri->get_ref<const std::string&>();
-            if (u.rfind("data:", 0) == 0) continue;  // embedded
-            files.push_back(join_to_folder_of(path, decode_uri(u)));
+            // Empty: no file (a GLB's BIN chunk, an image left out); a data URI tinygltf decodes
+            // (its own test: only some media types are) is inside the file.
+            if (u.empty() || tinygltf::IsDataURI(u)) continue;
+            files.push_back(find_file(path, decode_uri(u)));
         }
     }
     return files;
@@ -135,15 +154,8 @@ std::vector<std::string> files_load_reads(const std::string& path, const std::ve
         const std::vector<std::string> external = gltf_external_files(path);
         files.insert(files.end(), external.begin(), external.end());
     }
-    std::error_code error;
-    for (const std::string& c : clip_files) {
-        if (!std::filesystem::is_directory(c, error)) {
-            files.push_back(c);
-            continue;
-        }
-        const std::vector<std::string> inside = expand_clip_files({c});
-        files.insert(files.end(), inside.begin(), inside.end());
-    }
+    const std::vector<std::string> clips = expand_clip_files(clip_files);
+    files.insert(files.end(), clips.begin(), clips.end());
     return files;
 }
 

@@ -563,6 +563,13 @@ TEST(GltfCharacters, DoubleSidedMaterialsOfSharedData) {
     }
 }
 
+// The current folder moved to `folder` while it lives (tinygltf also looks for files there).
+struct InFolder {
+    explicit InFolder(const fs::path& folder) : before(fs::current_path()) { fs::current_path(folder); }
+    ~InFolder() { fs::current_path(before); }
+    fs::path before;
+};
+
 // files_load_reads lists what the loader will read, resolved as tinygltf resolves it: the files
 // here are read by loading the same glTF (every listed buffer is one the load needs), and the
 // spellings are worked out by hand from the URIs ('+' a space, %XY a byte, data: URIs inside).
@@ -616,13 +623,35 @@ TEST_F(GltfLoader, FilesThatAreNotRegularAreRefusedWithoutReadingThem) {
     // an empty folder): /dev/zero.
     g.doc["buffers"] = json::array({{{"byteLength", 12}, {"uri", "/dev/zero"}}});
     write("zero.gltf", g.doc.dump());
-    const fs::path before = fs::current_path();
-    fs::current_path(dir_);
+    const InFolder here(dir_);
     test::expect_one_line_load_error("zero.gltf", "reads /dev/zero, which is not a regular file",
                                      [&] { load_character("zero.gltf"); });
-    fs::current_path(before);
     const std::string glb = (dir_ / "pipe.glb").string();
     ASSERT_EQ(::mkfifo(glb.c_str(), 0600), 0);
     test::expect_one_line_load_error(glb, "is not a regular file", [&] { load_character(glb); });
     test::expect_one_line_load_error(fifo, "is not a regular file", [&] { load_character(fifo); });
+}
+
+// tinygltf's other rules, each worked out from its source (tiny_gltf.h 2.7: FindFile tries the
+// glTF's folder, then the current one; IsDataURI knows seven media types; an empty image URI is
+// skipped): a buffer found only in the current folder is the one listed and read, a "data:" URI
+// of another type is a file name, an empty image URI names nothing.
+TEST_F(GltfLoader, UrisResolveAsTinygltfResolvesThem) {
+    Gltf g = skinned_bar();
+    fs::create_directories(dir_ / "a");
+    write("x.bin", g.bin);  // beside the current folder only
+    g.doc["buffers"] = json::array({{{"byteLength", g.bin.size()}, {"uri", "x.bin"}}});
+    g.doc["images"] = json::array({{{"uri", ""}}, {{"uri", "data:x"}}});
+    write("a/a.gltf", g.doc.dump());
+    const InFolder here(dir_);
+    const std::vector<std::string> expected = {"a/a.gltf", "./x.bin", "a/data:x"};
+    EXPECT_EQ(files_load_reads("a/a.gltf"), expected);
+    std::vector<std::string> read;
+    LoadOptions options;
+    options.files_read = &read;
+    EXPECT_EQ(load_character("a/a.gltf", {}, options).triangle_count(), 2u);
+    EXPECT_EQ(read, expected);
+    ASSERT_EQ(::mkfifo("a/data:x", 0600), 0);  // a file, so a FIFO there is refused, not read
+    test::expect_one_line_load_error("a/a.gltf", "reads a/data:x, which is not a regular file",
+                                     [&] { load_character("a/a.gltf"); });
 }

@@ -21,8 +21,11 @@
 #include "animorder/atomic_write.h"
 #include "animorder/evaluation.h"
 
+#include <fcntl.h>
 #include <nettle/sha2.h>
 #include <signal.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -37,6 +40,8 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 namespace animorder::tool {
@@ -97,12 +102,17 @@ std::string read_text(const std::string& path, const char* what) {
 }
 
 // Text that the JSON reports can hold: valid UTF-8 (a report names items and paths).
-void require_utf8(const std::string& text, const std::string& where) {
+bool is_utf8(const std::string& text) {
     try {
         (void)json(text).dump();
+        return true;
     } catch (const json::exception&) {
-        throw std::runtime_error(where + " is not valid UTF-8 (the reports are JSON)");
+        return false;
     }
+}
+
+void require_utf8(const std::string& text, const std::string& where) {
+    if (!is_utf8(text)) throw std::runtime_error(where + " is not valid UTF-8 (the reports are JSON)");
 }
 
 // "options" as a string of optimize arguments, a list of them, or an object {"lambda": 3, "joint": true}.
@@ -142,16 +152,14 @@ std::vector<std::string> options_from_json(const json& value, const std::string&
 std::vector<ManifestItem> parse_json_manifest(const std::string& text, const std::string& path) {
     json doc;
     // The parser keeps the last of two equal keys; a manifest that says one thing twice is refused.
-    std::vector<std::vector<std::string>> keys;  // the keys of each object being parsed
+    std::vector<std::unordered_set<std::string>> keys;  // the keys of each object being parsed
     std::string duplicate;
     const json::parser_callback_t no_duplicate_keys = [&](int, json::parse_event_t event, json& parsed) {
         if (event == json::parse_event_t::object_start) keys.emplace_back();
         if (event == json::parse_event_t::object_end && !keys.empty()) keys.pop_back();
         if (event == json::parse_event_t::key && !keys.empty()) {
-            const std::string key = parsed.get<std::string>();
-            if (std::find(keys.back().begin(), keys.back().end(), key) != keys.back().end() && duplicate.empty())
-                duplicate = key;
-            keys.back().push_back(key);
+            std::string key = parsed.get<std::string>();
+            if (!keys.back().insert(key).second && duplicate.empty()) duplicate = std::move(key);
         }
         return true;
     };
@@ -321,7 +329,7 @@ std::vector<ManifestItem> read_manifest(const std::string& path) {
         for (std::string& c : item.clips) {
             std::error_code error;
             const fs::path beside = fs::path(c).is_absolute() ? fs::path(c) : base / c;
-            if (fs::exists(beside, error)) c = fs::absolute(beside, error).lexically_normal().string();
+            if (fs::exists(beside, error)) c = fs::absolute(beside, error).string();
         }
     }
     return items;
@@ -386,22 +394,27 @@ public:
         sha256_update(&ctx_, text.size(), reinterpret_cast<const uint8_t*>(text.data()));
     }
     // A file's name and bytes (never its folder: a library moved whole keeps its stamps). A path
-    // that is no regular file (missing, a folder, a FIFO or a device, which would never end)
-    // hashes as that: the item then fails to load it.
+    // that is no regular file (missing, a folder, a FIFO or a device, which would never end:
+    // checked on the open file) hashes as that: the item then fails to load it.
     void add_file(const fs::path& path) {
         add("file:" + path.filename().string());
-        std::error_code error;
-        if (!fs::is_regular_file(path, error)) return add(fs::exists(path, error) ? "not a regular file" : "missing");
-        std::ifstream in(path, std::ios::binary);
-        if (!in) return add("unreadable");
-        std::vector<char> block(1 << 16);
-        uint64_t total = 0;
-        while (in) {
-            in.read(block.data(), std::streamsize(block.size()));
-            const std::streamsize got = in.gcount();
-            if (got > 0) sha256_update(&ctx_, size_t(got), reinterpret_cast<const uint8_t*>(block.data()));
-            total += uint64_t(got > 0 ? got : 0);
+        const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+        if (fd < 0) return add(errno == ENOENT ? "missing" : "unreadable");
+        struct stat st {};
+        if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+            ::close(fd);
+            return add("not a regular file");
         }
+        std::vector<uint8_t> block(1 << 16);
+        uint64_t total = 0;
+        for (;;) {
+            const ssize_t got = ::read(fd, block.data(), block.size());
+            if (got < 0 && errno == EINTR) continue;
+            if (got <= 0) break;
+            sha256_update(&ctx_, size_t(got), block.data());
+            total += uint64_t(got);
+        }
+        ::close(fd);
         add("bytes:" + std::to_string(total));
     }
     std::string hex() {
@@ -465,19 +478,58 @@ fs::path folder_of(const std::string& path) {
     return p.has_parent_path() ? p.parent_path() : fs::path(".");
 }
 
-// The files loading read beyond the stamp's (an OBJ's .mtl: only the importer knows them), each
-// with its path from the report's folder and its digest, for the report's "side_files".
+// A side file's path from the report's folder, as the report keeps it: "file" when it is UTF-8,
+// else "file_bytes" with every byte outside printable ASCII (and '%') as %XY, so that it reads
+// back as the same bytes (a JSON string cannot hold them).
+json side_file_name(const std::string& path) {
+    if (is_utf8(path)) return {{"file", path}};
+    std::string escaped;
+    static const char* digits = "0123456789ABCDEF";
+    for (const unsigned char c : path)
+        if (c < 0x20 || c >= 0x7f || c == '%')
+            escaped += {'%', digits[c >> 4], digits[c & 15]};
+        else
+            escaped += char(c);
+    return {{"file_bytes", escaped}};
+}
+
+std::string side_file_path(const json& entry) {
+    const std::string file = string_at(entry, "file");
+    if (!file.empty()) return file;
+    const std::string escaped = string_at(entry, "file_bytes");
+    std::string out;
+    for (size_t i = 0; i < escaped.size(); ++i) {
+        if (escaped[i] == '%' && i + 2 < escaped.size() && std::isxdigit(uint8_t(escaped[i + 1])) &&
+            std::isxdigit(uint8_t(escaped[i + 2]))) {
+            out += char(std::stoi(escaped.substr(i + 1, 2), nullptr, 16));
+            i += 2;
+        } else {
+            out += escaped[i];
+        }
+    }
+    return out;
+}
+
+// The files loading read beyond the stamp's (an OBJ's .mtl: only the importer knows them, found
+// or not), each with its path from the report's folder and its digest taken as it was loaded,
+// for the report's "side_files".
 json side_files(const PlannedItem& p, const std::vector<std::string>& files_read) {
+    std::unordered_set<std::string> known;
+    for (const std::string& input : p.plan.inputs) known.insert(file_identity(input));
     json list = json::array();
-    std::error_code error;
+    std::unordered_set<std::string> listed;
     for (const std::string& file : files_read) {
-        const bool known = std::any_of(p.plan.inputs.begin(), p.plan.inputs.end(), [&](const std::string& input) {
-            return fs::weakly_canonical(input, error) == fs::weakly_canonical(file, error);
-        });
-        if (known) continue;
-        const fs::path from_report = fs::relative(file, folder_of(p.report), error);
-        list.push_back(
-            {{"file", (error ? fs::absolute(file) : from_report).generic_string()}, {"sha256", file_digest(file)}});
+        if (known.count(file_identity(file))) continue;
+        std::error_code error;
+        fs::path from_report = fs::relative(file, folder_of(p.report), error);
+        if (error || from_report.empty()) from_report = fs::absolute(file, error);
+        const std::string name = from_report.generic_string();
+        if (!listed.insert(name).second) continue;
+        json entry = side_file_name(name);
+        // The digest of the path as kept (relative() normalises "dir/" to "dir"), as current_report
+        // will take it.
+        entry["sha256"] = file_digest(folder_of(p.report) / name);
+        list.push_back(entry);
     }
     return list;
 }
@@ -495,7 +547,7 @@ json current_report(const PlannedItem& p, const std::string& stamp) {
     if (side != batch.end()) {
         if (!side->is_array()) return json();
         for (const json& entry : *side) {
-            const std::string file = string_at(entry, "file");
+            const std::string file = side_file_path(entry);
             if (file.empty() || string_at(entry, "sha256") != file_digest(folder_of(p.report) / file)) return json();
         }
     }
@@ -544,13 +596,27 @@ void remove_stale_temporaries(const std::vector<std::string>& outputs) {
 json number_or_null(double v, bool have) { return have ? json(v) : json(nullptr); }
 
 // Runs one item into one OutputSet (the report, with its stamp, last): all files or none.
-void run_item(const PlannedItem& p, const std::string& stamp, const BatchOptions& batch) {
+// Every output of the batch by file_identity, for checking the files an item's loading read (an
+// importer's side files are known only then).
+using OutputsByIdentity = std::unordered_map<std::string, std::string>;
+
+void run_item(const PlannedItem& p, const std::string& stamp, const BatchOptions& batch,
+              const OutputsByIdentity& all_outputs) {
     const Clock::time_point start = Clock::now();
     std::vector<std::string> files_of_item = p.plan.outputs;
     files_of_item.push_back(p.error);
     remove_stale_temporaries(files_of_item);
     OutputSet files;
-    OptimizeProduct product = produce_optimize(p.options, p.plan, files);
+    json side;  // digests as loaded: an edit while the method runs makes the item stale
+    OptimizeProduct product = produce_optimize(p.options, p.plan, files, [&](const std::vector<std::string>& read) {
+        for (const std::string& file : read) {
+            const auto output = all_outputs.find(file_identity(file));
+            if (output != all_outputs.end())
+                throw OutputError(output->second + ": is an input of this run (loading " + p.options.common.input +
+                                  " reads it): refusing to overwrite the input; name another output");
+        }
+        side = side_files(p, read);
+    });
     const AnimatedMesh& mesh = product.mesh;
     const MethodResult& run = product.run;
 
@@ -585,7 +651,7 @@ void run_item(const PlannedItem& p, const std::string& stamp, const BatchOptions
                        {"eval_views", batch.eval_views},
                        {"eval_resolution", batch.eval_resolution},
                        {"index_bytes_added", uint64_t(buffers > 0 ? buffers - 1 : 0) * mesh.indices.size() * 4},
-                       {"side_files", side_files(p, product.files_read)},
+                       {"side_files", side},
                        {"time_s", std::chrono::duration<double>(Clock::now() - start).count()}};
     if (batch.no_timings) drop_timings(report);
     files.add(p.report, report_text(report));
@@ -743,6 +809,8 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
         inputs.insert(inputs.end(), p.plan.inputs.begin(), p.plan.inputs.end());
     }
     check_output_paths(outputs, inputs);
+    OutputsByIdentity outputs_by_identity;
+    for (const std::string& output : outputs) outputs_by_identity.emplace(file_identity(output), output);
 
     std::vector<std::string> stamps;
     for (const PlannedItem& p : items) stamps.push_back(item_stamp(p, batch));
@@ -764,7 +832,7 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
         }
         note(p.options.common, label + ": running");
         try {
-            run_item(p, stamps[i], batch);
+            run_item(p, stamps[i], batch, outputs_by_identity);
             ++done;
             note(p.options.common, label + ": done");
         } catch (const std::exception& e) {

@@ -106,7 +106,8 @@ OptimizePlan plan_optimize(const OptimizeOptions& options) {
     return plan;
 }
 
-OptimizeProduct produce_optimize(const OptimizeOptions& options, const OptimizePlan& plan, OutputSet& files) {
+OptimizeProduct produce_optimize(const OptimizeOptions& options, const OptimizePlan& plan, OutputSet& files,
+                                 const std::function<void(const std::vector<std::string>& files_read)>& loaded) {
     const Clock::time_point start = Clock::now();
     const Method method = plan.method;
     const MethodSettings& settings = plan.settings;
@@ -115,6 +116,7 @@ OptimizeProduct produce_optimize(const OptimizeOptions& options, const OptimizeP
     OptimizeProduct product;
     product.mesh = load_drawable_input(options.common, input_name, &product.files_read);
     check_output_paths(plan.outputs, product.files_read);
+    if (loaded) loaded(product.files_read);
     const AnimatedMesh& mesh = product.mesh;
     const double load_s = seconds_since(start);
     note(options.common, "loaded " + input_name + ": " + std::to_string(mesh.triangle_count()) + " triangles, " +

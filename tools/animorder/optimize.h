@@ -13,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -45,6 +46,8 @@ struct OptimizeProduct {
 // Loads the input, runs the method and adds the glTF / sidecar files of `plan` to `files`
 // (not the report, and without committing). Throws for any error, and before the method runs
 // when an output would replace a file that loading read (a side file plan_optimize cannot know).
-OptimizeProduct produce_optimize(const OptimizeOptions& options, const OptimizePlan& plan, OutputSet& files);
+// `loaded`, when set, is called with the files loading read, before the method runs.
+OptimizeProduct produce_optimize(const OptimizeOptions& options, const OptimizePlan& plan, OutputSet& files,
+                                 const std::function<void(const std::vector<std::string>& files_read)>& loaded = {});
 
 }  // namespace animorder::tool

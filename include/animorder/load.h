@@ -4,6 +4,7 @@
 
 #include "animorder/animated_mesh.h"
 
+#include <algorithm>
 #include <cstddef>
 #include <stdexcept>
 #include <string>
@@ -22,8 +23,11 @@ struct LoadOptions {
     double sample_rate = 30;  // keyframes per second of every clip (DESIGN.md)
     // Budget for the sampled animation: keyframes × vertices × 12 bytes of positions. A file
     // whose clips would need more fails with a LoadError naming the need and this budget before
-    // anything that size is allocated (`--max-memory` raises it).
+    // anything that size is allocated (`--max-memory` raises it). No file a loader reads whole
+    // (a glTF buffer, an assimp file) may be larger than file_budget(): this, or its default when
+    // that is more.
     size_t max_keyframe_bytes = size_t(4) << 30;
+    size_t file_budget() const { return std::max(max_keyframe_bytes, LoadOptions{}.max_keyframe_bytes); }
     // Clips to sample, by name; empty: every clip. A hint that saves the sampling (and memory) of
     // the others: glTF files honour it when every name is one of the file's clips (otherwise all
     // are sampled, so that select_clips names the file's clips in its error); other formats
@@ -51,6 +55,9 @@ AnimatedMesh load_character(const std::string& path, const std::vector<std::stri
 // lists no external file (loading it says what is wrong). LoadError for a clip folder that cannot
 // be listed or is empty, or glTF JSON over 1 GiB.
 std::vector<std::string> files_load_reads(const std::string& path, const std::vector<std::string>& clip_files = {});
+
+// Appends to files_read those of `more` it does not hold yet, in order (LoadOptions::files_read).
+void add_files_read(std::vector<std::string>& files_read, const std::vector<std::string>& more);
 
 // Throws LoadError when a file of files_load_reads(path, clip_files) exists but is not a regular
 // file: a FIFO or a device (a glTF buffer URI of /dev/zero) would never end, a folder is no file.

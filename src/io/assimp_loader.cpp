@@ -31,21 +31,30 @@
 
 #include "checked_size.h"
 #include "isolated_import.h"
+#include "regular_file.h"
 
 #include <assimp/DefaultIOSystem.h>
 #include <assimp/GltfMaterial.h>
+#include <assimp/MemoryIOWrapper.h>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <assimp/Importer.hpp>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <memory>
+#include <unordered_set>
 
 namespace animorder {
 namespace {
@@ -100,32 +109,46 @@ void flatten(const aiNode* root, Flat& flat) {
     }
 }
 
-// Assimp's file access, but only to regular files: a side file an importer opens as it reads (an
-// OBJ's mtllib, say) that is a FIFO or a device would never end; for assimp it is then missing.
-// Every file it looks for or opens goes to `looked_at` (once), found or not: a material file
-// missing today changes the mesh when it appears.
+// Assimp's file access, but only to regular files, through RegularFile (regular_file.h): a side
+// file an importer opens as it reads (an OBJ's mtllib, say) that is a FIFO or a device would never
+// end; for assimp it is then missing. A file is read whole into memory (no larger than the loading
+// budget), so nothing blocks once it is open. Every file it looks for or opens goes to
+// `looked_at` (once), found or not: a material file missing today changes the mesh when it
+// appears.
 class RegularFilesOnly : public Assimp::DefaultIOSystem {
 public:
-    explicit RegularFilesOnly(std::vector<std::string>& looked_at) : looked_at_(looked_at) {}
-    bool Exists(const char* file) const override { return note(file) && DefaultIOSystem::Exists(file); }
+    RegularFilesOnly(std::vector<std::string>& looked_at, uint64_t budget) : looked_at_(looked_at), budget_(budget) {}
+    bool Exists(const char* file) const override { return note(file); }
     Assimp::IOStream* Open(const char* file, const char* mode) override {
-        return note(file) ? DefaultIOSystem::Open(file, mode) : nullptr;
+        if (!note(file) || !mode || std::strpbrk(mode, "wa+")) return nullptr;  // importers only read
+        io::RegularFile regular(file);
+        if (!regular.ok() || regular.size() > budget_) return nullptr;
+        const size_t size = size_t(regular.size());
+        std::unique_ptr<uint8_t[]> bytes(new uint8_t[size > 0 ? size : 1]);
+        if (regular.read(bytes.get(), size) != size) return nullptr;
+        return new Assimp::MemoryIOStream(bytes.release(), size, true);  // Close() deletes it, and it the bytes
     }
 
 private:
     // Records the file; whether it is a regular file.
     bool note(const char* file) const {
         if (!file) return false;
-        if (std::find(looked_at_.begin(), looked_at_.end(), file) == looked_at_.end()) looked_at_.push_back(file);
-        std::error_code error;
-        return std::filesystem::is_regular_file(file, error);
+        if (listed_.insert(file).second) looked_at_.push_back(file);
+        struct stat st {};
+        return ::stat(file, &st) == 0 && S_ISREG(st.st_mode);
     }
     std::vector<std::string>& looked_at_;
+    mutable std::unordered_set<std::string> listed_;
+    uint64_t budget_;
 };
 
-const aiScene* import(Assimp::Importer& importer, const std::string& path, std::vector<std::string>& opened) {
+const aiScene* import(Assimp::Importer& importer, const std::string& path, std::vector<std::string>& opened,
+                      uint64_t budget) {
     if (!std::filesystem::exists(path)) throw LoadError(path + ": cannot open file");
-    importer.SetIOHandler(new RegularFilesOnly(opened));  // the importer owns it
+    if (const io::RegularFile file(path); file.ok() && file.size() > budget)
+        throw LoadError(path + ": is larger than the loading budget of " + std::to_string(budget) +
+                        " bytes (raise it with --max-memory)");
+    importer.SetIOHandler(new RegularFilesOnly(opened, budget));  // the importer owns it
     importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
     const aiScene* scene =
         importer.ReadFile(path, aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_JoinIdenticalVertices |
@@ -145,7 +168,7 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
     const io::ReadingFile& reading = child.reading;
     reading(0);
     Assimp::Importer importer;
-    const aiScene* scene = import(importer, path, child.opened);
+    const aiScene* scene = import(importer, path, child.opened, options.file_budget());
     Flat flat;
     flatten(scene->mRootNode, flat);
 
@@ -243,7 +266,7 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
         const std::string& file = clip_files[i];
         reading(i + 1);
         clip_importers.push_back(std::make_unique<Assimp::Importer>());
-        const aiScene* clip_scene = import(*clip_importers.back(), file, child.opened);
+        const aiScene* clip_scene = import(*clip_importers.back(), file, child.opened, options.file_budget());
         if (clip_scene->mNumAnimations == 0) throw LoadError(file + ": has no animation");
         for (unsigned a = 0; a < clip_scene->mNumAnimations; ++a) {
             const aiAnimation* anim = clip_scene->mAnimations[a];

@@ -4,6 +4,8 @@
 
 #include "animorder/load.h"
 
+#include "regular_file.h"
+
 #include <tiny_gltf.h>
 
 #include <fcntl.h>
@@ -37,41 +39,49 @@ inline int append_buffer_view(tinygltf::Model& model, const void* data, size_t b
     return int(model.bufferViews.size() - 1);
 }
 
-// tinygltf's file access, but to regular files only, checked on the open file (O_NONBLOCK, then
-// fstat): a FIFO or a device never ends, and a file swapped for one after a check must not hang
-// the read. For a missing or irregular file, FileExists is false (tinygltf then looks elsewhere or
-// says the file was not found).
+// tinygltf's file access, through RegularFile (regular_file.h): a FIFO, a device or a folder is
+// never opened (FileExists is false for it: tinygltf then looks in the current folder, or says
+// the file was not found), and no file larger than *user_data bytes (the loading budget) is read
+// whole into memory.
 inline bool regular_file_exists(const std::string& path, void*) {
     struct stat st {};
     return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);
 }
 
-inline bool read_regular_file(std::vector<unsigned char>* out, std::string* error, const std::string& path, void*) {
-    const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-    struct stat st {};
-    const bool regular = fd >= 0 && ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode);
-    size_t got = 0;
-    if (regular) {
-        out->resize(size_t(st.st_size));
-        while (got < out->size()) {
-            const ssize_t n = ::read(fd, out->data() + got, out->size() - got);
-            if (n < 0 && errno == EINTR) continue;
-            if (n <= 0) break;
-            got += size_t(n);
-        }
+inline bool read_regular_file(std::vector<unsigned char>* out, std::string* error, const std::string& path,
+                              void* limit) {
+    RegularFile file(path);
+    const uint64_t most = limit ? *static_cast<const uint64_t*>(limit) : UINT64_MAX;
+    std::string why = file.ok() ? "" : std::string("is ") + file.why();
+    if (why.empty() && file.size() > most)
+        why = "is larger than the loading budget of " + std::to_string(most) + " bytes (raise it with --max-memory)";
+    if (why.empty()) {
+        out->resize(size_t(file.size()));
+        if (file.read(out->data(), out->size()) != out->size())
+            why = "cannot be read whole";
+        else if (out->empty())
+            why = "is empty";
     }
-    if (fd >= 0) ::close(fd);
-    const char* why = fd < 0               ? "cannot open"
-                      : !regular           ? "not a regular file"
-                      : got != out->size() ? "cannot read all of"
-                      : out->empty()       ? "empty file"
-                                           : nullptr;
-    if (why && error) *error += std::string(why) + " : " + path + "\n";
-    return !why;
+    if (!why.empty() && error) *error += path + " " + why + "\n";
+    return why.empty();
 }
 
-inline tinygltf::FsCallbacks regular_file_callbacks() {
-    return {regular_file_exists, tinygltf::ExpandFilePath, read_regular_file, tinygltf::WriteWholeFile, nullptr};
+// `limit` must outlive the loads made with the callbacks.
+inline tinygltf::FsCallbacks regular_file_callbacks(const uint64_t* limit) {
+    return {regular_file_exists, tinygltf::ExpandFilePath, read_regular_file, tinygltf::WriteWholeFile,
+            const_cast<uint64_t*>(limit)};
+}
+
+// The first four bytes of a regular file ("glTF" for a GLB); LoadError naming the path when it is
+// missing, not a regular file, or shorter.
+inline std::string magic_of(const std::string& path) {
+    RegularFile file(path);
+    if (!file.ok())
+        throw LoadError(
+            path + (std::string(file.why()) == "missing" ? ": cannot open file" : std::string(": is ") + file.why()));
+    std::string magic(4, '\0');
+    if (file.read(magic.data(), 4) != 4) throw LoadError(path + ": file is empty or truncated");
+    return magic;
 }
 
 // The glTF file at `path` (binary when it starts with "glTF"), images left undecoded; LoadError
@@ -80,16 +90,13 @@ inline tinygltf::Model read_model(const std::string& path) {
     require_regular_files(path);
     tinygltf::Model model;
     tinygltf::TinyGLTF loader;
-    loader.SetFsCallbacks(regular_file_callbacks());
+    static const uint64_t budget = LoadOptions{}.file_budget();
+    loader.SetFsCallbacks(regular_file_callbacks(&budget));
     loader.SetImageLoader([](tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*,
                              int, void*) { return true; },
                           nullptr);
     std::string error, warning;
-    std::string magic(4, '\0');
-    if (FILE* f = std::fopen(path.c_str(), "rb")) {
-        if (std::fread(magic.data(), 1, 4, f) != 4) magic.clear();
-        std::fclose(f);
-    }
+    const std::string magic = magic_of(path);
     const bool ok = magic == "glTF" ? loader.LoadBinaryFromFile(&model, &error, &warning, path)
                                     : loader.LoadASCIIFromFile(&model, &error, &warning, path);
     if (!ok) {

@@ -323,23 +323,17 @@ size_t channel_components(const Scene& s, size_t node, const std::string& path) 
 }
 
 // The file through tinygltf (binary when it starts with "glTF", else JSON), textures passed
-// through undecoded.
-tinygltf::Model parse_file(const std::string& path) {
+// through undecoded; no file it reads larger than the loading budget.
+tinygltf::Model parse_file(const std::string& path, const LoadOptions& options) {
     tinygltf::Model model;
     tinygltf::TinyGLTF loader;
-    loader.SetFsCallbacks(io::regular_file_callbacks());  // a FIFO or a device is never opened
+    const uint64_t budget = options.file_budget();               // no file read whole is larger
+    loader.SetFsCallbacks(io::regular_file_callbacks(&budget));  // a FIFO or a device is never opened
     loader.SetImageLoader([](tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*,
                              int, void*) { return true; },  // textures pass through untouched: never decoded
                           nullptr);
     std::string error, warning;
-    std::string magic(4, '\0');
-    if (FILE* f = std::fopen(path.c_str(), "rb")) {
-        const size_t got = std::fread(magic.data(), 1, 4, f);
-        std::fclose(f);
-        if (got < 4) throw LoadError(path + ": file is empty or truncated");
-    } else {
-        throw LoadError(path + ": cannot open file");
-    }
+    const std::string magic = io::magic_of(path);
     const bool ok = magic == "glTF" ? loader.LoadBinaryFromFile(&model, &error, &warning, path)
                                     : loader.LoadASCIIFromFile(&model, &error, &warning, path);
     if (!ok) {
@@ -691,7 +685,7 @@ void keep_asked_clips(std::vector<ClipChannels>& clips, const std::vector<std::s
 AnimatedMesh load_gltf(const std::string& path, const LoadOptions& options) {
     if (!(options.sample_rate > 0 && options.sample_rate <= 1000))
         throw LoadError(path + ": sample rate must be in (0, 1000]");
-    const tinygltf::Model model = parse_file(path);
+    const tinygltf::Model model = parse_file(path, options);
     const Reader reader(model, path, options.max_keyframe_bytes);
     Scene scene{model, reader, {}, {}, {}, {}, {}, {}};
     AnimatedMesh mesh;

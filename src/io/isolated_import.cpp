@@ -409,10 +409,7 @@ AnimatedMesh load_isolated(const std::vector<std::string>& files, const LoadOpti
     if (kind != 'M') r.bad("an unknown answer");
     std::vector<std::string> opened;
     AnimatedMesh mesh = read_mesh(r, path, options, opened);
-    if (options.files_read)
-        for (const std::string& file : opened)
-            if (std::find(options.files_read->begin(), options.files_read->end(), file) == options.files_read->end())
-                options.files_read->push_back(file);
+    if (options.files_read) add_files_read(*options.files_read, opened);
     return mesh;
 }
 

@@ -8,6 +8,8 @@
 #include "animorder/iqm_loader.h"
 #include "animorder/md2_loader.h"
 
+#include "regular_file.h"
+
 #include <tiny_gltf.h>
 #include <nlohmann/json.hpp>
 
@@ -17,6 +19,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <unordered_set>
 
 namespace animorder {
 namespace {
@@ -57,29 +60,25 @@ std::vector<std::string> expand_clip_files(const std::vector<std::string>& clip_
 // 1 GiB (its external files could not be known).
 constexpr uint64_t kMaxJsonBytes = uint64_t(1) << 30;
 std::string gltf_json_text(const std::string& path) {
-    std::error_code error;
-    if (!std::filesystem::is_regular_file(path, error)) return {};
-    std::ifstream in(path, std::ios::binary);
-    if (!in) return {};
-    const uint64_t size = std::filesystem::file_size(path, error);
-    if (error) return {};
+    io::RegularFile file(path);
+    if (!file.ok()) return {};
+    const uint64_t size = file.size();
     char header[20] = {};
-    in.read(header, sizeof header);
-    if (in.gcount() >= 4 && std::memcmp(header, "glTF", 4) == 0) {
-        if (in.gcount() < 20) return {};
+    const size_t got = file.read(header, sizeof header);
+    if (got >= 4 && std::memcmp(header, "glTF", 4) == 0) {
+        if (got < 20) return {};
         uint32_t length = 0;
         std::memcpy(&length, header + 12, 4);  // chunk 0: length, type "JSON", then the text
         if (std::memcmp(header + 16, "JSON", 4) != 0 || uint64_t(length) > size - 20) return {};
         if (length > kMaxJsonBytes) throw LoadError(path + ": its glTF JSON is larger than 1 GiB");
         std::string text(length, '\0');
-        in.read(text.data(), std::streamsize(length));
-        return in.gcount() == std::streamsize(length) ? text : std::string();
+        return file.read(text.data(), length) == length ? text : std::string();
     }
     if (size > kMaxJsonBytes) throw LoadError(path + ": its glTF JSON is larger than 1 GiB");
-    std::string text(size_t(size), '\0');
-    in.seekg(0);
-    in.read(text.data(), std::streamsize(size));
-    return in.gcount() == std::streamsize(size) ? text : std::string();
+    if (got < size_t(std::min<uint64_t>(size, sizeof header))) return {};
+    std::string text(header, got);
+    text.resize(size_t(size));
+    return file.read(text.data() + got, text.size() - got) == text.size() - got ? text : std::string();
 }
 
 // tinygltf's urldecode: '+' is a space, %XY the byte XY (a digit that is not hex counts 0).
@@ -111,15 +110,17 @@ std::string join_path(const std::string& folder, const std::string& name) {
 }
 
 // The file tinygltf's FindFile takes for a decoded URI: the first of the glTF's folder (its
-// GetBaseDir: the text before the last '/' or '\\') and the current folder where the file exists,
-// else the first (missing: the loader says so).
+// GetBaseDir: the text before the last '/' or '\\') and the current folder where it finds the
+// file, else the first (missing or irregular: the loader or require_regular_files says so).
 std::string find_file(const std::string& gltf, const std::string& name) {
     const size_t slash = gltf.find_last_of("/\\");
     const std::string beside = join_path(slash == std::string::npos ? std::string() : gltf.substr(0, slash), name);
     std::error_code error;
-    if (std::filesystem::exists(beside, error)) return beside;
+    // As our FileExists (gltf_buffer.h): only a regular file is found; a FIFO beside the glTF with
+    // a regular file in the current folder reads the latter, a FIFO in both is refused.
+    if (std::filesystem::is_regular_file(beside, error)) return beside;
     const std::string here = join_path(".", name);
-    return std::filesystem::exists(here, error) ? here : beside;
+    return std::filesystem::is_regular_file(here, error) ? here : beside;
 }
 
 std::vector<std::string> gltf_external_files(const std::string& path) {
@@ -147,6 +148,12 @@ std::vector<std::string> gltf_external_files(const std::string& path) {
 
 }  // namespace
 
+void add_files_read(std::vector<std::string>& files_read, const std::vector<std::string>& more) {
+    std::unordered_set<std::string> listed(files_read.begin(), files_read.end());
+    for (const std::string& file : more)
+        if (listed.insert(file).second) files_read.push_back(file);
+}
+
 std::vector<std::string> files_load_reads(const std::string& path, const std::vector<std::string>& clip_files) {
     std::vector<std::string> files = {path};
     const std::string extension = lower_extension(path);
@@ -159,10 +166,11 @@ std::vector<std::string> files_load_reads(const std::string& path, const std::ve
     return files;
 }
 
-void require_regular_files(const std::string& path, const std::vector<std::string>& clip_files) {
-    // A FIFO or a device (a glTF buffer named /dev/zero, say) would never end: only regular files
-    // are read. A missing one is left to its loader, which names it.
-    for (const std::string& file : files_load_reads(path, clip_files)) {
+namespace {
+
+// require_regular_files on the list already made.
+void require_regular(const std::string& path, const std::vector<std::string>& files) {
+    for (const std::string& file : files) {
         std::error_code error;
         const std::filesystem::file_status status = std::filesystem::status(file, error);
         if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status))
@@ -171,14 +179,19 @@ void require_regular_files(const std::string& path, const std::vector<std::strin
     }
 }
 
+}  // namespace
+
+void require_regular_files(const std::string& path, const std::vector<std::string>& clip_files) {
+    // A FIFO or a device (a glTF buffer named /dev/zero, say) would never end: only regular files
+    // are read. A missing one is left to its loader, which names it.
+    require_regular(path, files_load_reads(path, clip_files));
+}
+
 AnimatedMesh load_character(const std::string& path, const std::vector<std::string>& clip_files,
                             const LoadOptions& options) {
-    require_regular_files(path, clip_files);
-    if (options.files_read) {
-        for (const std::string& file : files_load_reads(path, clip_files))
-            if (std::find(options.files_read->begin(), options.files_read->end(), file) == options.files_read->end())
-                options.files_read->push_back(file);
-    }
+    const std::vector<std::string> reads = files_load_reads(path, clip_files);
+    require_regular(path, reads);
+    if (options.files_read) add_files_read(*options.files_read, reads);
     const std::vector<std::string> files = expand_clip_files(clip_files);
     const std::string extension = lower_extension(path);
     if (extension == ".gltf" || extension == ".glb" || extension == ".md2" || extension == ".iqm") {

@@ -655,3 +655,18 @@ TEST_F(GltfLoader, UrisResolveAsTinygltfResolvesThem) {
     test::expect_one_line_load_error("a/a.gltf", "reads a/data:x, which is not a regular file",
                                      [&] { load_character("a/a.gltf"); });
 }
+
+// No file is read whole beyond the loading budget (or its default, when that is more): a buffer
+// of 5 GiB (sparse: nothing is written) is refused at once, not read into memory.
+TEST_F(GltfLoader, AFileLargerThanTheBudgetIsNotRead) {
+    Gltf g = skinned_bar();
+    write("huge.bin", g.bin);
+    fs::resize_file(dir_ / "huge.bin", uintmax_t(5) << 30);
+    g.doc["buffers"] = json::array({{{"byteLength", g.bin.size()}, {"uri", "huge.bin"}}});
+    const std::string path = write("huge.gltf", g.doc.dump());
+    test::expect_one_line_load_error(path, "is larger than the loading budget of 4294967296 bytes",
+                                     [&] { load_character(path); });
+    LoadOptions small;
+    small.max_keyframe_bytes = 1 << 20;  // a small keyframe budget still reads files up to the default
+    EXPECT_EQ(small.file_budget(), LoadOptions{}.max_keyframe_bytes);
+}

@@ -398,10 +398,12 @@ public:
     // checked on the open file) hashes as that: the item then fails to load it.
     void add_file(const fs::path& path) {
         add("file:" + path.filename().string());
-        const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-        if (fd < 0) return add(errno == ENOENT ? "missing" : "unreadable");
         struct stat st {};
-        if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        if (::stat(path.c_str(), &st) != 0) return add(errno == ENOENT ? "missing" : "unreadable");
+        if (!S_ISREG(st.st_mode)) return add("not a regular file");  // never opened: some devices act on open
+        const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+        if (fd < 0) return add("unreadable");
+        if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {  // swapped since the stat
             ::close(fd);
             return add("not a regular file");
         }
@@ -521,7 +523,9 @@ json side_files(const PlannedItem& p, const std::vector<std::string>& files_read
     for (const std::string& file : files_read) {
         if (known.count(file_identity(file))) continue;
         std::error_code error;
-        fs::path from_report = fs::relative(file, folder_of(p.report), error);
+        // Both absolute first: relative() leaves a relative path whose folders are all missing as
+        // it is, and the result was empty (the absolute path was kept, tying the report to a place).
+        fs::path from_report = fs::relative(fs::absolute(file, error), fs::absolute(folder_of(p.report), error), error);
         if (error || from_report.empty()) from_report = fs::absolute(file, error);
         const std::string name = from_report.generic_string();
         if (!listed.insert(name).second) continue;
@@ -596,7 +600,16 @@ void remove_stale_temporaries(const std::vector<std::string>& outputs) {
 json number_or_null(double v, bool have) { return have ? json(v) : json(nullptr); }
 
 // Runs one item into one OutputSet (the report, with its stamp, last): all files or none.
-// Every output of the batch by file_identity, for checking the files an item's loading read (an
+// Where a file is, whether or not it exists yet: its folder resolved, then its name. A commit
+// renames a new file into place, so an output keeps its place but not its inode.
+std::string place_of(const std::string& path) {
+    const fs::path p(path);
+    std::error_code error;
+    const fs::path folder = fs::weakly_canonical(fs::absolute(folder_of(path), error), error);
+    return (folder / p.filename()).string();
+}
+
+// Every output of the batch by place_of, for checking the files an item's loading read (an
 // importer's side files are known only then).
 using OutputsByIdentity = std::unordered_map<std::string, std::string>;
 
@@ -610,7 +623,10 @@ void run_item(const PlannedItem& p, const std::string& stamp, const BatchOptions
     json side;  // digests as loaded: an edit while the method runs makes the item stale
     OptimizeProduct product = produce_optimize(p.options, p.plan, files, [&](const std::vector<std::string>& read) {
         for (const std::string& file : read) {
-            const auto output = all_outputs.find(file_identity(file));
+            std::error_code error;  // the file as named, and where a link there leads
+            auto output = all_outputs.find(place_of(file));
+            if (output == all_outputs.end())
+                output = all_outputs.find(fs::weakly_canonical(fs::absolute(file, error), error).string());
             if (output != all_outputs.end())
                 throw OutputError(output->second + ": is an input of this run (loading " + p.options.common.input +
                                   " reads it): refusing to overwrite the input; name another output");
@@ -810,7 +826,7 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
     }
     check_output_paths(outputs, inputs);
     OutputsByIdentity outputs_by_identity;
-    for (const std::string& output : outputs) outputs_by_identity.emplace(file_identity(output), output);
+    for (const std::string& output : outputs) outputs_by_identity.emplace(place_of(output), output);
 
     std::vector<std::string> stamps;
     for (const PlannedItem& p : items) stamps.push_back(item_stamp(p, batch));

@@ -29,9 +29,9 @@
 #include "animorder/load.h"
 #include "animorder/skinning.h"
 
+#include "animorder/regular_file.h"
 #include "checked_size.h"
 #include "isolated_import.h"
-#include "regular_file.h"
 
 #include <assimp/DefaultIOSystem.h>
 #include <assimp/GltfMaterial.h>
@@ -109,7 +109,7 @@ void flatten(const aiNode* root, Flat& flat) {
     }
 }
 
-// Assimp's file access, but only to regular files, through RegularFile (regular_file.h): a side
+// Assimp's file access, but only to regular files, through RegularFile (animorder/regular_file.h): a side
 // file an importer opens as it reads (an OBJ's mtllib, say) that is a FIFO or a device would never
 // end; for assimp it is then missing. A file is read whole into memory (no larger than the loading
 // budget), so nothing blocks once it is open. Every file it looks for or opens goes to
@@ -121,7 +121,7 @@ public:
     bool Exists(const char* file) const override { return note(file); }
     Assimp::IOStream* Open(const char* file, const char* mode) override {
         if (!note(file) || !mode || std::strpbrk(mode, "wa+")) return nullptr;  // importers only read
-        io::RegularFile regular(file);
+        RegularFile regular(file);
         if (!regular.ok() || regular.size() > budget_) return nullptr;
         const size_t size = size_t(regular.size());
         std::unique_ptr<uint8_t[]> bytes(new uint8_t[size > 0 ? size : 1]);
@@ -145,7 +145,7 @@ private:
 const aiScene* import(Assimp::Importer& importer, const std::string& path, std::vector<std::string>& opened,
                       uint64_t budget) {
     if (!std::filesystem::exists(path)) throw LoadError(path + ": cannot open file");
-    if (const io::RegularFile file(path); file.ok() && file.size() > budget)
+    if (const RegularFile file(path); file.ok() && file.size() > budget)
         throw LoadError(path + ": is larger than the loading budget of " + std::to_string(budget) +
                         " bytes (raise it with --max-memory)");
     importer.SetIOHandler(new RegularFilesOnly(opened, budget));  // the importer owns it

@@ -4,7 +4,7 @@
 
 #include "animorder/load.h"
 
-#include "regular_file.h"
+#include "animorder/regular_file.h"
 
 #include <tiny_gltf.h>
 
@@ -39,7 +39,7 @@ inline int append_buffer_view(tinygltf::Model& model, const void* data, size_t b
     return int(model.bufferViews.size() - 1);
 }
 
-// tinygltf's file access, through RegularFile (regular_file.h): a FIFO, a device or a folder is
+// tinygltf's file access, through RegularFile (animorder/regular_file.h): a FIFO, a device or a folder is
 // never opened (FileExists is false for it: tinygltf then looks in the current folder, or says
 // the file was not found), and no file larger than *user_data bytes (the loading budget) is read
 // whole into memory.

@@ -8,7 +8,7 @@
 #include "animorder/iqm_loader.h"
 #include "animorder/md2_loader.h"
 
-#include "regular_file.h"
+#include "animorder/regular_file.h"
 
 #include <tiny_gltf.h>
 #include <nlohmann/json.hpp>
@@ -59,7 +59,7 @@ std::vector<std::string> expand_clip_files(const std::vector<std::string>& clip_
 // 1 GiB (its external files could not be known).
 constexpr uint64_t kMaxJsonBytes = uint64_t(1) << 30;
 std::string gltf_json_text(const std::string& path) {
-    io::RegularFile file(path);
+    RegularFile file(path);
     if (!file.ok()) return {};
     const uint64_t size = file.size();
     char header[20] = {};

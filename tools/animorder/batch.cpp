@@ -20,12 +20,10 @@
 
 #include "animorder/atomic_write.h"
 #include "animorder/evaluation.h"
+#include "animorder/regular_file.h"
 
-#include <fcntl.h>
 #include <nettle/sha2.h>
 #include <signal.h>
-#include <sys/stat.h>
-#include <unistd.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -35,7 +33,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <numeric>
 #include <sstream>
 #include <stdexcept>
@@ -87,18 +84,16 @@ std::vector<std::string> split_words(const std::string& text) {
 // A manifest or a report: a regular file of at most kMaxTextBytes (a FIFO or a device would never end).
 constexpr uintmax_t kMaxTextBytes = uintmax_t(1) << 30;
 std::string read_text(const std::string& path, const char* what) {
-    std::error_code error;
-    if (fs::is_directory(path, error)) throw std::runtime_error(path + ": is a folder, not " + what);
-    if (!fs::is_regular_file(path, error))
-        throw std::runtime_error(path + (fs::exists(path, error) ? ": is not a regular file" : ": does not exist") +
-                                 " (expected " + what + ")");
-    if (fs::file_size(path, error) > kMaxTextBytes)
-        throw std::runtime_error(path + ": larger than 1 GiB, too large for " + what);
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw std::runtime_error(path + ": cannot read " + what);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
+    RegularFile file(path);
+    const std::string why = file.why();
+    if (why == "a folder") throw std::runtime_error(path + ": is a folder, not " + what);
+    if (!file.ok())
+        throw std::runtime_error(path + (why == "missing" ? ": does not exist" : ": is " + why) + " (expected " + what +
+                                 ")");
+    if (file.size() > kMaxTextBytes) throw std::runtime_error(path + ": larger than 1 GiB, too large for " + what);
+    std::string text(size_t(file.size()), '\0');
+    if (file.read(text.data(), text.size()) != text.size()) throw std::runtime_error(path + ": cannot read " + what);
+    return text;
 }
 
 // Text that the JSON reports can hold: valid UTF-8 (a report names items and paths).
@@ -398,25 +393,12 @@ public:
     // checked on the open file) hashes as that: the item then fails to load it.
     void add_file(const fs::path& path) {
         add("file:" + path.filename().string());
-        struct stat st {};
-        if (::stat(path.c_str(), &st) != 0) return add(errno == ENOENT ? "missing" : "unreadable");
-        if (!S_ISREG(st.st_mode)) return add("not a regular file");  // never opened: some devices act on open
-        const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
-        if (fd < 0) return add("unreadable");
-        if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {  // swapped since the stat
-            ::close(fd);
-            return add("not a regular file");
-        }
+        RegularFile file(path.string());  // never opens a FIFO or a device (some act on open)
+        if (!file.ok()) return add(std::string(file.why()) == "a folder" ? "not a regular file" : file.why());
         std::vector<uint8_t> block(1 << 16);
         uint64_t total = 0;
-        for (;;) {
-            const ssize_t got = ::read(fd, block.data(), block.size());
-            if (got < 0 && errno == EINTR) continue;
-            if (got <= 0) break;
-            sha256_update(&ctx_, size_t(got), block.data());
-            total += uint64_t(got);
-        }
-        ::close(fd);
+        for (size_t got; (got = file.read(block.data(), block.size())) > 0; total += got)
+            sha256_update(&ctx_, got, block.data());
         add("bytes:" + std::to_string(total));
     }
     std::string hex() {
@@ -611,10 +593,10 @@ std::string place_of(const std::string& path) {
 
 // Every output of the batch by place_of, for checking the files an item's loading read (an
 // importer's side files are known only then).
-using OutputsByIdentity = std::unordered_map<std::string, std::string>;
+using OutputsByPlace = std::unordered_map<std::string, std::string>;
 
 void run_item(const PlannedItem& p, const std::string& stamp, const BatchOptions& batch,
-              const OutputsByIdentity& all_outputs) {
+              const OutputsByPlace& all_outputs) {
     const Clock::time_point start = Clock::now();
     std::vector<std::string> files_of_item = p.plan.outputs;
     files_of_item.push_back(p.error);
@@ -825,8 +807,8 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
         inputs.insert(inputs.end(), p.plan.inputs.begin(), p.plan.inputs.end());
     }
     check_output_paths(outputs, inputs);
-    OutputsByIdentity outputs_by_identity;
-    for (const std::string& output : outputs) outputs_by_identity.emplace(place_of(output), output);
+    OutputsByPlace outputs_by_place;
+    for (const std::string& output : outputs) outputs_by_place.emplace(place_of(output), output);
 
     std::vector<std::string> stamps;
     for (const PlannedItem& p : items) stamps.push_back(item_stamp(p, batch));
@@ -848,7 +830,7 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
         }
         note(p.options.common, label + ": running");
         try {
-            run_item(p, stamps[i], batch, outputs_by_identity);
+            run_item(p, stamps[i], batch, outputs_by_place);
             ++done;
             note(p.options.common, label + ": done");
         } catch (const std::exception& e) {

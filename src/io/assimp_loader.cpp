@@ -109,12 +109,12 @@ void flatten(const aiNode* root, Flat& flat) {
     }
 }
 
-// Assimp's file access, but only to regular files, through RegularFile (animorder/regular_file.h): a side
-// file an importer opens as it reads (an OBJ's mtllib, say) that is a FIFO or a device would never
-// end; for assimp it is then missing. A file is read whole into memory (no larger than the loading
-// budget), so nothing blocks once it is open. Every file it looks for or opens goes to
-// `looked_at` (once), found or not: a material file missing today changes the mesh when it
-// appears.
+// Assimp's file access, but only to regular files, through RegularFile (animorder/regular_file.h):
+// a side file an importer opens as it reads (an OBJ's mtllib, say) that is a FIFO or a device
+// would never end; for assimp it is then missing. A file is read whole into memory (no larger
+// than the loading budget), so nothing blocks once it is open. Every file it looks for or opens
+// goes to `looked_at` (once), found or not: a material file missing today changes the mesh when
+// it appears.
 class RegularFilesOnly : public Assimp::DefaultIOSystem {
 public:
     RegularFilesOnly(std::vector<std::string>& looked_at, uint64_t budget) : looked_at_(looked_at), budget_(budget) {}

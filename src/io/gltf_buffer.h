@@ -3,16 +3,12 @@
 #pragma once
 
 #include "animorder/load.h"
-
 #include "animorder/regular_file.h"
 
 #include <tiny_gltf.h>
 
-#include <fcntl.h>
 #include <sys/stat.h>
-#include <unistd.h>
 
-#include <cerrno>
 #include <cstddef>
 #include <cstdio>
 #include <filesystem>
@@ -39,10 +35,10 @@ inline int append_buffer_view(tinygltf::Model& model, const void* data, size_t b
     return int(model.bufferViews.size() - 1);
 }
 
-// tinygltf's file access, through RegularFile (animorder/regular_file.h): a FIFO, a device or a folder is
-// never opened (FileExists is false for it: tinygltf then looks in the current folder, or says
-// the file was not found), and no file larger than *user_data bytes (the loading budget) is read
-// whole into memory.
+// tinygltf's file access, through RegularFile (animorder/regular_file.h): a FIFO, a device or a
+// folder is never opened (FileExists is false for it: tinygltf then looks in the current folder,
+// or says the file was not found), and no file larger than *user_data bytes (the loading budget)
+// is read whole into memory.
 inline bool regular_file_exists(const std::string& path, void*) {
     struct stat st {};
     return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode);

@@ -1,5 +1,7 @@
 // Per-node cost of the overdraw engine on one thread (issue 19): transform to clip space,
-// NodeRasterizer::rasterize_validated, keep_fragments and score_kept (1 and 5 random patch orders),
+// NodeRasterizer::rasterize_validated from the FacingFilter's candidates (the filter's time
+// included; then the widest copy again from every triangle, in the same run, for the filter's
+// worth), keep_fragments and score_kept (1 and 5 random patch orders),
 // as CPU time of this thread (CLOCK_THREAD_CPUTIME_ID, so other processes on a shared machine do
 // not count), over a spread of nodes of a character (default protocol: 162 views, 256², λ = 0.85).
 // Also prints hashes: the rasteriser's output (raw fragments in order, grouped lists, counts), the
@@ -13,6 +15,7 @@
 //   ... --simd all: every copy this CPU runs, narrowest first, in the same run, with each wide
 //       copy's speed against the portable one's and whether their hashes agree
 #include "animorder/camera.h"
+#include "animorder/facing_filter.h"
 #include "animorder/kept_fragments.h"
 #include "animorder/load.h"
 #include "animorder/mesh_patches.h"
@@ -124,10 +127,13 @@ int main(int argc, char** argv) try {
     const std::vector<uint32_t> ranks1 = rank_tables(1), ranks5 = rank_tables(5);
     const std::vector<uint16_t> unit_ranks1 = make_unit_rank_table(ranks1.data(), 1, partition),
                                 unit_ranks5 = make_unit_rank_table(ranks5.data(), 5, partition);
-    const auto measure = [&](Copy copy) {
+    const auto measure = [&](Copy copy, bool filtered) {
         NodeRasterizer rasterizer;
         rasterizer.set_copy(copy);
         KeepScratch scratch;
+        FacingFilter facing;
+        size_t facing_keyframe = SIZE_MAX;
+        double candidates = 0;
         double transform_s = 0, raster_s = 0, keep_s = 0, score1_s = 0, score5_s = 0, replay5_s = 0;
         Hash score_hash;  // the scores of the random unit orders
         size_t nodes = 0, fragments = 0;
@@ -141,10 +147,21 @@ int main(int argc, char** argv) try {
                     transform_to_clip(clip.data(), mesh.keyframe(uint32_t(k)), mesh.vertex_count,
                                       &framing.centres[3 * k],
                                       node_view_projection(&directions[3 * v], framing.radius));
+                    transform_s += thread_seconds() - t0;
+                    if (facing_keyframe != k) {  // once per keyframe, as NodeCache's workers do (not timed)
+                        facing.build(mesh.keyframe(uint32_t(k)), mesh.vertex_count, mesh.indices.data(),
+                                     mesh.indices.size(), &framing.centres[3 * k], framing.radius, 256,
+                                     modes.empty() ? nullptr : modes.data());
+                        facing_keyframe = k;
+                    }
                     const double t1 = thread_seconds();
+                    const FacingFilter::Candidates listed =
+                        filtered ? facing.candidates(&directions[3 * v]) : FacingFilter::Candidates{nullptr, 0};
                     rasterizer.rasterize_validated(clip.data(), mesh.vertex_count, mesh.indices.data(),
-                                                   mesh.indices.size(), 256, modes.empty() ? nullptr : modes.data());
+                                                   mesh.indices.size(), 256, modes.empty() ? nullptr : modes.data(),
+                                                   listed.ids, listed.count);
                     const double t2 = thread_seconds();
+                    candidates += double(listed.ids ? listed.count : mesh.triangle_count());
                     const NodeRasterizer::FragmentLists lists = rasterizer.fragment_lists();
                     const KeptNode kept = keep_fragments(lists.visible, lists.single, lists.starts, lists.pixels,
                                                          lists.fragments, partition, scratch);
@@ -162,7 +179,6 @@ int main(int argc, char** argv) try {
                     for (const uint64_t p : passed) score_hash.value(p);
                     const double t5 = thread_seconds();
                     score5_s += t5 - t4;
-                    transform_s += t1 - t0;
                     raster_s += t2 - t1;
                     keep_s += t3 - t2;
                     ++nodes;
@@ -194,7 +210,8 @@ int main(int argc, char** argv) try {
                         triangle_lists += kept.triangle_lists;
                     }
                 }
-        std::printf("%s copy%s: ", NodeRasterizer::copy_name(copy), copy == widest ? " (default)" : "");
+        std::printf("%s copy%s%s: ", NodeRasterizer::copy_name(copy), copy == widest ? " (default)" : "",
+                    filtered ? "" : ", facing filter off");
         std::printf(
             "%zu triangles, %zu nodes, %.0f fragments/node: transform %.3f ms/node, rasterize %.3f ms/node, "
             "keep %.3f ms/node (thread CPU time); output hash %016llx\n",
@@ -211,10 +228,17 @@ int main(int argc, char** argv) try {
             "lists; kept hash %016llx\n",
             multi / hashed, unit_lists / hashed, unit_entries / hashed, triangle_lists / hashed,
             (unsigned long long)kept_hash.h);
+        std::printf("  facing filter %s: %.0f of %zu triangles rasterised per node\n", filtered ? "on" : "off",
+                    candidates / double(nodes), mesh.triangle_count());
         return Timing{1e3 * raster_s / double(nodes), hash.h};
     };
     std::vector<Timing> timings;
-    for (const Copy copy : copies) timings.push_back(measure(copy));
+    for (const Copy copy : copies) timings.push_back(measure(copy, true));
+    // The widest copy again from every triangle (the filter off): the filter's worth, same run.
+    const Timing unfiltered = measure(copies.back(), false);
+    std::printf("rasterize: %.2fx faster with the facing filter (%s copy); hashes %s\n",
+                unfiltered.rasterize_ms / timings.back().rasterize_ms, NodeRasterizer::copy_name(copies.back()),
+                unfiltered.hash == timings.back().hash ? "equal" : "DIFFER");
     for (size_t i = 1; i < timings.size() && copies[0] == Copy::Portable; ++i)
         std::printf("rasterize: %s copy %.2fx the portable copy's speed; hashes %s\n",
                     NodeRasterizer::copy_name(copies[i]), timings[0].rasterize_ms / timings[i].rasterize_ms,

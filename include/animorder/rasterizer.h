@@ -36,8 +36,13 @@ public:
     // rasterize for indices the caller has already checked with validate_indices against this
     // vertex_count (a mesh drawn at many nodes is checked once, not once per node). Unchecked
     // indices here are undefined behaviour; everything else (the resolution) is still checked.
+    // candidates: null, or `candidate_count` ascending triangle indices below index_count / 3
+    // (FacingFilter's, unchecked like the indices) outside which no triangle draws at this node:
+    // the same fragments, fewer triangles looked at. They are ignored when a corner is clipped or
+    // far outside the viewport (the filter vouches for neither).
     void rasterize_validated(const float* clip_xyzw, size_t vertex_count, const uint32_t* indices, size_t index_count,
-                             unsigned resolution, const uint8_t* modes = nullptr);
+                             unsigned resolution, const uint8_t* modes = nullptr, const uint32_t* candidates = nullptr,
+                             size_t candidate_count = 0);
 
     // The per-node code is compiled in up to three copies, each doing the same operations in the
     // same order, so each giving the same bits: portable (SSE2 on x86-64); AVX2, where the CPU

@@ -6,6 +6,7 @@
 // not depend on the thread count or on scheduling, and memory grows with the workers, not with
 // the nodes.
 #include "animorder/overdraw.h"
+#include "animorder/facing_filter.h"
 
 #include "animorder/animated_mesh.h"
 #include "animorder/camera.h"
@@ -48,6 +49,30 @@ private:
     size_t total_, every_;
     std::atomic<size_t> done_{0};
     std::mutex mutex_;
+};
+
+// One worker's rasteriser: a node transformed to clip space and rasterised from the facing
+// filter's candidates (built again when the keyframe changes; the same fragments as from every
+// triangle).
+struct NodeWorker {
+    NodeRasterizer rasterizer;
+    std::vector<float> clip;
+    FacingFilter facing;
+
+    void rasterize(const float* keyframe_positions, size_t vertex_count, const Framing& framing,
+                   const uint32_t* indices, size_t index_count, const OverdrawNode& node,
+                   const ScoreSettings& settings) {
+        clip.resize(vertex_count * 4);
+        const float* keyframe = keyframe_positions + size_t(node.keyframe) * vertex_count * 3;
+        const float* centre = framing.centres.data() + 3 * size_t(node.keyframe);
+        transform_to_clip(clip.data(), keyframe, vertex_count, centre,
+                          node_view_projection(node.direction, framing.radius));
+        facing.build_for(node.keyframe, keyframe, vertex_count, indices, index_count, centre, framing.radius,
+                         settings.resolution, settings.triangle_modes);
+        const FacingFilter::Candidates candidates = facing.candidates(node.direction);
+        rasterizer.rasterize_validated(clip.data(), vertex_count, indices, index_count, settings.resolution,
+                                       settings.triangle_modes, candidates.ids, candidates.count);
+    }
 };
 
 }  // namespace
@@ -97,23 +122,13 @@ void score_nodes(uint64_t* visible, uint64_t* passed, const float* keyframe_posi
             throw InvalidInput("node " + std::to_string(n) + " names keyframe " + std::to_string(nodes[n].keyframe) +
                                ", but there are " + std::to_string(keyframes));
 
-    struct Worker {
-        NodeRasterizer rasterizer;
-        std::vector<float> clip;
-    };
-    tbb::enumerable_thread_specific<Worker> workers;
+    tbb::enumerable_thread_specific<NodeWorker> workers;
     ProgressCounter progress(settings.progress, node_count);
 
     auto body = [&](const tbb::blocked_range<size_t>& range) {
-        Worker& w = workers.local();
-        w.clip.resize(vertex_count * 4);
+        NodeWorker& w = workers.local();
         for (size_t n = range.begin(); n != range.end(); ++n) {
-            const OverdrawNode& node = nodes[n];
-            const Mat4d vp = node_view_projection(node.direction, framing.radius);
-            transform_to_clip(w.clip.data(), keyframe_positions + size_t(node.keyframe) * vertex_count * 3,
-                              vertex_count, framing.centres.data() + 3 * size_t(node.keyframe), vp);
-            w.rasterizer.rasterize_validated(w.clip.data(), vertex_count, indices, index_count, settings.resolution,
-                                             settings.triangle_modes);
+            w.rasterize(keyframe_positions, vertex_count, framing, indices, index_count, nodes[n], settings);
             visible[n] = w.rasterizer.visible_pixels();
             w.rasterizer.score(passed + n * order_count, ranks, order_count);
             progress.node_done();
@@ -138,21 +153,11 @@ std::vector<NodeFragments> rasterize_nodes(const float* keyframe_positions, size
     std::atomic<size_t> total{0};
     std::atomic<bool> too_big{false};
     ProgressCounter progress(settings.progress, node_count);
-    struct Worker {
-        NodeRasterizer rasterizer;
-        std::vector<float> clip;
-    };
-    tbb::enumerable_thread_specific<Worker> workers;
+    tbb::enumerable_thread_specific<NodeWorker> workers;
     auto body = [&](const tbb::blocked_range<size_t>& range) {
-        Worker& w = workers.local();
-        w.clip.resize(vertex_count * 4);
+        NodeWorker& w = workers.local();
         for (size_t n = range.begin(); n != range.end() && !too_big; ++n) {
-            const OverdrawNode& node = nodes[n];
-            transform_to_clip(w.clip.data(), keyframe_positions + size_t(node.keyframe) * vertex_count * 3,
-                              vertex_count, framing.centres.data() + 3 * size_t(node.keyframe),
-                              node_view_projection(node.direction, framing.radius));
-            w.rasterizer.rasterize_validated(w.clip.data(), vertex_count, indices, index_count, settings.resolution,
-                                             settings.triangle_modes);
+            w.rasterize(keyframe_positions, vertex_count, framing, indices, index_count, nodes[n], settings);
             kept[n] = w.rasterizer.export_fragments();
             if ((total += kept[n].bytes()) > max_bytes) too_big = true;
             progress.node_done();
@@ -182,8 +187,7 @@ void score_kept_nodes(uint64_t* visible, uint64_t* passed, const std::vector<Nod
 }
 
 struct NodeCache::Worker {
-    NodeRasterizer rasterizer;
-    std::vector<float> clip;
+    NodeWorker node;
     KeepScratch scratch;
 };
 
@@ -201,13 +205,7 @@ void NodeCache::for_nodes(size_t count, size_t grain, Body&& body) const {
 }
 
 void NodeCache::rasterize_node(Worker& w, size_t n) const {
-    const OverdrawNode& node = nodes_[n];
-    w.clip.resize(vertex_count_ * 4);
-    transform_to_clip(w.clip.data(), positions_ + size_t(node.keyframe) * vertex_count_ * 3, vertex_count_,
-                      framing_.centres.data() + 3 * size_t(node.keyframe),
-                      node_view_projection(node.direction, framing_.radius));
-    w.rasterizer.rasterize_validated(w.clip.data(), vertex_count_, indices_, index_count_, settings_.resolution,
-                                     settings_.triangle_modes);
+    w.node.rasterize(positions_, vertex_count_, framing_, indices_, index_count_, nodes_[n], settings_);
 }
 
 NodeCache::NodeCache(const float* keyframe_positions, size_t vertex_count, const Framing& framing,
@@ -241,7 +239,7 @@ NodeCache::NodeCache(const float* keyframe_positions, size_t vertex_count, const
         batch.assign(end - begin, KeptNode{});
         for_nodes(end - begin, 1, [&](Worker& w, size_t i) {
             rasterize_node(w, begin + i);
-            const NodeRasterizer::FragmentLists l = w.rasterizer.fragment_lists();
+            const NodeRasterizer::FragmentLists l = w.node.rasterizer.fragment_lists();
             batch[i] = keep_fragments(l.visible, l.single, l.starts, l.pixels, l.fragments, partition_, w.scratch);
         });
         for (KeptNode& node : batch) {
@@ -267,8 +265,8 @@ void NodeCache::score(uint64_t* visible, uint64_t* passed, const uint32_t* ranks
             score_kept(passed + n * order_count, *k, unit_ranks.data(), ranks, order_count);
         } else {
             rasterize_node(w, n);
-            visible[n] = w.rasterizer.visible_pixels();
-            w.rasterizer.score(passed + n * order_count, ranks, order_count);
+            visible[n] = w.node.rasterizer.visible_pixels();
+            w.node.rasterizer.score(passed + n * order_count, ranks, order_count);
         }
         progress.node_done();
     });
@@ -279,7 +277,7 @@ std::vector<KeptNode> NodeCache::rasterize_again(const uint32_t* which, size_t c
     for_nodes(count, 1, [&](Worker& w, size_t i) {
         if (which[i] >= node_count_) throw InvalidInput("node cache: no node " + std::to_string(which[i]));
         rasterize_node(w, which[i]);
-        const NodeRasterizer::FragmentLists l = w.rasterizer.fragment_lists();
+        const NodeRasterizer::FragmentLists l = w.node.rasterizer.fragment_lists();
         out[i] = keep_fragments(l.visible, l.single, l.starts, l.pixels, l.fragments, partition_, w.scratch);
     });
     return out;

@@ -889,34 +889,41 @@ __attribute__((target("avx2"))) size_t project_vertices_avx2(const ClipVertex* c
 
 namespace {
 void rasterize_node_portable(NodeRasterizer::State& s, const float* clip_xyzw, size_t vertex_count,
-                             const uint32_t* indices, size_t index_count, unsigned resolution, const uint8_t* modes);
+                             const uint32_t* indices, size_t index_count, unsigned resolution, const uint8_t* modes,
+                             const uint32_t* candidates, size_t candidate_count);
 #ifdef ANIMORDER_RASTER_AVX2
 void rasterize_node_avx2(NodeRasterizer::State& s, const float* clip_xyzw, size_t vertex_count, const uint32_t* indices,
-                         size_t index_count, unsigned resolution, const uint8_t* modes);
+                         size_t index_count, unsigned resolution, const uint8_t* modes, const uint32_t* candidates,
+                         size_t candidate_count);
 void rasterize_node_avx512(NodeRasterizer::State& s, const float* clip_xyzw, size_t vertex_count,
-                           const uint32_t* indices, size_t index_count, unsigned resolution, const uint8_t* modes);
+                           const uint32_t* indices, size_t index_count, unsigned resolution, const uint8_t* modes,
+                           const uint32_t* candidates, size_t candidate_count);
 #endif
 }  // namespace
 
 void NodeRasterizer::rasterize(const float* clip_xyzw, size_t vertex_count, const uint32_t* indices, size_t index_count,
                                unsigned resolution, const uint8_t* modes) {
     validate_indices(indices, index_count, vertex_count);
-    rasterize_validated(clip_xyzw, vertex_count, indices, index_count, resolution, modes);
+    rasterize_validated(clip_xyzw, vertex_count, indices, index_count, resolution, modes, nullptr, 0);
 }
 
 void NodeRasterizer::rasterize_validated(const float* clip_xyzw, size_t vertex_count, const uint32_t* indices,
-                                         size_t index_count, unsigned resolution, const uint8_t* modes) {
+                                         size_t index_count, unsigned resolution, const uint8_t* modes,
+                                         const uint32_t* candidates, size_t candidate_count) {
     if (resolution == 0 || resolution > 16384)
         throw InvalidInput("resolution " + std::to_string(resolution) + " is outside 1..16384");
     State& s = *state_;
     s.resolution = resolution;
 #ifdef ANIMORDER_RASTER_AVX2
     if (s.copy == Copy::Avx512)
-        return rasterize_node_avx512(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes);
+        return rasterize_node_avx512(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes, candidates,
+                                     candidate_count);
     if (s.copy == Copy::Avx2)
-        return rasterize_node_avx2(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes);
+        return rasterize_node_avx2(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes, candidates,
+                                   candidate_count);
 #endif
-    rasterize_node_portable(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes);
+    rasterize_node_portable(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes, candidates,
+                            candidate_count);
 }
 
 NodeRasterizer::Copy NodeRasterizer::widest_copy() {
@@ -953,7 +960,7 @@ namespace {
 template <NodeRasterizer::Copy kCopy>
 ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip_xyzw, size_t vertex_count,
                                      const uint32_t* indices, size_t index_count, unsigned resolution,
-                                     const uint8_t* modes) {
+                                     const uint8_t* modes, const uint32_t* candidates, size_t candidate_count) {
     constexpr bool kAvx2 = kCopy != NodeRasterizer::Copy::Portable;
     const ClipVertex* cv = reinterpret_cast<const ClipVertex*>(clip_xyzw);
     s.snapped.resize(vertex_count);
@@ -980,10 +987,19 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
         s.vertices[v] = {w.x, w.y, w.z, 0.0f};
     }
 
+    // The candidates stand for every triangle only when every corner took the fast path (the
+    // facing filter's guarantee is about those); otherwise every triangle is drawn.
+    bool listed = candidates != nullptr;
+    if (listed) {
+        uint8_t any = 0;
+        for (size_t v = 0; v < vertex_count; ++v) any |= s.vertex_flags[v];  // vectorised
+        listed = any == 0;
+    }
+
     // Triangles in batches: gather the snapped corners, test area and box for the whole batch at
     // once, then draw the survivors in triangle order (the order of the fragments is unchanged).
     FragmentSink sink{s.raw_pixel, s.raw_triangle, s.raw_depth};
-    const size_t triangle_count = index_count / 3;
+    const size_t triangle_count = listed ? candidate_count : index_count / 3;
     const NodeRasterizer::State::Snapped* corner = s.snapped.data();
     const NodeRasterizer::State::VertexRecord* vertex = s.vertices.data();
     const uint8_t* flags = s.vertex_flags.data();
@@ -992,11 +1008,26 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
     int32_t boxes[kBatch][4];
     int64_t areas[kBatch];
     int32_t special[kBatch];
-    uint32_t draw[kBatch];
+    uint32_t draw[kBatch], id[kBatch], listed_corners[3 * kBatch];
+    uint8_t listed_modes[kBatch];
     BatchSetup& setup = s.setup;
     for (size_t first = 0; first < triangle_count; first += kBatch) {
         const size_t n = std::min(kBatch, triangle_count - first);
+        // The batch's triangles (id) with their corners (tri) and modes (mode) side by side: the
+        // index list's own entries, or the candidates' copied out.
         const uint32_t* tri = indices + 3 * first;
+        const uint8_t* mode = modes ? modes + first : nullptr;
+        if (listed) {
+            for (size_t i = 0; i < n; ++i) {
+                id[i] = candidates[first + i];
+                std::memcpy(&listed_corners[3 * i], indices + 3 * size_t(id[i]), 3 * sizeof(uint32_t));
+                listed_modes[i] = modes ? modes[id[i]] : 0;
+            }
+            tri = listed_corners;
+            mode = modes ? listed_modes : nullptr;
+        } else {
+            for (size_t i = 0; i < n; ++i) id[i] = uint32_t(first + i);
+        }
         for (size_t i = 0; i < n; ++i) {
             const uint32_t a = tri[3 * i], b = tri[3 * i + 1], c = tri[3 * i + 2];
             x0[i] = corner[a].X;
@@ -1006,7 +1037,6 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
             x2[i] = corner[c].X;
             y2[i] = corner[c].Y;
         }
-        const uint8_t* mode = modes ? modes + first : nullptr;
         for (size_t i = 0; i < n; ++i) {  // vectorised
             const int32_t m = mode ? mode[i] : 0;
             two[i] = m & kDrawBothFaces;
@@ -1034,10 +1064,9 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
         for (size_t j = 0; j < m; ++j) {
             const size_t i = draw[j];
             const bool fast = special[i] == 1, front = areas[i] < 0;
-            const size_t t = first + i;
-            const auto* w0 = vertex + indices[3 * t];
-            const auto* w1 = vertex + indices[3 * t + (front ? 2 : 1)];
-            const auto* w2 = vertex + indices[3 * t + (front ? 1 : 2)];
+            const auto* w0 = vertex + tri[3 * i];
+            const auto* w1 = vertex + tri[3 * i + (front ? 2 : 1)];
+            const auto* w2 = vertex + tri[3 * i + (front ? 1 : 2)];
             setup.X[0][j] = x0[i];
             setup.Y[0][j] = y0[i];
             setup.X[1][j] = front ? x2[i] : x1[i];
@@ -1059,8 +1088,8 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
         }
         setup.compute(m);
         for (size_t j = 0; j < m; ++j) {
-            const size_t t = first + draw[j];
-            const uint32_t a = indices[3 * t], b = indices[3 * t + 1], c = indices[3 * t + 2];
+            const size_t t = id[draw[j]];
+            const uint32_t a = tri[3 * draw[j]], b = tri[3 * draw[j] + 1], c = tri[3 * draw[j] + 2];
             const bool two_sided = two[draw[j]] != 0;
             if (special[draw[j]] == 1) {            // passed the pre-pass: its box and set-up are known
                 if (setup.det[j] == 0.0) continue;  // float-degenerate sliver: no fragment has a defined depth
@@ -1109,24 +1138,28 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
 }
 
 void rasterize_node_portable(NodeRasterizer::State& s, const float* clip_xyzw, size_t vertex_count,
-                             const uint32_t* indices, size_t index_count, unsigned resolution, const uint8_t* modes) {
-    rasterize_node<NodeRasterizer::Copy::Portable>(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes);
+                             const uint32_t* indices, size_t index_count, unsigned resolution, const uint8_t* modes,
+                             const uint32_t* candidates, size_t candidate_count) {
+    rasterize_node<NodeRasterizer::Copy::Portable>(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes,
+                                                   candidates, candidate_count);
 }
 
 #ifdef ANIMORDER_RASTER_AVX2
 __attribute__((target("avx2"))) void rasterize_node_avx2(NodeRasterizer::State& s, const float* clip_xyzw,
                                                          size_t vertex_count, const uint32_t* indices,
-                                                         size_t index_count, unsigned resolution,
-                                                         const uint8_t* modes) {
-    rasterize_node<NodeRasterizer::Copy::Avx2>(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes);
+                                                         size_t index_count, unsigned resolution, const uint8_t* modes,
+                                                         const uint32_t* candidates, size_t candidate_count) {
+    rasterize_node<NodeRasterizer::Copy::Avx2>(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes,
+                                               candidates, candidate_count);
 }
 
 // The AVX2 copy's source compiled with AVX-512 allowed; GCC keeps its loops at 256-bit vectors
 // (its default width for these targets), so no 512-bit clock penalty where a CPU has one.
 __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) void rasterize_node_avx512(
     NodeRasterizer::State& s, const float* clip_xyzw, size_t vertex_count, const uint32_t* indices, size_t index_count,
-    unsigned resolution, const uint8_t* modes) {
-    rasterize_node<NodeRasterizer::Copy::Avx512>(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes);
+    unsigned resolution, const uint8_t* modes, const uint32_t* candidates, size_t candidate_count) {
+    rasterize_node<NodeRasterizer::Copy::Avx512>(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes,
+                                                 candidates, candidate_count);
 }
 #endif
 

@@ -13,6 +13,7 @@
 
 #include "animorder/animated_mesh.h"
 #include "animorder/camera.h"
+#include "animorder/facing_filter.h"
 #include "animorder/invalid_input.h"
 #include "animorder/mesh_patches.h"
 #include "animorder/methods.h"
@@ -87,6 +88,7 @@ std::vector<OrderEvaluation> evaluate_methods(const AnimatedMesh& mesh, const st
     std::vector<std::vector<Accumulator>> per_clip(method_count, std::vector<Accumulator>(mesh.clips.size()));
     struct Worker {
         NodeRasterizer rasterizer;
+        FacingFilter facing;  // the keyframe last drawn's: the same fragments, fewer triangles
         std::vector<float> clip;
         std::vector<uint32_t> ranks;  // this node's table: triangles × methods
     };
@@ -120,10 +122,16 @@ std::vector<OrderEvaluation> evaluate_methods(const AnimatedMesh& mesh, const st
             const uint32_t* rank = node_ranks(method, rank_of[m], node.clip, node.f, node.keyframe, node.direction);
             for (size_t t = 0; t < triangles; ++t) w.ranks[t * method_count + m] = rank[t];
         }
-        transform_to_clip(w.clip.data(), mesh.keyframe(node.keyframe), mesh.vertex_count,
-                          &all.centres[3 * node.keyframe], node_view_projection(node.direction, framing.radius));
+        const float* centre = &all.centres[3 * node.keyframe];
+        transform_to_clip(w.clip.data(), mesh.keyframe(node.keyframe), mesh.vertex_count, centre,
+                          node_view_projection(node.direction, framing.radius));
+        const uint8_t* triangle_modes = modes.empty() ? nullptr : modes.data();
+        w.facing.build_for(uint64_t(node.clip) << 32 | node.keyframe, mesh.keyframe(node.keyframe), mesh.vertex_count,
+                           mesh.indices.data(), mesh.indices.size(), centre, framing.radius, settings.resolution,
+                           triangle_modes);
+        const FacingFilter::Candidates candidates = w.facing.candidates(node.direction);
         w.rasterizer.rasterize_validated(w.clip.data(), mesh.vertex_count, mesh.indices.data(), mesh.indices.size(),
-                                         settings.resolution, modes.empty() ? nullptr : modes.data());
+                                         settings.resolution, triangle_modes, candidates.ids, candidates.count);
         visible[node.index] = w.rasterizer.visible_pixels();
         w.rasterizer.score(&passed[node.index * method_count], w.ranks.data(), method_count);
     };

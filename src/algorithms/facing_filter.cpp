@@ -1,0 +1,188 @@
+// Back faces left out before rasterising: a conservative, exact form of the rasteriser's culling.
+//
+// Not from the papers; it serves Han & Sander, "Triangle Reordering for Efficient Rendering in
+// Complex Scenes" (JCGT 2017), whose every node is one rasterisation of the whole mesh, and whose
+// meshes are mostly single-sided, so about half the triangles of a node are back faces. The
+// rasteriser (rasterizer.cpp) finds them only after gathering and snapping their corners; this
+// finds most of them from the keyframe's geometry, one dot product per triangle and node.
+//
+// Why it is exact. In the framed space (positions minus the keyframe's centre, in float as
+// transform_to_clip computes them), the camera sits at e = 3R·d looking at the origin with
+// cot(fovy/2) = 2√2 (camera.cpp). For a triangle a, b, c with n = (b − a) × (c − a) and
+// s = n · (e − a), the doubled signed area of its exact projection in OpenGL window space (y up,
+// pixels) is
+//     2A = (res/2)² · cot² · s / (w_a · w_b · w_c),
+// w the distance along the view axis (the clip w): s > 0 is a front face. When every corner of
+// the keyframe lies within ρ ≤ R of the origin (inside the sphere the field of view fits), so
+// does every point of a triangle whose corners lie within ρ_t, and w lies in [3R − ρ_t, 3R + ρ_t].
+// The rasteriser's corners are these projections moved by at most δ per coordinate: half a
+// subpixel of snapping plus float rounding in the vertex transform, the projection and the
+// snapping (below 1e-6 · res pixels when ρ ≤ R; δ allows four times that). Moving corner i by
+// ε_i changes the doubled area by a term linear in the ε_i, each times the length of the edge
+// opposite corner i, plus the cross product of two corner differences: at most √2·δ·P + 8δ², P
+// the projected perimeter. The projection's gradient on the triangle bounds P: P ≤ p · (res/2) ·
+// cot · (1 + g) / (3R − ρ_t), p the perimeter in the framed space, ρ_t the triangle's largest
+// corner distance, g = ρ_t / √(9R² − ρ_t²) the largest |x_view| / w on the ball of radius ρ_t.
+// So if
+//     −s · (res/2)² · cot² / (3R + ρ_t)³ > √2·δ·P + 8δ²,
+// the rasteriser's area has the back-face sign (or is zero) and a single-sided triangle is
+// culled: such a triangle is left out. The threshold per triangle adds the float rounding of the
+// per-node dot product (below 1e-6 · (|n|·|e| + |n·a|)) and a 1% margin.
+#include "animorder/facing_filter.h"
+
+#include <algorithm>
+#include <cmath>
+
+#if (defined(__GNUC__) || defined(__clang__)) && (defined(__x86_64__) || defined(__i386__))
+#include <immintrin.h>
+#endif
+
+namespace animorder {
+namespace {
+
+constexpr double kCotHalfFov = 2.8284271247461903;  // 2√2, camera.cpp
+constexpr uint8_t kDrawBothFaces = 1;               // rasterizer.h: never left out
+
+// The test for one triangle, in this order of float operations in every copy (no fused
+// multiply-add: the build turns contraction off), so every copy gives the same candidates.
+inline bool may_draw(float nx, float ny, float nz, float limit, float ex, float ey, float ez) {
+    return !(((nx * ex + ny * ey) + nz * ez) < limit);
+}
+
+size_t candidates_portable(const float* nx, const float* ny, const float* nz, const float* limit, size_t triangles,
+                           float ex, float ey, float ez, uint32_t* out) {
+    size_t m = 0;
+    for (size_t t = 0; t < triangles; ++t) {
+        out[m] = uint32_t(t);
+        m += may_draw(nx[t], ny[t], nz[t], limit[t], ex, ey, ez);
+    }
+    return m;
+}
+
+#if (defined(__GNUC__) || defined(__clang__)) && (defined(__x86_64__) || defined(__i386__))
+#define ANIMORDER_FACING_AVX2 1
+// For each 8-bit mask of lanes, those lanes in order (the rest zero).
+struct LanePacking {
+    alignas(32) int32_t lanes[256][8] = {};
+    constexpr LanePacking() {
+        for (int mask = 0; mask < 256; ++mask) {
+            int n = 0;
+            for (int lane = 0; lane < 8; ++lane)
+                if (mask >> lane & 1) lanes[mask][n++] = lane;
+        }
+    }
+};
+constexpr LanePacking kLanePacking;
+
+// Eight triangles a step: the test in float lanes (may_draw's operations), then the ids of the
+// lanes that pass packed to the front with one permutation and stored (8 slots written, the
+// count advanced by those that pass).
+__attribute__((target("avx2,popcnt"))) size_t candidates_avx2(const float* nx, const float* ny, const float* nz,
+                                                              const float* limit, size_t triangles, float ex, float ey,
+                                                              float ez, uint32_t* out) {
+    const __m256 x = _mm256_set1_ps(ex), y = _mm256_set1_ps(ey), z = _mm256_set1_ps(ez);
+    const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    size_t m = 0, t = 0;
+    for (; t + 8 <= triangles; t += 8) {
+        const __m256 dot = _mm256_add_ps(
+            _mm256_add_ps(_mm256_mul_ps(_mm256_loadu_ps(nx + t), x), _mm256_mul_ps(_mm256_loadu_ps(ny + t), y)),
+            _mm256_mul_ps(_mm256_loadu_ps(nz + t), z));
+        const int mask = _mm256_movemask_ps(_mm256_cmp_ps(dot, _mm256_loadu_ps(limit + t), _CMP_NLT_UQ));
+        const __m256i ids = _mm256_add_epi32(_mm256_set1_epi32(int32_t(t)), lane);
+        const __m256i order = _mm256_load_si256(reinterpret_cast<const __m256i*>(kLanePacking.lanes[mask]));
+        _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + m), _mm256_permutevar8x32_epi32(ids, order));
+        m += size_t(__builtin_popcount(unsigned(mask)));
+    }
+    for (; t < triangles; ++t) {
+        out[m] = uint32_t(t);
+        m += may_draw(nx[t], ny[t], nz[t], limit[t], ex, ey, ez);
+    }
+    return m;
+}
+#endif
+
+}  // namespace
+
+void FacingFilter::build(const float* positions, size_t vertex_count, const uint32_t* indices, size_t index_count,
+                         const float centre[3], float radius, unsigned resolution, const uint8_t* modes) {
+    const size_t triangles = index_count / 3;
+    usable_ = false;
+    radius_ = radius;
+    nx_.resize(triangles);
+    ny_.resize(triangles);
+    nz_.resize(triangles);
+    limit_.resize(triangles);
+    out_.resize(triangles + 8);  // candidates_avx2 writes 8 slots a step
+    const double R = radius;
+    if (!(R > 0) || !std::isfinite(R) || resolution == 0) return;
+    // The corners as transform_to_clip has them (float differences), and ρ over the corners drawn.
+    corners_.resize(3 * vertex_count);
+    float* q = corners_.data();
+    for (size_t v = 0; v < vertex_count; ++v)
+        for (int k = 0; k < 3; ++k) q[3 * v + k] = positions[3 * v + k] - centre[k];
+    const auto radius_of = [q](uint32_t v) {
+        const float* p = q + 3 * size_t(v);
+        return std::sqrt(double(p[0]) * p[0] + double(p[1]) * p[1] + double(p[2]) * p[2]);
+    };
+    double rho = 0;
+    for (size_t i = 0; i < 3 * triangles; ++i) {
+        const double r = radius_of(indices[i]);
+        if (!std::isfinite(r)) return;
+        rho = std::max(rho, r);
+    }
+    if (rho > 1.001 * R) return;
+    const double half = 0.5 * double(resolution);
+    const double delta = 1.0 / 512.0 + 4e-6 * double(resolution);
+    const double eye = 3.0 * R;
+    bool can_leave_out = false;
+    for (size_t t = 0; t < triangles; ++t) {
+        const uint32_t ia = indices[3 * t], ib = indices[3 * t + 1], ic = indices[3 * t + 2];
+        const float *a = q + 3 * size_t(ia), *b = q + 3 * size_t(ib), *c = q + 3 * size_t(ic);
+        const double u[3] = {double(b[0]) - a[0], double(b[1]) - a[1], double(b[2]) - a[2]};
+        const double w[3] = {double(c[0]) - a[0], double(c[1]) - a[1], double(c[2]) - a[2]};
+        const double v[3] = {double(c[0]) - b[0], double(c[1]) - b[1], double(c[2]) - b[2]};
+        const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+        const double offset = n[0] * a[0] + n[1] * a[1] + n[2] * a[2];
+        const double perimeter = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]) +
+                                 std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) +
+                                 std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        // This triangle's bounds (every point of it lies within ρ_t of the origin): w in
+        // [3R − ρ_t, 3R + ρ_t], |x_view| / w ≤ ρ_t / √(9R² − ρ_t²) (the cone around the ball).
+        const double rho_t = std::max({radius_of(ia), radius_of(ib), radius_of(ic)});
+        const double w_min = eye - rho_t, w_max = eye + rho_t;
+        const double slope = 1.0001 * rho_t / std::sqrt(eye * eye - rho_t * rho_t);
+        const double P = perimeter * half * kCotHalfFov * (1.0 + slope) / w_min;
+        const double area_scale = half * half * kCotHalfFov * kCotHalfFov / (w_max * w_max * w_max);
+        const double rounding = 1e-6 * (std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) * eye + std::fabs(offset));
+        const double threshold = 1.01 * (std::sqrt(2.0) * delta * P + 8.0 * delta * delta) / area_scale + rounding;
+        nx_[t] = float(n[0]);
+        ny_[t] = float(n[1]);
+        nz_[t] = float(n[2]);
+        // Left out when n · e < offset − threshold: the limit rounded down (the float nearest may
+        // lie above). A double-sided triangle, or one whose limit is not finite, is never left out.
+        const float limit = float(offset - threshold);
+        const bool never = (modes && (modes[t] & kDrawBothFaces)) || !std::isfinite(limit);
+        limit_[t] = never ? -INFINITY : std::nextafter(limit, -INFINITY);
+        can_leave_out |= !never;
+    }
+    usable_ = can_leave_out;  // a mesh all double-sided: nothing to gain, the rasteriser's plain path
+}
+
+FacingFilter::Candidates FacingFilter::candidates(const float view_direction[3]) {
+    const size_t triangles = limit_.size();
+    uint32_t* out = out_.data();
+    if (!usable_) return {nullptr, triangles};
+    // The eye as node_view_projection places it.
+    const double d[3] = {view_direction[0], view_direction[1], view_direction[2]};
+    const double norm = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    const float ex = float(3.0 * radius_ * (d[0] / norm)), ey = float(3.0 * radius_ * (d[1] / norm)),
+                ez = float(3.0 * radius_ * (d[2] / norm));
+#ifdef ANIMORDER_FACING_AVX2
+    static const bool avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("popcnt");
+    if (avx2 && !portable_)
+        return {out, candidates_avx2(nx_.data(), ny_.data(), nz_.data(), limit_.data(), triangles, ex, ey, ez, out)};
+#endif
+    return {out, candidates_portable(nx_.data(), ny_.data(), nz_.data(), limit_.data(), triangles, ex, ey, ez, out)};
+}
+
+}  // namespace animorder

@@ -1,0 +1,223 @@
+// The facing filter (facing_filter.cpp) against the rasteriser it stands in front of: from its
+// candidates the rasteriser draws exactly the fragments it draws from every triangle, on the
+// bundled character and on random triangles small and slanted enough that snapping turns some
+// of them over; hand-worked cases for what is left out.
+#include "animorder/camera.h"
+#include "animorder/facing_filter.h"
+#include "animorder/overdraw.h"
+#include "animorder/procedural_character.h"
+#include "animorder/rasterizer.h"
+#include "animorder/viewpoints.h"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <random>
+#include <tuple>
+#include <vector>
+
+using namespace animorder;
+
+namespace {
+
+using Fragments = std::vector<std::tuple<uint32_t, uint32_t, float>>;
+
+Fragments fragments_of(const NodeRasterizer& r) {
+    Fragments out;
+    r.visit_fragments([&](uint32_t p, uint32_t t, float z) { out.emplace_back(p, t, z); });
+    return out;
+}
+
+struct NodeCheck {
+    size_t nodes = 0, left_out = 0, triangles = 0, differing_nodes = 0;
+};
+
+// Every view of one keyframe at one resolution: the rasteriser from the candidates against the
+// rasteriser from every triangle, fragment for fragment. Also counts the triangles left out and
+// checks that the portable and the AVX2 copies of the filter list the same candidates.
+void compare_views(const float* positions, size_t vertex_count, const std::vector<uint32_t>& indices,
+                   const float centre[3], float radius, unsigned resolution, const uint8_t* modes,
+                   const std::vector<float>& directions, NodeCheck& check) {
+    FacingFilter filter, portable;
+    filter.build(positions, vertex_count, indices.data(), indices.size(), centre, radius, resolution, modes);
+    portable.build(positions, vertex_count, indices.data(), indices.size(), centre, radius, resolution, modes);
+    portable.set_portable(true);
+    ASSERT_TRUE(filter.usable());
+    NodeRasterizer all, some;
+    std::vector<float> clip(4 * vertex_count);
+    for (size_t v = 0; v < directions.size() / 3; ++v) {
+        const float* d = &directions[3 * v];
+        transform_to_clip(clip.data(), positions, vertex_count, centre, node_view_projection(d, radius));
+        all.rasterize(clip.data(), vertex_count, indices.data(), indices.size(), resolution, modes);
+        const FacingFilter::Candidates c = filter.candidates(d);
+        const std::vector<uint32_t> listed(c.ids, c.ids + c.count);
+        const FacingFilter::Candidates p = portable.candidates(d);
+        ASSERT_EQ(listed, std::vector<uint32_t>(p.ids, p.ids + p.count)) << "view " << v;
+        some.rasterize_validated(clip.data(), vertex_count, indices.data(), indices.size(), resolution, modes,
+                                 listed.data(), listed.size());
+        const bool same = fragments_of(all) == fragments_of(some);
+        EXPECT_TRUE(same) << "view " << v << " at " << resolution << "²";
+        check.differing_nodes += !same;
+        ++check.nodes;
+        check.triangles += indices.size() / 3;
+        check.left_out += indices.size() / 3 - listed.size();
+    }
+}
+
+// n random triangles inside the unit ball (sizes log-uniform from 1e-4 to 0.3, each a right angle
+// at a random point with random orientation), then slivers nearly edge-on from each of the 42
+// views the test uses.
+std::vector<float> random_triangles(size_t n, uint32_t seed, std::vector<uint32_t>& indices) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0), exponent(-4.0, std::log10(0.3));
+    std::vector<float> positions;
+    const auto random_direction = [&] {
+        double v[3];
+        do {
+            for (double& x : v) x = unit(rng);
+        } while (v[0] * v[0] + v[1] * v[1] + v[2] * v[2] > 1.0 || v[0] * v[0] + v[1] * v[1] + v[2] * v[2] < 1e-6);
+        const double r = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        return std::array<double, 3>{v[0] / r, v[1] / r, v[2] / r};
+    };
+    for (size_t t = 0; t < n; ++t) {
+        const double size = std::pow(10.0, exponent(rng));
+        std::array<double, 3> centre = random_direction();
+        const double reach = 0.7 * std::cbrt(std::abs(unit(rng)));
+        for (double& x : centre) x *= reach;
+        const std::array<double, 3> a = random_direction(), b = random_direction();
+        const double corners[3][2] = {{0, 0}, {1, 0}, {0, 1}};
+        for (const auto& k : corners)
+            for (int i = 0; i < 3; ++i) positions.push_back(float(centre[i] + size * (k[0] * a[i] + k[1] * b[i])));
+        indices.insert(indices.end(), {uint32_t(3 * t), uint32_t(3 * t + 1), uint32_t(3 * t + 2)});
+    }
+    // Slivers edge-on from a view, give or take a tilt of 1e-7 to 1e-4: snapping decides which
+    // way they face there.
+    const std::vector<float> views = icosphere_directions(icosphere_subdivisions_for(42));
+    std::uniform_real_distribution<double> tilt(-7.0, -4.0), sign(-1.0, 1.0);
+    for (size_t v = 0; v < views.size() / 3; ++v)
+        for (int i = 0; i < 100; ++i) {
+            std::array<double, 3> a = random_direction();
+            for (double& x : a) x *= 0.5;
+            double e[3], to_eye[3];
+            for (int k = 0; k < 3; ++k) e[k] = 3.0 * views[3 * v + k] - a[k];
+            const double r = std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+            for (int k = 0; k < 3; ++k) to_eye[k] = e[k] / r;
+            const std::array<double, 3> any = random_direction();
+            double t[3] = {any[1] * to_eye[2] - any[2] * to_eye[1], any[2] * to_eye[0] - any[0] * to_eye[2],
+                           any[0] * to_eye[1] - any[1] * to_eye[0]};
+            const double tn = std::sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+            for (double& x : t) x /= tn;
+            const double m[3] = {t[1] * to_eye[2] - t[2] * to_eye[1], t[2] * to_eye[0] - t[0] * to_eye[2],
+                                 t[0] * to_eye[1] - t[1] * to_eye[0]};
+            const double eta = (sign(rng) < 0 ? -1.0 : 1.0) * std::pow(10.0, tilt(rng));
+            const uint32_t first = uint32_t(positions.size() / 3);
+            for (int k = 0; k < 3; ++k) positions.push_back(float(a[k]));
+            for (int k = 0; k < 3; ++k) positions.push_back(float(a[k] + 0.3 * t[k]));
+            for (int k = 0; k < 3; ++k) positions.push_back(float(a[k] + 0.15 * t[k] + 0.02 * to_eye[k] + eta * m[k]));
+            indices.insert(indices.end(), {first, first + 1, first + 2});
+        }
+    // A corner at distance 1 (the framing radius) so the sphere is the one the views fit.
+    const uint32_t last = uint32_t(positions.size() / 3);
+    positions.insert(positions.end(), {1.0f, 0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 1.0f, 0.0f, 0.0f});
+    indices.insert(indices.end(), {last, last + 1, last + 2});
+    return positions;
+}
+
+}  // namespace
+
+TEST(FacingFilter, TheBundledCharacterDrawsTheSameFragmentsFromTheCandidates) {
+    const AnimatedMesh mesh = make_procedural_character();
+    const Framing framing = frame_animated_mesh(mesh);
+    const std::vector<uint8_t> modes = opaque_pass_modes(mesh);
+    const std::vector<float> directions = icosphere_directions(icosphere_subdivisions_for(162));
+    NodeCheck check;
+    for (size_t k = 0; k < mesh.keyframe_count(); k += mesh.keyframe_count() / 3)
+        for (const unsigned resolution : {256u, 61u})
+            compare_views(mesh.keyframe(uint32_t(k)), mesh.vertex_count, mesh.indices, &framing.centres[3 * k],
+                          framing.radius, resolution, modes.empty() ? nullptr : modes.data(), directions, check);
+    EXPECT_EQ(check.differing_nodes, 0u);
+    // It must leave out a good share, or it is not worth having: most of the back faces.
+    EXPECT_GT(double(check.left_out) / double(check.triangles), 0.3) << check.left_out << " of " << check.triangles;
+}
+
+TEST(FacingFilter, TinySlantedTrianglesThatSnappingTurnsOverAreKept) {
+    std::vector<uint32_t> indices;
+    const std::vector<float> positions = random_triangles(6000, 7, indices);
+    const float centre[3] = {0, 0, 0};
+    const std::vector<float> directions = icosphere_directions(icosphere_subdivisions_for(42));
+    NodeCheck check;
+    for (const unsigned resolution : {256u, 64u, 1024u})
+        compare_views(positions.data(), positions.size() / 3, indices, centre, 1.0f, resolution, nullptr, directions,
+                      check);
+    EXPECT_EQ(check.differing_nodes, 0u);
+    EXPECT_GT(check.left_out, check.triangles / 4);
+
+    // The scene is hard enough to tell: leaving out every triangle that faces away in exact
+    // arithmetic (no margin) loses fragments of triangles that snapping turned to face the eye.
+    size_t naive_differences = 0;
+    NodeRasterizer all, some;
+    std::vector<float> clip(positions.size() / 3 * 4);
+    const size_t vertex_count = positions.size() / 3;
+    for (size_t v = 0; v < directions.size() / 3; ++v) {
+        const float* d = &directions[3 * v];
+        const double norm = std::sqrt(double(d[0]) * d[0] + double(d[1]) * d[1] + double(d[2]) * d[2]);
+        const double eye[3] = {3.0 * d[0] / norm, 3.0 * d[1] / norm, 3.0 * d[2] / norm};
+        std::vector<uint32_t> naive;
+        for (size_t t = 0; t < indices.size() / 3; ++t) {
+            const float* a = &positions[3 * indices[3 * t]];
+            const float* b = &positions[3 * indices[3 * t + 1]];
+            const float* c = &positions[3 * indices[3 * t + 2]];
+            const double u[3] = {double(b[0]) - a[0], double(b[1]) - a[1], double(b[2]) - a[2]};
+            const double w[3] = {double(c[0]) - a[0], double(c[1]) - a[1], double(c[2]) - a[2]};
+            const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+            if (n[0] * (eye[0] - a[0]) + n[1] * (eye[1] - a[1]) + n[2] * (eye[2] - a[2]) >= 0)
+                naive.push_back(uint32_t(t));
+        }
+        transform_to_clip(clip.data(), positions.data(), vertex_count, centre, node_view_projection(d, 1.0f));
+        all.rasterize(clip.data(), vertex_count, indices.data(), indices.size(), 256);
+        some.rasterize_validated(clip.data(), vertex_count, indices.data(), indices.size(), 256, nullptr, naive.data(),
+                                 naive.size());
+        naive_differences += fragments_of(all) != fragments_of(some);
+    }
+    EXPECT_GT(naive_differences, 0u);
+}
+
+TEST(FacingFilter, HandWorkedTriangles) {
+    // Seen from +z (eye at (0, 0, 3)), a triangle counter-clockwise in x, y faces the eye.
+    const std::vector<float> positions = {
+        -0.5f, -0.5f, 0.0f, 0.5f, -0.5f, 0.0f, 0.0f, 0.5f,  0.0f,  // 0: faces +z
+        -0.5f, -0.5f, 0.0f, 0.0f, 0.5f,  0.0f, 0.5f, -0.5f, 0.0f,  // 1: the same, wound the other way
+        -0.5f, -0.5f, 0.0f, 0.0f, 0.5f,  0.0f, 0.5f, -0.5f, 0.0f,  // 2: as 1, double-sided
+        0.0f,  -0.5f, 0.0f, 0.0f, 0.5f,  0.0f, 0.0f, 0.0f,  0.5f,  // 3: in the plane x = 0: edge-on from +z
+        1.0f,  0.0f,  0.0f, 1.0f, 0.0f,  0.0f, 1.0f, 0.0f,  0.0f,  // 4: a point on the framing sphere
+    };
+    std::vector<uint32_t> indices(15);
+    for (uint32_t i = 0; i < 15; ++i) indices[i] = i;
+    const uint8_t modes[5] = {0, 0, kDrawBothFaces, 0, 0};
+    const float centre[3] = {0, 0, 0}, from_z[3] = {0, 0, 1}, from_minus_z[3] = {0, 0, -1};
+    FacingFilter filter;
+    filter.build(positions.data(), 15, indices.data(), 15, centre, 1.0f, 256, modes);
+    ASSERT_TRUE(filter.usable());
+    FacingFilter::Candidates c = filter.candidates(from_z);
+    EXPECT_EQ(std::vector<uint32_t>(c.ids, c.ids + c.count), (std::vector<uint32_t>{0, 2, 3, 4}));
+    c = filter.candidates(from_minus_z);
+    EXPECT_EQ(std::vector<uint32_t>(c.ids, c.ids + c.count), (std::vector<uint32_t>{1, 2, 3, 4}));
+
+    // A corner outside the framing sphere voids the guarantee: every triangle is a candidate.
+    std::vector<float> outside = positions;
+    outside[0] = -2.0f;
+    filter.build(outside.data(), 15, indices.data(), 15, centre, 1.0f, 256, modes);
+    EXPECT_FALSE(filter.usable());
+    c = filter.candidates(from_z);
+    EXPECT_EQ(c.ids, nullptr);
+    EXPECT_EQ(c.count, 5u);
+    // So does a value that is not a number.
+    outside[0] = std::nanf("");
+    filter.build(outside.data(), 15, indices.data(), 15, centre, 1.0f, 256, modes);
+    EXPECT_FALSE(filter.usable());
+    // And a mesh all double-sided has nothing to leave out.
+    const uint8_t both[5] = {kDrawBothFaces, kDrawBothFaces, kDrawBothFaces, kDrawBothFaces, kDrawBothFaces};
+    filter.build(positions.data(), 15, indices.data(), 15, centre, 1.0f, 256, both);
+    EXPECT_FALSE(filter.usable());
+}

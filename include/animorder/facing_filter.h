@@ -50,9 +50,8 @@ public:
 private:
     bool usable_ = false, portable_ = false, built_ = false;
     uint64_t key_ = 0;
-    double radius_ = 0;
-    // Per triangle, in float: the normal n = (b − a) × (c − a) in the framed space, and the limit:
-    // the triangle is left out at eye e when n · e < limit (n · a less the threshold).
+    // Per triangle, in float: the normal n = (b − a) × (c − a) in the framed space in units of R,
+    // and the limit: the triangle is left out at eye e when n · e < limit (n · a less the threshold).
     std::vector<float> nx_, ny_, nz_, limit_;
     std::vector<float> corners_;  // build's scratch: the framed corners
     std::vector<uint32_t> out_;

@@ -107,7 +107,6 @@ void FacingFilter::build(const float* positions, size_t vertex_count, const uint
                          const float centre[3], float radius, unsigned resolution, const uint8_t* modes) {
     const size_t triangles = index_count / 3;
     usable_ = false;
-    radius_ = radius;
     nx_.resize(triangles);
     ny_.resize(triangles);
     nz_.resize(triangles);
@@ -133,14 +132,21 @@ void FacingFilter::build(const float* positions, size_t vertex_count, const uint
     if (rho > 1.001 * R) return;
     const double half = 0.5 * double(resolution);
     const double delta = 1.0 / 512.0 + 4e-6 * double(resolution);
-    const double eye = 3.0 * R;
+    // In units of R from here on (the test and its threshold scale alike): the eye at distance 3,
+    // and every value between about 1e-38 and 5, which floats hold; the threshold's 8δ² part
+    // outweighs any rounding of a value that small.
+    const double unit = 1.0 / R, eye = 3.0;
     bool can_leave_out = false;
     for (size_t t = 0; t < triangles; ++t) {
         const uint32_t ia = indices[3 * t], ib = indices[3 * t + 1], ic = indices[3 * t + 2];
-        const float *a = q + 3 * size_t(ia), *b = q + 3 * size_t(ib), *c = q + 3 * size_t(ic);
-        const double u[3] = {double(b[0]) - a[0], double(b[1]) - a[1], double(b[2]) - a[2]};
-        const double w[3] = {double(c[0]) - a[0], double(c[1]) - a[1], double(c[2]) - a[2]};
-        const double v[3] = {double(c[0]) - b[0], double(c[1]) - b[1], double(c[2]) - b[2]};
+        const float *qa = q + 3 * size_t(ia), *qb = q + 3 * size_t(ib), *qc = q + 3 * size_t(ic);
+        const double a[3] = {unit * qa[0], unit * qa[1], unit * qa[2]};
+        const double u[3] = {unit * (double(qb[0]) - qa[0]), unit * (double(qb[1]) - qa[1]),
+                             unit * (double(qb[2]) - qa[2])};
+        const double w[3] = {unit * (double(qc[0]) - qa[0]), unit * (double(qc[1]) - qa[1]),
+                             unit * (double(qc[2]) - qa[2])};
+        const double v[3] = {unit * (double(qc[0]) - qb[0]), unit * (double(qc[1]) - qb[1]),
+                             unit * (double(qc[2]) - qb[2])};
         const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
         const double offset = n[0] * a[0] + n[1] * a[1] + n[2] * a[2];
         const double perimeter = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]) +
@@ -148,7 +154,7 @@ void FacingFilter::build(const float* positions, size_t vertex_count, const uint
                                  std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
         // This triangle's bounds (every point of it lies within ρ_t of the origin): w in
         // [3R − ρ_t, 3R + ρ_t], |x_view| / w ≤ ρ_t / √(9R² − ρ_t²) (the cone around the ball).
-        const double rho_t = std::max({radius_of(ia), radius_of(ib), radius_of(ic)});
+        const double rho_t = unit * std::max({radius_of(ia), radius_of(ib), radius_of(ic)});
         const double w_min = eye - rho_t, w_max = eye + rho_t;
         const double slope = 1.0001 * rho_t / std::sqrt(eye * eye - rho_t * rho_t);
         const double P = perimeter * half * kCotHalfFov * (1.0 + slope) / w_min;
@@ -159,10 +165,9 @@ void FacingFilter::build(const float* positions, size_t vertex_count, const uint
         ny_[t] = float(n[1]);
         nz_[t] = float(n[2]);
         // Left out when n · e < offset − threshold: the limit rounded down (the float nearest may
-        // lie above). A double-sided triangle, or one whose limit is not finite, is never left out.
-        const float limit = float(offset - threshold);
-        const bool never = (modes && (modes[t] & kDrawBothFaces)) || !std::isfinite(limit);
-        limit_[t] = never ? -INFINITY : std::nextafter(limit, -INFINITY);
+        // lie above). A double-sided triangle is never left out.
+        const bool never = modes && (modes[t] & kDrawBothFaces);
+        limit_[t] = never ? -INFINITY : std::nextafter(float(offset - threshold), -INFINITY);
         can_leave_out |= !never;
     }
     usable_ = can_leave_out;  // a mesh all double-sided: nothing to gain, the rasteriser's plain path
@@ -172,11 +177,10 @@ FacingFilter::Candidates FacingFilter::candidates(const float view_direction[3])
     const size_t triangles = limit_.size();
     uint32_t* out = out_.data();
     if (!usable_) return {nullptr, triangles};
-    // The eye as node_view_projection places it.
+    // The eye as node_view_projection places it, in units of R.
     const double d[3] = {view_direction[0], view_direction[1], view_direction[2]};
     const double norm = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-    const float ex = float(3.0 * radius_ * (d[0] / norm)), ey = float(3.0 * radius_ * (d[1] / norm)),
-                ez = float(3.0 * radius_ * (d[2] / norm));
+    const float ex = float(3.0 * (d[0] / norm)), ey = float(3.0 * (d[1] / norm)), ez = float(3.0 * (d[2] / norm));
 #ifdef ANIMORDER_FACING_AVX2
     static const bool avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("popcnt");
     if (avx2 && !portable_)

@@ -141,6 +141,24 @@ TEST(FacingFilter, TheBundledCharacterDrawsTheSameFragmentsFromTheCandidates) {
     EXPECT_GT(double(check.left_out) / double(check.triangles), 0.3) << check.left_out << " of " << check.triangles;
 }
 
+TEST(FacingFilter, AnyScaleOfTheCharacterGivesTheSameFragments) {
+    // The filter works in units of the framing radius: far from 1 its floats neither overflow nor
+    // lose the small triangles to underflow.
+    const AnimatedMesh mesh = make_procedural_character();
+    const std::vector<float> directions = icosphere_directions(icosphere_subdivisions_for(42));
+    for (const float scale : {1e-15f, 1e15f}) {
+        std::vector<float> positions(mesh.keyframe(0), mesh.keyframe(0) + 3 * mesh.vertex_count);
+        for (float& p : positions) p *= scale;
+        const Framing framing =
+            frame_keyframes(positions.data(), 1, mesh.vertex_count, mesh.indices.data(), mesh.indices.size());
+        NodeCheck check;
+        compare_views(positions.data(), mesh.vertex_count, mesh.indices, framing.centres.data(), framing.radius, 256,
+                      nullptr, directions, check);
+        EXPECT_EQ(check.differing_nodes, 0u) << "scale " << scale;
+        EXPECT_GT(double(check.left_out) / double(check.triangles), 0.3) << "scale " << scale;
+    }
+}
+
 TEST(FacingFilter, TinySlantedTrianglesThatSnappingTurnsOverAreKept) {
     std::vector<uint32_t> indices;
     const std::vector<float> positions = random_triangles(6000, 7, indices);

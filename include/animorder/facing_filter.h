@@ -53,7 +53,8 @@ private:
     // Per triangle, in float: the normal n = (b − a) × (c − a) in the framed space in units of R,
     // and the limit: the triangle is left out at eye e when n · e < limit (n · a less the threshold).
     std::vector<float> nx_, ny_, nz_, limit_;
-    std::vector<float> corners_;  // build's scratch: the framed corners
+    std::vector<float> corners_;  // build's scratch: the framed corners and their distances from the centre
+    std::vector<double> radii_;
     std::vector<uint32_t> out_;
 };
 

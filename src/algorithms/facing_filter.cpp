@@ -114,18 +114,21 @@ void FacingFilter::build(const float* positions, size_t vertex_count, const uint
     out_.resize(triangles + 8);  // candidates_avx2 writes 8 slots a step
     const double R = radius;
     if (!(R > 0) || !std::isfinite(R) || resolution == 0) return;
-    // The corners as transform_to_clip has them (float differences), and ρ over the corners drawn.
+    // The corners as transform_to_clip has them (float differences), their distances from the
+    // centre, and ρ over the corners drawn.
     corners_.resize(3 * vertex_count);
     float* q = corners_.data();
     for (size_t v = 0; v < vertex_count; ++v)
         for (int k = 0; k < 3; ++k) q[3 * v + k] = positions[3 * v + k] - centre[k];
-    const auto radius_of = [q](uint32_t v) {
-        const float* p = q + 3 * size_t(v);
-        return std::sqrt(double(p[0]) * p[0] + double(p[1]) * p[1] + double(p[2]) * p[2]);
-    };
+    radii_.resize(vertex_count);
+    for (size_t v = 0; v < vertex_count; ++v) {
+        const float* p = q + 3 * v;
+        radii_[v] = std::sqrt(double(p[0]) * p[0] + double(p[1]) * p[1] + double(p[2]) * p[2]);
+    }
+    const double* radius_of = radii_.data();
     double rho = 0;
     for (size_t i = 0; i < 3 * triangles; ++i) {
-        const double r = radius_of(indices[i]);
+        const double r = radius_of[indices[i]];
         if (!std::isfinite(r)) return;
         rho = std::max(rho, r);
     }
@@ -154,7 +157,7 @@ void FacingFilter::build(const float* positions, size_t vertex_count, const uint
                                  std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
         // This triangle's bounds (every point of it lies within ρ_t of the origin): w in
         // [3R − ρ_t, 3R + ρ_t], |x_view| / w ≤ ρ_t / √(9R² − ρ_t²) (the cone around the ball).
-        const double rho_t = unit * std::max({radius_of(ia), radius_of(ib), radius_of(ic)});
+        const double rho_t = unit * std::max({radius_of[ia], radius_of[ib], radius_of[ic]});
         const double w_min = eye - rho_t, w_max = eye + rho_t;
         const double slope = 1.0001 * rho_t / std::sqrt(eye * eye - rho_t * rho_t);
         const double P = perimeter * half * kCotHalfFov * (1.0 + slope) / w_min;

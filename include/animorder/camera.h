@@ -14,6 +14,9 @@ using Mat4d = std::array<double, 16>;  // column-major, as OpenGL
 // direction is within ~2.6° of ±Y. Returns projection · view (OpenGL clip space, z in [−w, w]).
 Mat4d node_view_projection(const float view_direction[3], float radius);
 
+// cot of half that field of view: tan(asin(1/3)) = 1/(2√2), so 2√2 (the double nearest).
+constexpr double kCotHalfFov = 2.8284271247461903;
+
 // clip[4v..4v+3] = view_projection · (positions[v] − centre, 1), in float as a vertex shader would
 // (row by row, ((m·x + m·y) + m·z) + m, no fused multiply-add). Runs a copy compiled for AVX2
 // where the CPU has it: the same operations, so the same bits.

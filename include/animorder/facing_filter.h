@@ -21,18 +21,22 @@ public:
     void build(const float* positions, size_t vertex_count, const uint32_t* indices, size_t index_count,
                const float centre[3], float radius, unsigned resolution, const uint8_t* modes);
 
-    // build, unless the last build was this one's: `key` names the arguments (a keyframe's
-    // number, for a worker that draws the nodes of one keyframe after another).
+    // build, unless the last build was build_for's with the same arguments: `key` names what the
+    // addresses cannot (a keyframe's number, for a worker that draws the nodes of one keyframe
+    // after another); the other arguments are compared too, positions by address.
     void build_for(uint64_t key, const float* positions, size_t vertex_count, const uint32_t* indices,
                    size_t index_count, const float centre[3], float radius, unsigned resolution, const uint8_t* modes) {
-        if (built_ && key == key_) return;
+        const Arguments arguments{key,       positions, vertex_count, indices,    index_count, centre[0],
+                                  centre[1], centre[2], radius,       resolution, modes};
+        if (built_ && arguments == built_for_) return;
         build(positions, vertex_count, indices, index_count, centre, radius, resolution, modes);
         built_ = true;
-        key_ = key;
+        built_for_ = arguments;
     }
 
     // False when the keyframe gives no guarantee (a corner outside the framing sphere, a value
-    // that is not finite, nothing built) or no triangle could be left out (all double-sided).
+    // that is not finite, a radius beyond 2^±100, nothing built) or no triangle could be left out
+    // (all double-sided).
     bool usable() const { return usable_; }
 
     // The candidates, ascending, for the camera node_view_projection(view_direction, radius):
@@ -48,13 +52,29 @@ public:
     void set_portable(bool portable) { portable_ = portable; }
 
 private:
-    bool usable_ = false, portable_ = false, built_ = false;
-    uint64_t key_ = 0;
+    struct Arguments {
+        uint64_t key;
+        const float* positions;
+        size_t vertex_count;
+        const uint32_t* indices;
+        size_t index_count;
+        float x, y, z, radius;
+        unsigned resolution;
+        const uint8_t* modes;
+        bool operator==(const Arguments& o) const {
+            return key == o.key && positions == o.positions && vertex_count == o.vertex_count && indices == o.indices &&
+                   index_count == o.index_count && x == o.x && y == o.y && z == o.z && radius == o.radius &&
+                   resolution == o.resolution && modes == o.modes;
+        }
+    };
+    bool usable_ = false, portable_ = false;
+    bool built_ = false;  // by build_for, with built_for_ (build alone clears it)
+    Arguments built_for_{};
     // Per triangle, in float: the normal n = (b − a) × (c − a) in the framed space in units of R,
     // and the limit: the triangle is left out at eye e when n · e < limit (n · a less the threshold).
     std::vector<float> nx_, ny_, nz_, limit_;
-    std::vector<float> corners_;  // build's scratch: the framed corners and their distances from the centre
-    std::vector<double> radii_;
+    std::vector<float> corners_;  // build's scratch: the framed corners,
+    std::vector<double> radii_;   // and their distances from the centre
     std::vector<uint32_t> out_;
 };
 

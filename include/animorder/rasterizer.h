@@ -38,8 +38,8 @@ public:
     // indices here are undefined behaviour; everything else (the resolution) is still checked.
     // candidates: null, or `candidate_count` ascending triangle indices below index_count / 3
     // (FacingFilter's, unchecked like the indices) outside which no triangle draws at this node:
-    // the same fragments, fewer triangles looked at. They are ignored when a corner is clipped or
-    // far outside the viewport (the filter vouches for neither).
+    // the same fragments, fewer triangles looked at. They are ignored when any vertex, drawn or
+    // not, is clipped or far outside the viewport (the filter vouches for neither).
     void rasterize_validated(const float* clip_xyzw, size_t vertex_count, const uint32_t* indices, size_t index_count,
                              unsigned resolution, const uint8_t* modes = nullptr, const uint32_t* candidates = nullptr,
                              size_t candidate_count = 0);

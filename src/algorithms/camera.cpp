@@ -43,10 +43,10 @@ Mat4d node_view_projection(const float view_direction[3], float radius) {
                         s.z, u.z, -f.z, 0, -dot3(s, eye), -dot3(u, eye), dot3(f, eye), 1};
 
     // perspective: tan(fovy/2) = tan(asin(1/3)) = 1/(2√2); near R, far 5R (the sphere spans 2R..4R).
-    const double cot_half_fov = 2.0 * std::sqrt(2.0);
+
     const double n = radius, fr = 5.0 * radius;
     const Mat4d projection = {
-        cot_half_fov, 0, 0, 0, 0, cot_half_fov, 0, 0, 0, 0, (fr + n) / (n - fr), -1, 0, 0, 2.0 * fr * n / (n - fr), 0};
+        kCotHalfFov, 0, 0, 0, 0, kCotHalfFov, 0, 0, 0, 0, (fr + n) / (n - fr), -1, 0, 0, 2.0 * fr * n / (n - fr), 0};
     return multiply_mat4(projection, view);
 }
 

@@ -21,14 +21,19 @@
 // ε_i changes the doubled area by a term linear in the ε_i, each times the length of the edge
 // opposite corner i, plus the cross product of two corner differences: at most √2·δ·P + 8δ², P
 // the projected perimeter. The projection's gradient on the triangle bounds P: P ≤ p · (res/2) ·
-// cot · (1 + g) / (3R − ρ_t), p the perimeter in the framed space, ρ_t the triangle's largest
-// corner distance, g = ρ_t / √(9R² − ρ_t²) the largest |x_view| / w on the ball of radius ρ_t.
+// cot · √(1 + g²) / (3R − ρ_t), p the perimeter in the framed space, ρ_t the triangle's largest
+// corner distance, g = ρ_t / √(9R² − ρ_t²) the largest view-space radial distance over w on the
+// ball of radius ρ_t. (R itself lies a hair above the farthest corner, frame_keyframes; a
+// keyframe with a corner beyond 1.001 R gets no filtering.)
 // So if
 //     −s · (res/2)² · cot² / (3R + ρ_t)³ > √2·δ·P + 8δ²,
 // the rasteriser's area has the back-face sign (or is zero) and a single-sided triangle is
 // culled: such a triangle is left out. The threshold per triangle adds the float rounding of the
 // per-node dot product (below 1e-6 · (|n|·|e| + |n·a|)) and a 1% margin.
 #include "animorder/facing_filter.h"
+
+#include "animorder/camera.h"
+#include "animorder/rasterizer.h"
 
 #include <algorithm>
 #include <cmath>
@@ -39,9 +44,6 @@
 
 namespace animorder {
 namespace {
-
-constexpr double kCotHalfFov = 2.8284271247461903;  // 2√2, camera.cpp
-constexpr uint8_t kDrawBothFaces = 1;               // rasterizer.h: never left out
 
 // The test for one triangle, in this order of float operations in every copy (no fused
 // multiply-add: the build turns contraction off), so every copy gives the same candidates.
@@ -106,14 +108,16 @@ __attribute__((target("avx2,popcnt"))) size_t candidates_avx2(const float* nx, c
 void FacingFilter::build(const float* positions, size_t vertex_count, const uint32_t* indices, size_t index_count,
                          const float centre[3], float radius, unsigned resolution, const uint8_t* modes) {
     const size_t triangles = index_count / 3;
-    usable_ = false;
+    usable_ = built_ = false;
     nx_.resize(triangles);
     ny_.resize(triangles);
     nz_.resize(triangles);
     limit_.resize(triangles);
     out_.resize(triangles + 8);  // candidates_avx2 writes 8 slots a step
+    // R within 2^±100 (frame_keyframes refuses others): clip coordinates then stay far from float
+    // overflow (w ≤ 4.01 R) and underflow, which the error budget δ below assumes.
     const double R = radius;
-    if (!(R > 0) || !std::isfinite(R) || resolution == 0) return;
+    if (!(R >= 0x1p-100 && R <= 0x1p100) || resolution == 0) return;
     // The corners as transform_to_clip has them (float differences), their distances from the
     // centre, and ρ over the corners drawn.
     corners_.resize(3 * vertex_count);
@@ -132,7 +136,7 @@ void FacingFilter::build(const float* positions, size_t vertex_count, const uint
         if (!std::isfinite(r)) return;
         rho = std::max(rho, r);
     }
-    if (rho > 1.001 * R) return;
+    if (rho > 1.001 * R) return;  // the framing's radius is a hair above its farthest corner; not ours: no guarantee
     const double half = 0.5 * double(resolution);
     const double delta = 1.0 / 512.0 + 4e-6 * double(resolution);
     // In units of R from here on (the test and its threshold scale alike): the eye at distance 3,
@@ -156,11 +160,13 @@ void FacingFilter::build(const float* positions, size_t vertex_count, const uint
                                  std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) +
                                  std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
         // This triangle's bounds (every point of it lies within ρ_t of the origin): w in
-        // [3R − ρ_t, 3R + ρ_t], |x_view| / w ≤ ρ_t / √(9R² − ρ_t²) (the cone around the ball).
+        // [3R − ρ_t, 3R + ρ_t], and the view-space radial distance over w at most
+        // g = ρ_t / √(9R² − ρ_t²) (the cone around the ball), so the projection's gradient is at
+        // most (res/2)·cot·√(1 + g²) / w.
         const double rho_t = unit * std::max({radius_of[ia], radius_of[ib], radius_of[ic]});
         const double w_min = eye - rho_t, w_max = eye + rho_t;
         const double slope = 1.0001 * rho_t / std::sqrt(eye * eye - rho_t * rho_t);
-        const double P = perimeter * half * kCotHalfFov * (1.0 + slope) / w_min;
+        const double P = perimeter * half * kCotHalfFov * std::sqrt(1.0 + slope * slope) / w_min;
         const double area_scale = half * half * kCotHalfFov * kCotHalfFov / (w_max * w_max * w_max);
         const double rounding = 1e-6 * (std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) * eye + std::fabs(offset));
         const double threshold = 1.01 * (std::sqrt(2.0) * delta * P + 8.0 * delta * delta) / area_scale + rounding;

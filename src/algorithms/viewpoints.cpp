@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <random>
 #include <string>
@@ -136,6 +137,14 @@ Framing frame_keyframes(const float* keyframe_positions, size_t keyframe_count, 
         for (int c = 0; c < 3; ++c) framing.centres[3 * k + c] = float(centre[c]);
     }
     framing.radius = float(radius * (1.0 + 1e-6));
+    // Clip coordinates are floats of the order of R (w up to 4R): a model beyond 2^100 would
+    // overflow them, one below 2^-100 would lose them to underflow. Neither is a model in any unit.
+    if (radius > 0 && !(radius >= 0x1p-100 && radius <= 0x1p100)) {
+        char extent[32];
+        std::snprintf(extent, sizeof extent, "%g", radius);
+        throw InvalidInput(std::string("the model's extent (framing radius ") + extent +
+                           ") is outside 2^-100 to 2^100: float clip coordinates cannot hold it");
+    }
     return framing;
 }
 

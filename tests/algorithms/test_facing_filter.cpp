@@ -4,6 +4,7 @@
 // of them over; hand-worked cases for what is left out.
 #include "animorder/camera.h"
 #include "animorder/facing_filter.h"
+#include "animorder/invalid_input.h"
 #include "animorder/overdraw.h"
 #include "animorder/procedural_character.h"
 #include "animorder/rasterizer.h"
@@ -13,6 +14,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <random>
 #include <tuple>
 #include <vector>
@@ -157,6 +159,20 @@ TEST(FacingFilter, AnyScaleOfTheCharacterGivesTheSameFragments) {
         EXPECT_EQ(check.differing_nodes, 0u) << "scale " << scale;
         EXPECT_GT(double(check.left_out) / double(check.triangles), 0.3) << "scale " << scale;
     }
+    // Beyond 2^±100 float clip coordinates overflow or underflow: the framing refuses such a model,
+    // and the filter alone would not vouch for it.
+    for (const float scale : {1e31f, 1e-31f}) {
+        std::vector<float> positions(mesh.keyframe(0), mesh.keyframe(0) + 3 * mesh.vertex_count);
+        for (float& p : positions) p *= scale;
+        EXPECT_THROW(frame_keyframes(positions.data(), 1, mesh.vertex_count, mesh.indices.data(), mesh.indices.size()),
+                     InvalidInput)
+            << "scale " << scale;
+        const float centre[3] = {0, 0, 0};
+        FacingFilter filter;
+        filter.build(positions.data(), mesh.vertex_count, mesh.indices.data(), mesh.indices.size(), centre,
+                     scale * 2.0f, 256, nullptr);
+        EXPECT_FALSE(filter.usable()) << "scale " << scale;
+    }
 }
 
 TEST(FacingFilter, TinySlantedTrianglesThatSnappingTurnsOverAreKept) {
@@ -199,6 +215,118 @@ TEST(FacingFilter, TinySlantedTrianglesThatSnappingTurnsOverAreKept) {
         naive_differences += fragments_of(all) != fragments_of(some);
     }
     EXPECT_GT(naive_differences, 0u);
+}
+
+// Slivers that snapping turns to face the eye by nearly as much as it can: each has a pixel
+// centre on an edge (so it draws), a snapped doubled area of a few subpixel² on the front side,
+// and corners moved up to 0.49 subpixel against the area's gradient before snapping, so that in
+// exact arithmetic it faces away. Built in window space and taken back through the camera, near
+// the middle of the screen and elsewhere, at the sphere's front, middle and back.
+std::vector<float> turned_slivers(const float* direction, unsigned resolution, std::mt19937& rng,
+                                  std::vector<uint32_t>& indices) {
+    std::uniform_real_distribution<double> u01(0.0, 1.0);
+    // The six ends of the axes at distance 1: the framing's centre is the origin, its radius a hair
+    // above 1 (the camera the slivers are built for).
+    std::vector<float> positions = {1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1};
+    indices = {0, 1, 0, 2, 3, 2, 4, 5, 4};
+    const Framing axes = frame_keyframes(positions.data(), 1, 6, indices.data(), indices.size());
+    const Mat4d vp = node_view_projection(direction, axes.radius);
+    const double half = 0.5 * resolution;
+    // A window position (pixels, y up) at clip w: the point of the framed space (rows x, y, w of vp).
+    const auto back = [&](double xw, double yw, double w_in_radii, float* out) {
+        const double w = w_in_radii * axes.radius;
+        double A[3][4] = {{vp[0], vp[4], vp[8], (xw - half) / half * w - vp[12]},
+                          {vp[1], vp[5], vp[9], (yw - half) / half * w - vp[13]},
+                          {vp[3], vp[7], vp[11], w - vp[15]}};
+        for (int i = 0; i < 3; ++i) {
+            int pivot = i;
+            for (int r = i + 1; r < 3; ++r)
+                if (std::fabs(A[r][i]) > std::fabs(A[pivot][i])) pivot = r;
+            for (int c = 0; c < 4; ++c) std::swap(A[i][c], A[pivot][c]);
+            for (int r = 0; r < 3; ++r)
+                if (r != i)
+                    for (int c = 3; c >= i; --c) A[r][c] -= A[r][i] / A[i][i] * A[i][c];
+        }
+        for (int i = 0; i < 3; ++i) out[i] = float(A[i][3] / A[i][i]);
+    };
+    for (int t = 0; t < 400; ++t) {
+        const double w = t % 3 == 0 ? 3.0 : t % 3 == 1 ? 3.9 : 2.1, spread = t % 2 ? 0.02 : 0.5;
+        const int64_t ax = 256 * int64_t(half + (u01(rng) - 0.5) * spread * half);
+        const int64_t ay = 256 * int64_t(half + (u01(rng) - 0.5) * spread * half);
+        const int p = 2 + int(u01(rng) * (resolution >= 256 ? 8 : 3)), q = p - 1;  // near 45 degrees
+        const int64_t k = 257 + int64_t(u01(rng) * 40);  // the centre a + 256 (p, q) lies on edge a b
+        const int64_t sx = u01(rng) < 0.5 ? 1 : -1, sy = u01(rng) < 0.5 ? 1 : -1;
+        const int64_t bx = ax + sx * k * p, by = ay + sy * k * q;
+        int64_t corner[3][2] = {{ax, ay}, {bx, by}, {0, 0}}, best = INT64_MAX;
+        for (int64_t i = -8; i <= 8; ++i)
+            for (int64_t j = -8; j <= 8; ++j) {  // c: the smallest positive (front) snapped area
+                const int64_t cx = (ax + bx) / 2 + i, cy = (ay + by) / 2 + j;
+                const int64_t area = (bx - ax) * (cy - ay) - (cx - ax) * (by - ay);
+                if (area > 0 && area < best) best = area, corner[2][0] = cx, corner[2][1] = cy;
+            }
+        const uint32_t first = uint32_t(positions.size() / 3);
+        bool outside = false;
+        for (int i = 0; i < 3; ++i) {
+            const int64_t* b = corner[(i + 1) % 3];
+            const int64_t* c = corner[(i + 2) % 3];
+            const double gradient[2] = {double(b[1] - c[1]), double(c[0] - b[0])};  // of the area at corner i
+            const double move = 0.49 - 0.1 * u01(rng);
+            const auto against = [&](double g) { return g > 0 ? -move : g < 0 ? move : 0.0; };
+            float point[3];
+            back((double(corner[i][0]) + against(gradient[0])) / 256.0 + 0.5,
+                 (double(corner[i][1]) + against(gradient[1])) / 256.0 + 0.5, w + 0.01 * (u01(rng) - 0.5), point);
+            positions.insert(positions.end(), point, point + 3);
+            outside |= double(point[0]) * point[0] + double(point[1]) * point[1] + double(point[2]) * point[2] > 0.99;
+        }
+        if (outside) {
+            positions.resize(3 * first);
+            continue;
+        }
+        indices.insert(indices.end(), {first, first + 1, first + 2});
+    }
+    return positions;
+}
+
+TEST(FacingFilter, SliversThatSnappingTurnsToTheEyeAreKept) {
+    const std::vector<float> directions = icosphere_directions(0);
+    std::mt19937 rng(12345);
+    size_t turned = 0;
+    for (const unsigned resolution : {61u, 256u}) {
+        for (size_t v = 0; v < directions.size() / 3; ++v) {
+            const float* d = &directions[3 * v];
+            std::vector<uint32_t> indices;
+            const std::vector<float> positions = turned_slivers(d, resolution, rng, indices);
+            const size_t vertex_count = positions.size() / 3;
+            const Framing framing = frame_keyframes(positions.data(), 1, vertex_count, indices.data(), indices.size());
+            NodeCheck check;
+            compare_views(positions.data(), vertex_count, indices, framing.centres.data(), framing.radius, resolution,
+                          nullptr, std::vector<float>(d, d + 3), check);
+            EXPECT_EQ(check.differing_nodes, 0u) << "view " << v << " at " << resolution << "²";
+
+            // How many of them draw although they face away in exact arithmetic: the scene must
+            // hold such triangles for the comparison to tell a margin too small.
+            std::vector<float> clip(4 * vertex_count);
+            transform_to_clip(clip.data(), positions.data(), vertex_count, framing.centres.data(),
+                              node_view_projection(d, framing.radius));
+            NodeRasterizer all;
+            all.rasterize(clip.data(), vertex_count, indices.data(), indices.size(), resolution);
+            std::vector<uint8_t> drew(indices.size() / 3, 0);
+            all.visit_fragments([&](uint32_t, uint32_t t, float) { drew[t] = 1; });
+            for (size_t t = 3; t < indices.size() / 3; ++t) {
+                double q[3][3];
+                for (int c = 0; c < 3; ++c)
+                    for (int k = 0; k < 3; ++k)
+                        q[c][k] = double(positions[3 * indices[3 * t + c] + k]) - framing.centres[k];
+                const double u[3] = {q[1][0] - q[0][0], q[1][1] - q[0][1], q[1][2] - q[0][2]};
+                const double w[3] = {q[2][0] - q[0][0], q[2][1] - q[0][1], q[2][2] - q[0][2]};
+                const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+                double facing = 0;
+                for (int k = 0; k < 3; ++k) facing += n[k] * (3.0 * framing.radius * d[k] - q[0][k]);
+                turned += drew[t] && facing < 0;
+            }
+        }
+    }
+    EXPECT_GT(turned, 100u);
 }
 
 TEST(FacingFilter, HandWorkedTriangles) {

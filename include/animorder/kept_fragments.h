@@ -94,9 +94,13 @@ std::vector<uint16_t> make_unit_rank_table(const uint32_t* triangle_ranks, size_
 // A unit's row in make_unit_rank_table: 2 to 8 orders padded to 8 (one vector for score_kept).
 constexpr size_t unit_rank_stride(size_t order_count) { return order_count < 2 || order_count > 8 ? order_count : 8; }
 
-// passed[o] for each order: what score_fragments gives on the node's NodeFragments.
+// passed[o] for each order: what score_fragments gives on the node's NodeFragments. 2 to 8 orders
+// run an AVX2 copy where the CPU has it (two lists a vector step; the same counts).
 void score_kept(uint64_t* passed, const KeptNode& node, const uint16_t* unit_ranks, const uint32_t* triangle_ranks,
                 size_t order_count);
+// The same in the portable copy only (tests compare the two).
+void score_kept_portable(uint64_t* passed, const KeptNode& node, const uint16_t* unit_ranks,
+                         const uint32_t* triangle_ranks, size_t order_count);
 
 // Every list of the node as units nearest first (unit | 0x80000000 when at the previous entry's
 // depth), with its weight: unit lists as kept, triangle lists mapped through unit_of_triangle

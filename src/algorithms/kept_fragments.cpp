@@ -32,6 +32,9 @@
 #ifdef __SSE2__
 #include <emmintrin.h>
 #endif
+#if (defined(__GNUC__) || defined(__clang__)) && (defined(__x86_64__) || defined(__i386__))
+#include <immintrin.h>
+#endif
 
 namespace animorder {
 namespace {
@@ -346,7 +349,121 @@ void score_unit_lists_k(uint64_t* passed, const KeptNode& node, const uint16_t* 
     for (size_t o = 0; o < K; ++o) passed[o] += o < 4 ? low[o] : high[o - 4];
 }
 
-void score_unit_lists_any(uint64_t* passed, const KeptNode& node, const uint16_t* unit_ranks, size_t order_count) {
+#if (defined(__GNUC__) || defined(__clang__)) && (defined(__x86_64__) || defined(__i386__))
+#define ANIMORDER_KEPT_AVX2 1
+// score_unit_lists_k in AVX2: two lists of a run side by side (the first in the low 128-bit half,
+// the second in the high one), so each vector step serves both; a list with ties, or the last of
+// an odd run, goes alone (the high half zero, weighed 0). The same comparisons, minimums and
+// 16 × 16 → 32-bit products lane by lane, so the same counts; the halves' sums are added at the
+// end. (Plain functions, not lambdas: a lambda does not inherit the target attribute.)
+#define ANIMORDER_KEPT_AVX2_INLINE __attribute__((target("avx2"), always_inline)) inline
+
+struct Avx2Sums {
+    __m256i low, high;  // per order: lanes 0-3 (orders 0-3) of each half, and 4-7 (orders 4-7)
+};
+
+ANIMORDER_KEPT_AVX2_INLINE __m128i avx2_row(const uint16_t* unit_ranks, uint32_t u) {
+    return _mm_loadu_si128(reinterpret_cast<const __m128i*>(unit_ranks + size_t(u & ~uint32_t(kUnitTieBit)) * 8));
+}
+
+template <size_t K>
+ANIMORDER_KEPT_AVX2_INLINE void avx2_add(Avx2Sums& sums, __m256i passes, uint32_t first_weight,
+                                         uint32_t second_weight) {
+    const __m256i w = _mm256_set_m128i(_mm_set1_epi16(int16_t(uint16_t(second_weight))),
+                                       _mm_set1_epi16(int16_t(uint16_t(first_weight))));
+    const __m256i product_low = _mm256_mullo_epi16(passes, w), product_high = _mm256_mulhi_epu16(passes, w);
+    sums.low = _mm256_add_epi32(sums.low, _mm256_unpacklo_epi16(product_low, product_high));
+    if constexpr (K > 4) sums.high = _mm256_add_epi32(sums.high, _mm256_unpackhi_epi16(product_low, product_high));
+}
+
+// One list, ties or not: replay_list's rule entry by entry (score_unit_lists_k's `general`), in
+// the low half.
+ANIMORDER_KEPT_AVX2_INLINE __m256i avx2_alone(const uint16_t* unit_ranks, const uint16_t* f, uint32_t n) {
+    __m128i running = _mm_set1_epi16(INT16_MAX), passes = _mm_setzero_si128(), before = running;
+    for (uint32_t j = 0; j < n; ++j) {
+        const __m128i r = avx2_row(unit_ranks, f[j]);
+        if (j == 0 || !(f[j] & kUnitTieBit)) before = running;
+        const __m128i below = _mm_cmpgt_epi16(running, r);
+        passes = _mm_sub_epi16(passes, _mm_and_si128(below, _mm_cmpeq_epi16(running, before)));
+        running = _mm_min_epi16(running, r);
+    }
+    return _mm256_inserti128_si256(_mm256_setzero_si256(), passes, 0);
+}
+
+// A run of lists of one length (N > 0: known at compile time; 0: n).
+template <size_t K, uint32_t N>
+ANIMORDER_KEPT_AVX2_INLINE void avx2_run(Avx2Sums& sums, const uint16_t* unit_ranks, const uint16_t* weights,
+                                         const uint16_t*& e, uint32_t first, uint32_t end, uint32_t n) {
+    const uint32_t count = N ? N : n;
+    uint32_t list = first;
+    for (; list + 1 < end; list += 2, e += 2 * count) {
+        const uint16_t* second = e + count;
+        uint32_t ties = 0;
+        for (uint32_t j = 1; j < count; ++j) ties |= e[j] | second[j];
+        if (__builtin_expect(ties & kUnitTieBit, 0)) {
+            avx2_add<K>(sums, avx2_alone(unit_ranks, e, count), weights[list], 0);
+            avx2_add<K>(sums, avx2_alone(unit_ranks, second, count), weights[list + 1], 0);
+            continue;
+        }
+        __m256i running = _mm256_set1_epi16(INT16_MAX), passes = _mm256_setzero_si256();
+        for (uint32_t j = 0; j < count; ++j) {
+            const __m256i r = _mm256_inserti128_si256(_mm256_castsi128_si256(avx2_row(unit_ranks, e[j])),
+                                                      avx2_row(unit_ranks, second[j]), 1);
+            passes = _mm256_sub_epi16(passes, _mm256_cmpgt_epi16(running, r));
+            running = _mm256_min_epi16(running, r);
+        }
+        avx2_add<K>(sums, passes, weights[list], weights[list + 1]);
+    }
+    if (list < end) {
+        avx2_add<K>(sums, avx2_alone(unit_ranks, e, count), weights[list], 0);
+        e += count;
+    }
+}
+
+template <size_t K>
+__attribute__((target("avx2"))) void score_unit_lists_k_avx2(uint64_t* passed, const KeptNode& node,
+                                                             const uint16_t* unit_ranks) {
+    static_assert(K >= 2 && K <= 8 && unit_rank_stride(K) == 8, "one lane per order");
+    const Layout l = layout_of(node);
+    const uint16_t* weights = at<uint16_t>(node, l.weights);
+    const uint16_t* e = at<uint16_t>(node, l.entries);
+    const uint8_t* lengths = at<uint8_t>(node, l.lengths);
+    Avx2Sums sums{_mm256_setzero_si256(), _mm256_setzero_si256()};
+    for (uint32_t list = 0; list < node.unit_lists;) {  // runs of one length, as for_each_length_run
+        const uint32_t n = lengths[list];
+        uint32_t end = list + 1;
+        while (end < node.unit_lists && lengths[end] == n) ++end;
+        switch (n) {
+            case 2: avx2_run<K, 2>(sums, unit_ranks, weights, e, list, end, n); break;
+            case 3: avx2_run<K, 3>(sums, unit_ranks, weights, e, list, end, n); break;
+            case 4: avx2_run<K, 4>(sums, unit_ranks, weights, e, list, end, n); break;
+            case 5: avx2_run<K, 5>(sums, unit_ranks, weights, e, list, end, n); break;
+            default: avx2_run<K, 0>(sums, unit_ranks, weights, e, list, end, n); break;
+        }
+        list = end;
+    }
+    alignas(32) uint32_t low[8], high[8];
+    _mm256_store_si256(reinterpret_cast<__m256i*>(low), sums.low);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(high), sums.high);
+    for (size_t o = 0; o < K; ++o) passed[o] += o < 4 ? uint64_t(low[o]) + low[4 + o] : uint64_t(high[o - 4]) + high[o];
+}
+#endif
+
+void score_unit_lists_any(uint64_t* passed, const KeptNode& node, const uint16_t* unit_ranks, size_t order_count,
+                          bool portable) {
+#ifdef ANIMORDER_KEPT_AVX2
+    static const bool avx2 = __builtin_cpu_supports("avx2");
+    if (avx2 && !portable) switch (order_count) {
+            case 2: return score_unit_lists_k_avx2<2>(passed, node, unit_ranks);
+            case 3: return score_unit_lists_k_avx2<3>(passed, node, unit_ranks);
+            case 4: return score_unit_lists_k_avx2<4>(passed, node, unit_ranks);
+            case 5: return score_unit_lists_k_avx2<5>(passed, node, unit_ranks);
+            case 6: return score_unit_lists_k_avx2<6>(passed, node, unit_ranks);
+            case 7: return score_unit_lists_k_avx2<7>(passed, node, unit_ranks);
+            case 8: return score_unit_lists_k_avx2<8>(passed, node, unit_ranks);
+            default: break;
+        }
+#endif
     switch (order_count) {
         case 1: return score_unit_lists_1(passed, node, unit_ranks);
         case 2: return score_unit_lists_k<2>(passed, node, unit_ranks);
@@ -507,10 +624,12 @@ std::vector<uint16_t> make_unit_rank_table(const uint32_t* triangle_ranks, size_
     return table;
 }
 
-void score_kept(uint64_t* passed, const KeptNode& node, const uint16_t* unit_ranks, const uint32_t* triangle_ranks,
-                size_t order_count) {
+namespace {
+
+void score_kept_copy(uint64_t* passed, const KeptNode& node, const uint16_t* unit_ranks, const uint32_t* triangle_ranks,
+                     size_t order_count, bool portable) {
     for (size_t o = 0; o < order_count; ++o) passed[o] = node.single;
-    if (node.unit_lists) score_unit_lists_any(passed, node, unit_ranks, order_count);
+    if (node.unit_lists) score_unit_lists_any(passed, node, unit_ranks, order_count, portable);
     if (node.triangle_lists == 0) return;
     const uint32_t* t = at<uint32_t>(node, layout_of(node).triangles);
     std::vector<uint32_t> scratch(2 * order_count);
@@ -520,6 +639,18 @@ void score_kept(uint64_t* passed, const KeptNode& node, const uint16_t* unit_ran
                     [&](size_t o) { ++passed[o]; });
         t += n;
     }
+}
+
+}  // namespace
+
+void score_kept(uint64_t* passed, const KeptNode& node, const uint16_t* unit_ranks, const uint32_t* triangle_ranks,
+                size_t order_count) {
+    score_kept_copy(passed, node, unit_ranks, triangle_ranks, order_count, false);
+}
+
+void score_kept_portable(uint64_t* passed, const KeptNode& node, const uint16_t* unit_ranks,
+                         const uint32_t* triangle_ranks, size_t order_count) {
+    score_kept_copy(passed, node, unit_ranks, triangle_ranks, order_count, true);
 }
 
 void for_each_unit_list(const KeptNode& node, const uint32_t* unit_of_triangle, size_t triangle_count,

@@ -69,7 +69,8 @@ std::vector<uint32_t> face_order(const UnitPartition& p, const std::vector<uint3
     return faces;
 }
 
-// Both forms scored with the same orders must agree; returns the kept form's counts.
+// Both forms scored with the same orders must agree, the kept form in the copy the CPU runs (AVX2
+// for 2 to 8 orders where it has it) and in the portable one; returns the kept form's counts.
 std::vector<uint64_t> expect_same_counts(const NodeFragments& full, const KeptNode& kept, const UnitPartition& p,
                                          const std::vector<std::vector<uint32_t>>& unit_orders) {
     std::vector<std::vector<uint32_t>> faces;
@@ -82,6 +83,9 @@ std::vector<uint64_t> expect_same_counts(const NodeFragments& full, const KeptNo
     score_fragments(expected.data(), full, ranks.data(), faces.size());
     score_kept(got.data(), kept, unit_ranks.data(), ranks.data(), faces.size());
     EXPECT_EQ(got, expected);
+    std::vector<uint64_t> portable(faces.size());
+    score_kept_portable(portable.data(), kept, unit_ranks.data(), ranks.data(), faces.size());
+    EXPECT_EQ(portable, expected);
     EXPECT_EQ(kept.visible, full.visible);
     return got;
 }

@@ -14,6 +14,8 @@
 #include "gl_overdraw.h"
 #endif
 
+#include "machine.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -117,6 +119,7 @@ void compare_with_gl(const AnimatedMesh& mesh, size_t keyframe_step) {
 }  // namespace
 
 int main() {
+    std::printf("machine: %s\n", animorder::bench::machine_description().c_str());
     std::printf("k = 5 orders per node, 256x256, 42 icosphere views per keyframe\n");
     compare_with_gl(make_procedural_character(), 8);
     std::printf("\nScaling (engine, 2 threads, 5 orders, 42 views of a static mesh):\n");

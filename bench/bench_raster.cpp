@@ -24,6 +24,8 @@
 #include "animorder/triangle_order.h"
 #include "animorder/viewpoints.h"
 
+#include "machine.h"
+
 #include <time.h>
 
 #include <cstdio>
@@ -88,6 +90,7 @@ int main(int argc, char** argv) try {
             return 1;
         }
     }
+    std::printf("machine: %s\n", bench::machine_description().c_str());
     AnimatedMesh mesh = load_character(argv[1]);
     if (!clips.empty()) mesh = select_clips(mesh, clips);
     const Framing framing = frame_animated_mesh(mesh);

@@ -16,6 +16,8 @@
 #include "animorder/load.h"
 #include "animorder/methods.h"
 
+#include "machine.h"
+
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -131,6 +133,7 @@ int main(int argc, char** argv) {
             return 1;
         }
     }
+    std::printf("machine: %s\n", animorder::bench::machine_description().c_str());
     std::printf("bench_scale: %s; data %s\n",
                 quick
                     ? "QUICK smoke settings (12 views, 64^2, k 2, 1 iteration, at most 2 clips): not the goals' figures"

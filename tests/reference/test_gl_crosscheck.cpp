@@ -44,6 +44,17 @@ std::unique_ptr<GlOverdrawReference> open_reference(unsigned resolution, std::st
 // less than twice that; a GPU driver may round differently, so the exact count is checked only
 // on llvmpipe.
 constexpr double kTolerance = 0.0002;
+
+// A hardware driver rounds depths differently from llvmpipe, and near-coincident surfaces (the
+// double-sided cards and cape) then resolve a few ties the other way. Measured on an NVIDIA H100
+// 80GB HBM3 (driver 580.159.04, EGL device platform, 2026-11-27): the procedural meshes 225 of 240
+// counts exactly equal, worst 0.0137%; double-sided 96 of 160, worst 0.0296%. The tolerance for
+// any renderer but llvmpipe allows about twice the worst.
+constexpr double kDriverTolerance = 0.0006;
+
+double tolerance_for(const GlOverdrawReference& gl) {
+    return gl.renderer().find("llvmpipe") != std::string::npos ? kTolerance : kDriverTolerance;
+}
 constexpr size_t kProceduralExactOnLlvmpipe = 234;  // of 240 (walk, wave, torus knot); Ganfaul adds 79 of 80
 
 // Without culling (torus knot and the character's walk, 20 views x 4 counts each): measured on
@@ -75,6 +86,7 @@ struct Totals {
 
 void compare_mesh(GlOverdrawReference& gl, const AnimatedMesh& mesh, size_t keyframe, unsigned resolution,
                   Totals& totals, bool double_sided = false) {
+    const double tolerance = tolerance_for(gl);
     SCOPED_TRACE(mesh.name + " keyframe " + std::to_string(keyframe));
     const Framing framing = frame_animated_mesh(mesh);
     const size_t n = mesh.triangle_count();
@@ -132,7 +144,7 @@ void compare_mesh(GlOverdrawReference& gl, const AnimatedMesh& mesh, size_t keyf
             totals.worst = std::max(totals.worst, relative);
             totals.exact += a == b;
             ++totals.comparisons;
-            EXPECT_LE(relative, kTolerance) << what << " view " << v << ": ours " << a << ", OpenGL " << b;
+            EXPECT_LE(relative, tolerance) << what << " view " << v << ": ours " << a << ", OpenGL " << b;
         };
         check(ours.visible_pixels(), reference.visible, "visible");
         for (size_t o = 0; o < 3; ++o)
@@ -182,7 +194,7 @@ TEST(GlCrosscheck, ThreeMeshesTwentyViewsThreeOrdersMatchOpenGL) {
     std::printf("cross-check: %zu counts compared, %zu exactly equal, worst relative difference %.6f%%\n",
                 totals.comparisons, totals.exact, 100 * totals.worst);
     EXPECT_EQ(totals.comparisons, have_ganfaul ? 320u : 240u);  // 20 views x 4 counts per mesh
-    EXPECT_LE(totals.worst, kTolerance);
+    EXPECT_LE(totals.worst, tolerance_for(*gl));
     if (gl->renderer().find("llvmpipe") != std::string::npos) {
         EXPECT_EQ(procedural_exact, kProceduralExactOnLlvmpipe) << "of the 240 counts of the three procedural meshes";
         if (have_ganfaul) {
@@ -210,8 +222,8 @@ TEST(GlCrosscheck, DoubleSidedMeshesMatchOpenGLWithoutCulling) {
     std::printf("double-sided cross-check: %zu counts compared, %zu exactly equal, worst relative difference %.6f%%\n",
                 both.comparisons, both.exact, 100 * both.worst);
     EXPECT_EQ(both.comparisons, 160u);
-    EXPECT_LE(both.worst, kTolerance);
-    EXPECT_LE(culled.worst, kTolerance);
+    EXPECT_LE(both.worst, tolerance_for(*gl));
+    EXPECT_LE(culled.worst, tolerance_for(*gl));
     if (gl->renderer().find("llvmpipe") != std::string::npos) {
         EXPECT_EQ(both.exact, kDoubleSidedExactOnLlvmpipe) << "of the 160 double-sided counts";
     }

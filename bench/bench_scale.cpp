@@ -5,11 +5,18 @@
 //
 //   build/bench/bench_scale                    every case (heavy: minutes, gigabytes)
 //   build/bench/bench_scale clip60-single      one case (names below); --quick: tiny settings, a smoke run
+//   build/bench/bench_scale --baseline EXE [--rounds N] xbot-single clip60-single
+//       each case as an `optimize` command line, run by this build's animorder and by EXE, another
+//       build's (scripts/build-baseline.sh builds the one the issue's figures came from), one after
+//       the other, N rounds (the first order reversed each round, the fastest run of each kept):
+//       wall times, peak memory, the speed-up and whether the two wrote the same buffers
 //
 // Cases and their goals:
 //   ganfaul-joint   Ganfaul, joint over all 12 clips          <= 120 s, <= 3 GB
 //   xbot-single     Xbot, single over every clip              <= 12 s,  <= 0.7 GB
 //   clip60-single   Ganfaul Idle (13.8k triangles, 60 keyframes), single   <= 2.5 s
+//   xbot-single-sided  xbot-single on a copy whose materials are single-sided: the work the issue
+//                   measured (issue 18 since draws Xbot's double-sided material's both faces)
 //   engine-ratio    bench_overdraw's engine vs llvmpipe, 5 orders per node  >= 40x
 // Data from ../shared/data beside the repository (or $ANIMORDER_DATA); a case without its file
 // says so and is skipped.
@@ -17,6 +24,8 @@
 #include "animorder/methods.h"
 
 #include "machine.h"
+
+#include <nlohmann/json.hpp>
 
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -28,6 +37,9 @@
 #include <cstring>
 #include <exception>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -43,12 +55,19 @@ struct Case {
     std::vector<std::string> clips;  // empty: all
     Method method;
     const char* goal;
+    // The issue's wall times, as it states them: the run it filed ("today") and the goal. Their
+    // ratio is the speed-up the goal asks of the engine the issue measured.
+    double issue_today_s, issue_goal_s;
+    // Run on a copy of the file whose materials are all single-sided: the work the issue measured,
+    // before materials were modelled (issue 18) and a double-sided one drew both faces.
+    bool single_sided = false;
 };
 
 const std::vector<Case> kCases = {
-    {"ganfaul-joint", "mixamo-ganfaul/Ganfaul.gltf", {}, Method::Joint, "<= 120 s, <= 3 GB"},
-    {"xbot-single", "glb-xbot/Xbot.glb", {}, Method::Single, "<= 12 s, <= 0.7 GB"},
-    {"clip60-single", "mixamo-ganfaul/Ganfaul.gltf", {"Idle"}, Method::Single, "<= 2.5 s"},
+    {"ganfaul-joint", "mixamo-ganfaul/Ganfaul.gltf", {}, Method::Joint, "<= 120 s, <= 3 GB", 557.0, 120.0},
+    {"xbot-single", "glb-xbot/Xbot.glb", {}, Method::Single, "<= 12 s, <= 0.7 GB", 33.0, 12.0},
+    {"clip60-single", "mixamo-ganfaul/Ganfaul.gltf", {"Idle"}, Method::Single, "<= 2.5 s", 5.0, 2.5},
+    {"xbot-single-sided", "glb-xbot/Xbot.glb", {}, Method::Single, "<= 12 s, as the issue measured", 33.0, 12.0, true},
 };
 
 fs::path data_folder() {
@@ -56,13 +75,66 @@ fs::path data_folder() {
     return fs::path(ANIMORDER_SOURCE_DIR).parent_path() / "shared" / "data";
 }
 
+// A copy of a GLB with every material's doubleSided false (its JSON chunk rewritten, the binary
+// chunk as it was).
+void write_single_sided_copy(const fs::path& from, const fs::path& to) {
+    std::ifstream in(from, std::ios::binary);
+    const std::string glb((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const auto word = [&glb](size_t at) {
+        uint32_t v = 0;
+        std::memcpy(&v, glb.data() + at, 4);
+        return v;
+    };
+    if (glb.size() < 20 || glb.compare(0, 4, "glTF") != 0 || word(12 + 4) != 0x4E4F534Au || word(12) > glb.size() - 20)
+        throw std::runtime_error(from.string() + ": not a GLB with a JSON chunk first");
+    const size_t json_length = word(12);
+    nlohmann::json gltf = nlohmann::json::parse(glb.substr(20, json_length));
+    for (auto& material : gltf["materials"]) material["doubleSided"] = false;
+    std::string text = gltf.dump();
+    text.append((4 - text.size() % 4) % 4, ' ');
+    const std::string rest = glb.substr(20 + json_length);
+    const uint32_t header[5] = {0x46546C67u, 2u, uint32_t(20 + text.size() + rest.size()), uint32_t(text.size()),
+                                0x4E4F534Au};
+    std::ofstream out(to, std::ios::binary);
+    out.write(reinterpret_cast<const char*>(header), sizeof header);
+    out << text << rest;
+    if (!out.flush()) throw std::runtime_error("cannot write " + to.string());
+}
+
+// The case's input: the data file, or its single-sided copy written into `scratch`.
+fs::path case_input(const Case& c, const fs::path& scratch) {
+    const fs::path file = data_folder() / c.file;
+    if (!c.single_sided) return file;
+    const fs::path copy = scratch / ("single-sided-" + file.filename().string());
+    write_single_sided_copy(file, copy);
+    return copy;
+}
+
+// A scratch folder of the run's own under the system's temporary folder, removed with its owner
+// (an exception too unwinds through it).
+struct Scratch {
+    fs::path path;
+    Scratch() {
+        std::string name = (fs::temp_directory_path() / "bench_scale-XXXXXX").string();
+        if (!::mkdtemp(name.data())) throw std::runtime_error("cannot make a scratch folder under /tmp");
+        path = name;
+    }
+    Scratch(const Scratch&) = delete;
+    Scratch& operator=(const Scratch&) = delete;
+    ~Scratch() {
+        std::error_code ignored;
+        fs::remove_all(path, ignored);
+    }
+};
+
 // In the child: load, run, print one line; exit code 0 when it ran.
 int run_case(const Case& c, bool quick) {
-    const fs::path file = data_folder() / c.file;
-    if (!fs::exists(file)) {
-        std::printf("%-14s skipped: %s is absent\n", c.name, file.string().c_str());
+    if (!fs::exists(data_folder() / c.file)) {
+        std::printf("%-17s skipped: %s is absent\n", c.name, (data_folder() / c.file).string().c_str());
         return 0;
     }
+    const Scratch scratch;
+    const fs::path file = case_input(c, scratch.path);
     const Clock::time_point start = Clock::now();
     LoadOptions options;  // as `animorder optimize --clip`: only the case's clips are sampled
     options.clips = c.clips;
@@ -83,7 +155,7 @@ int run_case(const Case& c, bool quick) {
     const double total_s = std::chrono::duration<double>(Clock::now() - start).count();
     size_t nodes = 0;
     for (const ClusteringResult& run : r.runs) nodes += run.assignment.size();
-    std::printf("%-14s %6zu triangles %3zu clips %5zu keyframes %7zu nodes  load %.1f s  method %.1f s  total %.1f s",
+    std::printf("%-17s %6zu triangles %3zu clips %5zu keyframes %7zu nodes  load %.1f s  method %.1f s  total %.1f s",
                 c.name, mesh.triangle_count(), mesh.clips.size(), mesh.keyframe_count(), nodes, load_s, r.seconds,
                 total_s);
     std::fflush(stdout);
@@ -106,16 +178,122 @@ void engine_ratio() {
     std::printf("engine-ratio   goal >= 40x (bench_overdraw exit status %d)\n", status);
 }
 
+struct CommandRun {
+    bool ok = false;
+    double wall_s = 0.0, peak_gb = 0.0;
+};
+
+// One command line in a child process (output and progress to `log`): its wall time and peak RSS.
+CommandRun run_command(const std::vector<std::string>& args, const fs::path& log) {
+    std::vector<char*> argv;
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    const Clock::time_point start = Clock::now();
+    const pid_t child = fork();
+    if (child < 0) return {};
+    if (child == 0) {
+        if (!std::freopen(log.c_str(), "w", stdout) || !std::freopen(log.c_str(), "a", stderr)) _exit(126);
+        ::execv(argv[0], argv.data());
+        _exit(127);
+    }
+    int status = 0;
+    struct rusage usage {};
+    wait4(child, &status, 0, &usage);
+    CommandRun r;
+    r.ok = WIFEXITED(status) && WEXITSTATUS(status) == 0;
+    r.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
+    r.peak_gb = double(usage.ru_maxrss) * 1024.0 / 1e9;
+    return r;
+}
+
+std::string file_bytes(const fs::path& path) {
+    std::FILE* f = std::fopen(path.c_str(), "rb");
+    if (!f) return {};
+    std::string bytes;
+    char buffer[1 << 16];
+    for (size_t n; (n = std::fread(buffer, 1, sizeof buffer, f)) > 0;) bytes.append(buffer, n);
+    std::fclose(f);
+    return bytes;
+}
+
+// The case as the command line a user runs, `animorder optimize --method M FILE [--clip C]... -o
+// OUT -q`, by this build's animorder and then by `baseline` (another build's, with the same
+// command-line interface), one after the other on the same machine, each in a child process of
+// its own: wall times, peak memory, the speed-up next to the one the issue's goal asks, and
+// whether both wrote the same buffers (OUT.animorder.bin).
+int compare_with_baseline(const Case& c, const std::string& baseline, unsigned rounds, bool quick) {
+    if (!fs::exists(data_folder() / c.file)) {
+        std::printf("%-17s skipped: %s is absent\n", c.name, (data_folder() / c.file).string().c_str());
+        return 0;
+    }
+    const Scratch scratch_folder;
+    const fs::path& scratch = scratch_folder.path;
+    const fs::path file = case_input(c, scratch);
+    const std::string method = c.method == Method::Joint ? "joint" : "single";
+    struct Build {
+        const char* label;
+        std::string exe;
+        CommandRun run;
+        std::string buffers;
+    };
+    Build builds[2] = {{"this build", ANIMORDER_EXE, {}, {}}, {"baseline", baseline, {}, {}}};
+    int failed = 0;
+    for (unsigned round = 0; round < rounds && !failed; ++round)
+        for (int i = 0; i < 2 && !failed; ++i) {
+            Build& b = builds[(i + round) % 2];  // this build first in even rounds, the baseline in odd ones
+            const fs::path out = scratch / (&b == builds ? "this" : "baseline");
+            std::vector<std::string> args = {b.exe,         "optimize", "--method",   method,
+                                             file.string(), "-o",       out.string(), "-q"};
+            for (const std::string& clip : c.clips) args.insert(args.end(), {"--clip", clip});
+            if (quick) args.insert(args.end(), {"--views", "12", "--resolution", "64", "-k", "2"});
+            const CommandRun run = run_command(args, out.string() + ".log");
+            if (!run.ok) {
+                std::printf("%-17s %-10s  failed: %s\n", c.name, b.label, file_bytes(out.string() + ".log").c_str());
+                failed = 1;
+                break;
+            }
+            if (round == 0 || run.wall_s < b.run.wall_s) b.run = run;
+            b.buffers = file_bytes(out.string() + ".animorder.bin");
+        }
+    for (const Build& b : builds)
+        if (!failed)
+            std::printf("%-17s %-10s  wall %.1f s  peak RSS %.2f GB  (fastest of %u; %s)\n", c.name, b.label,
+                        b.run.wall_s, b.run.peak_gb, rounds, b.exe.c_str());
+    if (!failed)
+        std::printf("%-17s speed-up %.2fx the baseline's (the goal asks %.2fx: %.0f s -> %.1f s); buffers %s\n", c.name,
+                    builds[1].run.wall_s / builds[0].run.wall_s, c.issue_today_s / c.issue_goal_s, c.issue_today_s,
+                    c.issue_goal_s, builds[0].buffers == builds[1].buffers ? "identical" : "differ");
+    std::fflush(stdout);
+    return failed ? 1 : 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
     bool quick = false;
+    std::string baseline;
+    unsigned rounds = 1;
     std::vector<std::string> wanted;
     for (int i = 1; i < argc; ++i) {
-        if (std::strcmp(argv[i], "--quick") == 0)
+        if (std::strcmp(argv[i], "--quick") == 0) {
             quick = true;
-        else
+        } else if (std::strcmp(argv[i], "--baseline") == 0) {
+            if (i + 1 == argc || ::access(argv[i + 1], X_OK) != 0) {
+                std::fprintf(stderr, "bench_scale: --baseline needs another build's animorder executable\n");
+                return 1;
+            }
+            baseline = argv[++i];
+        } else if (std::strcmp(argv[i], "--rounds") == 0) {
+            char* end = nullptr;
+            rounds = i + 1 < argc ? unsigned(std::strtoul(argv[i + 1], &end, 10)) : 0;
+            if (rounds < 1 || rounds > 100 || *end != '\0') {
+                std::fprintf(stderr, "bench_scale: --rounds needs a count from 1 to 100\n");
+                return 1;
+            }
+            ++i;
+        } else {
             wanted.push_back(argv[i]);
+        }
     }
     auto selected = [&](const std::string& name) {
         if (wanted.empty()) return true;
@@ -128,7 +306,8 @@ int main(int argc, char** argv) {
         for (const Case& c : kCases) known = known || w == c.name;
         if (!known) {
             std::fprintf(stderr,
-                         "bench_scale: unknown case '%s' (ganfaul-joint, xbot-single, clip60-single, engine-ratio)\n",
+                         "bench_scale: unknown case '%s' (ganfaul-joint, xbot-single, clip60-single, "
+                         "xbot-single-sided, engine-ratio)\n",
                          w.c_str());
             return 1;
         }
@@ -140,6 +319,17 @@ int main(int argc, char** argv) {
                     : "default protocol (162 views, 256^2, k = 5, lambda 0.85, all cores)",
                 data_folder().string().c_str());
     std::fflush(stdout);
+    if (!baseline.empty()) {
+        int status = 0;
+        for (const Case& c : kCases)
+            if (selected(c.name)) try {
+                    status |= compare_with_baseline(c, baseline, rounds, quick);
+                } catch (const std::exception& e) {
+                    std::printf("%-17s failed: %s\n", c.name, e.what());
+                    status = 1;
+                }
+        return status;
+    }
     for (const Case& c : kCases) {
         if (!selected(c.name)) continue;
         const pid_t child = fork();
@@ -151,7 +341,7 @@ int main(int argc, char** argv) {
             try {
                 _exit(run_case(c, quick));
             } catch (const std::exception& e) {
-                std::printf("%-14s failed: %s", c.name, e.what());
+                std::printf("%-17s failed: %s", c.name, e.what());
                 std::fflush(stdout);
                 _exit(2);
             }

@@ -16,7 +16,7 @@
 //   xbot-single     Xbot, single over every clip              <= 12 s,  <= 0.7 GB
 //   clip60-single   Ganfaul Idle (13.8k triangles, 60 keyframes), single   <= 2.5 s
 //   xbot-single-sided  xbot-single on a copy whose materials are single-sided: the work the issue
-//                   measured (issue 18 since draws Xbot's double-sided material's both faces)
+//                   measured (since issue 18 both faces of Xbot's double-sided material are drawn)
 //   engine-ratio    bench_overdraw's engine vs llvmpipe, 5 orders per node  >= 40x
 // Data from ../shared/data beside the repository (or $ANIMORDER_DATA); a case without its file
 // says so and is skipped.
@@ -262,7 +262,10 @@ int compare_with_baseline(const Case& c, const std::string& baseline, unsigned r
     if (!failed)
         std::printf("%-17s speed-up %.2fx the baseline's (the goal asks %.2fx: %.0f s -> %.1f s); buffers %s\n", c.name,
                     builds[1].run.wall_s / builds[0].run.wall_s, c.issue_today_s / c.issue_goal_s, c.issue_today_s,
-                    c.issue_goal_s, builds[0].buffers == builds[1].buffers ? "identical" : "differ");
+                    c.issue_goal_s,
+                    builds[0].buffers.empty() || builds[1].buffers.empty() ? "not found (no .animorder.bin)"
+                    : builds[0].buffers == builds[1].buffers               ? "identical"
+                                                                           : "differ");
     std::fflush(stdout);
     return failed ? 1 : 0;
 }

@@ -20,8 +20,10 @@
 //   engine-ratio    bench_overdraw's engine vs llvmpipe, 5 orders per node  >= 40x
 // Data from ../shared/data beside the repository (or $ANIMORDER_DATA); a case without its file
 // says so and is skipped.
+#include "animorder/atomic_write.h"
 #include "animorder/load.h"
 #include "animorder/methods.h"
+#include "animorder/regular_file.h"
 
 #include "machine.h"
 
@@ -37,8 +39,6 @@
 #include <cstring>
 #include <exception>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -75,11 +75,19 @@ fs::path data_folder() {
     return fs::path(ANIMORDER_SOURCE_DIR).parent_path() / "shared" / "data";
 }
 
-// A copy of a GLB with every material's doubleSided false (its JSON chunk rewritten, the binary
-// chunk as it was).
+// A file's bytes through RegularFile, as the tool reads files; empty when it is no regular file.
+std::string file_bytes(const fs::path& path) {
+    RegularFile file(path.string());
+    std::string bytes(file.ok() ? size_t(file.size()) : 0, '\0');
+    bytes.resize(file.ok() ? file.read(bytes.data(), bytes.size()) : 0);
+    return bytes;
+}
+
+// A copy of a GLB with every material's doubleSided false: its JSON chunk rewritten, the binary
+// chunk kept byte for byte (a loader-writer round trip could re-encode the buffers, another
+// workload).
 void write_single_sided_copy(const fs::path& from, const fs::path& to) {
-    std::ifstream in(from, std::ios::binary);
-    const std::string glb((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string glb = file_bytes(from);
     const auto word = [&glb](size_t at) {
         uint32_t v = 0;
         std::memcpy(&v, glb.data() + at, 4);
@@ -89,16 +97,14 @@ void write_single_sided_copy(const fs::path& from, const fs::path& to) {
         throw std::runtime_error(from.string() + ": not a GLB with a JSON chunk first");
     const size_t json_length = word(12);
     nlohmann::json gltf = nlohmann::json::parse(glb.substr(20, json_length));
-    for (auto& material : gltf["materials"]) material["doubleSided"] = false;
+    if (gltf.contains("materials"))
+        for (auto& material : gltf["materials"]) material["doubleSided"] = false;
     std::string text = gltf.dump();
     text.append((4 - text.size() % 4) % 4, ' ');
     const std::string rest = glb.substr(20 + json_length);
     const uint32_t header[5] = {0x46546C67u, 2u, uint32_t(20 + text.size() + rest.size()), uint32_t(text.size()),
                                 0x4E4F534Au};
-    std::ofstream out(to, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(header), sizeof header);
-    out << text << rest;
-    if (!out.flush()) throw std::runtime_error("cannot write " + to.string());
+    write_file_atomically(to.string(), std::string(reinterpret_cast<const char*>(header), sizeof header) + text + rest);
 }
 
 // The case's input: the data file, or its single-sided copy written into `scratch`.
@@ -204,16 +210,6 @@ CommandRun run_command(const std::vector<std::string>& args, const fs::path& log
     r.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
     r.peak_gb = double(usage.ru_maxrss) * 1024.0 / 1e9;
     return r;
-}
-
-std::string file_bytes(const fs::path& path) {
-    std::FILE* f = std::fopen(path.c_str(), "rb");
-    if (!f) return {};
-    std::string bytes;
-    char buffer[1 << 16];
-    for (size_t n; (n = std::fread(buffer, 1, sizeof buffer, f)) > 0;) bytes.append(buffer, n);
-    std::fclose(f);
-    return bytes;
 }
 
 // The case as the command line a user runs, `animorder optimize --method M FILE [--clip C]... -o

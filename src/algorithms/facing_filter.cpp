@@ -35,6 +35,8 @@
 #include "animorder/camera.h"
 #include "animorder/rasterizer.h"
 
+#include "lane_packing.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -63,19 +65,6 @@ size_t candidates_portable(const float* nx, const float* ny, const float* nz, co
 
 #if (defined(__GNUC__) || defined(__clang__)) && (defined(__x86_64__) || defined(__i386__))
 #define ANIMORDER_FACING_AVX2 1
-// For each 8-bit mask of lanes, those lanes in order (the rest zero).
-struct LanePacking {
-    alignas(32) int32_t lanes[256][8] = {};
-    constexpr LanePacking() {
-        for (int mask = 0; mask < 256; ++mask) {
-            int n = 0;
-            for (int lane = 0; lane < 8; ++lane)
-                if (mask >> lane & 1) lanes[mask][n++] = lane;
-        }
-    }
-};
-constexpr LanePacking kLanePacking;
-
 // Eight triangles a step: the test in float lanes (may_draw's operations), then the ids of the
 // lanes that pass packed to the front with one permutation and stored (8 slots written, the
 // count advanced by those that pass).

@@ -29,6 +29,7 @@
 #include "animorder/triangle_order.h"
 
 #include "fragment_encoding.h"
+#include "lane_packing.h"
 
 #include <algorithm>
 #include <cmath>
@@ -81,10 +82,12 @@ struct BatchSetup {
     // Out: edge functions at the first pixel centre and their steps, the plane.
     double e[3][kBatch], sx[3][kBatch], sy[3][kBatch], det[kBatch], dzdx[kBatch], dzdy[kBatch], z_origin[kBatch];
 
-    ANIMORDER_INLINE void compute(size_t n) {
+    // Edge functions for the first `edges` entries of X, Y, px0, py0 and planes for the first
+    // `planes` entries of the rest (the triangles of the pre-pass's small-box test need no edges).
+    ANIMORDER_INLINE void compute(size_t edges, size_t planes) {
         for (int k = 0; k < 3; ++k) {
             const int b = (k + 1) % 3;
-            for (size_t j = 0; j < n; ++j) {
+            for (size_t j = 0; j < edges; ++j) {
                 const double dx = X[b][j] - X[k][j], dy = Y[b][j] - Y[k][j];
                 // 1 unless a top or left edge (dy < 0, or dy = 0 and dx > 0): branch-free selects.
                 const double right = dx > 0.0 ? 0.0 : 1.0;
@@ -95,7 +98,7 @@ struct BatchSetup {
                 sy[k][j] = dx * 256.0;
             }
         }
-        for (size_t j = 0; j < n; ++j) {
+        for (size_t j = 0; j < planes; ++j) {
             det[j] = ax[j] * by[j] - ay[j] * bx[j];
             dzdx[j] = (az[j] * by[j] - ay[j] * bz[j]) / det[j];
             dzdy[j] = (ax[j] * bz[j] - az[j] * bx[j]) / det[j];
@@ -385,6 +388,31 @@ __attribute__((target("avx2"))) inline void emit_small_box_avx2(const double (&e
     sink.count = emit_group_avx2(a0, a1, a2, in_box, _mm256_add_pd(z_row, _mm256_mul_pd(_mm256_set1_pd(dzdx), x)),
                                  pixels, _mm_set1_epi32(int32_t(triangle)), sink, sink.count);
 }
+
+// emit_small_box_avx2 for a triangle of the pre-pass's small-box test: its covered centres (cover's
+// low four bits, lanes as emit_small_box's) are known, so only the depths are computed, as there.
+__attribute__((target("avx2"))) inline void emit_covered_box_avx2(int32_t cover, double dzdx, double dzdy,
+                                                                  double z_origin, int32_t px0, int32_t py0,
+                                                                  uint32_t triangle, unsigned resolution,
+                                                                  FragmentSink& sink) {
+    sink.reserve_more(4);
+    const double x0 = double(px0), x1 = x0 + 1.0;
+    const double z_row0 = z_origin + dzdy * double(py0), z_row1 = z_origin + dzdy * double(py0 + 1);
+    const __m256d x = _mm256_set_pd(x1, x0, x1, x0), z_row = _mm256_set_pd(z_row1, z_row1, z_row0, z_row0);
+    const __m128 depth = _mm256_cvtpd_ps(_mm256_add_pd(z_row, _mm256_mul_pd(_mm256_set1_pd(dzdx), x)));
+    const __m128 in_range = _mm_and_ps(_mm_cmplt_ps(depth, _mm_set1_ps(1.0f)), _mm_cmpge_ps(depth, _mm_setzero_ps()));
+    const int mask = cover & _mm_movemask_ps(in_range);
+    const uint32_t row = uint32_t(py0) * resolution + uint32_t(px0);
+    const __m128i pixels =
+        _mm_add_epi32(_mm_set1_epi32(int32_t(row)), _mm_set_epi32(int32_t(resolution + 1), int32_t(resolution), 1, 0));
+    const __m128i order = _mm_load_si128(reinterpret_cast<const __m128i*>(kLaneCompaction.lanes[mask]));
+    const size_t count = sink.count;
+    _mm_storeu_ps(reinterpret_cast<float*>(sink.pixel.data() + count),
+                  _mm_permutevar_ps(_mm_castsi128_ps(pixels), order));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(sink.triangle.data() + count), _mm_set1_epi32(int32_t(triangle)));
+    _mm_storeu_ps(sink.depth.data() + count, _mm_permutevar_ps(depth, order));
+    sink.count = count + kLaneCompaction.count[mask];
+}
 #endif
 
 // emit_box for a box of at most 2 × 2 pixels (most drawn triangles of a character at 256²):
@@ -418,6 +446,28 @@ ANIMORDER_INLINE void emit_small_box(const int64_t (&e)[3], const int64_t (&step
         out_triangle[count] = triangle;
         out_depth[count] = d1;
         count += size_t(row_in & wide) & size_t((b0 | b1 | b2) >= 0) & size_t(d1 < 1.0f) & size_t(d1 >= 0.0f);
+    }
+    sink.count = count;
+}
+
+// emit_small_box for a triangle of the pre-pass's small-box test: its covered centres (cover's low
+// four bits, in emit_small_box's order) are known, so only the depths are computed, as there.
+ANIMORDER_INLINE void emit_covered_box(int32_t cover, double dzdx, double dzdy, double z_origin, int32_t px0,
+                                       int32_t py0, uint32_t triangle, unsigned resolution, FragmentSink& sink) {
+    sink.reserve_more(4);
+    uint32_t* out_pixel = sink.pixel.data();
+    uint32_t* out_triangle = sink.triangle.data();
+    float* out_depth = sink.depth.data();
+    size_t count = sink.count;
+    const double x[2] = {double(px0), double(px0) + 1.0};
+    for (int lane = 0; lane < 4; ++lane) {
+        const int dx = lane & 1, dy = lane >> 1;
+        const double z_row = z_origin + dzdy * double(py0 + dy);
+        const float depth = float(z_row + dzdx * x[dx]);
+        out_pixel[count] = (uint32_t(py0) + uint32_t(dy)) * resolution + uint32_t(px0) + uint32_t(dx);
+        out_triangle[count] = triangle;
+        out_depth[count] = depth;
+        count += size_t(cover >> lane & 1) & size_t(depth < 1.0f) & size_t(depth >= 0.0f);
     }
     sink.count = count;
 }
@@ -755,9 +805,14 @@ constexpr int32_t kSpecialVertex = int32_t(1) << 30;
 // 1, 2), in int32 lanes: every difference is then below 2^11 in magnitude, every product below 2^21,
 // so the values are exact (the orientation too: its area below 2^21). The other triangles' lanes
 // compute wrapped values (uint32) that are not used.
+//
+// For such a triangle, cover[i] holds kSmallBox and, in its low four bits, the centres it covers
+// (x0 y0, x1 y0, x0 y1, x1 y1: emit_small_box's lanes, those past the box clear), which are the
+// signs emit_small_box would find: the drawn ones skip the edge functions' set-up. Else 0.
+constexpr int32_t kSmallBox = 16;
 ANIMORDER_INLINE void batch_box_test(size_t n, const int32_t* x0, const int32_t* y0, const int32_t* x1,
                                      const int32_t* y1, const int32_t* x2, const int32_t* y2, int32_t last,
-                                     int32_t* keep, int32_t (*box)[4]) {
+                                     int32_t* keep, int32_t (*box)[4], int32_t* cover) {
     constexpr int32_t kNear = 4 * int32_t(kSubpixel);
     for (size_t i = 0; i < n; ++i) {
         const int32_t min_x = std::min(x0[i], std::min(x1[i], x2[i])), max_x = std::max(x0[i], std::max(x1[i], x2[i]));
@@ -793,6 +848,9 @@ ANIMORDER_INLINE void batch_box_test(size_t n, const int32_t* x0, const int32_t*
         const bool small = (px1 - px0 < 2) & (py1 - py0 < 2) & (max_x - min_x < kNear) & (max_y - min_y < kNear);
         const bool covered = int32_t(inside[0] | inside[1] | inside[2] | inside[3]) < 0;
         keep[i] = int32_t(px0 <= px1) & int32_t(py0 <= py1) & int32_t(!small | covered);
+        const uint32_t lanes =
+            inside[0] >> 31 | (inside[1] >> 31) << 1 | (inside[2] >> 31) << 2 | (inside[3] >> 31) << 3;
+        cover[i] = small ? kSmallBox | int32_t(lanes) : 0;
     }
 }
 
@@ -860,12 +918,12 @@ __attribute__((target("avx2"))) size_t project_vertices_avx2(const ClipVertex* c
         const __m256 FX = _mm256_castsi256_ps(_mm256_blendv_epi8(special, X, compact));
         const __m256 FY = _mm256_castsi256_ps(_mm256_blendv_epi8(special, Y, compact));
         // flags: 0 compact, kWideVertex inside but not compact, kClippedVertex outside
-        const int inside_bits = _mm256_movemask_ps(inside),
-                  compact_bits = _mm256_movemask_ps(_mm256_castsi256_ps(compact));
-        for (int i = 0; i < 8; ++i)
-            flags[v + size_t(i)] = uint8_t(!(inside_bits >> i & 1)   ? kClippedVertex
-                                           : (compact_bits >> i & 1) ? 0
-                                                                     : kWideVertex);
+        const __m256i in = _mm256_castps_si256(inside);  // compact implies inside
+        const __m256i flag =
+            _mm256_or_si256(_mm256_andnot_si256(in, _mm256_set1_epi32(kClippedVertex)),
+                            _mm256_andnot_si256(compact, _mm256_and_si256(in, _mm256_set1_epi32(kWideVertex))));
+        const __m128i flag16 = _mm_packus_epi32(_mm256_castsi256_si128(flag), _mm256_extracti128_si256(flag, 1));
+        _mm_storel_epi64(reinterpret_cast<__m128i*>(flags + v), _mm_packus_epi16(flag16, flag16));
         // Snapped pairs: X and Y interleaved; records: the 8 × 4 transpose of (x, y, z, 0).
         const __m256 u0 = _mm256_unpacklo_ps(FX, FY), u1 = _mm256_unpackhi_ps(FX, FY);
         float* o = reinterpret_cast<float*>(snapped + v);
@@ -882,6 +940,26 @@ __attribute__((target("avx2"))) size_t project_vertices_avx2(const ClipVertex* c
         _mm256_storeu_ps(r + 24, _mm256_permute2f128_ps(q2, q3, 0x31));
     }
     return v;
+}
+
+// The drawn triangles' places in the batch (those with keep[i] = 1), 8 at a time: the lanes packed
+// to the front with one permutation and stored (8 slots written). Returns how many of the n it
+// did (a multiple of 8); the caller's scalar loop does the rest, m counting on.
+template <NodeRasterizer::Copy>  // one instance a wide copy: each inlines its own
+__attribute__((target("avx2,popcnt"))) size_t pack_drawn_avx2(size_t n, const int32_t* keep, uint32_t* draw,
+                                                              size_t& m) {
+    const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    size_t i = 0;
+    for (; i + 8 <= n; i += 8) {
+        const __m256i kept = _mm256_cmpgt_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(keep + i)),
+                                                _mm256_setzero_si256());
+        const int mask = _mm256_movemask_ps(_mm256_castsi256_ps(kept));
+        const __m256i order = _mm256_load_si256(reinterpret_cast<const __m256i*>(kLanePacking.lanes[mask]));
+        const __m256i places = _mm256_add_epi32(_mm256_set1_epi32(int32_t(i)), lane);
+        _mm256_storeu_si256(reinterpret_cast<__m256i*>(draw + m), _mm256_permutevar8x32_epi32(places, order));
+        m += size_t(__builtin_popcount(unsigned(mask)));
+    }
+    return i;
 }
 #endif
 
@@ -1004,32 +1082,32 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
     const NodeRasterizer::State::VertexRecord* vertex = s.vertices.data();
     const uint8_t* flags = s.vertex_flags.data();
     alignas(16) int32_t x0[kBatch], y0[kBatch], x1[kBatch], y1[kBatch], x2[kBatch], y2[kBatch], keep[kBatch];
-    int32_t two[kBatch];
+    int32_t two[kBatch], cover[kBatch], edged[kBatch];
+    uint32_t general[kBatch + 8];  // the drawn triangles that need the edge functions' set-up
     int32_t boxes[kBatch][4];
     int64_t areas[kBatch];
     int32_t special[kBatch];
-    uint32_t draw[kBatch], id[kBatch], listed_corners[3 * kBatch];
+    uint32_t draw[kBatch + 8], id[kBatch];  // draw: 8 slots past the batch for the wide copies' stores
     uint8_t listed_modes[kBatch];
+    static constexpr uint8_t kNoModes[kBatch] = {};  // every triangle drawn, back faces culled
     BatchSetup& setup = s.setup;
     for (size_t first = 0; first < triangle_count; first += kBatch) {
         const size_t n = std::min(kBatch, triangle_count - first);
-        // The batch's triangles (id) with their corners (tri) and modes (mode) side by side: the
-        // index list's own entries, or the candidates' copied out.
-        const uint32_t* tri = indices + 3 * first;
-        const uint8_t* mode = modes ? modes + first : nullptr;
+        // The batch's triangles (id) and their modes (mode): the index list's own, or the
+        // candidates'. Triangle id's corners are indices[3 · id ...].
+        const uint8_t* mode = modes ? modes + first : kNoModes;
         if (listed) {
-            for (size_t i = 0; i < n; ++i) {
-                id[i] = candidates[first + i];
-                std::memcpy(&listed_corners[3 * i], indices + 3 * size_t(id[i]), 3 * sizeof(uint32_t));
-                listed_modes[i] = modes ? modes[id[i]] : 0;
+            std::memcpy(id, candidates + first, n * sizeof(uint32_t));
+            if (modes) {
+                for (size_t i = 0; i < n; ++i) listed_modes[i] = modes[id[i]];
+                mode = listed_modes;
             }
-            tri = listed_corners;
-            mode = modes ? listed_modes : nullptr;
         } else {
             for (size_t i = 0; i < n; ++i) id[i] = uint32_t(first + i);
         }
         for (size_t i = 0; i < n; ++i) {
-            const uint32_t a = tri[3 * i], b = tri[3 * i + 1], c = tri[3 * i + 2];
+            const uint32_t* tri = indices + 3 * size_t(id[i]);
+            const uint32_t a = tri[0], b = tri[1], c = tri[2];
             x0[i] = corner[a].X;
             y0[i] = corner[a].Y;
             x1[i] = corner[b].X;
@@ -1038,14 +1116,14 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
             y2[i] = corner[c].Y;
         }
         for (size_t i = 0; i < n; ++i) {  // vectorised
-            const int32_t m = mode ? mode[i] : 0;
+            const int32_t m = mode[i];
             two[i] = m & kDrawBothFaces;
             // Skipped: never drawn (0); a clipped or wide corner: an exact path below (2).
             const int32_t exact =
                 int32_t(x0[i] == kSpecialVertex) | int32_t(x1[i] == kSpecialVertex) | int32_t(x2[i] == kSpecialVertex);
             special[i] = (m & kSkipTriangle) ? 0 : 1 + exact;
         }
-        batch_box_test(n, x0, y0, x1, y1, x2, y2, int32_t(resolution - 1), keep, boxes);
+        batch_box_test(n, x0, y0, x1, y1, x2, y2, int32_t(resolution - 1), keep, boxes, cover);
         for (size_t i = 0; i < n; ++i) {  // int32 and int64 lanes only: vectorised
             // As triangle_box: y points down, so OpenGL's counter-clockwise front faces have
             // negative area; |coordinates| < 2^24 keeps the int64 products exact.
@@ -1053,28 +1131,46 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
             const int32_t drawn = int32_t(area < 0) | (int32_t(area > 0) & two[i]);
             areas[i] = area;
             keep[i] = int32_t(special[i] > 1) | (int32_t(special[i] == 1) & drawn & keep[i]);
+            edged[i] = keep[i] & (int32_t(special[i] != 1) | int32_t(cover[i] == 0));
         }
-        size_t m = 0;
-        for (size_t i = 0; i < n; ++i) {
+        size_t m = 0, packed = 0, edges = 0, edges_packed = 0;
+#ifdef ANIMORDER_RASTER_AVX2
+        if constexpr (kAvx2) {
+            packed = pack_drawn_avx2<kCopy>(n, keep, draw, m);
+            edges_packed = pack_drawn_avx2<kCopy>(n, edged, general, edges);
+        }
+#endif
+        for (size_t i = packed; i < n; ++i) {
             draw[m] = uint32_t(i);
             m += size_t(keep[i]);
         }
-        // The set-up of rasterize_window_triangle for every drawn triangle of the batch at once.
-        // Corners in positive order: 0, 2, 1 for a front face (negative area), else 0, 1, 2.
+        for (size_t i = edges_packed; i < n; ++i) {
+            general[edges] = uint32_t(i);
+            edges += size_t(edged[i]);
+        }
+        // The set-up of rasterize_window_triangle for every drawn triangle of the batch at once:
+        // the depth plane of each (entry j), the edge functions of those that the small-box test
+        // did not decide (entry g, in the same order). Corners in positive order: 0, 2, 1 for a
+        // front face (negative area), else 0, 1, 2.
+        for (size_t g = 0; g < edges; ++g) {
+            const size_t i = general[g];
+            const bool front = areas[i] < 0;
+            setup.X[0][g] = x0[i];
+            setup.Y[0][g] = y0[i];
+            setup.X[1][g] = front ? x2[i] : x1[i];
+            setup.Y[1][g] = front ? y2[i] : y1[i];
+            setup.X[2][g] = front ? x1[i] : x2[i];
+            setup.Y[2][g] = front ? y1[i] : y2[i];
+            setup.px0[g] = boxes[i][0];
+            setup.py0[g] = boxes[i][2];
+        }
         for (size_t j = 0; j < m; ++j) {
             const size_t i = draw[j];
             const bool fast = special[i] == 1, front = areas[i] < 0;
-            const auto* w0 = vertex + tri[3 * i];
-            const auto* w1 = vertex + tri[3 * i + (front ? 2 : 1)];
-            const auto* w2 = vertex + tri[3 * i + (front ? 1 : 2)];
-            setup.X[0][j] = x0[i];
-            setup.Y[0][j] = y0[i];
-            setup.X[1][j] = front ? x2[i] : x1[i];
-            setup.Y[1][j] = front ? y2[i] : y1[i];
-            setup.X[2][j] = front ? x1[i] : x2[i];
-            setup.Y[2][j] = front ? y1[i] : y2[i];
-            setup.px0[j] = boxes[i][0];
-            setup.py0[j] = boxes[i][2];
+            const uint32_t* tri = indices + 3 * size_t(id[i]);
+            const auto* w0 = vertex + tri[0];
+            const auto* w1 = vertex + tri[front ? 2 : 1];
+            const auto* w2 = vertex + tri[front ? 1 : 2];
             // As rasterize_window_triangle: differences in float, then widened.
             setup.ax[j] = fast ? w1->x - w0->x : 0.0f;
             setup.ay[j] = fast ? w1->y - w0->y : 0.0f;
@@ -1086,20 +1182,37 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
             setup.y[j] = fast ? w0->y : 0.0f;
             setup.z[j] = fast ? w0->z : 0.0f;
         }
-        setup.compute(m);
+        setup.compute(edges, m);
+        size_t g = 0;
         for (size_t j = 0; j < m; ++j) {
             const size_t t = id[draw[j]];
-            const uint32_t a = tri[3 * draw[j]], b = tri[3 * draw[j] + 1], c = tri[3 * draw[j] + 2];
+            const uint32_t* tri = indices + 3 * t;
+            const uint32_t a = tri[0], b = tri[1], c = tri[2];
             const bool two_sided = two[draw[j]] != 0;
+            if (special[draw[j]] == 1 && cover[draw[j]] != 0) {  // the small-box test found its covered centres
+                if (setup.det[j] == 0.0) continue;               // float-degenerate sliver: no defined depth
+                const int32_t* known = boxes[draw[j]];
+#ifdef ANIMORDER_RASTER_AVX2
+                if (kAvx2) {
+                    emit_covered_box_avx2(cover[draw[j]], setup.dzdx[j], setup.dzdy[j], setup.z_origin[j], known[0],
+                                          known[2], uint32_t(t), resolution, sink);
+                    continue;
+                }
+#endif
+                emit_covered_box(cover[draw[j]], setup.dzdx[j], setup.dzdy[j], setup.z_origin[j], known[0], known[2],
+                                 uint32_t(t), resolution, sink);
+                continue;
+            }
+            const size_t k = g++;  // its edge functions' entry
             if (special[draw[j]] == 1) {            // passed the pre-pass: its box and set-up are known
                 if (setup.det[j] == 0.0) continue;  // float-degenerate sliver: no fragment has a defined depth
                 const int32_t* known = boxes[draw[j]];
                 const TriangleBox box{areas[draw[j]], known[0], known[1], known[2], known[3]};
 #ifdef ANIMORDER_RASTER_AVX2
                 if (kAvx2) {  // the set-up's doubles as they are: no conversion to int64
-                    const double e[3] = {setup.e[0][j], setup.e[1][j], setup.e[2][j]};
-                    const double sx[3] = {setup.sx[0][j], setup.sx[1][j], setup.sx[2][j]};
-                    const double sy[3] = {setup.sy[0][j], setup.sy[1][j], setup.sy[2][j]};
+                    const double e[3] = {setup.e[0][k], setup.e[1][k], setup.e[2][k]};
+                    const double sx[3] = {setup.sx[0][k], setup.sx[1][k], setup.sx[2][k]};
+                    const double sy[3] = {setup.sy[0][k], setup.sy[1][k], setup.sy[2][k]};
                     if (box.px1 - box.px0 < 2 && box.py1 - box.py0 < 2)
                         emit_small_box_avx2(e, sx, sy, setup.dzdx[j], setup.dzdy[j], setup.z_origin[j], box,
                                             uint32_t(t), resolution, sink);
@@ -1109,9 +1222,9 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
                     continue;
                 }
 #endif
-                const int64_t e[3] = {int64_t(setup.e[0][j]), int64_t(setup.e[1][j]), int64_t(setup.e[2][j])};
-                const int64_t sx[3] = {int64_t(setup.sx[0][j]), int64_t(setup.sx[1][j]), int64_t(setup.sx[2][j])};
-                const int64_t sy[3] = {int64_t(setup.sy[0][j]), int64_t(setup.sy[1][j]), int64_t(setup.sy[2][j])};
+                const int64_t e[3] = {int64_t(setup.e[0][k]), int64_t(setup.e[1][k]), int64_t(setup.e[2][k])};
+                const int64_t sx[3] = {int64_t(setup.sx[0][k]), int64_t(setup.sx[1][k]), int64_t(setup.sx[2][k])};
+                const int64_t sy[3] = {int64_t(setup.sy[0][k]), int64_t(setup.sy[1][k]), int64_t(setup.sy[2][k])};
                 if (box.px1 - box.px0 < 2 && box.py1 - box.py0 < 2)
                     emit_small_box(e, sx, sy, setup.dzdx[j], setup.dzdy[j], setup.z_origin[j], box, uint32_t(t),
                                    resolution, sink);

@@ -527,19 +527,22 @@ KeptNode keep_fragments(uint64_t visible, uint64_t single, const uint32_t* start
     uint16_t* pending = nullptr;
     uint32_t pending_n = 0;
     uint64_t pending_key = 0, pending_hash = 0;
-    // The units of the fragments kPrefetchAhead entries on are fetched meanwhile: the triangle ->
-    // (unit, place) table is larger than the nearest cache and the lists follow no order in it.
-    constexpr size_t kPrefetchAhead = 24;
-    const size_t fragment_count = pixel_count ? starts[pixel_count] - starts[0] : 0;
+    // The units of the fragments kPrefetchAhead entries on are fetched meanwhile when the triangle
+    // -> (unit, place) table is larger than kPrefetchTriangles entries (256 KB: half the nearest
+    // cache a core has to itself on common CPUs; the lists follow no order in it). Below, the
+    // table stays cached and prefetching only adds work (measured: Ganfaul's 13,802 triangles).
+    constexpr size_t kPrefetchAhead = 24, kPrefetchTriangles = size_t(1) << 15;
     const size_t triangle_count = partition.unit_position.size();
-    size_t prefetched = std::min(kPrefetchAhead, fragment_count);
+    const size_t to_prefetch =  // the node's fragments, or none
+        pixel_count && triangle_count > kPrefetchTriangles ? starts[pixel_count] - starts[0] : 0;
+    size_t prefetched = std::min(kPrefetchAhead, to_prefetch);
     for (size_t j = 0; j < prefetched; ++j) {
         const uint32_t t = fragments[starts[0] + j] & kTriangleMask;
         if (t < triangle_count) __builtin_prefetch(&partition.unit_position[t]);
     }
     for (size_t p = 0; p < pixel_count; ++p) {
         const uint32_t n = starts[p + 1] - starts[p];
-        for (const size_t until = std::min(size_t(starts[p + 1] - starts[0]) + kPrefetchAhead, fragment_count);
+        for (const size_t until = std::min(size_t(starts[p + 1] - starts[0]) + kPrefetchAhead, to_prefetch);
              prefetched < until; ++prefetched) {
             const uint32_t t = fragments[starts[0] + prefetched] & kTriangleMask;
             if (t < triangle_count) __builtin_prefetch(&partition.unit_position[t]);

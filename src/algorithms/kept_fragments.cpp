@@ -535,11 +535,7 @@ KeptNode keep_fragments(uint64_t visible, uint64_t single, const uint32_t* start
     const size_t triangle_count = partition.unit_position.size();
     const size_t to_prefetch =  // the node's fragments, or none
         pixel_count && triangle_count > kPrefetchTriangles ? starts[pixel_count] - starts[0] : 0;
-    size_t prefetched = std::min(kPrefetchAhead, to_prefetch);
-    for (size_t j = 0; j < prefetched; ++j) {
-        const uint32_t t = fragments[starts[0] + j] & kTriangleMask;
-        if (t < triangle_count) __builtin_prefetch(&partition.unit_position[t]);
-    }
+    size_t prefetched = 0;
     for (size_t p = 0; p < pixel_count; ++p) {
         const uint32_t n = starts[p + 1] - starts[p];
         for (const size_t until = std::min(size_t(starts[p + 1] - starts[0]) + kPrefetchAhead, to_prefetch);

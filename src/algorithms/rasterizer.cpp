@@ -269,9 +269,25 @@ struct LaneCompaction {
 };
 constexpr LaneCompaction kLaneCompaction;
 
-// One group of four pixels in the wide (AVX2, AVX-512) copies: the lanes whose three edge values are >= 0, that lie
-// in the box and whose depth (z, rounded to float) lies in [0, 1), packed to the front and stored
-// at `count` (one 16-byte store per array, whatever the count); returns the new count.
+// Four pixels' fragments in the wide (AVX2, AVX-512) copies: the lanes set in `covered` (bit k for
+// lane k) whose depth (z, rounded to float) lies in [0, 1), packed to the front and stored at
+// `count` (one 16-byte store per array, whatever the count); returns the new count.
+__attribute__((target("avx2"))) ANIMORDER_INLINE size_t emit_lanes_avx2(int covered, __m256d z, __m128i pixels,
+                                                                        __m128i triangles, FragmentSink& sink,
+                                                                        size_t count) {
+    const __m128 depth = _mm256_cvtpd_ps(z);
+    const __m128 in_range = _mm_and_ps(_mm_cmplt_ps(depth, _mm_set1_ps(1.0f)), _mm_cmpge_ps(depth, _mm_setzero_ps()));
+    const int mask = covered & _mm_movemask_ps(in_range);
+    const __m128i order = _mm_load_si128(reinterpret_cast<const __m128i*>(kLaneCompaction.lanes[mask]));
+    _mm_storeu_ps(reinterpret_cast<float*>(sink.pixel.data() + count),
+                  _mm_permutevar_ps(_mm_castsi128_ps(pixels), order));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(sink.triangle.data() + count), triangles);
+    _mm_storeu_ps(sink.depth.data() + count, _mm_permutevar_ps(depth, order));
+    return count + kLaneCompaction.count[mask];
+}
+
+// One group of four pixels in the wide copies: emit_lanes_avx2 of the lanes whose three edge
+// values are >= 0 and that lie in the box.
 __attribute__((target("avx2"))) ANIMORDER_INLINE size_t emit_group_avx2(__m256d a0, __m256d a1, __m256d a2,
                                                                         __m256d in_box, __m256d z, __m128i pixels,
                                                                         __m128i triangles, FragmentSink& sink,
@@ -280,15 +296,7 @@ __attribute__((target("avx2"))) ANIMORDER_INLINE size_t emit_group_avx2(__m256d 
     const __m256d covered = _mm256_and_pd(
         _mm256_and_pd(_mm256_cmp_pd(a0, zero, _CMP_GE_OQ), _mm256_cmp_pd(a1, zero, _CMP_GE_OQ)),
         _mm256_and_pd(_mm256_cmp_pd(a2, zero, _CMP_GE_OQ), in_box));
-    const __m128 depth = _mm256_cvtpd_ps(z);
-    const __m128 in_range = _mm_and_ps(_mm_cmplt_ps(depth, _mm_set1_ps(1.0f)), _mm_cmpge_ps(depth, _mm_setzero_ps()));
-    const int mask = _mm256_movemask_pd(covered) & _mm_movemask_ps(in_range);
-    const __m128i order = _mm_load_si128(reinterpret_cast<const __m128i*>(kLaneCompaction.lanes[mask]));
-    _mm_storeu_ps(reinterpret_cast<float*>(sink.pixel.data() + count),
-                  _mm_permutevar_ps(_mm_castsi128_ps(pixels), order));
-    _mm_storeu_si128(reinterpret_cast<__m128i*>(sink.triangle.data() + count), triangles);
-    _mm_storeu_ps(sink.depth.data() + count, _mm_permutevar_ps(depth, order));
-    return count + kLaneCompaction.count[mask];
+    return emit_lanes_avx2(_mm256_movemask_pd(covered), z, pixels, triangles, sink, count);
 }
 
 // emit_box in the wide copies, from BatchSetup's doubles (no conversion to int64): 4 pixels of a row
@@ -361,34 +369,6 @@ __attribute__((target("avx2"))) void emit_box_avx2(const double (&e_first)[3], c
     sink.count = count;
 }
 
-// emit_small_box in the wide copies: the box's four pixels are the four lanes (x0 y0, x1 y0, x0 y1,
-// x1 y1, emit_small_box's order), edge values e, e + sx, e + sy, e + sx + sy (integers below 2^53:
-// exact in double), depths emit_small_box's float(z_row + dzdx · x), the lanes past the box masked,
-// then one emit_group_avx2. Takes BatchSetup's doubles as they are: no conversion to int64.
-__attribute__((target("avx2"))) inline void emit_small_box_avx2(const double (&e)[3], const double (&step_x)[3],
-                                                                const double (&step_y)[3], double dzdx, double dzdy,
-                                                                double z_origin, const TriangleBox& box,
-                                                                uint32_t triangle, unsigned resolution,
-                                                                FragmentSink& sink) {
-    sink.reserve_more(4);
-    const double x0 = double(box.px0), x1 = x0 + 1.0;
-    const double z_row0 = z_origin + dzdy * double(box.py0), z_row1 = z_origin + dzdy * double(box.py0 + 1);
-    const __m256d a0 =
-        _mm256_add_pd(_mm256_set1_pd(e[0]), _mm256_set_pd(step_x[0] + step_y[0], step_y[0], step_x[0], 0.0));
-    const __m256d a1 =
-        _mm256_add_pd(_mm256_set1_pd(e[1]), _mm256_set_pd(step_x[1] + step_y[1], step_y[1], step_x[1], 0.0));
-    const __m256d a2 =
-        _mm256_add_pd(_mm256_set1_pd(e[2]), _mm256_set_pd(step_x[2] + step_y[2], step_y[2], step_x[2], 0.0));
-    const __m256d x = _mm256_set_pd(x1, x0, x1, x0), z_row = _mm256_set_pd(z_row1, z_row1, z_row0, z_row0);
-    const bool wide = box.px1 > box.px0, tall = box.py1 > box.py0;
-    const __m256d in_box = _mm256_castsi256_pd(_mm256_set_epi64x(wide && tall ? -1 : 0, tall ? -1 : 0, wide ? -1 : 0, -1));
-    const uint32_t row = uint32_t(box.py0 * resolution) + uint32_t(box.px0);
-    const __m128i pixels =
-        _mm_add_epi32(_mm_set1_epi32(int32_t(row)), _mm_set_epi32(int32_t(resolution + 1), int32_t(resolution), 1, 0));
-    sink.count = emit_group_avx2(a0, a1, a2, in_box, _mm256_add_pd(z_row, _mm256_mul_pd(_mm256_set1_pd(dzdx), x)),
-                                 pixels, _mm_set1_epi32(int32_t(triangle)), sink, sink.count);
-}
-
 // emit_small_box_avx2 for a triangle of the pre-pass's small-box test: its covered centres (cover's
 // low four bits, lanes as emit_small_box's) are known, so only the depths are computed, as there.
 __attribute__((target("avx2"))) inline void emit_covered_box_avx2(int32_t cover, double dzdx, double dzdy,
@@ -399,56 +379,34 @@ __attribute__((target("avx2"))) inline void emit_covered_box_avx2(int32_t cover,
     const double x0 = double(px0), x1 = x0 + 1.0;
     const double z_row0 = z_origin + dzdy * double(py0), z_row1 = z_origin + dzdy * double(py0 + 1);
     const __m256d x = _mm256_set_pd(x1, x0, x1, x0), z_row = _mm256_set_pd(z_row1, z_row1, z_row0, z_row0);
-    const __m128 depth = _mm256_cvtpd_ps(_mm256_add_pd(z_row, _mm256_mul_pd(_mm256_set1_pd(dzdx), x)));
-    const __m128 in_range = _mm_and_ps(_mm_cmplt_ps(depth, _mm_set1_ps(1.0f)), _mm_cmpge_ps(depth, _mm_setzero_ps()));
-    const int mask = cover & _mm_movemask_ps(in_range);
     const uint32_t row = uint32_t(py0) * resolution + uint32_t(px0);
     const __m128i pixels =
         _mm_add_epi32(_mm_set1_epi32(int32_t(row)), _mm_set_epi32(int32_t(resolution + 1), int32_t(resolution), 1, 0));
-    const __m128i order = _mm_load_si128(reinterpret_cast<const __m128i*>(kLaneCompaction.lanes[mask]));
-    const size_t count = sink.count;
-    _mm_storeu_ps(reinterpret_cast<float*>(sink.pixel.data() + count),
-                  _mm_permutevar_ps(_mm_castsi128_ps(pixels), order));
-    _mm_storeu_si128(reinterpret_cast<__m128i*>(sink.triangle.data() + count), _mm_set1_epi32(int32_t(triangle)));
-    _mm_storeu_ps(sink.depth.data() + count, _mm_permutevar_ps(depth, order));
-    sink.count = count + kLaneCompaction.count[mask];
+    sink.count = emit_lanes_avx2(cover, _mm256_add_pd(z_row, _mm256_mul_pd(_mm256_set1_pd(dzdx), x)), pixels,
+                                 _mm_set1_epi32(int32_t(triangle)), sink, sink.count);
+}
+
+// emit_small_box in the wide copies: the box's four pixels are the four lanes (x0 y0, x1 y0, x0 y1,
+// x1 y1, emit_small_box's order), edge values e, e + sx, e + sy, e + sx + sy (integers below 2^53:
+// exact in double), the lanes past the box masked, then emit_covered_box_avx2 of the covered
+// lanes. Takes BatchSetup's doubles as they are: no conversion to int64.
+__attribute__((target("avx2"))) inline void emit_small_box_avx2(const double (&e)[3], const double (&step_x)[3],
+                                                                const double (&step_y)[3], double dzdx, double dzdy,
+                                                                double z_origin, const TriangleBox& box,
+                                                                uint32_t triangle, unsigned resolution,
+                                                                FragmentSink& sink) {
+    const __m256d zero = _mm256_setzero_pd();
+    __m256d covered = _mm256_castsi256_pd(_mm256_set_epi64x(box.px1 > box.px0 && box.py1 > box.py0 ? -1 : 0,
+                                                            box.py1 > box.py0 ? -1 : 0, box.px1 > box.px0 ? -1 : 0, -1));
+    for (int k = 0; k < 3; ++k) {
+        const __m256d a = _mm256_add_pd(_mm256_set1_pd(e[k]),
+                                        _mm256_set_pd(step_x[k] + step_y[k], step_y[k], step_x[k], 0.0));
+        covered = _mm256_and_pd(covered, _mm256_cmp_pd(a, zero, _CMP_GE_OQ));
+    }
+    emit_covered_box_avx2(_mm256_movemask_pd(covered), dzdx, dzdy, z_origin, int32_t(box.px0), int32_t(box.py0),
+                          triangle, resolution, sink);
 }
 #endif
-
-// emit_box for a box of at most 2 × 2 pixels (most drawn triangles of a character at 256²):
-// its four pixels unrolled, those past the box's right or bottom end masked like uncovered ones,
-// so no loop exit to mispredict. The same arithmetic and the same fragment order as emit_box.
-ANIMORDER_INLINE void emit_small_box(const int64_t (&e)[3], const int64_t (&step_x)[3], const int64_t (&step_y)[3],
-                                     double dzdx, double dzdy, double z_origin, const TriangleBox& box,
-                                     uint32_t triangle, unsigned resolution, FragmentSink& sink) {
-    sink.reserve_more(4);
-    uint32_t* out_pixel = sink.pixel.data();
-    uint32_t* out_triangle = sink.triangle.data();
-    float* out_depth = sink.depth.data();
-    size_t count = sink.count;
-    const bool wide = box.px1 > box.px0, tall = box.py1 > box.py0;
-    const double x0 = double(box.px0), x1 = x0 + 1.0;
-    for (int dy = 0; dy < 2; ++dy) {
-        const int64_t py = box.py0 + dy;
-        const double z_row = z_origin + dzdy * double(py);
-        const uint32_t row = uint32_t(py * resolution) + uint32_t(box.px0);
-        const bool row_in = dy == 0 || tall;
-        const int64_t a0 = e[0] + (dy ? step_y[0] : 0), a1 = e[1] + (dy ? step_y[1] : 0),
-                      a2 = e[2] + (dy ? step_y[2] : 0);
-        const float d0 = float(z_row + dzdx * x0);
-        out_pixel[count] = row;
-        out_triangle[count] = triangle;
-        out_depth[count] = d0;
-        count += size_t(row_in) & size_t((a0 | a1 | a2) >= 0) & size_t(d0 < 1.0f) & size_t(d0 >= 0.0f);
-        const float d1 = float(z_row + dzdx * x1);
-        const int64_t b0 = a0 + step_x[0], b1 = a1 + step_x[1], b2 = a2 + step_x[2];
-        out_pixel[count] = row + 1;
-        out_triangle[count] = triangle;
-        out_depth[count] = d1;
-        count += size_t(row_in & wide) & size_t((b0 | b1 | b2) >= 0) & size_t(d1 < 1.0f) & size_t(d1 >= 0.0f);
-    }
-    sink.count = count;
-}
 
 // emit_small_box for a triangle of the pre-pass's small-box test: its covered centres (cover's low
 // four bits, in emit_small_box's order) are known, so only the depths are computed, as there.
@@ -470,6 +428,24 @@ ANIMORDER_INLINE void emit_covered_box(int32_t cover, double dzdx, double dzdy, 
         count += size_t(cover >> lane & 1) & size_t(depth < 1.0f) & size_t(depth >= 0.0f);
     }
     sink.count = count;
+}
+
+// emit_box for a box of at most 2 × 2 pixels (most drawn triangles of a character at 256²):
+// its four pixels unrolled, those past the box's right or bottom end masked like uncovered ones,
+// then emit_covered_box of the covered ones: the same arithmetic and fragment order as emit_box.
+ANIMORDER_INLINE void emit_small_box(const int64_t (&e)[3], const int64_t (&step_x)[3], const int64_t (&step_y)[3],
+                                     double dzdx, double dzdy, double z_origin, const TriangleBox& box,
+                                     uint32_t triangle, unsigned resolution, FragmentSink& sink) {
+    const bool wide = box.px1 > box.px0, tall = box.py1 > box.py0;
+    const bool in_box[4] = {true, wide, tall, wide && tall};
+    int32_t cover = 0;
+    for (int lane = 0; lane < 4; ++lane) {
+        const int64_t dx = lane & 1, dy = lane >> 1;
+        const int64_t a0 = e[0] + dx * step_x[0] + dy * step_y[0], a1 = e[1] + dx * step_x[1] + dy * step_y[1],
+                      a2 = e[2] + dx * step_x[2] + dy * step_y[2];
+        cover |= int32_t(in_box[lane] && (a0 | a1 | a2) >= 0) << lane;
+    }
+    emit_covered_box(cover, dzdx, dzdy, z_origin, int32_t(box.px0), int32_t(box.py0), triangle, resolution, sink);
 }
 
 // Rasterises one window-space triangle that passed triangle_box: fill rule and depth as
@@ -806,10 +782,9 @@ constexpr int32_t kSpecialVertex = int32_t(1) << 30;
 // so the values are exact (the orientation too: its area below 2^21). The other triangles' lanes
 // compute wrapped values (uint32) that are not used.
 //
-// For such a triangle, cover[i] holds kSmallBox and, in its low four bits, the centres it covers
-// (x0 y0, x1 y0, x0 y1, x1 y1: emit_small_box's lanes, those past the box clear), which are the
-// signs emit_small_box would find: the drawn ones skip the edge functions' set-up. Else 0.
-constexpr int32_t kSmallBox = 16;
+// For such a triangle, cover[i] holds in its four bits the centres it covers (x0 y0, x1 y0, x0 y1,
+// x1 y1: emit_small_box's lanes, those past the box clear), the signs emit_small_box would find:
+// a drawn one (it covers some) skips the edge functions' set-up. Else 0.
 ANIMORDER_INLINE void batch_box_test(size_t n, const int32_t* x0, const int32_t* y0, const int32_t* x1,
                                      const int32_t* y1, const int32_t* x2, const int32_t* y2, int32_t last,
                                      int32_t* keep, int32_t (*box)[4], int32_t* cover) {
@@ -850,7 +825,7 @@ ANIMORDER_INLINE void batch_box_test(size_t n, const int32_t* x0, const int32_t*
         keep[i] = int32_t(px0 <= px1) & int32_t(py0 <= py1) & int32_t(!small | covered);
         const uint32_t lanes =
             inside[0] >> 31 | (inside[1] >> 31) << 1 | (inside[2] >> 31) << 2 | (inside[3] >> 31) << 3;
-        cover[i] = small ? kSmallBox | int32_t(lanes) : 0;
+        cover[i] = small ? int32_t(lanes) : 0;
     }
 }
 
@@ -1189,8 +1164,8 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
             const uint32_t* tri = indices + 3 * t;
             const uint32_t a = tri[0], b = tri[1], c = tri[2];
             const bool two_sided = two[draw[j]] != 0;
-            if (special[draw[j]] == 1 && cover[draw[j]] != 0) {  // the small-box test found its covered centres
-                if (setup.det[j] == 0.0) continue;               // float-degenerate sliver: no defined depth
+            if (!edged[draw[j]]) {                  // the small-box test found its covered centres
+                if (setup.det[j] == 0.0) continue;  // float-degenerate sliver: no defined depth
                 const int32_t* known = boxes[draw[j]];
 #ifdef ANIMORDER_RASTER_AVX2
                 if (kAvx2) {

@@ -1,8 +1,11 @@
 // animorder — the camera of every node (camera.cpp; DESIGN.md "Camera").
 #pragma once
 
+#include "animorder/rasterizer.h"
+
 #include <array>
 #include <cstddef>
+#include <vector>
 
 namespace animorder {
 
@@ -25,5 +28,30 @@ void transform_to_clip(float* clip_xyzw, const float* positions, size_t vertex_c
 // The same, always in the portable copy (tests compare the two).
 void transform_to_clip_portable(float* clip_xyzw, const float* positions, size_t vertex_count, const float centre[3],
                                 const Mat4d& view_projection);
+
+// transform_to_clip's first step for a whole keyframe, done once for all its views: positions[v] −
+// centre in float, into one array per coordinate (x, y, z: vertex_count floats each).
+void centre_positions(float* x, float* y, float* z, const float* positions, size_t vertex_count,
+                      const float centre[3]);
+// The matrix as transform_to_clip uses it: each entry rounded to float.
+std::array<float, 16> float_matrix(const Mat4d& m);
+
+// A worker's keyframe moved to its frame's centre (centre_positions), kept while its nodes follow
+// one another: what NodeRasterizer's centred entry reads, so that no node transforms the whole
+// keyframe to clip space apart from its vertex pass.
+class CentredKeyframe {
+public:
+    // Centres the keyframe unless it is the one centred last (same address, count and centre: the
+    // positions are compared by address, so they must not change while their nodes are drawn).
+    void centre(const float* positions, size_t vertex_count, const float centre[3]);
+    // The centred keyframe under a node's view-projection; valid until the next centre().
+    NodeRasterizer::CentredVertices vertices(const Mat4d& view_projection) const;
+
+private:
+    std::vector<float> xyz_;  // x | y | z
+    const float* positions_ = nullptr;
+    size_t vertex_count_ = 0;
+    float centre_[3] = {0.0f, 0.0f, 0.0f};
+};
 
 }  // namespace animorder

@@ -44,6 +44,20 @@ public:
                              unsigned resolution, const uint8_t* modes = nullptr, const uint32_t* candidates = nullptr,
                              size_t candidate_count = 0);
 
+    // The vertices as positions moved to the frame's centre (one array per coordinate) and a
+    // view-projection matrix (column-major, in float): the clip-space positions transform_to_clip
+    // gives (its float operations, in its order), computed in the vertex pass instead of stored and
+    // read back. The same fragments as rasterize_validated of transform_to_clip's array.
+    struct CentredVertices {
+        const float* x = nullptr;
+        const float* y = nullptr;
+        const float* z = nullptr;
+        float view_projection[16] = {};
+    };
+    void rasterize_validated(const CentredVertices& vertices, size_t vertex_count, const uint32_t* indices,
+                             size_t index_count, unsigned resolution, const uint8_t* modes = nullptr,
+                             const uint32_t* candidates = nullptr, size_t candidate_count = 0);
+
     // The per-node code is compiled in up to three copies, each doing the same operations in the
     // same order, so each giving the same bits: portable (SSE2 on x86-64); AVX2, where the CPU
     // has it; AVX-512, the AVX2 copy compiled with AVX-512 (F, VL, BW, DQ) allowed at the same

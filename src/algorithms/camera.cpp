@@ -7,6 +7,8 @@
 // array feeds both our rasteriser and the OpenGL reference, so the two see identical input.
 #include "animorder/camera.h"
 
+#include <algorithm>
+
 #include "animorder/invalid_input.h"
 
 #include "mat4.h"
@@ -78,8 +80,8 @@ inline __attribute__((always_inline)) void transform_block(float* out, const flo
 
 inline __attribute__((always_inline)) void transform_all(float* clip_xyzw, const float* positions, size_t vertex_count,
                                                          const float centre[3], const Mat4d& vp) {
-    float m[16];
-    for (int i = 0; i < 16; ++i) m[i] = float(vp[i]);
+    const std::array<float, 16> matrix = float_matrix(vp);
+    const float* m = matrix.data();
     size_t v = 0;
     for (; v + kBlock <= vertex_count; v += kBlock)
         transform_block(clip_xyzw + 4 * v, positions + 3 * v, kBlock, centre, m);
@@ -95,6 +97,41 @@ __attribute__((target("avx2"))) void transform_all_avx2(float* clip_xyzw, const 
 #endif
 
 }  // namespace
+
+std::array<float, 16> float_matrix(const Mat4d& m) {
+    std::array<float, 16> out;
+    for (int i = 0; i < 16; ++i) out[size_t(i)] = float(m[size_t(i)]);
+    return out;
+}
+
+void centre_positions(float* x, float* y, float* z, const float* positions, size_t vertex_count,
+                      const float centre[3]) {
+    for (size_t v = 0; v < vertex_count; ++v) {
+        x[v] = positions[3 * v] - centre[0];
+        y[v] = positions[3 * v + 1] - centre[1];
+        z[v] = positions[3 * v + 2] - centre[2];
+    }
+}
+
+void CentredKeyframe::centre(const float* positions, size_t vertex_count, const float centre[3]) {
+    if (positions == positions_ && vertex_count == vertex_count_ && std::equal(centre, centre + 3, centre_)) return;
+    xyz_.resize(3 * vertex_count);
+    centre_positions(xyz_.data(), xyz_.data() + vertex_count, xyz_.data() + 2 * vertex_count, positions, vertex_count,
+                     centre);
+    positions_ = positions;
+    vertex_count_ = vertex_count;
+    std::copy(centre, centre + 3, centre_);
+}
+
+NodeRasterizer::CentredVertices CentredKeyframe::vertices(const Mat4d& view_projection) const {
+    NodeRasterizer::CentredVertices v;
+    v.x = xyz_.data();
+    v.y = xyz_.data() + vertex_count_;
+    v.z = xyz_.data() + 2 * vertex_count_;
+    const std::array<float, 16> m = float_matrix(view_projection);
+    std::copy(m.begin(), m.end(), v.view_projection);
+    return v;
+}
 
 void transform_to_clip_portable(float* clip_xyzw, const float* positions, size_t vertex_count, const float centre[3],
                                 const Mat4d& vp) {

@@ -51,26 +51,26 @@ private:
     std::mutex mutex_;
 };
 
-// One worker's rasteriser: a node transformed to clip space and rasterised from the facing
-// filter's candidates (built again when the keyframe changes; the same fragments as from every
-// triangle).
+// One worker's rasteriser: a node rasterised from its keyframe's positions moved to the frame's
+// centre (done once for the keyframe's views; the rasteriser transforms them to clip space in its
+// vertex pass, as transform_to_clip would) and from the facing filter's candidates (built again
+// when the keyframe changes; the same fragments as from every triangle).
 struct NodeWorker {
     NodeRasterizer rasterizer;
-    std::vector<float> clip;
+    CentredKeyframe centred;
     FacingFilter facing;
 
     void rasterize(const float* keyframe_positions, size_t vertex_count, const Framing& framing,
                    const uint32_t* indices, size_t index_count, const OverdrawNode& node,
                    const ScoreSettings& settings) {
-        clip.resize(vertex_count * 4);
         const float* keyframe = keyframe_positions + size_t(node.keyframe) * vertex_count * 3;
         const float* centre = framing.centres.data() + 3 * size_t(node.keyframe);
-        transform_to_clip(clip.data(), keyframe, vertex_count, centre,
-                          node_view_projection(node.direction, framing.radius));
+        centred.centre(keyframe, vertex_count, centre);
         facing.build_for(node.keyframe, keyframe, vertex_count, indices, index_count, centre, framing.radius,
                          settings.resolution, settings.triangle_modes);
         const FacingFilter::Candidates candidates = facing.candidates(node.direction);
-        rasterizer.rasterize_validated(clip.data(), vertex_count, indices, index_count, settings.resolution,
+        rasterizer.rasterize_validated(centred.vertices(node_view_projection(node.direction, framing.radius)),
+                                       vertex_count, indices, index_count, settings.resolution,
                                        settings.triangle_modes, candidates.ids, candidates.count);
     }
 };

@@ -160,6 +160,22 @@ struct ClipVertex {
     float x, y, z, w;
 };
 
+// Where the vertex pass reads the clip-space vertices: an array of them, or positions moved to the
+// frame's centre (NodeRasterizer::CentredVertices) transformed as transform_to_clip does, row by
+// row ((m·x + m·y) + m·z) + m in float (no fused multiply-add: the build turns contraction off),
+// so the same bits.
+struct VertexSource {
+    const ClipVertex* clip = nullptr;  // null: the centred positions and m
+    const float *x = nullptr, *y = nullptr, *z = nullptr, *m = nullptr;
+
+    ClipVertex operator[](size_t v) const {
+        if (clip) return clip[v];
+        const float px = x[v], py = y[v], pz = z[v];
+        return {m[0] * px + m[4] * py + m[8] * pz + m[12], m[1] * px + m[5] * py + m[9] * pz + m[13],
+                m[2] * px + m[6] * py + m[10] * pz + m[14], m[3] * px + m[7] * py + m[11] * pz + m[15]};
+    }
+};
+
 // llvmpipe's util_iround: round half away from zero.
 int64_t round_half_away(float v) { return int64_t(v >= 0.0f ? v + 0.5f : v - 0.5f); }
 
@@ -837,8 +853,17 @@ ANIMORDER_INLINE void batch_box_test(size_t n, const int32_t* x0, const int32_t*
 // taken as an int32 truncation where |v ± 0.5f| < 2^30 (the same integer) and the compact test
 // as there: X compact iff |t| < 2^24 (t = v ± 0.5f; floats at 2^23 and above are integers), Y
 // compact iff top_row − trunc(t) lies inside ±2^24; NaN compares false (not compact).
-template <NodeRasterizer::Copy>  // one instance a wide copy: each inlines its own
-__attribute__((target("avx2"))) size_t project_vertices_avx2(const ClipVertex* cv, size_t count, unsigned resolution,
+// Row r of VertexSource's transform for 8 vertices: ((m[r]·x + m[4+r]·y) + m[8+r]·z) + m[12+r].
+__attribute__((target("avx2"), always_inline)) inline __m256 transform_row_avx2(const __m256 (&m)[16], int r, __m256 x,
+                                                                                __m256 y, __m256 z) {
+    return _mm256_add_ps(
+        _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(m[r], x), _mm256_mul_ps(m[4 + r], y)), _mm256_mul_ps(m[8 + r], z)),
+        m[12 + r]);
+}
+
+template <NodeRasterizer::Copy, bool kCentred>  // one instance a wide copy and source: each inlines its own
+__attribute__((target("avx2"))) size_t project_vertices_avx2(const VertexSource& source, size_t count,
+                                                             unsigned resolution,
                                                              NodeRasterizer::State::Snapped* snapped,
                                                              NodeRasterizer::State::VertexRecord* out, uint8_t* flags) {
     const __m256 half = _mm256_set1_ps(0.5f * float(resolution)), point5 = _mm256_set1_ps(0.5f);
@@ -849,18 +874,33 @@ __attribute__((target("avx2"))) size_t project_vertices_avx2(const ClipVertex* c
     const __m256i top_row = _mm256_set1_epi32(int32_t(int64_t(resolution - 1) * kSubpixel));
     const __m256i special = _mm256_set1_epi32(kSpecialVertex);
     const __m256i low = _mm256_set1_epi32(-int32_t(kCompactLimit)), high = _mm256_set1_epi32(int32_t(kCompactLimit));
-    const float* p = reinterpret_cast<const float*>(cv);
+    const float* p = reinterpret_cast<const float*>(source.clip);
+    __m256 m[16];  // kCentred: VertexSource's matrix, an entry a vector
+    if constexpr (kCentred)
+        for (int i = 0; i < 16; ++i) m[i] = _mm256_set1_ps(source.m[i]);
     size_t v = 0;
-    for (; v + 8 <= count; v += 8, p += 32) {
-        // Vertices 0-3 in the low halves, 4-7 in the high ones: the transpose leaves them in order.
-        const __m256 r0 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(p)), _mm_loadu_ps(p + 16), 1);
-        const __m256 r1 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(p + 4)), _mm_loadu_ps(p + 20), 1);
-        const __m256 r2 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(p + 8)), _mm_loadu_ps(p + 24), 1);
-        const __m256 r3 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(p + 12)), _mm_loadu_ps(p + 28), 1);
-        const __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpackhi_ps(r0, r1);
-        const __m256 t2 = _mm256_unpacklo_ps(r2, r3), t3 = _mm256_unpackhi_ps(r2, r3);
-        const __m256 x = _mm256_shuffle_ps(t0, t2, 0x44), y = _mm256_shuffle_ps(t0, t2, 0xEE);
-        const __m256 z = _mm256_shuffle_ps(t1, t3, 0x44), w = _mm256_shuffle_ps(t1, t3, 0xEE);
+    for (; v + 8 <= count; v += 8) {
+        __m256 x, y, z, w;
+        if constexpr (kCentred) {  // VertexSource's transform, its operations in its order
+            const __m256 px = _mm256_loadu_ps(source.x + v), py = _mm256_loadu_ps(source.y + v);
+            const __m256 pz = _mm256_loadu_ps(source.z + v);
+            x = transform_row_avx2(m, 0, px, py, pz), y = transform_row_avx2(m, 1, px, py, pz);
+            z = transform_row_avx2(m, 2, px, py, pz), w = transform_row_avx2(m, 3, px, py, pz);
+        } else {
+            // Vertices 0-3 in the low halves, 4-7 in the high ones: the transpose leaves them in order.
+            const float* q = p + 4 * v;
+            const __m256 r0 = _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(q)), _mm_loadu_ps(q + 16), 1);
+            const __m256 r1 =
+                _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(q + 4)), _mm_loadu_ps(q + 20), 1);
+            const __m256 r2 =
+                _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(q + 8)), _mm_loadu_ps(q + 24), 1);
+            const __m256 r3 =
+                _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(q + 12)), _mm_loadu_ps(q + 28), 1);
+            const __m256 t0 = _mm256_unpacklo_ps(r0, r1), t1 = _mm256_unpackhi_ps(r0, r1);
+            const __m256 t2 = _mm256_unpacklo_ps(r2, r3), t3 = _mm256_unpackhi_ps(r2, r3);
+            x = _mm256_shuffle_ps(t0, t2, 0x44), y = _mm256_shuffle_ps(t0, t2, 0xEE);
+            z = _mm256_shuffle_ps(t1, t3, 0x44), w = _mm256_shuffle_ps(t1, t3, 0xEE);
+        }
         // inside_all
         const __m256 w2 = _mm256_mul_ps(guard, w);
         const __m256 inside = _mm256_and_ps(
@@ -941,17 +981,36 @@ __attribute__((target("avx2,popcnt"))) size_t pack_drawn_avx2(size_t n, const in
 }  // namespace
 
 namespace {
-void rasterize_node_portable(NodeRasterizer::State& s, const float* clip_xyzw, size_t vertex_count,
+void rasterize_node_portable(NodeRasterizer::State& s, const VertexSource& source, size_t vertex_count,
                              const uint32_t* indices, size_t index_count, unsigned resolution, const uint8_t* modes,
                              const uint32_t* candidates, size_t candidate_count);
 #ifdef ANIMORDER_RASTER_AVX2
-void rasterize_node_avx2(NodeRasterizer::State& s, const float* clip_xyzw, size_t vertex_count, const uint32_t* indices,
+void rasterize_node_avx2(NodeRasterizer::State& s, const VertexSource& source, size_t vertex_count, const uint32_t* indices,
                          size_t index_count, unsigned resolution, const uint8_t* modes, const uint32_t* candidates,
                          size_t candidate_count);
-void rasterize_node_avx512(NodeRasterizer::State& s, const float* clip_xyzw, size_t vertex_count,
+void rasterize_node_avx512(NodeRasterizer::State& s, const VertexSource& source, size_t vertex_count,
                            const uint32_t* indices, size_t index_count, unsigned resolution, const uint8_t* modes,
                            const uint32_t* candidates, size_t candidate_count);
 #endif
+
+// The checks, then the widest copy set_copy allows.
+void rasterize_source(NodeRasterizer::State& s, const VertexSource& source, size_t vertex_count,
+                      const uint32_t* indices, size_t index_count, unsigned resolution, const uint8_t* modes,
+                      const uint32_t* candidates, size_t candidate_count) {
+    if (resolution == 0 || resolution > 16384)
+        throw InvalidInput("resolution " + std::to_string(resolution) + " is outside 1..16384");
+    s.resolution = resolution;
+#ifdef ANIMORDER_RASTER_AVX2
+    if (s.copy == NodeRasterizer::Copy::Avx512)
+        return rasterize_node_avx512(s, source, vertex_count, indices, index_count, resolution, modes, candidates,
+                                     candidate_count);
+    if (s.copy == NodeRasterizer::Copy::Avx2)
+        return rasterize_node_avx2(s, source, vertex_count, indices, index_count, resolution, modes, candidates,
+                                   candidate_count);
+#endif
+    rasterize_node_portable(s, source, vertex_count, indices, index_count, resolution, modes, candidates,
+                            candidate_count);
+}
 }  // namespace
 
 void NodeRasterizer::rasterize(const float* clip_xyzw, size_t vertex_count, const uint32_t* indices, size_t index_count,
@@ -963,20 +1022,22 @@ void NodeRasterizer::rasterize(const float* clip_xyzw, size_t vertex_count, cons
 void NodeRasterizer::rasterize_validated(const float* clip_xyzw, size_t vertex_count, const uint32_t* indices,
                                          size_t index_count, unsigned resolution, const uint8_t* modes,
                                          const uint32_t* candidates, size_t candidate_count) {
-    if (resolution == 0 || resolution > 16384)
-        throw InvalidInput("resolution " + std::to_string(resolution) + " is outside 1..16384");
-    State& s = *state_;
-    s.resolution = resolution;
-#ifdef ANIMORDER_RASTER_AVX2
-    if (s.copy == Copy::Avx512)
-        return rasterize_node_avx512(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes, candidates,
-                                     candidate_count);
-    if (s.copy == Copy::Avx2)
-        return rasterize_node_avx2(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes, candidates,
-                                   candidate_count);
-#endif
-    rasterize_node_portable(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes, candidates,
-                            candidate_count);
+    VertexSource source;
+    source.clip = reinterpret_cast<const ClipVertex*>(clip_xyzw);
+    rasterize_source(*state_, source, vertex_count, indices, index_count, resolution, modes, candidates,
+                     candidate_count);
+}
+
+void NodeRasterizer::rasterize_validated(const CentredVertices& vertices, size_t vertex_count, const uint32_t* indices,
+                                         size_t index_count, unsigned resolution, const uint8_t* modes,
+                                         const uint32_t* candidates, size_t candidate_count) {
+    VertexSource source;
+    source.x = vertices.x;
+    source.y = vertices.y;
+    source.z = vertices.z;
+    source.m = vertices.view_projection;
+    rasterize_source(*state_, source, vertex_count, indices, index_count, resolution, modes, candidates,
+                     candidate_count);
 }
 
 NodeRasterizer::Copy NodeRasterizer::widest_copy() {
@@ -1011,29 +1072,32 @@ namespace {
 // for its own instructions). Inlined into the three copies below; kAvx2: the AVX2 and AVX-512
 // copies, whose boxes take the emit_*_avx2 paths.
 template <NodeRasterizer::Copy kCopy>
-ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip_xyzw, size_t vertex_count,
+ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const VertexSource& source, size_t vertex_count,
                                      const uint32_t* indices, size_t index_count, unsigned resolution,
                                      const uint8_t* modes, const uint32_t* candidates, size_t candidate_count) {
     constexpr bool kAvx2 = kCopy != NodeRasterizer::Copy::Portable;
-    const ClipVertex* cv = reinterpret_cast<const ClipVertex*>(clip_xyzw);
+    const VertexSource& cv = source;
     s.snapped.resize(vertex_count);
     s.vertices.resize(vertex_count);
     s.vertex_flags.resize(vertex_count);
     size_t first_vertex = 0;
 #ifdef ANIMORDER_RASTER_AVX2
     if constexpr (kAvx2)
-        first_vertex = project_vertices_avx2<kCopy>(cv, vertex_count, resolution, s.snapped.data(), s.vertices.data(),
-                                                    s.vertex_flags.data());
+        first_vertex = cv.clip ? project_vertices_avx2<kCopy, false>(cv, vertex_count, resolution, s.snapped.data(),
+                                                                     s.vertices.data(), s.vertex_flags.data())
+                               : project_vertices_avx2<kCopy, true>(cv, vertex_count, resolution, s.snapped.data(),
+                                                                    s.vertices.data(), s.vertex_flags.data());
 #endif
     for (size_t v = first_vertex; v < vertex_count; ++v) {
-        if (!inside_all(cv[v])) {
+        const ClipVertex c = cv[v];
+        if (!inside_all(c)) {
             s.vertex_flags[v] = kClippedVertex;
             s.snapped[v] = {kSpecialVertex, kSpecialVertex};
             s.vertices[v] = {0.0f, 0.0f, 0.0f, 0.0f};
             continue;
         }
         WindowVertex w;
-        project(cv[v], resolution, w);
+        project(c, resolution, w);
         const bool compact = w.X > -kCompactLimit && w.X < kCompactLimit && w.Y > -kCompactLimit && w.Y < kCompactLimit;
         s.vertex_flags[v] = compact ? 0 : kWideVertex;
         s.snapped[v] = {compact ? int32_t(w.X) : kSpecialVertex, compact ? int32_t(w.Y) : kSpecialVertex};
@@ -1225,28 +1289,28 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const float* clip
     group_fragments(s);
 }
 
-void rasterize_node_portable(NodeRasterizer::State& s, const float* clip_xyzw, size_t vertex_count,
+void rasterize_node_portable(NodeRasterizer::State& s, const VertexSource& source, size_t vertex_count,
                              const uint32_t* indices, size_t index_count, unsigned resolution, const uint8_t* modes,
                              const uint32_t* candidates, size_t candidate_count) {
-    rasterize_node<NodeRasterizer::Copy::Portable>(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes,
+    rasterize_node<NodeRasterizer::Copy::Portable>(s, source, vertex_count, indices, index_count, resolution, modes,
                                                    candidates, candidate_count);
 }
 
 #ifdef ANIMORDER_RASTER_AVX2
-__attribute__((target("avx2"))) void rasterize_node_avx2(NodeRasterizer::State& s, const float* clip_xyzw,
+__attribute__((target("avx2"))) void rasterize_node_avx2(NodeRasterizer::State& s, const VertexSource& source,
                                                          size_t vertex_count, const uint32_t* indices,
                                                          size_t index_count, unsigned resolution, const uint8_t* modes,
                                                          const uint32_t* candidates, size_t candidate_count) {
-    rasterize_node<NodeRasterizer::Copy::Avx2>(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes,
+    rasterize_node<NodeRasterizer::Copy::Avx2>(s, source, vertex_count, indices, index_count, resolution, modes,
                                                candidates, candidate_count);
 }
 
 // The AVX2 copy's source compiled with AVX-512 allowed; GCC keeps its loops at 256-bit vectors
 // (its default width for these targets), so no 512-bit clock penalty where a CPU has one.
 __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) void rasterize_node_avx512(
-    NodeRasterizer::State& s, const float* clip_xyzw, size_t vertex_count, const uint32_t* indices, size_t index_count,
+    NodeRasterizer::State& s, const VertexSource& source, size_t vertex_count, const uint32_t* indices, size_t index_count,
     unsigned resolution, const uint8_t* modes, const uint32_t* candidates, size_t candidate_count) {
-    rasterize_node<NodeRasterizer::Copy::Avx512>(s, clip_xyzw, vertex_count, indices, index_count, resolution, modes,
+    rasterize_node<NodeRasterizer::Copy::Avx512>(s, source, vertex_count, indices, index_count, resolution, modes,
                                                  candidates, candidate_count);
 }
 #endif

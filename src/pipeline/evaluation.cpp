@@ -89,7 +89,7 @@ std::vector<OrderEvaluation> evaluate_methods(const AnimatedMesh& mesh, const st
     struct Worker {
         NodeRasterizer rasterizer;
         FacingFilter facing;  // the keyframe last drawn's: the same fragments, fewer triangles
-        std::vector<float> clip;
+        CentredKeyframe centred;      // the keyframe last drawn's, moved to its frame's centre
         std::vector<uint32_t> ranks;  // this node's table: triangles × methods
     };
     tbb::enumerable_thread_specific<Worker> workers;
@@ -104,7 +104,6 @@ std::vector<OrderEvaluation> evaluate_methods(const AnimatedMesh& mesh, const st
     };
     auto visit = [&](const Node& node) {
         Worker& w = workers.local();
-        w.clip.resize(mesh.vertex_count * 4);
         w.ranks.resize(triangles * method_count);
         const Framing& framing = *node.framing;
         for (size_t m = 0; m < method_count; ++m) {
@@ -123,14 +122,14 @@ std::vector<OrderEvaluation> evaluate_methods(const AnimatedMesh& mesh, const st
             for (size_t t = 0; t < triangles; ++t) w.ranks[t * method_count + m] = rank[t];
         }
         const float* centre = &all.centres[3 * node.keyframe];
-        transform_to_clip(w.clip.data(), mesh.keyframe(node.keyframe), mesh.vertex_count, centre,
-                          node_view_projection(node.direction, framing.radius));
+        w.centred.centre(mesh.keyframe(node.keyframe), mesh.vertex_count, centre);
         const uint8_t* triangle_modes = modes.empty() ? nullptr : modes.data();
         w.facing.build_for(uint64_t(node.clip) << 32 | node.keyframe, mesh.keyframe(node.keyframe), mesh.vertex_count,
                            mesh.indices.data(), mesh.indices.size(), centre, framing.radius, settings.resolution,
                            triangle_modes);
         const FacingFilter::Candidates candidates = w.facing.candidates(node.direction);
-        w.rasterizer.rasterize_validated(w.clip.data(), mesh.vertex_count, mesh.indices.data(), mesh.indices.size(),
+        w.rasterizer.rasterize_validated(w.centred.vertices(node_view_projection(node.direction, framing.radius)),
+                                         mesh.vertex_count, mesh.indices.data(), mesh.indices.size(),
                                          settings.resolution, triangle_modes, candidates.ids, candidates.count);
         visible[node.index] = w.rasterizer.visible_pixels();
         w.rasterizer.score(&passed[node.index * method_count], w.ranks.data(), method_count);

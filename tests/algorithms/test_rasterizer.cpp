@@ -1009,3 +1009,74 @@ TEST(Rasterizer, WideVertexPassGivesThePortableBits) {
     }
     EXPECT_GT(fragments, 20000u);
 }
+
+// The centred-positions entry (the transform to clip space inside the vertex pass) against
+// transform_to_clip and the clip-space entry, bit for bit, in every copy: the bundled character
+// from 42 directions at two keyframes, at 64² and 256², with extra vertices that take the exact
+// paths (one behind the near plane, one beyond the guard band, one not a number) in triangles
+// with the character's vertices, and every vertex count modulo 8 (the vertex pass's scalar tail,
+// which transforms one vertex at a time). Fails when a clip coordinate differs (fragments then
+// move, change depth or go; checked: m·x + (m·y + m·z) for (m·x + m·y) + m·z, in the wide vertex
+// pass or in the one-vertex transform, fails it).
+TEST(Rasterizer, CentredVerticesGiveTheClipSpaceBits) {
+    const AnimatedMesh mesh = make_procedural_character();
+    const Framing framing = frame_animated_mesh(mesh);
+    const std::vector<float> dirs = icosphere_directions(1);
+    size_t compared = 0, exact_paths = 0;
+    for (size_t tail = 0; tail < 8; ++tail)
+        for (const uint32_t k : {0u, uint32_t(mesh.keyframe_count() / 2)}) {
+            const float* centre = &framing.centres[3 * k];
+            std::vector<float> positions(mesh.keyframe(k), mesh.keyframe(k) + 3 * mesh.vertex_count);
+            std::vector<uint32_t> ib = mesh.indices;
+            const uint32_t first_extra = uint32_t(mesh.vertex_count);
+            const float r = framing.radius;
+            // Beyond the near plane from every direction (inside the sphere of radius R around the
+            // camera at 3R: none is; so far out along one axis that some view has it behind), far
+            // beyond the guard band sideways, and NaN.
+            const float extra[4][3] = {{centre[0] + 2.8f * r, centre[1], centre[2]},
+                                       {centre[0], centre[1] + 40.0f * r, centre[2]},
+                                       {centre[0], centre[1], centre[2] - 2.9f * r},
+                                       {std::numeric_limits<float>::quiet_NaN(), centre[1], centre[2]}};
+            for (const auto& e : extra) positions.insert(positions.end(), e, e + 3);
+            for (uint32_t e = 0; e < 4; ++e)  // each with two of the character's vertices, both windings
+                for (uint32_t a = 0; a < 6; ++a) {
+                    const uint32_t u = a * 97 % first_extra, w = (a * 97 + 1) % first_extra;
+                    ib.insert(ib.end(), {first_extra + e, u, w, w, u, first_extra + e});
+                }
+            while ((positions.size() / 3) % 8 != tail) positions.insert(positions.end(), centre, centre + 3);
+            const size_t vertices = positions.size() / 3;
+            std::vector<uint8_t> modes(ib.size() / 3, 0);
+            for (size_t t = 0; t < modes.size(); t += 5) modes[t] = kDrawBothFaces;
+            std::vector<float> clip(4 * vertices);
+            CentredKeyframe centred;
+            centred.centre(positions.data(), vertices, centre);
+            for (size_t v = 0; v < dirs.size() / 3; v += tail + 1)
+                for (const unsigned resolution : {64u, 256u}) {
+                    const Mat4d vp = node_view_projection(&dirs[3 * v], framing.radius);
+                    transform_to_clip(clip.data(), positions.data(), vertices, centre, vp);
+                    const NodeRasterizer::CentredVertices source = centred.vertices(vp);
+                    for (size_t c = 0; c < 4; ++c) {  // how many extra vertices this view draws exactly
+                        const float* q = &clip[4 * (first_extra + c)];
+                        exact_paths += !(q[2] >= -q[3] && q[2] <= q[3] && std::fabs(q[0]) <= 2.0f * q[3] &&
+                                         std::fabs(q[1]) <= 2.0f * q[3]);
+                    }
+                    for (const Copy copy : copies_here()) {
+                        NodeRasterizer from_clip, from_centred;
+                        from_clip.set_copy(copy);
+                        from_centred.set_copy(copy);
+                        from_clip.rasterize(clip.data(), vertices, ib.data(), ib.size(), resolution, modes.data());
+                        from_centred.rasterize_validated(source, vertices, ib.data(), ib.size(), resolution,
+                                                         modes.data());
+                        const auto expected = engine_fragments(from_clip);
+                        expect_same_fragments(engine_fragments(from_centred), expected,
+                                              std::string(NodeRasterizer::copy_name(copy)) + " copy, view " +
+                                                  std::to_string(v) + ", " + std::to_string(vertices) + " vertices");
+                        if (HasFatalFailure()) return;
+                        ASSERT_EQ(from_clip.export_fragments().fragments, from_centred.export_fragments().fragments);
+                        compared += expected.size();
+                    }
+                }
+        }
+    EXPECT_GT(compared, 500000u);  // the views draw the character
+    EXPECT_GT(exact_paths, 100u);  // and the extra vertices take the exact paths
+}

@@ -22,6 +22,7 @@
 #include "animorder/measured_order.h"
 #include "animorder/overdraw.h"
 #include "animorder/rasterizer.h"
+#include "animorder/triangle_order.h"
 #include "worker_threads.h"
 
 #include <tbb/blocked_range.h>
@@ -68,26 +69,26 @@ std::vector<BlendFragments> blend_fragments_of_nodes(const AnimatedMesh& mesh, c
     const size_t views = run.directions.size() / 3, node_count = run.assignment.size();
     if (views == 0 || node_count != views * run.keyframes.size())
         throw InvalidInput("a clustering run's assignment does not cover its nodes");
+    validate_indices(mesh.indices.data(), mesh.indices.size(), mesh.vertex_count);  // once, not once a node
     const std::vector<uint8_t> blended = blended_triangles(mesh);
     const std::vector<uint8_t> modes = full_pass_modes(mesh);
     std::vector<BlendFragments> kept(node_count);
     struct Worker {
         NodeRasterizer rasterizer;
-        std::vector<float> clip;
+        CentredKeyframe centred;  // the keyframe last drawn's
     };
     tbb::enumerable_thread_specific<Worker> workers;
     tbb::task_arena arena(worker_threads(threads));
     arena.execute([&] {
         tbb::parallel_for(tbb::blocked_range<size_t>(0, node_count, 1), [&](const tbb::blocked_range<size_t>& range) {
             Worker& w = workers.local();
-            w.clip.resize(mesh.vertex_count * 4);
             for (size_t n = range.begin(); n != range.end(); ++n) {
                 const uint32_t keyframe = run.keyframes[n / views];
-                transform_to_clip(w.clip.data(), mesh.keyframe(keyframe), mesh.vertex_count,
-                                  &framing.centres[3 * size_t(keyframe)],
-                                  node_view_projection(&run.directions[3 * (n % views)], framing.radius));
-                w.rasterizer.rasterize(w.clip.data(), mesh.vertex_count, mesh.indices.data(), mesh.indices.size(),
-                                       resolution, modes.empty() ? nullptr : modes.data());
+                w.centred.centre(mesh.keyframe(keyframe), mesh.vertex_count, &framing.centres[3 * size_t(keyframe)]);
+                w.rasterizer.rasterize_validated(
+                    w.centred.vertices(node_view_projection(&run.directions[3 * (n % views)], framing.radius)),
+                    mesh.vertex_count, mesh.indices.data(), mesh.indices.size(), resolution,
+                    modes.empty() ? nullptr : modes.data());
                 kept[n] = w.rasterizer.export_blend_fragments(blended.data());
             }
         });

@@ -219,7 +219,7 @@ public:
         struct Worker {
             GraphWorker graph;
             NodeRasterizer rasterizer;
-            std::vector<float> clip;
+            CentredKeyframe centred;  // the keyframe last drawn's
             double seconds_raster = 0;
         };
         tbb::enumerable_thread_specific<Worker> workers;
@@ -233,12 +233,12 @@ public:
                 }
                 const Clock::time_point start = Clock::now();
                 const OverdrawNode& node = nodes_.list[n];
-                w.clip.resize(vertex_count_ * 4);
-                transform_to_clip(w.clip.data(), positions_ + size_t(node.keyframe) * vertex_count_ * 3, vertex_count_,
-                                  nodes_.framing.centres.data() + 3 * size_t(node.keyframe),
-                                  node_view_projection(node.direction, nodes_.framing.radius));
-                w.rasterizer.rasterize(w.clip.data(), vertex_count_, indices_, index_count_, settings_.resolution,
-                                       settings_.triangle_modes);
+                w.centred.centre(positions_ + size_t(node.keyframe) * vertex_count_ * 3, vertex_count_,
+                                 nodes_.framing.centres.data() + 3 * size_t(node.keyframe));
+                // The indices were checked once (order_static_nehab06).
+                w.rasterizer.rasterize_validated(
+                    w.centred.vertices(node_view_projection(node.direction, nodes_.framing.radius)), vertex_count_,
+                    indices_, index_count_, settings_.resolution, settings_.triangle_modes);
                 const NodeFragments fragments = w.rasterizer.export_fragments();
                 w.seconds_raster += seconds_since(start);
                 accumulate_node(w.graph, fragments, cluster_of, rank, cluster_count);

@@ -83,6 +83,7 @@ std::vector<uint32_t> back_to_front_blended_order(const AnimatedMesh& mesh, cons
 std::vector<BlendEvaluation> evaluate_blend(const AnimatedMesh& mesh, const std::vector<MethodBuffers>& methods,
                                             const EvaluationSettings& settings) {
     validate_animated_mesh(mesh);
+    validate_indices(mesh.indices.data(), mesh.indices.size(), mesh.vertex_count);  // once, not once a node
     if (!has_blended_primitives(mesh)) throw InvalidInput("the mesh has no blended primitive (alphaMode BLEND)");
     if (settings.views == 0) throw InvalidInput("evaluation needs at least one viewpoint");
     if (settings.resolution == 0) throw InvalidInput("evaluation needs a resolution of at least one pixel");
@@ -100,7 +101,7 @@ std::vector<BlendEvaluation> evaluate_blend(const AnimatedMesh& mesh, const std:
     std::vector<std::vector<BlendAccumulator>> per_clip(order_count, std::vector<BlendAccumulator>(mesh.clips.size()));
     struct Worker {
         NodeRasterizer rasterizer;
-        std::vector<float> clip;
+        CentredKeyframe centred;  // the keyframe last drawn's
         std::vector<uint32_t> ranks;
     };
     tbb::enumerable_thread_specific<Worker> workers;
@@ -110,7 +111,6 @@ std::vector<BlendEvaluation> evaluate_blend(const AnimatedMesh& mesh, const std:
     };
     auto visit = [&](const Node& node) {
         Worker& w = workers.local();
-        w.clip.resize(mesh.vertex_count * 4);
         w.ranks.assign(triangles * order_count, 0);
         const Framing& framing = *node.framing;
         for (size_t m = 0; m < method_count; ++m) {
@@ -123,10 +123,10 @@ std::vector<BlendEvaluation> evaluate_blend(const AnimatedMesh& mesh, const std:
         const std::vector<uint32_t> bound =
             back_to_front_blended_order(mesh, mesh.keyframe(node.keyframe), &all.centres[3 * node.keyframe], eye);
         for (size_t i = 0; i < triangles; ++i) w.ranks[size_t(bound[i]) * order_count + method_count] = uint32_t(i);
-        transform_to_clip(w.clip.data(), mesh.keyframe(node.keyframe), mesh.vertex_count,
-                          &all.centres[3 * node.keyframe], node_view_projection(node.direction, framing.radius));
-        w.rasterizer.rasterize(w.clip.data(), mesh.vertex_count, mesh.indices.data(), mesh.indices.size(),
-                               settings.resolution, modes.empty() ? nullptr : modes.data());
+        w.centred.centre(mesh.keyframe(node.keyframe), mesh.vertex_count, &all.centres[3 * node.keyframe]);
+        w.rasterizer.rasterize_validated(w.centred.vertices(node_view_projection(node.direction, framing.radius)),
+                                         mesh.vertex_count, mesh.indices.data(), mesh.indices.size(),
+                                         settings.resolution, modes.empty() ? nullptr : modes.data());
         score_blend(&counts[node.index * order_count], w.rasterizer.export_blend_fragments(blended.data()),
                     w.ranks.data(), order_count);
     };

@@ -1,8 +1,9 @@
 // Per-node cost of the overdraw engine on one thread (issue 19): NodeRasterizer::rasterize_validated
 // from the keyframe's centred positions (the transform to clip space in its vertex pass; centring,
 // once a keyframe, is "transform") and the FacingFilter's candidates (the filter's time included;
-// then the widest copy again from every triangle, and again from clip space with
-// transform_to_clip per node, in the same run, for the filter's and the fused transform's worth), keep_fragments and score_kept (1 and 5 random patch orders),
+// then the widest copy again from every triangle, in the same run, for the filter's worth),
+// keep_fragments and score_kept (1 and 5 random patch orders); then every node both from centred
+// positions and from clip space (transform_to_clip per node), in turns, for the fused transform's worth;
 // as CPU time of this thread (CLOCK_THREAD_CPUTIME_ID, so other processes on a shared machine do
 // not count), over a spread of nodes of a character (default protocol: 162 views, 256², λ = 0.85).
 // Also prints hashes: the rasteriser's output (raw fragments in order, grouped lists, counts), the
@@ -106,7 +107,7 @@ int main(int argc, char** argv) try {
     std::vector<float> clip(mesh.vertex_count * 4);
     validate_indices(mesh.indices.data(), mesh.indices.size(), mesh.vertex_count);  // once, as NodeCache does
     struct Timing {
-        double transform_ms = 0, rasterize_ms = 0;
+        double rasterize_ms = 0;
         uint64_t hash = 0;
     };
     // Random unit orders (whole patches in their inner order) for timing score_kept.
@@ -131,10 +132,9 @@ int main(int argc, char** argv) try {
     const std::vector<uint32_t> ranks1 = rank_tables(1), ranks5 = rank_tables(5);
     const std::vector<uint16_t> unit_ranks1 = make_unit_rank_table(ranks1.data(), 1, partition),
                                 unit_ranks5 = make_unit_rank_table(ranks5.data(), 5, partition);
-    // from_clip: transform_to_clip each node, then the clip-space entry; otherwise as NodeCache's
-    // workers: the keyframe's positions centred once (its share of that is "transform"), the
-    // transform to clip space inside the rasteriser's vertex pass.
-    const auto measure = [&](Copy copy, bool filtered, bool from_clip) {
+    // As NodeCache's workers: the keyframe's positions centred once (its share of that is
+    // "transform"), the transform to clip space inside the rasteriser's vertex pass.
+    const auto measure = [&](Copy copy, bool filtered) {
         NodeRasterizer rasterizer;
         rasterizer.set_copy(copy);
         KeepScratch scratch;
@@ -152,15 +152,9 @@ int main(int argc, char** argv) try {
             for (size_t k = 0; k < mesh.keyframe_count(); k += step)
                 for (size_t v = 0; v < views; ++v) {
                     const double t0 = thread_seconds();
-                    NodeRasterizer::CentredVertices vertices;
-                    if (from_clip) {
-                        transform_to_clip(clip.data(), mesh.keyframe(uint32_t(k)), mesh.vertex_count,
-                                          &framing.centres[3 * k],
-                                          node_view_projection(&directions[3 * v], framing.radius));
-                    } else {
-                        centred.centre(mesh.keyframe(uint32_t(k)), mesh.vertex_count, &framing.centres[3 * k]);
-                        vertices = centred.vertices(node_view_projection(&directions[3 * v], framing.radius));
-                    }
+                    centred.centre(mesh.keyframe(uint32_t(k)), mesh.vertex_count, &framing.centres[3 * k]);
+                    const NodeRasterizer::CentredVertices vertices =
+                        centred.vertices(node_view_projection(&directions[3 * v], framing.radius));
                     transform_s += thread_seconds() - t0;
                     if (facing_keyframe != k) {  // once per keyframe, as NodeCache's workers do (not timed)
                         facing.build(mesh.keyframe(uint32_t(k)), mesh.vertex_count, mesh.indices.data(),
@@ -171,13 +165,9 @@ int main(int argc, char** argv) try {
                     const double t1 = thread_seconds();
                     const FacingFilter::Candidates listed =
                         filtered ? facing.candidates(&directions[3 * v]) : FacingFilter::Candidates{nullptr, 0};
-                    const uint8_t* node_modes = modes.empty() ? nullptr : modes.data();
-                    if (from_clip)
-                        rasterizer.rasterize_validated(clip.data(), mesh.vertex_count, mesh.indices.data(),
-                                                       mesh.indices.size(), 256, node_modes, listed.ids, listed.count);
-                    else
-                        rasterizer.rasterize_validated(vertices, mesh.vertex_count, mesh.indices.data(),
-                                                       mesh.indices.size(), 256, node_modes, listed.ids, listed.count);
+                    rasterizer.rasterize_validated(vertices, mesh.vertex_count, mesh.indices.data(),
+                                                   mesh.indices.size(), 256, modes.empty() ? nullptr : modes.data(),
+                                                   listed.ids, listed.count);
                     const double t2 = thread_seconds();
                     candidates += double(listed.ids ? listed.count : mesh.triangle_count());
                     const NodeRasterizer::FragmentLists lists = rasterizer.fragment_lists();
@@ -228,8 +218,8 @@ int main(int argc, char** argv) try {
                         triangle_lists += kept.triangle_lists;
                     }
                 }
-        std::printf("%s copy%s%s%s: ", NodeRasterizer::copy_name(copy), copy == widest ? " (default)" : "",
-                    filtered ? "" : ", facing filter off", from_clip ? ", from clip space" : "");
+        std::printf("%s copy%s%s: ", NodeRasterizer::copy_name(copy), copy == widest ? " (default)" : "",
+                    filtered ? "" : ", facing filter off");
         std::printf(
             "%zu triangles, %zu nodes, %.0f fragments/node: transform %.3f ms/node, rasterize %.3f ms/node, "
             "keep %.3f ms/node (thread CPU time); output hash %016llx\n",
@@ -248,21 +238,62 @@ int main(int argc, char** argv) try {
             (unsigned long long)kept_hash.h);
         std::printf("  facing filter %s: %.0f of %zu triangles rasterised per node\n", filtered ? "on" : "off",
                     candidates / double(nodes), mesh.triangle_count());
-        return Timing{1e3 * transform_s / double(nodes), 1e3 * raster_s / double(nodes), hash.h};
+        return Timing{1e3 * raster_s / double(nodes), hash.h};
     };
     std::vector<Timing> timings;
-    for (const Copy copy : copies) timings.push_back(measure(copy, true, false));
+    for (const Copy copy : copies) timings.push_back(measure(copy, true));
     // The widest copy again from every triangle (the filter off): the filter's worth, same run.
-    const Timing unfiltered = measure(copies.back(), false, false);
-    // And from clip space (transform_to_clip per node, then the clip-space entry): what the
-    // transform inside the vertex pass saves, same run.
-    const Timing from_clip = measure(copies.back(), true, true);
-    const Timing& fused = timings.back();
-    std::printf("transform and rasterize: %.3f ms/node from centred positions, %.3f from clip space: %.2fx; "
-                "hashes %s\n",
-                fused.transform_ms + fused.rasterize_ms, from_clip.transform_ms + from_clip.rasterize_ms,
-                (from_clip.transform_ms + from_clip.rasterize_ms) / (fused.transform_ms + fused.rasterize_ms),
-                from_clip.hash == fused.hash ? "equal" : "DIFFER");
+    const Timing unfiltered = measure(copies.back(), false);
+    // The transform inside the vertex pass against transforming each node to a clip-space array
+    // first (transform_to_clip, then the clip-space entry): every node both ways, in turns (which
+    // goes first alternates node by node, so neither gains from going second), in the widest
+    // copy from the facing filter's candidates; both must give the same fragments.
+    {
+        NodeRasterizer rasterizer;
+        rasterizer.set_copy(copies.back());
+        FacingFilter facing;
+        CentredKeyframe centred;
+        double seconds[2] = {0, 0};  // centred, clip space
+        Hash hashes[2];
+        size_t nodes = 0;
+        for (size_t k = 0; k < mesh.keyframe_count(); k += step) {
+            facing.build(mesh.keyframe(uint32_t(k)), mesh.vertex_count, mesh.indices.data(), mesh.indices.size(),
+                         &framing.centres[3 * k], framing.radius, 256, modes.empty() ? nullptr : modes.data());
+            for (size_t v = 0; v < views; ++v, ++nodes) {
+                const FacingFilter::Candidates listed = facing.candidates(&directions[3 * v]);
+                const Mat4d vp = node_view_projection(&directions[3 * v], framing.radius);
+                for (size_t turn = 0; turn < 2; ++turn) {
+                    const size_t way = (turn + nodes) % 2;
+                    const double t0 = thread_seconds();
+                    if (way == 0) {
+                        centred.centre(mesh.keyframe(uint32_t(k)), mesh.vertex_count, &framing.centres[3 * k]);
+                        rasterizer.rasterize_validated(centred.vertices(vp), mesh.vertex_count, mesh.indices.data(),
+                                                       mesh.indices.size(), 256,
+                                                       modes.empty() ? nullptr : modes.data(), listed.ids,
+                                                       listed.count);
+                    } else {
+                        transform_to_clip(clip.data(), mesh.keyframe(uint32_t(k)), mesh.vertex_count,
+                                          &framing.centres[3 * k], vp);
+                        rasterizer.rasterize_validated(clip.data(), mesh.vertex_count, mesh.indices.data(),
+                                                       mesh.indices.size(), 256,
+                                                       modes.empty() ? nullptr : modes.data(), listed.ids,
+                                                       listed.count);
+                    }
+                    seconds[way] += thread_seconds() - t0;
+                    rasterizer.visit_fragments([&](uint32_t p, uint32_t t, float z) {
+                        hashes[way].value(p);
+                        hashes[way].value(t);
+                        hashes[way].value(z);
+                    });
+                }
+            }
+        }
+        const double centred_ms = 1e3 * seconds[0] / double(nodes), clip_ms = 1e3 * seconds[1] / double(nodes);
+        std::printf("transform and rasterize (%s copy, each node both ways in turns): %.3f ms/node from centred "
+                    "positions, %.3f from clip space: %.2fx; hashes %s\n",
+                    NodeRasterizer::copy_name(copies.back()), centred_ms, clip_ms, clip_ms / centred_ms,
+                    hashes[0].h == hashes[1].h ? "equal" : "DIFFER");
+    }
     std::printf("rasterize: %.2fx faster with the facing filter (%s copy); hashes %s\n",
                 unfiltered.rasterize_ms / timings.back().rasterize_ms, NodeRasterizer::copy_name(copies.back()),
                 unfiltered.hash == timings.back().hash ? "equal" : "DIFFER");

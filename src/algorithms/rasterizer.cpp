@@ -846,13 +846,6 @@ ANIMORDER_INLINE void batch_box_test(size_t n, const int32_t* x0, const int32_t*
 }
 
 #ifdef ANIMORDER_RASTER_AVX2
-// The vertex pass of rasterize_node (inside_all, project, the compact test, the record) for 8
-// vertices at a time in the wide copies: the same float operations in the same order (a division,
-// products and sums rounded one by one, no FMA), so the same bits. Returns how many vertices it
-// did (a multiple of 8); the scalar loop does the rest. round_half_away's int64(v ± 0.5f) is
-// taken as an int32 truncation where |v ± 0.5f| < 2^30 (the same integer) and the compact test
-// as there: X compact iff |t| < 2^24 (t = v ± 0.5f; floats at 2^23 and above are integers), Y
-// compact iff top_row − trunc(t) lies inside ±2^24; NaN compares false (not compact).
 // Row r of VertexSource's transform for 8 vertices: ((m[r]·x + m[4+r]·y) + m[8+r]·z) + m[12+r].
 __attribute__((target("avx2"), always_inline)) inline __m256 transform_row_avx2(const __m256 (&m)[16], int r, __m256 x,
                                                                                 __m256 y, __m256 z) {
@@ -861,6 +854,14 @@ __attribute__((target("avx2"), always_inline)) inline __m256 transform_row_avx2(
         m[12 + r]);
 }
 
+// The vertex pass of rasterize_node (from centred positions VertexSource's transform first;
+// inside_all, project, the compact test, the record) for 8 vertices at a time in the wide copies:
+// the same float operations in the same order (a division, products and sums rounded one by one,
+// no FMA), so the same bits. Returns how many vertices it
+// did (a multiple of 8); the scalar loop does the rest. round_half_away's int64(v ± 0.5f) is
+// taken as an int32 truncation where |v ± 0.5f| < 2^30 (the same integer) and the compact test
+// as there: X compact iff |t| < 2^24 (t = v ± 0.5f; floats at 2^23 and above are integers), Y
+// compact iff top_row − trunc(t) lies inside ±2^24; NaN compares false (not compact).
 template <NodeRasterizer::Copy, bool kCentred>  // one instance a wide copy and source: each inlines its own
 __attribute__((target("avx2"))) size_t project_vertices_avx2(const VertexSource& source, size_t count,
                                                              unsigned resolution,
@@ -985,9 +986,9 @@ void rasterize_node_portable(NodeRasterizer::State& s, const VertexSource& sourc
                              const uint32_t* indices, size_t index_count, unsigned resolution, const uint8_t* modes,
                              const uint32_t* candidates, size_t candidate_count);
 #ifdef ANIMORDER_RASTER_AVX2
-void rasterize_node_avx2(NodeRasterizer::State& s, const VertexSource& source, size_t vertex_count, const uint32_t* indices,
-                         size_t index_count, unsigned resolution, const uint8_t* modes, const uint32_t* candidates,
-                         size_t candidate_count);
+void rasterize_node_avx2(NodeRasterizer::State& s, const VertexSource& source, size_t vertex_count,
+                         const uint32_t* indices, size_t index_count, unsigned resolution, const uint8_t* modes,
+                         const uint32_t* candidates, size_t candidate_count);
 void rasterize_node_avx512(NodeRasterizer::State& s, const VertexSource& source, size_t vertex_count,
                            const uint32_t* indices, size_t index_count, unsigned resolution, const uint8_t* modes,
                            const uint32_t* candidates, size_t candidate_count);
@@ -1072,11 +1073,10 @@ namespace {
 // for its own instructions). Inlined into the three copies below; kAvx2: the AVX2 and AVX-512
 // copies, whose boxes take the emit_*_avx2 paths.
 template <NodeRasterizer::Copy kCopy>
-ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const VertexSource& source, size_t vertex_count,
+ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const VertexSource& cv, size_t vertex_count,
                                      const uint32_t* indices, size_t index_count, unsigned resolution,
                                      const uint8_t* modes, const uint32_t* candidates, size_t candidate_count) {
     constexpr bool kAvx2 = kCopy != NodeRasterizer::Copy::Portable;
-    const VertexSource& cv = source;
     s.snapped.resize(vertex_count);
     s.vertices.resize(vertex_count);
     s.vertex_flags.resize(vertex_count);
@@ -1308,8 +1308,8 @@ __attribute__((target("avx2"))) void rasterize_node_avx2(NodeRasterizer::State& 
 // The AVX2 copy's source compiled with AVX-512 allowed; GCC keeps its loops at 256-bit vectors
 // (its default width for these targets), so no 512-bit clock penalty where a CPU has one.
 __attribute__((target("avx2,avx512f,avx512vl,avx512bw,avx512dq"))) void rasterize_node_avx512(
-    NodeRasterizer::State& s, const VertexSource& source, size_t vertex_count, const uint32_t* indices, size_t index_count,
-    unsigned resolution, const uint8_t* modes, const uint32_t* candidates, size_t candidate_count) {
+    NodeRasterizer::State& s, const VertexSource& source, size_t vertex_count, const uint32_t* indices,
+    size_t index_count, unsigned resolution, const uint8_t* modes, const uint32_t* candidates, size_t candidate_count) {
     rasterize_node<NodeRasterizer::Copy::Avx512>(s, source, vertex_count, indices, index_count, resolution, modes,
                                                  candidates, candidate_count);
 }

@@ -105,3 +105,41 @@ TEST(Camera, TransformIsThePlainPerVertexProductBitForBit) {
         }
     }
 }
+
+// CentredKeyframe: the positions minus the centre, one array per coordinate, bit for bit as
+// transform_to_clip's first step (plain float subtractions); kept while the same keyframe follows
+// (not centred again: a change in place goes unseen), centred again when the positions (by
+// address), their count or the centre change; and the node's matrix rounded to float entry by entry.
+TEST(Camera, CentredKeyframeFollowsItsKeyframeAndCentre) {
+    std::vector<float> a = {1.5f, -2.25f, 3.0f, 0.1f, 0.2f, 0.3f, -7.0f, 8.5f, 1e-3f};
+    std::vector<float> b = {4.0f, 5.0f, 6.0f, 7.0f, 8.0f, 9.0f, 1.0f, 2.0f, 3.0f};
+    const float c1[3] = {0.5f, 0.25f, -1.0f}, c2[3] = {0.1f, 0.2f, 0.3f};
+    const float direction[3] = {0.0f, 0.6f, 0.8f};
+    const Mat4d vp = node_view_projection(direction, 2.0f);
+    CentredKeyframe centred;
+    const auto expect_centred = [&](const std::vector<float>& p, size_t count, const float* c, const char* what) {
+        const NodeRasterizer::CentredVertices v = centred.vertices(vp);
+        for (size_t i = 0; i < count; ++i) {
+            const float* got[3] = {v.x, v.y, v.z};
+            for (int k = 0; k < 3; ++k) {
+                const float want = p[3 * i + size_t(k)] - c[k];
+                ASSERT_EQ(std::memcmp(&got[k][i], &want, 4), 0) << what << ", vertex " << i << ", coordinate " << k;
+            }
+        }
+        for (int i = 0; i < 16; ++i) ASSERT_EQ(v.view_projection[i], float(vp[size_t(i)])) << what;
+    };
+    centred.centre(a.data(), 3, c1);
+    expect_centred(a, 3, c1, "first keyframe");
+    centred.centre(a.data(), 3, c2);
+    expect_centred(a, 3, c2, "the same positions, another centre");
+    centred.centre(b.data(), 3, c2);
+    expect_centred(b, 3, c2, "other positions, the same centre");
+    centred.centre(b.data(), 2, c2);
+    expect_centred(b, 2, c2, "fewer vertices");
+    // The same keyframe again (same address, count and centre): kept, not centred again, so a
+    // change made in place is not seen (the contract: positions must not change meanwhile).
+    const std::vector<float> before = b;
+    b[0] = 100.0f;
+    centred.centre(b.data(), 2, c2);
+    expect_centred(before, 2, c2, "the same keyframe again");
+}

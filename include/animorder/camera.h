@@ -35,6 +35,12 @@ void centre_positions(float* x, float* y, float* z, const float* positions, size
                       const float centre[3]);
 // The matrix as transform_to_clip uses it: each entry rounded to float.
 std::array<float, 16> float_matrix(const Mat4d& m);
+// Row `row` of m · (x, y, z, 1) for a centred position, as transform_to_clip computes it and every
+// copy of the vertex transform must: ((m[row]·x + m[4+row]·y) + m[8+row]·z) + m[12+row] in float,
+// no fused multiply-add (the build turns contraction off).
+inline float clip_row(const float* m, int row, float x, float y, float z) {
+    return m[row] * x + m[4 + row] * y + m[8 + row] * z + m[12 + row];
+}
 
 // A worker's keyframe moved to its frame's centre (centre_positions), kept while its nodes follow
 // one another: what NodeRasterizer's centred entry reads, so that no node transforms the whole
@@ -48,9 +54,8 @@ public:
     NodeRasterizer::CentredVertices vertices(const Mat4d& view_projection) const;
 
 private:
-    std::vector<float> xyz_;  // x | y | z
+    std::vector<float> xyz_;  // x | y | z: 3 · its vertex count
     const float* positions_ = nullptr;
-    size_t vertex_count_ = 0;
     float centre_[3] = {0.0f, 0.0f, 0.0f};
 };
 

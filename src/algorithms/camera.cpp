@@ -73,7 +73,7 @@ inline __attribute__((always_inline)) void transform_block(float* out, const flo
     float clip[4][kBlock];
     for (int row = 0; row < 4; ++row)
         for (size_t i = 0; i < kBlock; ++i)
-            clip[row][i] = m[row] * x[i] + m[4 + row] * y[i] + m[8 + row] * z[i] + m[12 + row];
+            clip[row][i] = clip_row(m, row, x[i], y[i], z[i]);
     for (size_t i = 0; i < n; ++i)
         for (int row = 0; row < 4; ++row) out[4 * i + row] = clip[row][i];
 }
@@ -114,20 +114,20 @@ void centre_positions(float* x, float* y, float* z, const float* positions, size
 }
 
 void CentredKeyframe::centre(const float* positions, size_t vertex_count, const float centre[3]) {
-    if (positions == positions_ && vertex_count == vertex_count_ && std::equal(centre, centre + 3, centre_)) return;
+    if (positions == positions_ && 3 * vertex_count == xyz_.size() && std::equal(centre, centre + 3, centre_)) return;
     xyz_.resize(3 * vertex_count);
     centre_positions(xyz_.data(), xyz_.data() + vertex_count, xyz_.data() + 2 * vertex_count, positions, vertex_count,
                      centre);
     positions_ = positions;
-    vertex_count_ = vertex_count;
     std::copy(centre, centre + 3, centre_);
 }
 
 NodeRasterizer::CentredVertices CentredKeyframe::vertices(const Mat4d& view_projection) const {
+    const size_t vertex_count = xyz_.size() / 3;
     NodeRasterizer::CentredVertices v;
     v.x = xyz_.data();
-    v.y = xyz_.data() + vertex_count_;
-    v.z = xyz_.data() + 2 * vertex_count_;
+    v.y = xyz_.data() + vertex_count;
+    v.z = xyz_.data() + 2 * vertex_count;
     const std::array<float, 16> m = float_matrix(view_projection);
     std::copy(m.begin(), m.end(), v.view_projection);
     return v;

@@ -25,6 +25,7 @@
 // drawn first can pass.
 #include "animorder/rasterizer.h"
 
+#include "animorder/camera.h"
 #include "animorder/invalid_input.h"
 #include "animorder/triangle_order.h"
 
@@ -161,9 +162,8 @@ struct ClipVertex {
 };
 
 // Where the vertex pass reads the clip-space vertices: an array of them, or positions moved to the
-// frame's centre (NodeRasterizer::CentredVertices) transformed as transform_to_clip does, row by
-// row ((m·x + m·y) + m·z) + m in float (no fused multiply-add: the build turns contraction off),
-// so the same bits.
+// frame's centre (NodeRasterizer::CentredVertices) transformed as transform_to_clip does
+// (clip_row), so the same bits.
 struct VertexSource {
     const ClipVertex* clip = nullptr;  // null: the centred positions and m
     const float *x = nullptr, *y = nullptr, *z = nullptr, *m = nullptr;
@@ -171,8 +171,8 @@ struct VertexSource {
     ClipVertex operator[](size_t v) const {
         if (clip) return clip[v];
         const float px = x[v], py = y[v], pz = z[v];
-        return {m[0] * px + m[4] * py + m[8] * pz + m[12], m[1] * px + m[5] * py + m[9] * pz + m[13],
-                m[2] * px + m[6] * py + m[10] * pz + m[14], m[3] * px + m[7] * py + m[11] * pz + m[15]};
+        return {clip_row(m, 0, px, py, pz), clip_row(m, 1, px, py, pz), clip_row(m, 2, px, py, pz),
+                clip_row(m, 3, px, py, pz)};
     }
 };
 
@@ -846,7 +846,7 @@ ANIMORDER_INLINE void batch_box_test(size_t n, const int32_t* x0, const int32_t*
 }
 
 #ifdef ANIMORDER_RASTER_AVX2
-// Row r of VertexSource's transform for 8 vertices: ((m[r]·x + m[4+r]·y) + m[8+r]·z) + m[12+r].
+// clip_row for 8 vertices: ((m[r]·x + m[4+r]·y) + m[8+r]·z) + m[12+r], rounded as there.
 __attribute__((target("avx2"), always_inline)) inline __m256 transform_row_avx2(const __m256 (&m)[16], int r, __m256 x,
                                                                                 __m256 y, __m256 z) {
     return _mm256_add_ps(

@@ -1016,8 +1016,9 @@ TEST(Rasterizer, WideVertexPassGivesThePortableBits) {
 // paths (one behind the near plane, one beyond the guard band, one not a number) in triangles
 // with the character's vertices, and every vertex count modulo 8 (the vertex pass's scalar tail,
 // which transforms one vertex at a time). Fails when a clip coordinate differs (fragments then
-// move, change depth or go; checked: m·x + (m·y + m·z) for (m·x + m·y) + m·z, in the wide vertex
-// pass or in the one-vertex transform, fails it).
+// move, change depth or go; checked: m·x + (m·y + m·z) for (m·x + m·y) + m·z in the wide vertex
+// pass fails it; the one-vertex transform is clip_row, transform_to_clip's own, which
+// Camera.TransformIsThePlainPerVertexProductBitForBit checks against the plain product).
 TEST(Rasterizer, CentredVerticesGiveTheClipSpaceBits) {
     const AnimatedMesh mesh = make_procedural_character();
     const Framing framing = frame_animated_mesh(mesh);
@@ -1030,9 +1031,9 @@ TEST(Rasterizer, CentredVerticesGiveTheClipSpaceBits) {
             std::vector<uint32_t> ib = mesh.indices;
             const uint32_t first_extra = uint32_t(mesh.vertex_count);
             const float r = framing.radius;
-            // Beyond the near plane from every direction (inside the sphere of radius R around the
-            // camera at 3R: none is; so far out along one axis that some view has it behind), far
-            // beyond the guard band sideways, and NaN.
+            // Vertices that take the exact paths in some views: 2.8R and 2.9R out along an axis
+            // (closer than the near plane, R in front of a camera 3R out, for the views near that
+            // axis), 40R out (beyond the guard band, or behind the camera), and NaN.
             const float extra[4][3] = {{centre[0] + 2.8f * r, centre[1], centre[2]},
                                        {centre[0], centre[1] + 40.0f * r, centre[2]},
                                        {centre[0], centre[1], centre[2] - 2.9f * r},

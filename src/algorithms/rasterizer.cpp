@@ -143,10 +143,12 @@ struct NodeRasterizer::State {
     std::vector<VertexRecord> vertices;
     std::vector<uint8_t> vertex_flags;
     NodeRasterizer::Copy copy = NodeRasterizer::widest_copy();  // set_copy; never wider than the CPU runs
-    std::vector<uint32_t> histogram;    // counting sort of the fragments by pixel
-    std::vector<uint32_t> pixel_count;  // per pixel, zero between nodes (kPixelImageLimit pixels at most)
-    std::vector<uint8_t> touched;       // per 64-pixel block, 1 when it has fragments; zero between nodes
-    std::vector<uint64_t> keys;         // (depth, triangle) sort keys of the fragments being grouped
+    std::vector<uint32_t> histogram;                            // counting sort of the fragments by pixel
+    std::vector<uint32_t>
+        pixel_last;  // per pixel, 1 + its last fragment; zero between nodes (kPixelImageLimit pixels at most)
+    std::vector<uint32_t> chain;   // per fragment, 1 + the one before it in its pixel (0: none)
+    std::vector<uint8_t> touched;  // per 64-pixel block, 1 when it has fragments; zero between nodes
+    std::vector<uint64_t> keys;    // (depth, triangle) sort keys of the fragments being grouped
     BatchSetup setup;
 };
 
@@ -309,9 +311,9 @@ __attribute__((target("avx2"))) ANIMORDER_INLINE size_t emit_group_avx2(__m256d 
                                                                         __m128i triangles, FragmentSink& sink,
                                                                         size_t count) {
     const __m256d zero = _mm256_setzero_pd();
-    const __m256d covered = _mm256_and_pd(
-        _mm256_and_pd(_mm256_cmp_pd(a0, zero, _CMP_GE_OQ), _mm256_cmp_pd(a1, zero, _CMP_GE_OQ)),
-        _mm256_and_pd(_mm256_cmp_pd(a2, zero, _CMP_GE_OQ), in_box));
+    const __m256d covered =
+        _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(a0, zero, _CMP_GE_OQ), _mm256_cmp_pd(a1, zero, _CMP_GE_OQ)),
+                      _mm256_and_pd(_mm256_cmp_pd(a2, zero, _CMP_GE_OQ), in_box));
     return emit_lanes_avx2(_mm256_movemask_pd(covered), z, pixels, triangles, sink, count);
 }
 
@@ -412,11 +414,11 @@ __attribute__((target("avx2"))) inline void emit_small_box_avx2(const double (&e
                                                                 uint32_t triangle, unsigned resolution,
                                                                 FragmentSink& sink) {
     const __m256d zero = _mm256_setzero_pd();
-    __m256d covered = _mm256_castsi256_pd(_mm256_set_epi64x(box.px1 > box.px0 && box.py1 > box.py0 ? -1 : 0,
-                                                            box.py1 > box.py0 ? -1 : 0, box.px1 > box.px0 ? -1 : 0, -1));
+    __m256d covered = _mm256_castsi256_pd(_mm256_set_epi64x(
+        box.px1 > box.px0 && box.py1 > box.py0 ? -1 : 0, box.py1 > box.py0 ? -1 : 0, box.px1 > box.px0 ? -1 : 0, -1));
     for (int k = 0; k < 3; ++k) {
-        const __m256d a = _mm256_add_pd(_mm256_set1_pd(e[k]),
-                                        _mm256_set_pd(step_x[k] + step_y[k], step_y[k], step_x[k], 0.0));
+        const __m256d a =
+            _mm256_add_pd(_mm256_set1_pd(e[k]), _mm256_set_pd(step_x[k] + step_y[k], step_y[k], step_x[k], 0.0));
         covered = _mm256_and_pd(covered, _mm256_cmp_pd(a, zero, _CMP_GE_OQ));
     }
     emit_covered_box_avx2(_mm256_movemask_pd(covered), dzdx, dzdy, z_origin, int32_t(box.px0), int32_t(box.py0),
@@ -548,142 +550,142 @@ void rasterize_clipped_triangle(const ClipVertex (&v)[3], uint32_t triangle, uns
     }
 }
 
-// group_fragments for viewports up to kPixelImageLimit pixels, with the same results: a counting
-// sort whose cost follows the covered pixels, not the viewport. Per-pixel counts live in an image
-// that is all zero between nodes (padded to whole blocks of 64 pixels), and the blocks with
+// group_fragments for viewports up to kPixelImageLimit pixels, with the same results, at a cost
+// that follows the covered pixels, not the viewport. Each pixel's fragments are chained: an image
+// (zero between nodes, padded to whole blocks of 64 pixels) holds 1 + the pixel's last fragment,
+// and `chain` 1 + each fragment's predecessor in its pixel (0 ends a chain). The blocks with
 // fragments (one byte a block, set by a plain store) are walked in pixel order, each as a 64-bit
-// mask of its non-zero counts; both are returned to zero where touched. A pixel's lone fragment is never moved;
-// the fragments of the other pixels are moved as (depth, triangle) keys, one 64-bit integer each:
-// a depth is a float in [0, 1), whose bits order as its values once −0 is made +0 (adding +0 does
-// that), so the keys compare as the pairs, and equal high halves are equal depths.
+// mask of its non-empty pixels; both are returned to zero where touched. A pixel's lone fragment
+// is only listed; the fragments of the other pixels are read along the chain as (depth, triangle)
+// keys, one 64-bit integer each: a depth is a float in [0, 1), whose bits order as its values
+// once −0 is made +0 (adding +0 does that), so the keys compare as the pairs (no two are equal:
+// a triangle covers a pixel once), and equal high halves are equal depths.
 ANIMORDER_INLINE void group_fragments_by_image(NodeRasterizer::State& s) {
     const size_t n = s.raw_count;
     const uint32_t pixels = s.resolution * s.resolution;
     const size_t blocks = (size_t(pixels) + 63) / 64;
-    s.pixel_count.resize(blocks * 64);
+    s.pixel_last.resize(blocks * 64);
     s.touched.resize(blocks);
+    if (s.chain.size() < n) s.chain.resize(n);
     if (s.single_pixels.size() < n) s.single_pixels.resize(n);
     if (s.multi_pixel.size() < n) s.multi_pixel.resize(n);
     if (s.multi_start.size() < n + 1) s.multi_start.resize(n + 1);
     if (s.multi_fragment.size() < n + 7) s.multi_fragment.resize(n + 7);
-    if (s.keys.size() < n + 1) s.keys.resize(n + 1);
-    uint32_t* count = s.pixel_count.data();
+    if (s.keys.size() < n) s.keys.resize(n);
+    uint32_t* last = s.pixel_last.data();
+    uint32_t* chain = s.chain.data();
     uint8_t* touched = s.touched.data();
     const uint32_t* raw_pixel = s.raw_pixel.data();
     const uint32_t* raw_triangle = s.raw_triangle.data();
     const float* raw_depth = s.raw_depth.data();
     for (size_t f = 0; f < n; ++f) {
         const uint32_t p = raw_pixel[f];
-        ++count[p];
+        chain[f] = last[p];
+        last[p] = uint32_t(f + 1);
         touched[p >> 6] = 1;  // a plain store: no chain through memory from one fragment to the next
     }
-    // Pixels in order: a single one is listed; a multiple one gets its slots. Afterwards count[p]
-    // is the pixel's next slot, or for a single pixel kLone | the spare slot past the end.
-    constexpr uint32_t kLone = uint32_t(1) << 31;
+    const auto key = [&](uint32_t f) {
+        const float depth = raw_depth[f] + 0.0f;
+        uint32_t depth_bits;
+        std::memcpy(&depth_bits, &depth, 4);
+        return uint64_t(depth_bits) << 32 | raw_triangle[f];
+    };
+    // Pixels in order: a single one is listed; a multiple one gets its slots, its keys sorted, then
+    // its triangles nearest first. Up to 4 keys (nearly all pixels): a sorting network of
+    // compare-exchanges on 4 values, the missing ones the largest key, and 4 triangles written
+    // (those past the pixel's are overwritten by the next pixel's, or land in the spare slots past
+    // the end): no branch on the data. Up to 8: the same on 8 values. More: insertion sort.
     uint32_t* single = s.single_pixels.data();
     uint32_t* multi = s.multi_pixel.data();
     uint32_t* starts = s.multi_start.data();
+    uint32_t* out = s.multi_fragment.data();
     size_t singles = 0, multis = 0;
     uint32_t offset = 0;
+    constexpr uint64_t kMissing = ~uint64_t(0);
     for (size_t w = 0; w < blocks; ++w) {
         if (!touched[w]) continue;
-        const uint32_t* block = count + w * 64;
-        uint64_t nonzero = 0;  // the block's pixels with fragments
+        touched[w] = 0;
+        uint32_t* block = last + w * 64;
+        uint64_t nonempty = 0;  // the block's pixels with fragments
 #ifdef __SSE2__
         const __m128i zero = _mm_setzero_si128();
         for (int g = 0; g < 16; ++g) {
             const __m128i c = _mm_loadu_si128(reinterpret_cast<const __m128i*>(block + 4 * g));
             const int empty = _mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(c, zero)));
-            nonzero |= uint64_t(empty ^ 15) << (4 * g);
+            nonempty |= uint64_t(empty ^ 15) << (4 * g);
         }
 #else
-        for (int k = 0; k < 64; ++k) nonzero |= uint64_t(block[k] != 0) << k;
+        for (int k = 0; k < 64; ++k) nonempty |= uint64_t(block[k] != 0) << k;
 #endif
-        for (uint64_t bits_left = nonzero; bits_left; bits_left &= bits_left - 1) {
-            const uint32_t p = uint32_t(w * 64 + size_t(__builtin_ctzll(bits_left)));
-            const uint32_t c = count[p];
-            single[singles] = p;
+        for (uint64_t bits_left = nonempty; bits_left; bits_left &= bits_left - 1) {
+            const size_t i = size_t(__builtin_ctzll(bits_left));
+            const uint32_t p = uint32_t(w * 64 + i);
+            const uint32_t f0 = block[i];
+            block[i] = 0;
+            const uint32_t f1 = chain[f0 - 1];
+            if (f1 == 0) {
+                single[singles++] = p;
+                continue;
+            }
             multi[multis] = p;
-            starts[multis] = offset;
-            singles += c == 1;
-            multis += c != 1;
-            count[p] = c == 1 ? kLone : offset;
-            offset += c == 1 ? 0 : c;
+            starts[multis++] = offset;
+            uint32_t* o = out + offset;
+            const uint32_t f2 = chain[f1 - 1];
+            const uint32_t f3 = f2 ? chain[f2 - 1] : 0;
+            const uint32_t f4 = f3 ? chain[f3 - 1] : 0;
+            if (f4 == 0) {
+                uint64_t v0 = key(f0 - 1), v1 = key(f1 - 1), v2 = f2 ? key(f2 - 1) : kMissing,
+                         v3 = f3 ? key(f3 - 1) : kMissing;
+                const auto exchange = [](uint64_t& a, uint64_t& b) {
+                    const uint64_t lo = a < b ? a : b, hi = a < b ? b : a;
+                    a = lo;
+                    b = hi;
+                };
+                exchange(v0, v1);
+                exchange(v2, v3);
+                exchange(v0, v2);
+                exchange(v1, v3);
+                exchange(v1, v2);
+                o[0] = uint32_t(v0);
+                o[1] = uint32_t(v1) | ((v1 >> 32) == (v0 >> 32) ? kTieBit : 0);
+                o[2] = uint32_t(v2) | ((v2 >> 32) == (v1 >> 32) ? kTieBit : 0);
+                o[3] = uint32_t(v3) | ((v3 >> 32) == (v2 >> 32) ? kTieBit : 0);
+                offset += 2 + uint32_t(f2 != 0) + uint32_t(f3 != 0);
+                continue;
+            }
+            uint64_t* k = s.keys.data();  // the pixel's keys, read along its chain
+            size_t c = 0;
+            for (uint32_t f = f0; f != 0; f = chain[f - 1]) k[c++] = key(f - 1);
+            offset += uint32_t(c);
+            if (c <= 8) {  // the same with 8 keys: a 19 compare-exchange network, 7 spare slots
+                uint64_t v[8];
+                for (size_t j = 0; j < 8; ++j) v[j] = j < c ? k[j < c ? j : 0] : kMissing;
+                const auto exchange = [&v](int a, int b) {
+                    const uint64_t lo = v[a] < v[b] ? v[a] : v[b], hi = v[a] < v[b] ? v[b] : v[a];
+                    v[a] = lo;
+                    v[b] = hi;
+                };
+                exchange(0, 2), exchange(1, 3), exchange(4, 6), exchange(5, 7);
+                exchange(0, 4), exchange(1, 5), exchange(2, 6), exchange(3, 7);
+                exchange(0, 1), exchange(2, 3), exchange(4, 5), exchange(6, 7);
+                exchange(2, 4), exchange(3, 5);
+                exchange(1, 4), exchange(3, 6);
+                exchange(1, 2), exchange(3, 4), exchange(5, 6);
+                o[0] = uint32_t(v[0]);
+                for (size_t j = 1; j < 8; ++j) o[j] = uint32_t(v[j]) | ((v[j] >> 32) == (v[j - 1] >> 32) ? kTieBit : 0);
+                continue;
+            }
+            for (size_t j = 1; j < c; ++j) {
+                const uint64_t moving = k[j];
+                size_t at = j;
+                for (; at > 0 && k[at - 1] > moving; --at) k[at] = k[at - 1];
+                k[at] = moving;
+            }
+            o[0] = uint32_t(k[0]);
+            for (size_t j = 1; j < c; ++j) o[j] = uint32_t(k[j]) | ((k[j] >> 32) == (k[j - 1] >> 32) ? kTieBit : 0);
         }
     }
     starts[multis] = offset;
-    for (size_t i = 0; i < singles; ++i) count[single[i]] = kLone | offset;
-    uint64_t* keys = s.keys.data();
-    for (size_t f = 0; f < n; ++f) {
-        uint32_t& slot = count[raw_pixel[f]];
-        const float depth = raw_depth[f] + 0.0f;
-        uint32_t depth_bits;
-        std::memcpy(&depth_bits, &depth, 4);
-        keys[slot & ~kLone] = uint64_t(depth_bits) << 32 | raw_triangle[f];
-        slot += (slot >> 31) ^ 1;
-    }
-    for (size_t i = 0; i < singles; ++i) count[single[i]] = 0;
-    for (size_t i = 0; i < multis; ++i) count[multi[i]] = 0;
-    std::fill(s.touched.begin(), s.touched.end(), 0);
-    // Each multiple pixel: its keys sorted, then its triangles nearest first. Up to 4 keys (nearly
-    // all pixels): a sorting network of compare-exchanges on 4 values, the missing ones the largest
-    // key, and 4 triangles written (those past the pixel's are overwritten by the next pixel's, or
-    // land in the spare slots past the end): no branch on the data. Up to 8: the same on 8 values.
-    // More: insertion sort.
-    uint32_t* out = s.multi_fragment.data();
-    for (size_t m = 0; m < multis; ++m) {
-        uint64_t* k = keys + starts[m];
-        const size_t c = starts[m + 1] - starts[m];
-        if (c <= 4) {
-            constexpr uint64_t kMissing = ~uint64_t(0);
-            uint64_t v0 = k[0], v1 = k[1], v2 = c > 2 ? k[2] : kMissing, v3 = c > 3 ? k[3] : kMissing;
-            const auto exchange = [](uint64_t& a, uint64_t& b) {
-                const uint64_t lo = a < b ? a : b, hi = a < b ? b : a;
-                a = lo;
-                b = hi;
-            };
-            exchange(v0, v1);
-            exchange(v2, v3);
-            exchange(v0, v2);
-            exchange(v1, v3);
-            exchange(v1, v2);
-            uint32_t* o = out + starts[m];
-            o[0] = uint32_t(v0);
-            o[1] = uint32_t(v1) | ((v1 >> 32) == (v0 >> 32) ? kTieBit : 0);
-            o[2] = uint32_t(v2) | ((v2 >> 32) == (v1 >> 32) ? kTieBit : 0);
-            o[3] = uint32_t(v3) | ((v3 >> 32) == (v2 >> 32) ? kTieBit : 0);
-            continue;
-        }
-        if (c <= 8) {  // the same with 8 keys: a 19 compare-exchange network, 7 spare slots
-            constexpr uint64_t kMissing = ~uint64_t(0);
-            uint64_t v[8];
-            for (size_t j = 0; j < 8; ++j) v[j] = j < c ? k[j < c ? j : 0] : kMissing;
-            const auto exchange = [&v](int a, int b) {
-                const uint64_t lo = v[a] < v[b] ? v[a] : v[b], hi = v[a] < v[b] ? v[b] : v[a];
-                v[a] = lo;
-                v[b] = hi;
-            };
-            exchange(0, 2), exchange(1, 3), exchange(4, 6), exchange(5, 7);
-            exchange(0, 4), exchange(1, 5), exchange(2, 6), exchange(3, 7);
-            exchange(0, 1), exchange(2, 3), exchange(4, 5), exchange(6, 7);
-            exchange(2, 4), exchange(3, 5);
-            exchange(1, 4), exchange(3, 6);
-            exchange(1, 2), exchange(3, 4), exchange(5, 6);
-            uint32_t* o = out + starts[m];
-            o[0] = uint32_t(v[0]);
-            for (size_t j = 1; j < 8; ++j) o[j] = uint32_t(v[j]) | ((v[j] >> 32) == (v[j - 1] >> 32) ? kTieBit : 0);
-            continue;
-        }
-        for (size_t j = 1; j < c; ++j) {
-            const uint64_t key = k[j];
-            size_t i = j;
-            for (; i > 0 && k[i - 1] > key; --i) k[i] = k[i - 1];
-            k[i] = key;
-        }
-        uint32_t* o = out + starts[m];
-        o[0] = uint32_t(k[0]);
-        for (size_t j = 1; j < c; ++j) o[j] = uint32_t(k[j]) | ((k[j] >> 32) == (k[j - 1] >> 32) ? kTieBit : 0);
-    }
     s.single = singles;
     s.visible = singles + multis;
     s.multi_count = multis;
@@ -967,8 +969,8 @@ __attribute__((target("avx2,popcnt"))) size_t pack_drawn_avx2(size_t n, const in
     const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
     size_t i = 0;
     for (; i + 8 <= n; i += 8) {
-        const __m256i kept = _mm256_cmpgt_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(keep + i)),
-                                                _mm256_setzero_si256());
+        const __m256i kept =
+            _mm256_cmpgt_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(keep + i)), _mm256_setzero_si256());
         const int mask = _mm256_movemask_ps(_mm256_castsi256_ps(kept));
         const __m256i order = _mm256_load_si256(reinterpret_cast<const __m256i*>(kLanePacking.lanes[mask]));
         const __m256i places = _mm256_add_epi32(_mm256_set1_epi32(int32_t(i)), lane);
@@ -1242,7 +1244,7 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const VertexSourc
                                  uint32_t(t), resolution, sink);
                 continue;
             }
-            const size_t k = g++;  // its edge functions' entry
+            const size_t k = g++;                   // its edge functions' entry
             if (special[draw[j]] == 1) {            // passed the pre-pass: its box and set-up are known
                 if (setup.det[j] == 0.0) continue;  // float-degenerate sliver: no fragment has a defined depth
                 const int32_t* known = boxes[draw[j]];

@@ -67,6 +67,72 @@ double distance(const float* a, const float* b) {
     return std::sqrt(dx * dx + dy * dy + dz * dz);
 }
 
+// Patch centroids as the integrated distance reads them: per keyframe, one array of doubles per
+// coordinate (the floats' exact conversions, made once rather than per term), so that a block of
+// patches is read contiguously and its distances are computed lane-wise.
+struct CentroidColumns {
+    size_t keyframes = 0, patches = 0;
+    std::vector<double> values;  // [(keyframe · 3 + axis) · patches + patch]
+
+    CentroidColumns() = default;
+    CentroidColumns(const float* centroids, size_t keyframe_count, size_t patch_count)
+        : keyframes(keyframe_count), patches(patch_count), values(keyframe_count * patch_count * 3) {
+        for (size_t k = 0; k < keyframe_count; ++k)
+            for (size_t p = 0; p < patch_count; ++p)
+                for (size_t axis = 0; axis < 3; ++axis)
+                    values[(k * 3 + axis) * patch_count + p] = centroids[(k * patch_count + p) * 3 + axis];
+    }
+    const double* axis(size_t keyframe, size_t a) const { return &values[(keyframe * 3 + a) * patches]; }
+};
+
+// integrated_distance_order (clustering.h) over centroid columns. Each term is distance()'s: the
+// same differences, products and sums in the same order, so the same bits.
+std::vector<uint32_t> integrated_distance_order(const CentroidColumns& centroids, const uint32_t* node_keyframes,
+                                                const float* node_eyes, size_t node_count, DistanceVariant variant,
+                                                const uint8_t* node_visible, const uint32_t* patch_primitive) {
+    const size_t keyframe_count = centroids.keyframes, patch_count = centroids.patches;
+    const bool i3d = variant == DistanceVariant::I3d;
+    for (size_t n = 0; n < node_count; ++n)
+        if (node_keyframes[n] >= keyframe_count)
+            throw InvalidInput("integrated distance: node " + std::to_string(n) + " names keyframe row " +
+                               std::to_string(node_keyframes[n]) + ", but there are " + std::to_string(keyframe_count));
+    std::vector<double> d(patch_count, 0.0), seen(patch_count, 0.0);
+    // Blocks of patches in parallel, each patch's sum in node order: the same sums for any thread
+    // count (the caller's task arena decides it).
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, patch_count, 64), [&](const tbb::blocked_range<size_t>& block) {
+        const size_t first = block.begin(), count = block.size();
+        double* sum = &d[first];
+        double* sights = &seen[first];
+        for (size_t n = 0; n < node_count; ++n) {
+            const double ex = node_eyes[3 * n], ey = node_eyes[3 * n + 1], ez = node_eyes[3 * n + 2];
+            const double* cx = centroids.axis(node_keyframes[n], 0) + first;
+            const double* cy = centroids.axis(node_keyframes[n], 1) + first;
+            const double* cz = centroids.axis(node_keyframes[n], 2) + first;
+            const uint8_t* vis = i3d && node_visible ? &node_visible[n * patch_count + first] : nullptr;
+            if (!vis) {  // the paper's sum: a loop without a branch, vectorised (sqrt is exact in any lane)
+                for (size_t p = 0; p < count; ++p) {
+                    const double dx = ex - cx[p], dy = ey - cy[p], dz = ez - cz[p];
+                    sum[p] += std::sqrt(dx * dx + dy * dy + dz * dz);
+                }
+                if (i3d)
+                    for (size_t p = 0; p < count; ++p) sights[p] += 1.0;
+                continue;
+            }
+            for (size_t p = 0; p < count; ++p) {
+                if (!vis[p]) continue;  // I3D: wholly back-facing at this node
+                const double dx = ex - cx[p], dy = ey - cy[p], dz = ez - cz[p];
+                sum[p] += std::sqrt(dx * dx + dy * dy + dz * dz);
+                sights[p] += 1.0;
+            }
+        }
+    });
+    if (i3d)
+        for (size_t p = 0; p < patch_count; ++p)
+            // A patch no node of the cluster sees goes last (it is never visible there).
+            d[p] = seen[p] > 0 ? d[p] / seen[p] : INFINITY;
+    return sort_patches(patch_primitive, d);
+}
+
 // Front-to-back from one eye, with each patch at its centroid averaged over the keyframes.
 std::vector<uint32_t> front_to_back(const MeshPatches& patches, const std::vector<float>& average_centroids,
                                     const float eye[3]) {
@@ -167,6 +233,7 @@ struct Nodes {
     std::vector<OverdrawNode> cameras;   // per node
     std::vector<float> eyes;             // per view: 3R · direction, in the framed space
     std::vector<float> centroids;        // per listed keyframe, per patch (patch_centroids)
+    CentroidColumns columns;             // the same, as integrated_distance_order reads them
     std::vector<float> average;          // per patch: its centroid averaged over the keyframes
     std::vector<uint8_t> patch_visible;  // I3D only: [n · patch_count + p], some triangle faces n
     ScoreSettings score;
@@ -288,9 +355,9 @@ std::vector<size_t> update_orders(const Nodes& nodes, DistanceVariant variant, c
     for (size_t c = 0; c < nodes.k; ++c) {
         members[c] = rows[c].size();
         if (members[c] == 0) continue;
-        patch_orders[c] = integrated_distance_order(
-            nodes.centroids.data(), nodes.keyframes, patch_count, rows[c].data(), eyes[c].data(), rows[c].size(),
-            variant, i3d ? visible[c].data() : nullptr, nodes.patches.patch_primitive.data());
+        patch_orders[c] =
+            integrated_distance_order(nodes.columns, rows[c].data(), eyes[c].data(), rows[c].size(), variant,
+                                      i3d ? visible[c].data() : nullptr, nodes.patches.patch_primitive.data());
     }
     return members;
 }
@@ -520,37 +587,8 @@ std::vector<uint32_t> integrated_distance_order(const float* centroids, size_t k
                                                 const uint32_t* node_keyframes, const float* node_eyes,
                                                 size_t node_count, DistanceVariant variant, const uint8_t* node_visible,
                                                 const uint32_t* patch_primitive) {
-    const bool i3d = variant == DistanceVariant::I3d;
-    for (size_t n = 0; n < node_count; ++n)
-        if (node_keyframes[n] >= keyframe_count)
-            throw InvalidInput("integrated distance: node " + std::to_string(n) + " names keyframe row " +
-                               std::to_string(node_keyframes[n]) + ", but there are " + std::to_string(keyframe_count));
-    std::vector<double> d(patch_count, 0.0), seen(patch_count, 0.0);
-    // Blocks of patches in parallel, each patch's sum in node order: the same sums for any thread
-    // count (the caller's task arena decides it).
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, patch_count, 64), [&](const tbb::blocked_range<size_t>& block) {
-        for (size_t n = 0; n < node_count; ++n) {
-            const float* eye = &node_eyes[3 * n];
-            const float* cent = &centroids[size_t(node_keyframes[n]) * patch_count * 3];
-            const uint8_t* vis = i3d && node_visible ? &node_visible[n * patch_count] : nullptr;
-            if (!vis) {  // the paper's sum: a loop without a branch, vectorised (sqrt is exact in any lane)
-                for (size_t p = block.begin(); p != block.end(); ++p) d[p] += distance(eye, cent + 3 * p);
-                if (i3d)
-                    for (size_t p = block.begin(); p != block.end(); ++p) seen[p] += 1.0;
-                continue;
-            }
-            for (size_t p = block.begin(); p != block.end(); ++p) {
-                if (!vis[p]) continue;  // I3D: wholly back-facing at this node
-                d[p] += distance(eye, cent + 3 * p);
-                seen[p] += 1.0;
-            }
-        }
-    });
-    if (i3d)
-        for (size_t p = 0; p < patch_count; ++p)
-            // A patch no node of the cluster sees goes last (it is never visible there).
-            d[p] = seen[p] > 0 ? d[p] / seen[p] : INFINITY;
-    return sort_patches(patch_primitive, d);
+    return integrated_distance_order(CentroidColumns(centroids, keyframe_count, patch_count), node_keyframes, node_eyes,
+                                     node_count, variant, node_visible, patch_primitive);
 }
 
 ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patches, const Framing& framing,
@@ -578,6 +616,7 @@ ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patc
                       nodes.cameras[i * nodes.views + v].direction);
         }
     nodes.centroids = patch_centroids(mesh, patches, framing, keyframes);
+    nodes.columns = CentroidColumns(nodes.centroids.data(), keyframes.size(), patches.patch_count());
     nodes.average = average_over_keyframes(nodes.centroids, keyframes.size(), patches.patch_count());
     if (settings.distance == DistanceVariant::I3d)
         nodes.patch_visible = patch_visibility(mesh, patches, framing, keyframes, nodes.eyes);

@@ -144,9 +144,9 @@ struct NodeRasterizer::State {
     std::vector<uint8_t> vertex_flags;
     NodeRasterizer::Copy copy = NodeRasterizer::widest_copy();  // set_copy; never wider than the CPU runs
     std::vector<uint32_t> histogram;                            // counting sort of the fragments by pixel
-    std::vector<uint32_t>
-        pixel_last;  // per pixel, 1 + its last fragment; zero between nodes (kPixelImageLimit pixels at most)
-    std::vector<uint32_t> chain;   // per fragment, 1 + the one before it in its pixel (0: none)
+    // group_fragments_by_image's chains: per pixel, 1 + its last fragment (zero between nodes;
+    // kPixelImageLimit pixels at most); per fragment, 1 + the one before it in its pixel (0: none).
+    std::vector<uint32_t> pixel_last, chain;
     std::vector<uint8_t> touched;  // per 64-pixel block, 1 when it has fragments; zero between nodes
     std::vector<uint64_t> keys;    // (depth, triangle) sort keys of the fragments being grouped
     BatchSetup setup;
@@ -154,7 +154,8 @@ struct NodeRasterizer::State {
 
 namespace {
 
-constexpr uint32_t kPixelImageLimit = uint32_t(1) << 20;  // pixels up to which group_fragments keeps a count image
+// Pixels up to which group_fragments chains the fragments through an image of the viewport.
+constexpr uint32_t kPixelImageLimit = uint32_t(1) << 20;
 constexpr int kSubpixelBits = 8;
 constexpr int64_t kSubpixel = int64_t(1) << kSubpixelBits;  // 256
 constexpr float kGuardBand = 2.0f;                          // |x|, |y| <= 2w: twice the viewport, never a visible pixel

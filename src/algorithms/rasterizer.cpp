@@ -980,6 +980,48 @@ __attribute__((target("avx2,popcnt"))) size_t pack_drawn_avx2(size_t n, const in
     }
     return i;
 }
+
+// The depth planes' inputs of rasterize_node for the drawn triangles, 4 at a time: each corner's
+// 16-byte record loaded whole, the differences taken in float lanes, the 4 triangles' (x, y, z)
+// turned into one vector per coordinate and widened to double: the same float subtractions and
+// exact widenings as the scalar loop, so the same bits (a triangle of an exact path gets zeros
+// there, as there). Returns how many of the m it did (a multiple of 4); the scalar loop does the rest.
+template <NodeRasterizer::Copy>  // one instance a wide copy: each inlines its own
+__attribute__((target("avx2"))) size_t plane_inputs_avx2(size_t m, const uint32_t* draw, const int32_t* special,
+                                                         const int64_t* areas, const uint32_t* id,
+                                                         const uint32_t* indices,
+                                                         const NodeRasterizer::State::VertexRecord* vertex,
+                                                         BatchSetup& setup) {
+    size_t j = 0;
+    for (; j + 4 <= m; j += 4) {
+        __m128 a[4], b[4], o[4];
+        for (int t = 0; t < 4; ++t) {
+            const size_t i = draw[j + size_t(t)];
+            const bool front = areas[i] < 0;
+            const uint32_t* tri = indices + 3 * size_t(id[i]);
+            const __m128 w0 = _mm_load_ps(&vertex[tri[0]].x);
+            const __m128 w1 = _mm_load_ps(&vertex[tri[front ? 2 : 1]].x);
+            const __m128 w2 = _mm_load_ps(&vertex[tri[front ? 1 : 2]].x);
+            const __m128 fast = _mm_castsi128_ps(_mm_set1_epi32(special[i] == 1 ? -1 : 0));
+            a[t] = _mm_and_ps(_mm_sub_ps(w1, w0), fast);
+            b[t] = _mm_and_ps(_mm_sub_ps(w2, w0), fast);
+            o[t] = _mm_and_ps(w0, fast);
+        }
+        _MM_TRANSPOSE4_PS(a[0], a[1], a[2], a[3]);
+        _MM_TRANSPOSE4_PS(b[0], b[1], b[2], b[3]);
+        _MM_TRANSPOSE4_PS(o[0], o[1], o[2], o[3]);
+        _mm256_storeu_pd(setup.ax + j, _mm256_cvtps_pd(a[0]));
+        _mm256_storeu_pd(setup.ay + j, _mm256_cvtps_pd(a[1]));
+        _mm256_storeu_pd(setup.az + j, _mm256_cvtps_pd(a[2]));
+        _mm256_storeu_pd(setup.bx + j, _mm256_cvtps_pd(b[0]));
+        _mm256_storeu_pd(setup.by + j, _mm256_cvtps_pd(b[1]));
+        _mm256_storeu_pd(setup.bz + j, _mm256_cvtps_pd(b[2]));
+        _mm256_storeu_pd(setup.x + j, _mm256_cvtps_pd(o[0]));
+        _mm256_storeu_pd(setup.y + j, _mm256_cvtps_pd(o[1]));
+        _mm256_storeu_pd(setup.z + j, _mm256_cvtps_pd(o[2]));
+    }
+    return j;
+}
 #endif
 
 }  // namespace
@@ -1206,7 +1248,12 @@ ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const VertexSourc
             setup.px0[g] = boxes[i][0];
             setup.py0[g] = boxes[i][2];
         }
-        for (size_t j = 0; j < m; ++j) {
+        size_t planes_done = 0;
+#ifdef ANIMORDER_RASTER_AVX2
+        if constexpr (kAvx2)
+            planes_done = plane_inputs_avx2<kCopy>(m, draw, special, areas, id, indices, vertex, setup);
+#endif
+        for (size_t j = planes_done; j < m; ++j) {
             const size_t i = draw[j];
             const bool fast = special[i] == 1, front = areas[i] < 0;
             const uint32_t* tri = indices + 3 * size_t(id[i]);

@@ -47,6 +47,21 @@
 namespace animorder {
 namespace {
 
+#define ANIMORDER_FACING_INLINE inline __attribute__((always_inline))
+
+struct BoundConstants {
+    double unit, eye, half, delta;
+};
+
+// build's scratch: a block of triangles' corners in columns and what bounds works out from them.
+struct BoundBlock {
+    static constexpr size_t kSize = 256;
+    float x[3][kSize], y[3][kSize], z[3][kSize];  // corner k of each triangle, framed
+    double r[3][kSize];                           // its distance from the centre
+    float nx[kSize], ny[kSize], nz[kSize];        // out: the normal
+    double bound[kSize];                          // out: offset − threshold
+};
+
 // The test for one triangle, in this order of float operations in every copy (no fused
 // multiply-add: the build turns contraction off), so every copy gives the same candidates.
 inline bool may_draw(float nx, float ny, float nz, float limit, float ex, float ey, float ez) {
@@ -92,6 +107,53 @@ __attribute__((target("avx2,popcnt"))) size_t candidates_avx2(const float* nx, c
 }
 #endif
 
+// The bound of one triangle (build's comment above): from its framed corners (x, y, z[k] in
+// float, as transform_to_clip has them) and their distances from the centre (r[k]), in units of
+// R: the normal n and offset − threshold. Columns of a block, one function per copy below so
+// that each compiles the loop for its own lanes.
+ANIMORDER_FACING_INLINE void bounds(BoundBlock& b, size_t count, const BoundConstants& k) {
+    const double unit = k.unit, eye = k.eye, half = k.half, delta = k.delta;
+    for (size_t i = 0; i < count; ++i) {
+        const double a[3] = {unit * b.x[0][i], unit * b.y[0][i], unit * b.z[0][i]};
+        const double u[3] = {unit * (double(b.x[1][i]) - b.x[0][i]), unit * (double(b.y[1][i]) - b.y[0][i]),
+                             unit * (double(b.z[1][i]) - b.z[0][i])};
+        const double w[3] = {unit * (double(b.x[2][i]) - b.x[0][i]), unit * (double(b.y[2][i]) - b.y[0][i]),
+                             unit * (double(b.z[2][i]) - b.z[0][i])};
+        const double v[3] = {unit * (double(b.x[2][i]) - b.x[1][i]), unit * (double(b.y[2][i]) - b.y[1][i]),
+                             unit * (double(b.z[2][i]) - b.z[1][i])};
+        const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+        const double offset = n[0] * a[0] + n[1] * a[1] + n[2] * a[2];
+        const double perimeter = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]) +
+                                 std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) +
+                                 std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        // This triangle's bounds (every point of it lies within ρ_t of the origin): w in
+        // [3R − ρ_t, 3R + ρ_t], and the view-space radial distance over w at most
+        // g = ρ_t / √(9R² − ρ_t²) (the cone around the ball), so the projection's gradient is at
+        // most (res/2)·cot·√(1 + g²) / w. The distances are finite (build checked): max's order
+        // of comparison does not matter.
+        const double r01 = b.r[0][i] < b.r[1][i] ? b.r[1][i] : b.r[0][i];
+        const double rho_t = unit * (r01 < b.r[2][i] ? b.r[2][i] : r01);
+        const double w_min = eye - rho_t, w_max = eye + rho_t;
+        const double slope = 1.0001 * rho_t / std::sqrt(eye * eye - rho_t * rho_t);
+        const double P = perimeter * half * kCotHalfFov * std::sqrt(1.0 + slope * slope) / w_min;
+        const double area_scale = half * half * kCotHalfFov * kCotHalfFov / (w_max * w_max * w_max);
+        const double rounding = 1e-6 * (std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) * eye + std::fabs(offset));
+        const double threshold = 1.01 * (std::sqrt(2.0) * delta * P + 8.0 * delta * delta) / area_scale + rounding;
+        b.nx[i] = float(n[0]);
+        b.ny[i] = float(n[1]);
+        b.nz[i] = float(n[2]);
+        b.bound[i] = offset - threshold;
+    }
+}
+
+void bounds_portable(BoundBlock& b, size_t count, const BoundConstants& k) { bounds(b, count, k); }
+
+#ifdef ANIMORDER_FACING_AVX2
+__attribute__((target("avx2"))) void bounds_avx2(BoundBlock& b, size_t count, const BoundConstants& k) {
+    bounds(b, count, k);
+}
+#endif
+
 }  // namespace
 
 void FacingFilter::build(const float* positions, size_t vertex_count, const uint32_t* indices, size_t index_count,
@@ -132,41 +194,43 @@ void FacingFilter::build(const float* positions, size_t vertex_count, const uint
     // and every value between about 1e-38 and 5, which floats hold; the threshold's 8δ² part
     // outweighs any rounding of a value that small.
     const double unit = 1.0 / R, eye = 3.0;
+    // In blocks of triangles: their corners and corner distances gathered into columns, then the
+    // bounds worked out over the columns in lanes (`bounds`, above: its square roots and
+    // divisions are most of build's time; the same operations per lane, so the same bits), then
+    // the limits.
+    const BoundConstants constants{unit, eye, half, delta};
     bool can_leave_out = false;
-    for (size_t t = 0; t < triangles; ++t) {
-        const uint32_t ia = indices[3 * t], ib = indices[3 * t + 1], ic = indices[3 * t + 2];
-        const float *qa = q + 3 * size_t(ia), *qb = q + 3 * size_t(ib), *qc = q + 3 * size_t(ic);
-        const double a[3] = {unit * qa[0], unit * qa[1], unit * qa[2]};
-        const double u[3] = {unit * (double(qb[0]) - qa[0]), unit * (double(qb[1]) - qa[1]),
-                             unit * (double(qb[2]) - qa[2])};
-        const double w[3] = {unit * (double(qc[0]) - qa[0]), unit * (double(qc[1]) - qa[1]),
-                             unit * (double(qc[2]) - qa[2])};
-        const double v[3] = {unit * (double(qc[0]) - qb[0]), unit * (double(qc[1]) - qb[1]),
-                             unit * (double(qc[2]) - qb[2])};
-        const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
-        const double offset = n[0] * a[0] + n[1] * a[1] + n[2] * a[2];
-        const double perimeter = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]) +
-                                 std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) +
-                                 std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-        // This triangle's bounds (every point of it lies within ρ_t of the origin): w in
-        // [3R − ρ_t, 3R + ρ_t], and the view-space radial distance over w at most
-        // g = ρ_t / √(9R² − ρ_t²) (the cone around the ball), so the projection's gradient is at
-        // most (res/2)·cot·√(1 + g²) / w.
-        const double rho_t = unit * std::max({radius_of[ia], radius_of[ib], radius_of[ic]});
-        const double w_min = eye - rho_t, w_max = eye + rho_t;
-        const double slope = 1.0001 * rho_t / std::sqrt(eye * eye - rho_t * rho_t);
-        const double P = perimeter * half * kCotHalfFov * std::sqrt(1.0 + slope * slope) / w_min;
-        const double area_scale = half * half * kCotHalfFov * kCotHalfFov / (w_max * w_max * w_max);
-        const double rounding = 1e-6 * (std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) * eye + std::fabs(offset));
-        const double threshold = 1.01 * (std::sqrt(2.0) * delta * P + 8.0 * delta * delta) / area_scale + rounding;
-        nx_[t] = float(n[0]);
-        ny_[t] = float(n[1]);
-        nz_[t] = float(n[2]);
-        // Left out when n · e < offset − threshold: the limit rounded down (the float nearest may
-        // lie above). A double-sided triangle is never left out.
-        const bool never = modes && (modes[t] & kDrawBothFaces);
-        limit_[t] = never ? -INFINITY : std::nextafter(float(offset - threshold), -INFINITY);
-        can_leave_out |= !never;
+    BoundBlock b;  // 20 KB on the stack
+    for (size_t first = 0; first < triangles; first += BoundBlock::kSize) {
+        const size_t count = std::min(BoundBlock::kSize, triangles - first);
+        for (size_t i = 0; i < count; ++i) {
+            const uint32_t* corner = indices + 3 * (first + i);
+            for (int k = 0; k < 3; ++k) {
+                const float* c = q + 3 * size_t(corner[k]);
+                b.x[k][i] = c[0];
+                b.y[k][i] = c[1];
+                b.z[k][i] = c[2];
+                b.r[k][i] = radius_of[corner[k]];
+            }
+        }
+#ifdef ANIMORDER_FACING_AVX2
+        static const bool avx2 = __builtin_cpu_supports("avx2");
+        if (avx2 && !portable_)
+            bounds_avx2(b, count, constants);
+        else
+#endif
+            bounds_portable(b, count, constants);
+        for (size_t i = 0; i < count; ++i) {
+            const size_t t = first + i;
+            nx_[t] = b.nx[i];
+            ny_[t] = b.ny[i];
+            nz_[t] = b.nz[i];
+            // Left out when n · e < offset − threshold: the limit rounded down (the float nearest may
+            // lie above). A double-sided triangle is never left out.
+            const bool never = modes && (modes[t] & kDrawBothFaces);
+            limit_[t] = never ? -INFINITY : std::nextafter(float(b.bound[i]), -INFINITY);
+            can_leave_out |= !never;
+        }
     }
     usable_ = can_leave_out;  // a mesh all double-sided: nothing to gain, the rasteriser's plain path
 }

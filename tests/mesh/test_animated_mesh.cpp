@@ -56,3 +56,25 @@ TEST(AnimatedMesh, NamesEachDefect) {
     expect_rejected([](AnimatedMesh& m) { m.clips[0].keyframe_count = 0; }, "clip 'clip'");
     expect_rejected([](AnimatedMesh& m) { m.keyframe_positions[13] = NAN; }, "keyframe 1: position of vertex 0");
 }
+
+TEST(AnimatedMesh, NamesTheFirstPositionThatIsNotFinite) {
+    // 500 keyframes of 4 vertices (6,000 floats: more than one of the blocks the check tests at
+    // once). Float 5,000 is keyframe 5000 / 12 = 416, vertex 5000 / 3 % 4 = 2; float 5,500 lies
+    // further on and is not named.
+    for (const float bad : {NAN, INFINITY, -INFINITY}) {
+        expect_rejected(
+            [bad](AnimatedMesh& m) {
+                m.keyframe_positions.assign(500 * 4 * 3, 0.5f);
+                m.keyframe_positions[5500] = NAN;
+                m.keyframe_positions[5000] = bad;
+            },
+            "keyframe 416: position of vertex 2 is not finite");
+    }
+    // The largest finite float, the smallest subnormal and −0 are positions like any other.
+    AnimatedMesh extreme = good();
+    extreme.keyframe_positions[0] = 3.4028235e38f;
+    extreme.keyframe_positions[1] = -3.4028235e38f;
+    extreme.keyframe_positions[2] = 1e-45f;
+    extreme.keyframe_positions[3] = -0.0f;
+    EXPECT_NO_THROW(validate_animated_mesh(extreme));
+}

@@ -615,7 +615,16 @@ ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patc
             std::copy(&result.directions[3 * v], &result.directions[3 * v] + 3,
                       nodes.cameras[i * nodes.views + v].direction);
         }
-    nodes.centroids = patch_centroids(mesh, patches, framing, keyframes);
+    // Each keyframe's patch centroids on its own (patch_centroids of that keyframe: the same
+    // values), the keyframes side by side.
+    const size_t centroid_floats = patches.patch_count() * 3;
+    nodes.centroids.resize(keyframes.size() * centroid_floats);
+    tbb::task_arena(worker_threads(settings.threads)).execute([&] {
+        tbb::parallel_for(size_t(0), keyframes.size(), [&](size_t i) {
+            const std::vector<float> row = patch_centroids(mesh, patches, framing, {keyframes[i]});
+            std::copy(row.begin(), row.end(), nodes.centroids.begin() + ptrdiff_t(i * centroid_floats));
+        });
+    });
     nodes.columns = CentroidColumns(nodes.centroids.data(), keyframes.size(), patches.patch_count());
     nodes.average = average_over_keyframes(nodes.centroids, keyframes.size(), patches.patch_count());
     if (settings.distance == DistanceVariant::I3d)

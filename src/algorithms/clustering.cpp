@@ -67,12 +67,11 @@ double distance(const float* a, const float* b) {
     return std::sqrt(dx * dx + dy * dy + dz * dz);
 }
 
-// Patch centroids as the integrated distance reads them: per keyframe, one array of doubles per
-// coordinate (the floats' exact conversions, made once rather than per term), so that a block of
-// patches is read contiguously and its distances are computed lane-wise.
+// Patch centroids as the integrated distance reads them: per keyframe, one array per coordinate,
+// so that a block of patches is read contiguously and its distances are computed lane-wise.
 struct CentroidColumns {
     size_t keyframes = 0, patches = 0;
-    std::vector<double> values;  // [(keyframe · 3 + axis) · patches + patch]
+    std::vector<float> values;  // [(keyframe · 3 + axis) · patches + patch]
 
     CentroidColumns() = default;
     CentroidColumns(const float* centroids, size_t keyframe_count, size_t patch_count)
@@ -82,7 +81,7 @@ struct CentroidColumns {
                 for (size_t axis = 0; axis < 3; ++axis)
                     values[(k * 3 + axis) * patch_count + p] = centroids[(k * patch_count + p) * 3 + axis];
     }
-    const double* axis(size_t keyframe, size_t a) const { return &values[(keyframe * 3 + a) * patches]; }
+    const float* axis(size_t keyframe, size_t a) const { return &values[(keyframe * 3 + a) * patches]; }
 };
 
 // integrated_distance_order (clustering.h) over centroid columns. Each term is distance()'s: the
@@ -105,13 +104,13 @@ std::vector<uint32_t> integrated_distance_order(const CentroidColumns& centroids
         double* sights = &seen[first];
         for (size_t n = 0; n < node_count; ++n) {
             const double ex = node_eyes[3 * n], ey = node_eyes[3 * n + 1], ez = node_eyes[3 * n + 2];
-            const double* cx = centroids.axis(node_keyframes[n], 0) + first;
-            const double* cy = centroids.axis(node_keyframes[n], 1) + first;
-            const double* cz = centroids.axis(node_keyframes[n], 2) + first;
+            const float* cx = centroids.axis(node_keyframes[n], 0) + first;
+            const float* cy = centroids.axis(node_keyframes[n], 1) + first;
+            const float* cz = centroids.axis(node_keyframes[n], 2) + first;
             const uint8_t* vis = i3d && node_visible ? &node_visible[n * patch_count + first] : nullptr;
             if (!vis) {  // the paper's sum: a loop without a branch, vectorised (sqrt is exact in any lane)
                 for (size_t p = 0; p < count; ++p) {
-                    const double dx = ex - cx[p], dy = ey - cy[p], dz = ez - cz[p];
+                    const double dx = ex - double(cx[p]), dy = ey - double(cy[p]), dz = ez - double(cz[p]);
                     sum[p] += std::sqrt(dx * dx + dy * dy + dz * dz);
                 }
                 if (i3d)
@@ -120,7 +119,7 @@ std::vector<uint32_t> integrated_distance_order(const CentroidColumns& centroids
             }
             for (size_t p = 0; p < count; ++p) {
                 if (!vis[p]) continue;  // I3D: wholly back-facing at this node
-                const double dx = ex - cx[p], dy = ey - cy[p], dz = ez - cz[p];
+                const double dx = ex - double(cx[p]), dy = ey - double(cy[p]), dz = ez - double(cz[p]);
                 sum[p] += std::sqrt(dx * dx + dy * dy + dz * dz);
                 sights[p] += 1.0;
             }

@@ -231,8 +231,7 @@ struct Nodes {
     size_t count = 0;                    // keyframes × views
     std::vector<OverdrawNode> cameras;   // per node
     std::vector<float> eyes;             // per view: 3R · direction, in the framed space
-    std::vector<float> centroids;        // per listed keyframe, per patch (patch_centroids)
-    CentroidColumns columns;             // the same, as integrated_distance_order reads them
+    CentroidColumns columns;             // per listed keyframe, per patch (patch_centroids), in columns
     std::vector<float> average;          // per patch: its centroid averaged over the keyframes
     std::vector<uint8_t> patch_visible;  // I3D only: [n · patch_count + p], some triangle faces n
     ScoreSettings score;
@@ -617,15 +616,15 @@ ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patc
     // Each keyframe's patch centroids on its own (patch_centroids of that keyframe: the same
     // values), the keyframes side by side.
     const size_t centroid_floats = patches.patch_count() * 3;
-    nodes.centroids.resize(keyframes.size() * centroid_floats);
+    std::vector<float> centroids(keyframes.size() * centroid_floats);
     tbb::task_arena(worker_threads(settings.threads)).execute([&] {
         tbb::parallel_for(size_t(0), keyframes.size(), [&](size_t i) {
             const std::vector<float> row = patch_centroids(mesh, patches, framing, {keyframes[i]});
-            std::copy(row.begin(), row.end(), nodes.centroids.begin() + ptrdiff_t(i * centroid_floats));
+            std::copy(row.begin(), row.end(), centroids.begin() + ptrdiff_t(i * centroid_floats));
         });
     });
-    nodes.columns = CentroidColumns(nodes.centroids.data(), keyframes.size(), patches.patch_count());
-    nodes.average = average_over_keyframes(nodes.centroids, keyframes.size(), patches.patch_count());
+    nodes.columns = CentroidColumns(centroids.data(), keyframes.size(), patches.patch_count());
+    nodes.average = average_over_keyframes(centroids, keyframes.size(), patches.patch_count());
     if (settings.distance == DistanceVariant::I3d)
         nodes.patch_visible = patch_visibility(mesh, patches, framing, keyframes, nodes.eyes);
     nodes.score.resolution = settings.resolution;

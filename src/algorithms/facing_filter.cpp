@@ -107,7 +107,7 @@ __attribute__((target("avx2,popcnt"))) size_t candidates_avx2(const float* nx, c
 }
 #endif
 
-// The bound of one triangle (build's comment above): from its framed corners (x, y, z[k] in
+// The bound of one triangle (the file's opening comment): from its framed corners (x, y, z[k] in
 // float, as transform_to_clip has them) and their distances from the centre (r[k]), in units of
 // R: the normal n and offset − threshold. Columns of a block, one function per copy below so
 // that each compiles the loop for its own lanes.

@@ -35,6 +35,7 @@
 #include "animorder/camera.h"
 #include "animorder/rasterizer.h"
 
+#include "always_inline.h"
 #include "lane_packing.h"
 
 #include <algorithm>
@@ -46,8 +47,6 @@
 
 namespace animorder {
 namespace {
-
-#define ANIMORDER_FACING_INLINE inline __attribute__((always_inline))
 
 struct BoundConstants {
     double unit, eye, half, delta;
@@ -111,7 +110,7 @@ __attribute__((target("avx2,popcnt"))) size_t candidates_avx2(const float* nx, c
 // float, as transform_to_clip has them) and their distances from the centre (r[k]), in units of
 // R: the normal n and offset − threshold. Columns of a block, one function per copy below so
 // that each compiles the loop for its own lanes.
-ANIMORDER_FACING_INLINE void bounds(BoundBlock& b, size_t count, const BoundConstants& k) {
+ANIMORDER_ALWAYS_INLINE void bounds(BoundBlock& b, size_t count, const BoundConstants& k) {
     const double unit = k.unit, eye = k.eye, half = k.half, delta = k.delta;
     for (size_t i = 0; i < count; ++i) {
         const double a[3] = {unit * b.x[0][i], unit * b.y[0][i], unit * b.z[0][i]};

@@ -19,6 +19,7 @@
 // first in every order. The rare list that still holds a unit three times keeps its triangles
 // (their inner order decides).
 #include "animorder/kept_fragments.h"
+#include "always_inline.h"
 #include "fragment_encoding.h"
 
 #include "animorder/invalid_input.h"
@@ -40,7 +41,6 @@ namespace animorder {
 namespace {
 
 constexpr uint32_t kMaxWeight = UINT16_MAX;
-#define ANIMORDER_KEPT_INLINE inline __attribute__((always_inline))
 
 // A list's first four entries side by side (zeros beyond its end): with its length, the whole of
 // nearly every list, so most lookups compare one word. `e` must have four entries readable.
@@ -73,8 +73,8 @@ uint64_t hash_list(uint64_t key, const uint16_t* e, size_t n) {
 // entries' units, positions and kept flags live in local arrays; N = 0 takes any n, with those in
 // the scratch arrays (each at least n long).
 template <uint32_t N>
-ANIMORDER_KEPT_INLINE uint32_t reduce_list(const uint32_t* f, uint32_t n, const UnitPartition& partition,
-                                           uint32_t* out, uint16_t* units, KeepScratch& scratch, bool& repeated) {
+ANIMORDER_ALWAYS_INLINE uint32_t reduce_list(const uint32_t* f, uint32_t n, const UnitPartition& partition,
+                                             uint32_t* out, uint16_t* units, KeepScratch& scratch, bool& repeated) {
     const uint32_t count = N ? N : n;
     const size_t triangles = partition.unit_of_triangle.size();
     uint32_t local_unit[N ? N : 1], local_position[N ? N : 1];
@@ -218,7 +218,7 @@ uint32_t replay_units_1(const uint16_t* f, uint32_t n, const uint16_t* unit_rank
 // Calls run(length, first list, end) for each run of lists of one length (keep_fragments stores
 // the lists by length), `length` a compile-time constant for 2 to 5 and 0 (any) beyond.
 template <typename Run>
-ANIMORDER_KEPT_INLINE void for_each_length_run(const KeptNode& node, const uint8_t* lengths, Run&& run) {
+ANIMORDER_ALWAYS_INLINE void for_each_length_run(const KeptNode& node, const uint8_t* lengths, Run&& run) {
     for (uint32_t list = 0; list < node.unit_lists;) {
         const uint32_t n = lengths[list];
         uint32_t end = list + 1;
@@ -269,7 +269,7 @@ typedef uint32_t U32x4 __attribute__((vector_size(16)));
 
 // The lane-wise minimum: one instruction on x86 (SSE2's pminsw), which the compiler does not find
 // in the portable form.
-ANIMORDER_KEPT_INLINE I16x8 lane_min(I16x8 a, I16x8 b) {
+ANIMORDER_ALWAYS_INLINE I16x8 lane_min(I16x8 a, I16x8 b) {
 #ifdef __SSE2__
     return I16x8(_mm_min_epi16(__m128i(a), __m128i(b)));
 #else

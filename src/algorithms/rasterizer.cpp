@@ -29,6 +29,7 @@
 #include "animorder/invalid_input.h"
 #include "animorder/triangle_order.h"
 
+#include "always_inline.h"
 #include "fragment_encoding.h"
 #include "lane_packing.h"
 
@@ -50,7 +51,6 @@
 #ifdef __SSE2__
 #include <emmintrin.h>
 #endif
-#define ANIMORDER_INLINE inline __attribute__((always_inline))
 
 namespace animorder {
 
@@ -85,7 +85,7 @@ struct BatchSetup {
 
     // Edge functions for the first `edges` entries of X, Y, px0, py0 and planes for the first
     // `planes` entries of the rest (the triangles of the pre-pass's small-box test need no edges).
-    ANIMORDER_INLINE void compute(size_t edges, size_t planes) {
+    ANIMORDER_ALWAYS_INLINE void compute(size_t edges, size_t planes) {
         for (int k = 0; k < 3; ++k) {
             const int b = (k + 1) % 3;
             for (size_t j = 0; j < edges; ++j) {
@@ -240,9 +240,10 @@ inline bool triangle_box(const WindowVertex& v0, const WindowVertex& v1, const W
 // Writes the fragments of one set-up triangle: edge functions at the box's first pixel centre and
 // their steps, the depth plane. Every pixel of the box is written and the count advances only for
 // a covered pixel whose depth lies in [0, 1): no branch on coverage.
-ANIMORDER_INLINE void emit_box(const int64_t (&e_first)[3], const int64_t (&step_x)[3], const int64_t (&step_y)[3],
-                               double dzdx, double dzdy, double z_origin, const TriangleBox& box, uint32_t triangle,
-                               unsigned resolution, FragmentSink& sink) {
+ANIMORDER_ALWAYS_INLINE void emit_box(const int64_t (&e_first)[3], const int64_t (&step_x)[3],
+                                      const int64_t (&step_y)[3], double dzdx, double dzdy, double z_origin,
+                                      const TriangleBox& box, uint32_t triangle, unsigned resolution,
+                                      FragmentSink& sink) {
     const int64_t px0 = box.px0, px1 = box.px1, py0 = box.py0, py1 = box.py1;
     int64_t e_row[3] = {e_first[0], e_first[1], e_first[2]};
     sink.reserve_more(size_t(px1 - px0 + 1) * size_t(py1 - py0 + 1));
@@ -291,9 +292,9 @@ constexpr LaneCompaction kLaneCompaction;
 // Four pixels' fragments in the wide (AVX2, AVX-512) copies: the lanes set in `covered` (bit k for
 // lane k) whose depth (z, rounded to float) lies in [0, 1), packed to the front and stored at
 // `count` (one 16-byte store per array, whatever the count); returns the new count.
-__attribute__((target("avx2"))) ANIMORDER_INLINE size_t emit_lanes_avx2(int covered, __m256d z, __m128i pixels,
-                                                                        __m128i triangles, FragmentSink& sink,
-                                                                        size_t count) {
+__attribute__((target("avx2"))) ANIMORDER_ALWAYS_INLINE size_t emit_lanes_avx2(int covered, __m256d z, __m128i pixels,
+                                                                               __m128i triangles, FragmentSink& sink,
+                                                                               size_t count) {
     const __m128 depth = _mm256_cvtpd_ps(z);
     const __m128 in_range = _mm_and_ps(_mm_cmplt_ps(depth, _mm_set1_ps(1.0f)), _mm_cmpge_ps(depth, _mm_setzero_ps()));
     const int mask = covered & _mm_movemask_ps(in_range);
@@ -307,10 +308,10 @@ __attribute__((target("avx2"))) ANIMORDER_INLINE size_t emit_lanes_avx2(int cove
 
 // One group of four pixels in the wide copies: emit_lanes_avx2 of the lanes whose three edge
 // values are >= 0 and that lie in the box.
-__attribute__((target("avx2"))) ANIMORDER_INLINE size_t emit_group_avx2(__m256d a0, __m256d a1, __m256d a2,
-                                                                        __m256d in_box, __m256d z, __m128i pixels,
-                                                                        __m128i triangles, FragmentSink& sink,
-                                                                        size_t count) {
+__attribute__((target("avx2"))) ANIMORDER_ALWAYS_INLINE size_t emit_group_avx2(__m256d a0, __m256d a1, __m256d a2,
+                                                                               __m256d in_box, __m256d z,
+                                                                               __m128i pixels, __m128i triangles,
+                                                                               FragmentSink& sink, size_t count) {
     const __m256d zero = _mm256_setzero_pd();
     const __m256d covered =
         _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(a0, zero, _CMP_GE_OQ), _mm256_cmp_pd(a1, zero, _CMP_GE_OQ)),
@@ -429,8 +430,8 @@ __attribute__((target("avx2"))) inline void emit_small_box_avx2(const double (&e
 
 // emit_small_box for a triangle of the pre-pass's small-box test: its covered centres (cover's low
 // four bits, in emit_small_box's order) are known, so only the depths are computed, as there.
-ANIMORDER_INLINE void emit_covered_box(int32_t cover, double dzdx, double dzdy, double z_origin, int32_t px0,
-                                       int32_t py0, uint32_t triangle, unsigned resolution, FragmentSink& sink) {
+ANIMORDER_ALWAYS_INLINE void emit_covered_box(int32_t cover, double dzdx, double dzdy, double z_origin, int32_t px0,
+                                              int32_t py0, uint32_t triangle, unsigned resolution, FragmentSink& sink) {
     sink.reserve_more(4);
     uint32_t* out_pixel = sink.pixel.data();
     uint32_t* out_triangle = sink.triangle.data();
@@ -452,9 +453,10 @@ ANIMORDER_INLINE void emit_covered_box(int32_t cover, double dzdx, double dzdy, 
 // emit_box for a box of at most 2 × 2 pixels (most drawn triangles of a character at 256²):
 // its four pixels unrolled, those past the box's right or bottom end masked like uncovered ones,
 // then emit_covered_box of the covered ones: the same arithmetic and fragment order as emit_box.
-ANIMORDER_INLINE void emit_small_box(const int64_t (&e)[3], const int64_t (&step_x)[3], const int64_t (&step_y)[3],
-                                     double dzdx, double dzdy, double z_origin, const TriangleBox& box,
-                                     uint32_t triangle, unsigned resolution, FragmentSink& sink) {
+ANIMORDER_ALWAYS_INLINE void emit_small_box(const int64_t (&e)[3], const int64_t (&step_x)[3],
+                                            const int64_t (&step_y)[3], double dzdx, double dzdy, double z_origin,
+                                            const TriangleBox& box, uint32_t triangle, unsigned resolution,
+                                            FragmentSink& sink) {
     const bool wide = box.px1 > box.px0, tall = box.py1 > box.py0;
     const bool in_box[4] = {true, wide, tall, wide && tall};
     int32_t cover = 0;
@@ -561,7 +563,7 @@ void rasterize_clipped_triangle(const ClipVertex (&v)[3], uint32_t triangle, uns
 // keys, one 64-bit integer each: a depth is a float in [0, 1), whose bits order as its values
 // once −0 is made +0 (adding +0 does that), so the keys compare as the pairs (no two are equal:
 // a triangle covers a pixel once), and equal high halves are equal depths.
-ANIMORDER_INLINE void group_fragments_by_image(NodeRasterizer::State& s) {
+ANIMORDER_ALWAYS_INLINE void group_fragments_by_image(NodeRasterizer::State& s) {
     const size_t n = s.raw_count;
     const uint32_t pixels = s.resolution * s.resolution;
     const size_t blocks = (size_t(pixels) + 63) / 64;
@@ -697,7 +699,7 @@ ANIMORDER_INLINE void group_fragments_by_image(NodeRasterizer::State& s) {
 // a loop over every pixel of the viewport). Each pixel with two or more fragments is then sorted
 // by depth into the compact list that scoring walks; a single-fragment pixel only counts, its
 // fragment passes under every order.
-ANIMORDER_INLINE void group_fragments(NodeRasterizer::State& s) {
+ANIMORDER_ALWAYS_INLINE void group_fragments(NodeRasterizer::State& s) {
     const uint32_t image_pixels = s.resolution * s.resolution;
     if (image_pixels <= kPixelImageLimit) return group_fragments_by_image(s);
     const size_t n = s.raw_count;
@@ -804,9 +806,9 @@ constexpr int32_t kSpecialVertex = int32_t(1) << 30;
 // For such a triangle, cover[i] holds in its four bits the centres it covers (x0 y0, x1 y0, x0 y1,
 // x1 y1: emit_small_box's lanes, those past the box clear), the signs emit_small_box would find:
 // a drawn one (it covers some) skips the edge functions' set-up. Else 0.
-ANIMORDER_INLINE void batch_box_test(size_t n, const int32_t* x0, const int32_t* y0, const int32_t* x1,
-                                     const int32_t* y1, const int32_t* x2, const int32_t* y2, int32_t last,
-                                     int32_t* keep, int32_t (*box)[4], int32_t* cover) {
+ANIMORDER_ALWAYS_INLINE void batch_box_test(size_t n, const int32_t* x0, const int32_t* y0, const int32_t* x1,
+                                            const int32_t* y1, const int32_t* x2, const int32_t* y2, int32_t last,
+                                            int32_t* keep, int32_t (*box)[4], int32_t* cover) {
     constexpr int32_t kNear = 4 * int32_t(kSubpixel);
     for (size_t i = 0; i < n; ++i) {
         const int32_t min_x = std::min(x0[i], std::min(x1[i], x2[i])), max_x = std::max(x0[i], std::max(x1[i], x2[i]));
@@ -1118,9 +1120,9 @@ namespace {
 // for its own instructions). Inlined into the three copies below; kAvx2: the AVX2 and AVX-512
 // copies, whose boxes take the emit_*_avx2 paths.
 template <NodeRasterizer::Copy kCopy>
-ANIMORDER_INLINE void rasterize_node(NodeRasterizer::State& s, const VertexSource& cv, size_t vertex_count,
-                                     const uint32_t* indices, size_t index_count, unsigned resolution,
-                                     const uint8_t* modes, const uint32_t* candidates, size_t candidate_count) {
+ANIMORDER_ALWAYS_INLINE void rasterize_node(NodeRasterizer::State& s, const VertexSource& cv, size_t vertex_count,
+                                            const uint32_t* indices, size_t index_count, unsigned resolution,
+                                            const uint8_t* modes, const uint32_t* candidates, size_t candidate_count) {
     constexpr bool kAvx2 = kCopy != NodeRasterizer::Copy::Portable;
     s.snapped.resize(vertex_count);
     s.vertices.resize(vertex_count);
@@ -1400,8 +1402,8 @@ void replay_all(uint64_t* passed, const uint32_t* starts, size_t pixels, const u
 // repeating its last fragment (which can neither pass nor lower the minimum); longer untied lists
 // go on one by one; lists with equal depths take replay_list. Integer counts: the same as replay_all.
 // One fragment of an untied list: passes under the orders whose running minimum its rank beats.
-__attribute__((target("avx2"))) ANIMORDER_INLINE void replay_step_avx2(const uint32_t* rank_row, __m256i live,
-                                                                       __m256i& running, __m256i& passes) {
+__attribute__((target("avx2"))) ANIMORDER_ALWAYS_INLINE void replay_step_avx2(const uint32_t* rank_row, __m256i live,
+                                                                              __m256i& running, __m256i& passes) {
     const __m256i r = _mm256_maskload_epi32(reinterpret_cast<const int*>(rank_row), live);
     passes = _mm256_sub_epi32(passes, _mm256_cmpgt_epi32(running, r));
     running = _mm256_min_epi32(running, r);

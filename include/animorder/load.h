@@ -33,6 +33,9 @@ struct LoadOptions {
     // are sampled, so that select_clips names the file's clips in its error); other formats
     // sample every clip. Callers still call select_clips for the order and the error.
     std::vector<std::string> clips;
+    // Threads that evaluate the keyframes (glTF files; 0: all cores). The keyframes are the same
+    // bits whatever the count.
+    unsigned threads = 0;
     // When set, receives every file the load read: files_load_reads' and the side files an
     // importer opened or looked for as it read (an OBJ's .mtl, found or not), each once, in the
     // order first met.

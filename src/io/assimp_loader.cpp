@@ -427,6 +427,7 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
             throw LoadError(path + ": the clips' keyframe count overflows");
     }
     io::check_keyframe_budget(path, total_keyframes, mesh.vertex_count, options);
+    mesh.keyframe_positions.reserve(std::max<size_t>(total_keyframes, 1) * mesh.vertex_count * 3);  // no regrowth
     for (const ClipSource& source : sources)
         if (!source.file.empty()) check_clip_skeleton(source);
 

@@ -21,11 +21,15 @@
 
 #include <tiny_gltf.h>
 
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <exception>
 #include <map>
 
 namespace animorder {
@@ -654,13 +658,41 @@ std::vector<NodePose> pose_at(const Scene& s, const std::vector<Channel>& channe
     return pose;
 }
 
-// A clip's keyframes, every 1 / sample_rate seconds from its first key time, the last one at its
-// last key time, appended to the mesh.
-void sample_keyframes(const Scene& s, ClipChannels& c, const LoadOptions& options, AnimatedMesh& mesh) {
-    c.clip.first_keyframe = mesh.keyframe_count();
-    for (size_t f = 0; f < c.clip.keyframe_count; ++f)
-        add_keyframe(s, pose_at(s, c.channels, std::min(c.t0 + double(f) / options.sample_rate, c.t1)), mesh);
-    mesh.clips.push_back(c.clip);
+// The clips' keyframes, every 1 / sample_rate seconds from each clip's first key time, the last
+// one at its last key time: the clips one after the other, `keyframes` in all. The keyframes are
+// evaluated in parallel (options.threads), each into its own slice of the one array allocated up
+// front; the first failing keyframe's error (in keyframe order) is the one thrown, whatever the
+// threads.
+void sample_keyframes(const Scene& s, std::vector<ClipChannels>& clips, size_t keyframes, const LoadOptions& options,
+                      AnimatedMesh& mesh) {
+    if (clips.empty()) return;
+    struct Sample {
+        const ClipChannels* clip;
+        size_t f;
+    };
+    std::vector<Sample> samples;
+    samples.reserve(keyframes);
+    for (ClipChannels& c : clips) {
+        c.clip.first_keyframe = samples.size();
+        for (size_t f = 0; f < c.clip.keyframe_count; ++f) samples.push_back({&c, f});
+        mesh.clips.push_back(c.clip);
+    }
+    const size_t floats = mesh.vertex_count * 3;
+    mesh.keyframe_positions.resize(samples.size() * floats);
+    std::vector<std::exception_ptr> errors(samples.size());
+    const auto evaluate = [&](size_t k) {
+        try {
+            const ClipChannels& c = *samples[k].clip;
+            const double t = std::min(c.t0 + double(samples[k].f) / options.sample_rate, c.t1);
+            evaluate_pose(s, pose_at(s, c.channels, t), mesh.keyframe_positions.data() + k * floats);
+        } catch (...) {
+            errors[k] = std::current_exception();
+        }
+    };
+    tbb::task_arena(options.threads ? int(std::min<size_t>(options.threads, 1024)) : tbb::task_arena::automatic)
+        .execute([&] { tbb::parallel_for(size_t(0), samples.size(), evaluate); });
+    for (const std::exception_ptr& e : errors)
+        if (e) std::rethrow_exception(e);
 }
 
 // Only the clips named in `asked` (LoadOptions::clips), when each name is one of them; every
@@ -704,7 +736,7 @@ AnimatedMesh load_gltf(const std::string& path, const LoadOptions& options) {
         add_keyframe(scene, scene.rest, mesh);
         mesh.clips.push_back({"static", 0.0, options.sample_rate, 0, 1});
     }
-    for (ClipChannels& c : clips) sample_keyframes(scene, c, options, mesh);
+    sample_keyframes(scene, clips, keyframes, options, mesh);
     try {
         validate_animated_mesh(mesh);
     } catch (const InvalidInput& e) {

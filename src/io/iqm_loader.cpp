@@ -224,6 +224,7 @@ AnimatedMesh load_iqm(const std::string& path, const LoadOptions& options) {
         anims.push_back({first, count, rate});
     }
     io::check_keyframe_budget(path, total_keyframes, num_vertexes, options);
+    mesh.keyframe_positions.reserve(total_keyframes * positions.size());  // no regrowth
 
     for (size_t a = 0; a < anims.size(); ++a) {
         const auto [first, count, rate] = anims[a];

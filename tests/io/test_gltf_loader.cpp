@@ -404,7 +404,7 @@ TEST_F(GltfLoader, OnlyTheAskedClipsAreSampled) {
         g.doc["animations"].push_back(
             {{"name", name}, {"samplers", json::array({sampler})}, {"channels", json::array({channel})}});
     };
-    add_clip("long", 3333, {0, 0, 0, 1, 0, 0, float(s), float(s)});   // 99,991 keyframes: 4.8 MB
+    add_clip("long", 3333, {0, 0, 0, 1, 0, 0, float(s), float(s)});  // 99,991 keyframes: 4.8 MB
     add_clip("back", 0.5f, {0, 0, float(s), float(s), 0, 0, 0, 1});  // 16 keyframes, from 90° to 0
     const std::string path = write("clips.gltf", g.text());
 
@@ -442,6 +442,40 @@ TEST_F(GltfLoader, OnlyTheAskedClipsAreSampled) {
         ADD_FAILURE() << "a missing clip was not reported";
     } catch (const std::exception& e) {
         EXPECT_NE(std::string(e.what()).find("clips: bend, long, back"), std::string::npos) << e.what();
+    }
+}
+
+// The keyframes are sampled in parallel (LoadOptions::threads), each into its own slice: every
+// thread count gives the same bits, and each clip's keyframes land where its first_keyframe says
+// (the hand-worked poses of SkinnedBarBendsAsWorkedOutByHand and of 'back', at their places).
+TEST_F(GltfLoader, KeyframesAreTheSameBitsWhateverTheThreads) {
+    Gltf g = skinned_bar();
+    const double s = std::sqrt(0.5);
+    const int t = g.floats({0, 2}, "SCALAR", 1), r = g.floats({0, 0, float(s), float(s), 0, 0, 0, 1}, "VEC4", 4);
+    json sampler = {{"input", t}, {"output", r}, {"interpolation", "LINEAR"}};
+    json channel = {{"sampler", 0}, {"target", {{"node", 1}, {"path", "rotation"}}}};
+    g.doc["animations"].push_back(
+        {{"name", "back"}, {"samplers", json::array({sampler})}, {"channels", json::array({channel})}});
+    const std::string path = write("threads.gltf", g.text());
+    std::vector<AnimatedMesh> loads;
+    for (const unsigned threads : {1u, 2u, 3u, 0u}) {
+        LoadOptions options;
+        options.threads = threads;
+        loads.push_back(load_gltf(path, options));
+    }
+    const AnimatedMesh& m = loads[0];
+    ASSERT_EQ(m.clips.size(), 2u);
+    EXPECT_EQ(m.clips[1].first_keyframe, 31u);
+    EXPECT_EQ(m.keyframe_count(), 31u + 61u);
+    expect_position(m, 15, 2, 0, 1 + std::sqrt(2.0), 0);  // 'bend' at t = 0.5: 45°
+    expect_position(m, 30, 2, -1, 2, 0);                  // 'bend' at t = 1: 90°
+    expect_position(m, 31, 2, -1, 2, 0);                  // 'back' at t = 0: 90°
+    expect_position(m, 31 + 60, 2, 1, 2, 0);              // 'back' at t = 2: the bind pose
+    for (size_t i = 1; i < loads.size(); ++i) {
+        EXPECT_EQ(loads[i].keyframe_positions, m.keyframe_positions) << "load " << i;
+        ASSERT_EQ(loads[i].clips.size(), m.clips.size());
+        for (size_t c = 0; c < m.clips.size(); ++c)
+            EXPECT_EQ(loads[i].clips[c].first_keyframe, m.clips[c].first_keyframe);
     }
 }
 

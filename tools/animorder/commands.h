@@ -24,6 +24,7 @@ struct CommonOptions {
     bool clip_files_absolute = false;
     unsigned cache_size = kDefaultCacheSize;
     size_t max_memory = LoadOptions{}.max_keyframe_bytes;  // --max-memory: the loading budget in bytes
+    unsigned threads = 0;  // threads that sample the keyframes (0: all cores): the command's --threads
 };
 
 // The settings of the methods, shared by optimize and evaluate: the library's MethodSettings,
@@ -58,7 +59,7 @@ struct EvaluateOptions {
     EvaluationSettings evaluation;  // views, seed, resolution (threads from --threads)
     std::string report_path;
     std::string csv_path;
-    bool stored = false;  // --stored: also the orders stored in INPUT (ANIMORDER_animated_triangle_orders)
+    bool stored = false;        // --stored: also the orders stored in INPUT (ANIMORDER_animated_triangle_orders)
     bool single_sided = false;  // --single-sided: every material culled, as before issue 18 (its cost)
 };
 

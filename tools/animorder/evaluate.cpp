@@ -197,7 +197,9 @@ int run_evaluate(const EvaluateOptions& options) {
     check_output_paths(outputs, {options.common.input});
 
     std::string input_name;
-    AnimatedMesh loaded = load_drawable_input(options.common, input_name);
+    CommonOptions common = options.common;
+    common.threads = b.clustering.threads;
+    AnimatedMesh loaded = load_drawable_input(common, input_name);
     if (options.single_sided)  // the cost of double-sidedness: orders and OVR with every back face culled
         for (Primitive& p : loaded.primitives) p.double_sided = false;
     const AnimatedMesh& mesh = loaded;

@@ -50,6 +50,7 @@ AnimatedMesh load_animated_input(const CommonOptions& common, std::string& input
         options.max_keyframe_bytes = common.max_memory;
         options.clips = clip_names;  // only these are sampled (select_clips below still picks and orders them)
         options.files_read = files_read;
+        options.threads = common.threads;
         mesh = load_character(common.input, clip_files, options);
         note(common, "loaded " + common.input + ": " + std::to_string(mesh.triangle_count()) + " triangles, " +
                          std::to_string(mesh.clips.size()) + " clips, " + std::to_string(mesh.keyframe_count()) +

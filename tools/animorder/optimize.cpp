@@ -114,7 +114,9 @@ OptimizeProduct produce_optimize(const OptimizeOptions& options, const OptimizeP
     const OptimizePlan& paths = plan;
     std::string input_name;
     OptimizeProduct product;
-    product.mesh = load_drawable_input(options.common, input_name, &product.files_read);
+    CommonOptions common = options.common;
+    common.threads = settings.clustering.threads;
+    product.mesh = load_drawable_input(common, input_name, &product.files_read);
     check_output_paths(plan.outputs, product.files_read);
     if (loaded) loaded(product.files_read);
     const AnimatedMesh& mesh = product.mesh;

@@ -983,6 +983,35 @@ __attribute__((target("avx2,popcnt"))) size_t pack_drawn_avx2(size_t n, const in
     return i;
 }
 
+// The batch's snapped corners (rasterize_node's gather), 8 triangles at a time: each corner's
+// 8-byte (X, Y) record loaded whole, two to a 128-bit half, then split into the X and the Y row
+// by one shuffle each: two vector stores per corner where the scalar loop stores 16 values one by
+// one. The same values. Returns how many of the n it did (a multiple of 8); the scalar loop does
+// the rest.
+template <NodeRasterizer::Copy>  // one instance a wide copy: each inlines its own
+__attribute__((target("avx2"))) size_t gather_corners_avx2(size_t n, const uint32_t* id, const uint32_t* indices,
+                                                           const NodeRasterizer::State::Snapped* corner,
+                                                           int32_t* const (&x)[3], int32_t* const (&y)[3]) {
+    static_assert(sizeof(NodeRasterizer::State::Snapped) == 8, "an (X, Y) record is 8 bytes");
+    const auto record = [corner](uint32_t v) { return reinterpret_cast<const double*>(corner + v); };
+    size_t i = 0;
+    for (; i + 8 <= n; i += 8) {
+        const uint32_t* tri[8];
+        for (int t = 0; t < 8; ++t) tri[t] = indices + 3 * size_t(id[i + size_t(t)]);
+        for (int k = 0; k < 3; ++k) {
+            // Halves: triangles (0, 1 | 4, 5) and (2, 3 | 6, 7), each as X, Y, X, Y.
+            __m128d pair[4];
+            for (int h = 0; h < 4; ++h)
+                pair[h] = _mm_loadh_pd(_mm_load_sd(record(tri[2 * h][k])), record(tri[2 * h + 1][k]));
+            const __m256 a = _mm256_castpd_ps(_mm256_insertf128_pd(_mm256_castpd128_pd256(pair[0]), pair[2], 1));
+            const __m256 b = _mm256_castpd_ps(_mm256_insertf128_pd(_mm256_castpd128_pd256(pair[1]), pair[3], 1));
+            _mm256_storeu_ps(reinterpret_cast<float*>(x[k] + i), _mm256_shuffle_ps(a, b, _MM_SHUFFLE(2, 0, 2, 0)));
+            _mm256_storeu_ps(reinterpret_cast<float*>(y[k] + i), _mm256_shuffle_ps(a, b, _MM_SHUFFLE(3, 1, 3, 1)));
+        }
+    }
+    return i;
+}
+
 // The depth planes' inputs of rasterize_node for the drawn triangles, 4 at a time: each corner's
 // 16-byte record loaded whole, the differences taken in float lanes, the 4 triangles' (x, y, z)
 // turned into one vector per coordinate and widened to double: the same float subtractions and
@@ -1191,7 +1220,11 @@ ANIMORDER_ALWAYS_INLINE void rasterize_node(NodeRasterizer::State& s, const Vert
         } else {
             for (size_t i = 0; i < n; ++i) id[i] = uint32_t(first + i);
         }
-        for (size_t i = 0; i < n; ++i) {
+        size_t gathered = 0;
+#ifdef ANIMORDER_RASTER_AVX2
+        if constexpr (kAvx2) gathered = gather_corners_avx2<kCopy>(n, id, indices, corner, {x0, x1, x2}, {y0, y1, y2});
+#endif
+        for (size_t i = gathered; i < n; ++i) {
             const uint32_t* tri = indices + 3 * size_t(id[i]);
             const uint32_t a = tri[0], b = tri[1], c = tri[2];
             x0[i] = corner[a].X;

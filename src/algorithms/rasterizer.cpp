@@ -1202,7 +1202,7 @@ ANIMORDER_ALWAYS_INLINE void rasterize_node(NodeRasterizer::State& s, const Vert
     int32_t boxes[kBatch][4];
     int64_t areas[kBatch];
     int32_t special[kBatch];
-    uint32_t draw[kBatch + 8], id[kBatch];  // draw: 8 slots past the batch for the wide copies' stores
+    uint32_t draw[kBatch + 8], every[kBatch];  // draw: 8 slots past the batch for the wide copies' stores
     uint8_t listed_modes[kBatch];
     static constexpr uint8_t kNoModes[kBatch] = {};  // every triangle drawn, back faces culled
     BatchSetup& setup = s.setup;
@@ -1211,14 +1211,15 @@ ANIMORDER_ALWAYS_INLINE void rasterize_node(NodeRasterizer::State& s, const Vert
         // The batch's triangles (id) and their modes (mode): the index list's own, or the
         // candidates'. Triangle id's corners are indices[3 · id ...].
         const uint8_t* mode = modes ? modes + first : kNoModes;
+        const uint32_t* id = every;
         if (listed) {
-            std::memcpy(id, candidates + first, n * sizeof(uint32_t));
+            id = candidates + first;
             if (modes) {
                 for (size_t i = 0; i < n; ++i) listed_modes[i] = modes[id[i]];
                 mode = listed_modes;
             }
         } else {
-            for (size_t i = 0; i < n; ++i) id[i] = uint32_t(first + i);
+            for (size_t i = 0; i < n; ++i) every[i] = uint32_t(first + i);
         }
         size_t gathered = 0;
 #ifdef ANIMORDER_RASTER_AVX2

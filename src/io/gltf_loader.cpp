@@ -15,6 +15,7 @@
 #include "animorder/load.h"
 #include "animorder/skinning.h"
 
+#include "../algorithms/worker_threads.h"
 #include "checked_size.h"
 #include "gltf_buffer.h"
 #include "transform.h"
@@ -689,8 +690,9 @@ void sample_keyframes(const Scene& s, std::vector<ClipChannels>& clips, size_t k
             errors[k] = std::current_exception();
         }
     };
-    tbb::task_arena(options.threads ? int(std::min<size_t>(options.threads, 1024)) : tbb::task_arena::automatic)
-        .execute([&] { tbb::parallel_for(size_t(0), samples.size(), evaluate); });
+    tbb::task_arena(worker_threads(options.threads)).execute([&] {
+        tbb::parallel_for(size_t(0), samples.size(), evaluate);
+    });
     for (const std::exception_ptr& e : errors)
         if (e) std::rethrow_exception(e);
 }

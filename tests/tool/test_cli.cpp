@@ -96,6 +96,12 @@ TEST_F(Cli, QuietSilencesStderr) {
         run("optimize --quiet -k 2 --views 12 --resolution 32 --max-iterations 1 --threads 1000");
     EXPECT_EQ(threads.exit_code, 0) << threads.err;
     EXPECT_EQ(threads.err, "");
+    // The same from a glTF input, whose keyframes the loader samples with those threads first.
+    ASSERT_EQ(run("subdivide -q --levels 0 --clip walk -o " + path("walk.glb").string()).exit_code, 0);
+    const test::Outcome loaded = run("optimize " + path("walk.glb").string() +
+                                     " --quiet -k 2 --views 12 --resolution 32 --max-iterations 1 --threads 1000");
+    EXPECT_EQ(loaded.exit_code, 0) << loaded.err;
+    EXPECT_EQ(loaded.err, "");
 }
 
 TEST_F(Cli, OptimizeWritesIndicesAndReport) {

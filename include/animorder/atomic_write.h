@@ -18,8 +18,12 @@ public:
 
 // Throws OutputError unless every output path can be written as a new or replaced file: its folder
 // exists, it is not a folder, its name leaves room for its temporary's, it is not (after
-// resolving links) one of `inputs`, and no two outputs are the same file. Call it before any long work, so a bad path fails at once.
-void check_output_paths(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs);
+// resolving links) one of `inputs`, it does not lie in one of `input_folders` (folders every
+// file of which the run reads, such as a clip folder: a later run would read the output as an
+// input), and no two outputs are the same file. Call it before any long work, so a bad path fails
+// at once.
+void check_output_paths(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs,
+                        const std::vector<std::string>& input_folders = {});
 
 // A key equal for two paths exactly when they name the same file: its device and inode when it
 // exists, else its path with links and "." / ".." resolved.

@@ -70,11 +70,15 @@ void check_output_stem(const std::string& stem) {
                           ": names a folder; give a file name the outputs extend (e.g. out/hero)");
 }
 
-void check_output_paths(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs) {
+void check_output_paths(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs,
+                        const std::vector<std::string>& input_folders) {
     // Each path resolved once (a library's batch checks thousands against thousands).
     std::unordered_set<std::string> input_files;
     for (const std::string& input : inputs)
         if (!input.empty()) input_files.insert(file_identity(input));
+    std::unordered_map<std::string, std::string> folders;  // identity → the folder as named
+    for (const std::string& folder : input_folders)
+        if (!folder.empty()) folders.emplace(file_identity(folder), folder);
     std::unordered_map<std::string, size_t> output_files;
     for (size_t i = 0; i < outputs.size(); ++i) {
         check_writable_target(outputs[i]);
@@ -82,6 +86,15 @@ void check_output_paths(const std::vector<std::string>& outputs, const std::vect
         if (input_files.count(identity))
             throw OutputError(outputs[i] +
                               ": is an input of this run: refusing to overwrite the input; name another output");
+        if (!folders.empty()) {
+            const fs::path target(outputs[i]);
+            const auto folder = folders.find(
+                file_identity(target.has_parent_path() ? target.parent_path().string() : std::string(".")));
+            if (folder != folders.end())
+                throw OutputError(outputs[i] + ": lies in " + folder->second +
+                                  ", a folder every file of which this run reads (a clip folder): a later run would "
+                                  "read the output as an input; name an output outside it");
+        }
         const auto [first, added] = output_files.emplace(identity, i);
         if (!added) throw OutputError(outputs[i] + ": named twice as an output (" + outputs[first->second] + ")");
     }

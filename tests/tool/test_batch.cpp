@@ -42,6 +42,7 @@ protected:
     test::Outcome run(const std::string& args) {
         return test::run_captured(std::string(ANIMORDER_EXE) + " " + args, dir_);
     }
+    test::Outcome run_shell(const std::string& command) { return test::run_captured(command, dir_); }
     std::string manifest() const { return path("m.json").string(); }
     void write(const std::string& name, const std::string& text) {
         std::ofstream(path(name), std::ios::binary) << text;
@@ -144,7 +145,7 @@ TEST_F(Batch, CsvManifestIsTheJsonManifest) {
         "m.json",
         R"({"items": [{"clips": ["walk", "wave"], "options": "-k 2 --views 12 --resolution 32 --max-iterations 2", "output": "out/a"}]})");
     write("m.csv",
-          "input,clips,method,options,output\n,walk;wave,single,\"-k 2 --views 12 --resolution 32 --max-iterations "
+          "clips,method,options,output\nwalk;wave,single,\"-k 2 --views 12 --resolution 32 --max-iterations "
           "2\",out/b\n");
     ASSERT_EQ(run("batch -q --eval-views 0 " + manifest()).exit_code, 0);
     const test::Outcome csv = run("batch -q --eval-views 0 " + path("m.csv").string());
@@ -297,6 +298,8 @@ TEST_F(Batch, EveryOutputIsCheckedBeforeAnyWork) {
     EXPECT_TRUE(outputs().empty());  // the first item did not run either
 
     write("prev.animorder.bin", "an input that an output would replace");
+    fs::create_directories(path("anims"));
+    write("anims/walk.fbx", "a clip");
     for (
         const char* bad :
         {R"({"items": [{"input": "prev.animorder.bin", "output": "out/x"}, {"method": "original", "output": "prev"}]})",
@@ -304,7 +307,13 @@ TEST_F(Batch, EveryOutputIsCheckedBeforeAnyWork) {
          R"({"items": [{"method": "original", "output": "out/x", "colour": "red"}]})",
          R"({"items": [{"method": "nonsense", "output": "out/x"}]})",
          R"({"items": [{"method": "original", "options": "-o elsewhere", "output": "out/x"}]})",
-         R"({"items": [{"method": "original"}]})", "not json"}) {
+         R"({"items": [{"method": "original"}]})", "not json",
+         // an output, or the summary, in a clip folder (every file of which an item reads)
+         R"({"items": [{"input": "prev.animorder.bin", "clips": ["anims/"], "method": "original",
+                        "output": "anims/x"}]})",
+         R"({"items": [{"method": "original", "output": "anims/x"},
+                       {"input": "prev.animorder.bin", "clips": ["anims"], "method": "original",
+                        "output": "out/y"}]})"}) {
         write("m.json", bad);  // NOLINT
         const test::Outcome e = run("batch -q " + manifest());
         EXPECT_EQ(e.exit_code, 1) << bad;
@@ -314,6 +323,16 @@ TEST_F(Batch, EveryOutputIsCheckedBeforeAnyWork) {
     const test::Outcome shard = run("batch -q --shard 3/3 " + manifest());
     EXPECT_EQ(shard.exit_code, 1);
     EXPECT_EQ(test::line_count(shard.err), 1u) << shard.err;
+    write("m.json", R"({"items": [{"method": "original", "output": "out/x"}]})");
+    const test::Outcome summary =
+        run("batch -q --eval-views 0 --summary " + path("anims/summary").string() + " " + manifest());
+    EXPECT_EQ(summary.exit_code, 0) << "no item reads anims/ now: " << summary.err;
+    write("m.json", R"({"items": [{"input": "prev.animorder.bin", "clips": ["anims"], "output": "out/y"}]})");
+    const test::Outcome in_clips =
+        run("batch -q --eval-views 0 --summary " + path("anims/summary2").string() + " " + manifest());
+    EXPECT_EQ(in_clips.exit_code, 1);
+    EXPECT_NE(in_clips.err.find("clip folder"), std::string::npos) << in_clips.err;
+    EXPECT_EQ(test::line_count(in_clips.err), 1u) << in_clips.err;
 }
 
 TEST_F(Batch, AChangedInputFileRerunsItsItemAndAGltfItemWritesTheGltf) {
@@ -516,7 +535,19 @@ TEST_F(Batch, ManifestMistakesAreRefusedBeforeAnyWork) {
         {"m.json", R"({"items": [{"method": "original", "options": "--help", "output": "out/a"}]})"},
         {"m.json", R"({"items": [{"method": "original", "output": "out/a", "output": "out/b"}]})"},
         {"m.csv", "method,output,method\noriginal,out/a,single\n"},
-        {"m.json", R"({"items": [{"method": "original", "output": "out/)" + long_name + R"("}]})"}};
+        {"m.json", R"({"items": [{"method": "original", "output": "out/)" + long_name + R"("}]})"},
+        // a stray quote, text after a closing quote: never silently dropped
+        {"m.csv", "method,output\noriginal,out/a\"b,c\"\n"},
+        {"m.csv", "method,output\noriginal,\"out/a\" x\n"},
+        // an input given but blank (the bundled character is an item without one)
+        {"m.csv", "input,method,output\n  ,original,out/a\n"},
+        {"m.json", R"({"items": [{"input": "", "method": "original", "output": "out/a"}]})"},
+        // options naming an output, glued to their values
+        {"m.json", R"({"items": [{"method": "original", "options": "-revil.json", "output": "out/a"}]})"},
+        {"m.json", R"({"items": [{"method": "original", "options": ["-q", "-oevil"], "output": "out/a"}]})"},
+        {"m.json", R"({"items": [{"method": "original", "options": "-qrevil.json", "output": "out/a"}]})"},
+        // a key the manifest does not know, beside "items"
+        {"m.json", R"({"items": [{"method": "original", "output": "out/a"}], "defaults": {"method": "joint"}})"}};
     for (const auto& [name, text] : bad) {
         write(name, text);
         const test::Outcome o = run("batch -q --eval-views 0 " + path(name).string());
@@ -532,8 +563,64 @@ TEST_F(Batch, ManifestMistakesAreRefusedBeforeAnyWork) {
         EXPECT_EQ(test::line_count(o.err), 1u) << options << "\n" << o.err;
     }
     EXPECT_TRUE(outputs().empty());
-    write("m.csv", "\xEF\xBB\xBFmethod , output\n original , out/a \n");
+    write("m.csv", "\xEF\xBB\xBFmethod , output\n original , \"out/a\" \n");
     const test::Outcome bom = run("batch -q --eval-views 0 " + path("m.csv").string());
     EXPECT_EQ(bom.exit_code, 0) << bom.err;
     EXPECT_TRUE(fs::exists(path("out/a.animorder.bin")));
+}
+
+// A report whose figures were edited into something else is not a result: the merge lists the
+// item as missing (not "ok" with the edited figures) and the next run redoes it.
+TEST_F(Batch, AReportEditedByHandIsStaleNotTrusted) {
+    write("m.json",
+          R"({"items": [{"method": "original", "output": "out/a"}, {"method": "original", "output": "out/b"}]})");
+    ASSERT_EQ(run("batch -q --eval-views 0 " + manifest()).exit_code, 0);
+    nlohmann::json report = nlohmann::json::parse(test::slurp(path("out/a.animorder.report.json")));
+    report["batch"]["triangles"] = "lots";
+    write("out/a.animorder.report.json", report.dump());
+    const test::Outcome merged = run("batch -q --eval-views 0 --merge " + manifest());
+    EXPECT_EQ(merged.exit_code, 4) << merged.err;
+    const nlohmann::json s = nlohmann::json::parse(test::slurp(path("m.summary.json")));
+    EXPECT_EQ(s["items"][0]["status"], "missing");
+    EXPECT_TRUE(s["items"][0]["triangles"].is_null());
+    EXPECT_EQ(s["items"][1]["status"], "ok");
+    const test::Outcome again = run("batch -q --eval-views 0 " + manifest());
+    EXPECT_EQ(again.exit_code, 0) << again.err;
+    EXPECT_NE(again.out.find("1 done, 1 up to date"), std::string::npos) << again.out;
+}
+
+// The README's Kubernetes Indexed Job runs its container command once per index: a pod whose
+// shard has a broken item completes (the failure is recorded, not retried), and the merge step
+// then lists it with exit code 3. The command is taken from the README as written.
+TEST_F(Batch, TheReadmesKubernetesCommandCompletesAShardWithAFailedItem) {
+    const std::string readme = test::slurp(fs::path(ANIMORDER_SOURCE_DIR) / "README.md");
+    const std::string marker = "command: [\"sh\", \"-c\", \"";
+    const size_t at = readme.find(marker);
+    ASSERT_NE(at, std::string::npos) << "the README's Job has no sh -c command";
+    std::string command = readme.substr(at + marker.size(), readme.find("\"]", at) - at - marker.size());
+    ASSERT_EQ(command.find('\''), std::string::npos) << command;
+    auto replace = [&](const std::string& from, const std::string& to) {
+        const size_t p = command.find(from);
+        ASSERT_NE(p, std::string::npos) << from << " in " << command;
+        command.replace(p, from.size(), to);
+    };
+    replace("animorder batch /library/manifest.json", std::string(ANIMORDER_EXE) + " batch " + manifest());
+    write("broken.gltf", "{\"asset\": {\"version\": \"2.0\"}, \"meshes\": 7}");
+    write("m.json", R"({"items": [{"method": "original", "output": "out/good"},
+                                  {"input": "broken.gltf", "method": "original", "output": "out/broken"}]})");
+    for (const char* index : {"0", "1"}) {
+        const std::string pod_command = "JOB_COMPLETION_INDEX=" + std::string(index) + " sh -c '" + command + "'";
+        const test::Outcome pod = run_shell(pod_command);
+        EXPECT_EQ(pod.exit_code, 0) << "index " << index << ": " << pod.err;
+    }
+    EXPECT_TRUE(fs::exists(path("out/good.animorder.bin")));
+    EXPECT_TRUE(fs::exists(path("out/broken.animorder.error.json")));
+    const test::Outcome merged = run("batch -q --merge " + manifest());
+    EXPECT_EQ(merged.exit_code, 3) << merged.err;
+    const nlohmann::json s = nlohmann::json::parse(test::slurp(path("m.summary.json")));
+    EXPECT_EQ(s["ok"], 1);
+    EXPECT_EQ(s["failed"], 1);
+    // An error before any work (here a manifest that is not JSON) still fails the pod.
+    write("m.json", "not json");
+    EXPECT_EQ(run_shell("JOB_COMPLETION_INDEX=0 sh -c '" + command + "'").exit_code, 1);
 }

@@ -422,6 +422,19 @@ TEST_F(CliOutputs, TwoOutputsOnOneFileAreRefusedBeforeAnyWrite) {
     EXPECT_EQ(entries_of(dir_), "in.glb ") << "nothing written";
 }
 
+// A clip folder is read whole: an output placed in it would be read as a clip by the next run.
+TEST_F(CliOutputs, AnOutputInAClipFolderIsRefused) {
+    fs::create_directories(path("clips"));
+    fs::copy_file(path("in.glb"), path("clips/walk.glb"));
+    expect_refused("optimize " + path("in.glb").string() + " --clip " + path("clips").string() + " -o " +
+                       path("clips/out").string(),
+                   "clip folder");
+    expect_refused("optimize " + path("in.glb").string() + " --clip " + path("clips").string() + " -r " +
+                       (dir_ / "clips" / "." / "r.json").string(),
+                   "clip folder");
+    EXPECT_EQ(entries_of(path("clips")), "walk.glb ") << "nothing written";
+}
+
 TEST_F(CliOutputs, AllOutputsAppearTogether) {
     const test::Outcome o = run("optimize -q --method original " + path("in.glb").string() + " -o " +
                                 path("out.glb").string() + " -r " + path("r.json").string());

@@ -10,9 +10,9 @@
 // is up to date and skipped; so a run killed at any moment and started
 // again redoes only the items it had not finished, and a changed option or input re-runs only the
 // items it affects. A failing item leaves OUT.animorder.error.json (its stamp and the error) and
-// the batch goes on. `--shard I/N` runs items i with i % N == I; the summary (SUMMARY.json and
-// SUMMARY.md) is always merged from the items' files in manifest order, so it is the same
-// whichever process ran which item.
+// the batch goes on. `--shard I/N` runs items i with i % N == I (and reads their files only);
+// the summary (SUMMARY.json and SUMMARY.md) is always merged from the items' files in manifest
+// order, so it is the same whichever process ran which item.
 #include "commands.h"
 #include "input.h"
 #include "optimize.h"
@@ -66,6 +66,7 @@ struct ManifestItem {
     // how the manifest's own path was spelled, nor on the current folder.
     std::string input_as_written, output_as_written;
     std::vector<std::string> clips_as_written;
+    bool input_given = false;  // an "input" key or column: then it may not be blank
 };
 
 // Items' relative paths are relative to the manifest's folder, so a manifest moves with its data.
@@ -168,6 +169,9 @@ std::vector<ManifestItem> parse_json_manifest(const std::string& text, const std
     const json* list = &doc;
     if (doc.is_object()) {
         if (!doc.contains("items")) throw std::runtime_error(path + ": a JSON manifest needs an \"items\" list");
+        for (auto it = doc.begin(); it != doc.end(); ++it)
+            if (it.key() != "items")
+                throw std::runtime_error(path + ": unknown key \"" + it.key() + "\" (a manifest holds only \"items\")");
         list = &doc["items"];
     }
     if (!list->is_array()) throw std::runtime_error(path + ": \"items\" must be a list");
@@ -189,6 +193,7 @@ std::vector<ManifestItem> parse_json_manifest(const std::string& text, const std
         ManifestItem item;
         item.name = text_of("name");
         item.input = text_of("input");
+        item.input_given = e.contains("input") && !e["input"].is_null();
         item.method = text_of("method");
         item.output = text_of("output");
         if (e.contains("clips")) {
@@ -209,28 +214,40 @@ std::vector<ManifestItem> parse_json_manifest(const std::string& text, const std
     return items;
 }
 
-// One CSV record (RFC 4180 quoting); `pos` moves past it and its line end.
+// One CSV record (RFC 4180 quoting); `pos` moves past it and its line end. A quote opens a
+// field (spaces or tabs may come before it and after its closing quote); anywhere else, as in
+// out/a"b, it is an error, never dropped.
 std::vector<std::string> csv_record(const std::string& text, size_t& pos, const std::string& where) {
     std::vector<std::string> fields(1);
-    bool quoted = false;
+    bool quoted = false, closed = false;  // in quotes; past a field's closing quote
+    const auto blank = [](const std::string& s) { return s.find_first_not_of(" \t") == std::string::npos; };
     for (; pos < text.size(); ++pos) {
         const char c = text[pos];
         if (quoted) {
             if (c == '"' && pos + 1 < text.size() && text[pos + 1] == '"')
                 fields.back() += '"', ++pos;
             else if (c == '"')
-                quoted = false;
+                quoted = false, closed = true;
             else
                 fields.back() += c;
-        } else if (c == '"') {
-            quoted = true;
         } else if (c == ',') {
             fields.emplace_back();
+            closed = false;
         } else if (c == '\n' || c == '\r') {
             if (c == '\r' && pos + 1 < text.size() && text[pos + 1] == '\n') ++pos;
             ++pos;
             return fields;
-        } else {
+        } else if (closed && c != ' ' && c != '\t') {
+            throw std::runtime_error(where + ": field " + std::to_string(fields.size()) +
+                                     ": text after its closing quote (quote the whole field, a quote inside as \"\")");
+        } else if (c == '"') {
+            if (closed || !blank(fields.back()))
+                throw std::runtime_error(where + ": field " + std::to_string(fields.size()) +
+                                         ": a quote inside an unquoted field (quote the whole field, a quote inside "
+                                         "as \"\")");
+            fields.back().clear();
+            quoted = true;
+        } else if (!closed) {
             fields.back() += c;
         }
     }
@@ -271,7 +288,7 @@ std::vector<ManifestItem> parse_csv_manifest(const std::string& text, const std:
             if (header[f] == "name")
                 item.name = v;
             else if (header[f] == "input")
-                item.input = v;
+                item.input = v, item.input_given = true;
             else if (header[f] == "method")
                 item.method = v;
             else if (header[f] == "output")
@@ -308,6 +325,8 @@ std::vector<ManifestItem> read_manifest(const std::string& path) {
         ManifestItem& item = items[i];
         const std::string where = path + ": item " + std::to_string(i + 1);
         if (item.output.empty()) throw std::runtime_error(where + " has no \"output\"");
+        if (item.input_given && item.input.find_first_not_of(" \t") == std::string::npos)
+            throw std::runtime_error(where + ": the input is empty (leave \"input\" out for the bundled character)");
         if (item.name.empty()) item.name = item.output;
         require_utf8(item.name, where + ": the name");
         require_utf8(item.input, where + ": the input");
@@ -345,6 +364,15 @@ std::string stem_of(const std::string& output) {
     return ext == ".glb" || ext == ".gltf" ? output.substr(0, output.size() - ext.size()) : output;
 }
 
+// An option that names an output, which batch names itself: -o, -r, --output, --report, also
+// glued to its value (-oOUT) or after flags in one word (-qrOUT).
+bool names_an_output(const std::string& o) {
+    if (o.rfind("--output", 0) == 0 || o.rfind("--report", 0) == 0) return true;
+    if (o.size() < 2 || o[0] != '-' || o[1] == '-') return false;
+    const size_t first = o.find_first_not_of("qh", 1);  // optimize's short flags that take no value
+    return first != std::string::npos && (o[first] == 'o' || o[first] == 'r');
+}
+
 PlannedItem plan_item(const ManifestItem& item, size_t index, const BatchOptions& batch, const ItemParser& parse) {
     PlannedItem p;
     p.item = item;
@@ -355,7 +383,7 @@ PlannedItem plan_item(const ManifestItem& item, size_t index, const BatchOptions
     for (const std::string& c : item.clips) args.insert(args.end(), {"--clip", c});
     if (!item.method.empty()) args.insert(args.end(), {"--method", item.method});
     for (const std::string& o : item.options) {
-        if (o == "-o" || o == "-r" || o.rfind("--output", 0) == 0 || o.rfind("--report", 0) == 0)
+        if (names_an_output(o))
             throw std::runtime_error(label + ": option " + o + ": batch names the outputs (use the item's \"output\")");
         if (o == "--clip" || o.rfind("--clip=", 0) == 0)
             throw std::runtime_error(label + ": option " + o +
@@ -520,11 +548,26 @@ json side_files(const PlannedItem& p, const std::vector<std::string>& files_read
     return list;
 }
 
-// The item's report when it is up to date: its stamp matches, every output is there and every
-// side file it lists still has its digest.
+// The summary's figures in a report as run_item writes them: counts, ACMRs, and OVRs and the time
+// as numbers or null (no evaluation; --no-timings).
+bool summary_fields_hold(const json& batch) {
+    if (!batch.is_object() || string_at(batch, "status") != "ok") return false;
+    for (const char* key : {"triangles", "clips", "buffers", "index_bytes_added"})
+        if (!batch.contains(key) || !batch[key].is_number_unsigned()) return false;
+    for (const char* key : {"acmr_before", "acmr_after"})
+        if (!batch.contains(key) || !batch[key].is_number()) return false;
+    for (const char* key : {"ovr_before", "ovr_after", "time_s"})
+        if (!batch.contains(key) || !(batch[key].is_number() || batch[key].is_null())) return false;
+    return true;
+}
+
+// The item's report when it is up to date: its stamp matches, the summary's figures are as
+// written, every output is there and every side file it lists still has its digest.
 json current_report(const PlannedItem& p, const std::string& stamp) {
     json report = read_json_file(p.report);
-    if (!report.is_object() || !report.contains("batch") || string_at(report["batch"], "stamp") != stamp) return json();
+    if (!report.is_object() || !report.contains("batch") || string_at(report["batch"], "stamp") != stamp ||
+        !summary_fields_hold(report["batch"]))
+        return json();
     std::error_code error;
     for (const std::string& out : p.plan.outputs)
         if (!fs::is_regular_file(out, error)) return json();
@@ -755,7 +798,8 @@ std::pair<size_t, size_t> parse_shard(const std::string& text) {
     auto number = [&](const std::string& s, const char* what) {
         if (s.empty() || s.size() > 9 ||
             !std::all_of(s.begin(), s.end(), [](char c) { return std::isdigit(uint8_t(c)); }))
-            throw std::runtime_error("--shard " + text + ": " + what + " must be a number (I/N, or env/N)");
+            throw std::runtime_error("--shard " + text + ": " + what +
+                                     " must be a whole number below 10^9 (I/N, or env/N)");
         return size_t(std::stoul(s));
     };
     if (slash == std::string::npos) throw std::runtime_error("--shard " + text + ": expected I/N (or env/N)");
@@ -800,18 +844,22 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
         summary = (m.parent_path() / m.stem()).string() + ".summary";
     }
     check_output_stem(summary);
-    std::vector<std::string> outputs = {summary + ".json", summary + ".md"}, inputs = {batch.manifest};
+    std::vector<std::string> outputs = {summary + ".json", summary + ".md"}, inputs = {batch.manifest}, folders;
     for (const PlannedItem& p : items) {
         outputs.insert(outputs.end(), p.plan.outputs.begin(), p.plan.outputs.end());
         outputs.push_back(p.error);
         inputs.insert(inputs.end(), p.plan.inputs.begin(), p.plan.inputs.end());
+        folders.insert(folders.end(), p.plan.input_folders.begin(), p.plan.input_folders.end());
     }
-    check_output_paths(outputs, inputs);
+    check_output_paths(outputs, inputs, folders);
     OutputsByPlace outputs_by_place;
     for (const std::string& output : outputs) outputs_by_place.emplace(place_of(output), output);
 
-    std::vector<std::string> stamps;
-    for (const PlannedItem& p : items) stamps.push_back(item_stamp(p, batch));
+    // A shard reads the files of its own items only (a farm's pods would each read the library);
+    // the merge, and an unsharded run, stamp every item.
+    std::vector<std::string> stamps(items.size());
+    for (size_t i = 0; i < items.size(); ++i)
+        if (batch.merge || i % shard.second == shard.first) stamps[i] = item_stamp(items[i], batch);
     const bool sharded = shard.second > 1 || !batch.shard.empty();
     if (batch.merge) return write_summary(items, stamps, summary, batch.manifest, batch);
 

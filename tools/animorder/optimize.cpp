@@ -103,6 +103,10 @@ OptimizePlan plan_optimize(const OptimizeOptions& options) {
     for (const std::string* p : named)
         if (!p->empty()) plan.outputs.push_back(*p);
     plan.inputs = input_paths(options.common);
+    for (const std::string& c : options.common.clips) {
+        std::error_code error;
+        if (clip_is_file(options.common, c) && std::filesystem::is_directory(c, error)) plan.input_folders.push_back(c);
+    }
     return plan;
 }
 
@@ -159,7 +163,7 @@ int run_optimize(const OptimizeOptions& options) {
     const OptimizePlan plan = plan_optimize(options);
     // Every output is checked now, not after minutes of work: folders exist, nothing is an input,
     // no file is named twice.
-    check_output_paths(plan.outputs, plan.inputs);
+    check_output_paths(plan.outputs, plan.inputs, plan.input_folders);
 
     OutputSet files;
     const OptimizeProduct product = produce_optimize(options, plan, files);

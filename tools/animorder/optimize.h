@@ -25,6 +25,7 @@ struct OptimizePlan {
     std::string gltf, sidecar, sidecar_json;  // empty when not written
     std::vector<std::string> outputs;         // every file the run writes (the report included)
     std::vector<std::string> inputs;          // every file it reads, as far as known before loading
+    std::vector<std::string> input_folders;   // folders every file of which it reads (clip folders)
 };
 
 // Validates the options (method, settings, output names) and names the outputs; touches no file.

@@ -161,6 +161,16 @@ const aiScene* import(Assimp::Importer& importer, const std::string& path, std::
     return scene;
 }
 
+// For a file with bones and no geometry (an .md5anim, a .bvh), assimp's SkeletonMeshBuilder adds a
+// mesh of its own that draws the bones, with a material it names "SkeletonMaterial": not the
+// character.
+bool is_skeleton_stand_in(const aiScene* scene, const aiMesh* m) {
+    if (m->mMaterialIndex >= scene->mNumMaterials || !scene->mMaterials[m->mMaterialIndex]) return false;
+    aiString name;
+    return scene->mMaterials[m->mMaterialIndex]->Get(AI_MATKEY_NAME, name) == AI_SUCCESS &&
+           std::strcmp(name.C_Str(), "SkeletonMaterial") == 0;
+}
+
 // The whole load, in the child process of load_assimp: reading(i) before reading file i (0: the
 // character, 1..: clip_files).
 AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::string>& clip_files,
@@ -186,10 +196,15 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
     AnimatedMesh mesh;
     mesh.name = path;
     std::vector<Part> parts;
+    bool stand_in = false;  // a mesh assimp drew of a skeleton alone (no geometry in the file)
     for (size_t n = 0; n < flat.nodes.size(); ++n)
         for (unsigned k = 0; k < flat.nodes[n]->mNumMeshes; ++k) {
             const aiMesh* m = scene->mMeshes[flat.nodes[n]->mMeshes[k]];
             if (!(m->mPrimitiveTypes & aiPrimitiveType_TRIANGLE) || m->mNumFaces == 0) continue;
+            if (is_skeleton_stand_in(scene, m)) {
+                stand_in = true;
+                continue;
+            }
             Part part{m, n, mesh.vertex_count, {}, {}, {}, {}};
             Primitive prim;
             prim.name = m->mName.length ? m->mName.C_Str() : "mesh" + std::to_string(parts.size());
@@ -246,6 +261,9 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
             mesh.primitives.push_back(prim);
             parts.push_back(std::move(part));
         }
+    if (parts.empty() && stand_in)
+        throw LoadError(path + ": no mesh in the file, only a skeleton and its animation (an .md5anim, a .bvh): give "
+                               "the character's mesh file as the input and this one as --clip");
     if (parts.empty()) throw LoadError(path + ": no triangle mesh in the file");
 
     // Clips: the file's own animations, then those of every clip file (matched by node name).

@@ -359,3 +359,20 @@ TEST_F(AssimpHostile, MaterialFlagsTravelThroughTheIsolatedReader) {
     EXPECT_FALSE(m.primitives[0].double_sided);
     EXPECT_FALSE(m.primitives[1].double_sided);
 }
+
+// A file of bones and motion alone (a .bvh here, like an .md5anim): assimp adds a mesh drawing the
+// bones ("SkeletonMaterial"), which is not a character. Loaded as one, it gave 16 triangles of
+// bones and every method "optimised" them; now it is a one-line error pointing at --clip.
+TEST_F(AssimpHostile, ASkeletonWithoutAMeshIsNotACharacter) {
+    const std::string bvh = write("walk.bvh",
+                                  "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0 0\n"
+                                  "  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n"
+                                  "  JOINT Chest\n  {\n    OFFSET 0 5 0\n    CHANNELS 3 Zrotation Xrotation Yrotation\n"
+                                  "    End Site\n    {\n      OFFSET 0 5 0\n    }\n  }\n}\n"
+                                  "MOTION\nFrames: 2\nFrame Time: 0.033333\n0 0 0 0 0 0 0 0 0\n0 0 0 0 0 0 10 0 0\n");
+    const std::string what = load_error(bvh);
+    EXPECT_EQ(what.rfind(bvh, 0), 0u) << what;
+    EXPECT_NE(what.find("only a skeleton"), std::string::npos) << what;
+    EXPECT_NE(what.find("--clip"), std::string::npos) << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+}

@@ -262,8 +262,9 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
             parts.push_back(std::move(part));
         }
     if (parts.empty() && stand_in)
-        throw LoadError(path + ": no mesh in the file, only a skeleton and its animation (an .md5anim, a .bvh): give "
-                               "the character's mesh file as the input and this one as --clip");
+        throw LoadError(path +
+                        ": no mesh in the file, only a skeleton and its animation (an .md5anim, a .bvh): give "
+                        "the character's mesh file as the input and this one as --clip");
     if (parts.empty()) throw LoadError(path + ": no triangle mesh in the file");
 
     // Clips: the file's own animations, then those of every clip file (matched by node name).

@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 #include "support/files.h"
+#include "support/gltf_builder.h"
 #include "support/require.h"
 
 #include <sys/wait.h>
@@ -225,6 +226,47 @@ TEST_F(Cli, ZeroAreaMeshIsAnError) {
     const test::Outcome o = run("optimize -q " + path("flat.gltf").string());
     EXPECT_NE(o.exit_code, 0);
     EXPECT_NE(o.err.find("zero area"), std::string::npos) << o.err;
+}
+
+// tipsify-per-frame writes one buffer per keyframe, which a clip's lookup table names in byte-sized
+// cells: a clip of more than 256 keyframes cannot be written. The run says so, naming the clip,
+// before the method runs (it used to fail after all of it with "the sidecar needs one lookup table
+// per clip"); 256 keyframes are written, and without -o a long clip still gets its report.
+TEST_F(Cli, TipsifyPerFrameNamesAClipTooLongForItsLookupTable) {
+    auto moving_triangle = [&](const std::string& name, float seconds) {
+        test::Gltf g;
+        const int positions = g.floats({0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3", 3);
+        const int indices = g.u16({0, 1, 2}, "SCALAR", 1);
+        const int times = g.floats({0.0f, seconds}, "SCALAR", 1);
+        const int moves = g.floats({0, 0, 0, 1, 0, 0}, "VEC3", 3);
+        g.doc["accessors"][size_t(times)]["min"] = {0.0};
+        g.doc["accessors"][size_t(times)]["max"] = {seconds};
+        g.doc["meshes"] = {{{"primitives", {{{"attributes", {{"POSITION", positions}}}, {"indices", indices}}}}}};
+        g.doc["nodes"] = {{{"mesh", 0}}};
+        g.doc["scenes"] = {{{"nodes", {0}}}};
+        g.doc["animations"] = {{{"name", "slide"},
+                                {"samplers", {{{"input", times}, {"output", moves}, {"interpolation", "LINEAR"}}}},
+                                {"channels", {{{"sampler", 0}, {"target", {{"node", 0}, {"path", "translation"}}}}}}}};
+        std::ofstream(path(name)) << g.text();
+        return path(name).string();
+    };
+    const std::string longest = moving_triangle("fits.gltf", 8.5f);    // 256 keyframes at 30/s
+    const std::string too_long = moving_triangle("long.gltf", 10.0f);  // 301
+    const test::Outcome fits =
+        run("optimize -q --method tipsify-per-frame " + longest + " -o " + path("fits").string());
+    EXPECT_EQ(fits.exit_code, 0) << fits.err;
+    EXPECT_TRUE(fs::exists(path("fits.animorder.bin")));
+    const test::Outcome o = run("optimize -q --method tipsify-per-frame " + too_long + " -o " + path("long").string() +
+                                " -r " + path("long.json").string());
+    EXPECT_EQ(o.exit_code, 1);
+    EXPECT_EQ(test::line_count(o.err), 1u) << o.err;
+    EXPECT_NE(o.err.find("clip 'slide' has 301 keyframes"), std::string::npos) << o.err;
+    EXPECT_NE(o.err.find("256"), std::string::npos) << o.err;
+    EXPECT_FALSE(fs::exists(path("long.animorder.bin")));
+    const test::Outcome report =
+        run("optimize -q --method tipsify-per-frame " + too_long + " -r " + path("r.json").string());
+    EXPECT_EQ(report.exit_code, 0) << report.err;
+    EXPECT_EQ(nlohmann::json::parse(test::slurp(path("r.json")))["methods"][0]["buffers"], 301);
 }
 
 TEST_F(Cli, LambdaChangesTheAcmrTheWayThePaperSays) {

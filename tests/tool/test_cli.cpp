@@ -2,6 +2,7 @@
 // report's schema, atomic and deterministic output.
 #include <gtest/gtest.h>
 
+#include <stb_image.h>
 #include <nlohmann/json.hpp>
 #include "support/files.h"
 #include "support/gltf_builder.h"
@@ -70,6 +71,49 @@ TEST_F(Cli, MaterialsBlendReportAndHeatmap) {
     ASSERT_EQ(h.exit_code, 0) << h.err;
     EXPECT_NE(h.out.find("mis-sorted pixels"), std::string::npos) << h.out;
     EXPECT_EQ(test::slurp(path("b.png")).substr(1, 3), "PNG");
+}
+
+// The heatmap's caption and legend fit whatever the resolution: at 16 pixels (the smallest allowed)
+// the caption used to run off the right edge and the legend off the bottom. The picture is read
+// back (stb_image): text (black) in the caption's band, and the right and bottom margins white.
+TEST_F(Cli, HeatmapKeepsItsCaptionAndLegendInsideAtSmallResolutions) {
+    for (const char* resolution : {"16", "64", "256"}) {
+        const std::string png = path(std::string("h") + resolution + ".png").string();
+        const test::Outcome o = run("heatmap -q --resolution " + std::string(resolution) + " -o " + png);
+        ASSERT_EQ(o.exit_code, 0) << o.err;
+        int w = 0, h = 0, channels = 0;
+        stbi_uc* pixels = stbi_load(png.c_str(), &w, &h, &channels, 3);
+        ASSERT_NE(pixels, nullptr) << png;
+        auto white = [&](int x, int y) {
+            const stbi_uc* p = pixels + (size_t(y) * size_t(w) + size_t(x)) * 3;
+            return p[0] == 255 && p[1] == 255 && p[2] == 255;
+        };
+        size_t caption_ink = 0, edge_ink = 0;
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                if (y < 40) caption_ink += !white(x, y);
+                if (x >= w - 8 || y >= h - 8) edge_ink += !white(x, y);
+            }
+        stbi_image_free(pixels);
+        EXPECT_GT(caption_ink, 100u) << resolution;
+        EXPECT_EQ(edge_ink, 0u) << resolution << ": something runs off the " << w << " x " << h << " image";
+    }
+}
+
+// The README's two heatmaps are what the command written beside them draws, byte for byte.
+TEST_F(Cli, TheReadmesHeatmapsAreWhatTheirCommandDraws) {
+    const std::string readme = test::slurp(fs::path(ANIMORDER_SOURCE_DIR) / "README.md");
+    const std::string command = "heatmap -q --order original\n--frame 55 --view 0.5,0.3,-1 --resolution 384";
+    ASSERT_NE(readme.find(command), std::string::npos) << "the README no longer gives the heatmaps' command";
+    for (const char* order : {"original", "static-sander07"}) {
+        const std::string png = path(std::string(order) + ".png").string();
+        const test::Outcome o = run(std::string("heatmap -q --order ") + order +
+                                    " --frame 55 --view 0.5,0.3,-1 --resolution 384 -o " + png);
+        ASSERT_EQ(o.exit_code, 0) << o.err;
+        EXPECT_TRUE(test::slurp(png) ==
+                    test::slurp(fs::path(ANIMORDER_SOURCE_DIR) / "docs" / ("heatmap-" + std::string(order) + ".png")))
+            << order << ": docs/heatmap-" << order << ".png is not what the command draws now";
+    }
 }
 
 TEST_F(Cli, SingleSidedCullsEveryMaterial) {

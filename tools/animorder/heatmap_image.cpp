@@ -71,7 +71,16 @@ std::string heatmap_png(const std::vector<uint32_t>& counts, unsigned resolution
     const uint32_t max_count = std::max<uint32_t>(4, *std::max_element(counts.begin(), counts.end()));
     const int margin = 16, legend = 110, caption_h = 40;
     const int r = int(resolution);
-    Canvas canvas(r + 2 * margin + legend, r + 2 * margin + caption_h, {255, 255, 255});
+    // The legend: one swatch per count value (or per evenly spaced value when there are many), each
+    // at least as tall as its label (stb_easy_font's line is 12 units, drawn at twice that).
+    const uint32_t steps = std::min<uint32_t>(max_count, 12);
+    const int swatch = std::max(16, std::min(28, (r - 30) / int(steps)));
+    const int legend_h = 24 + int(steps) * swatch;
+    // The image grows past the picture where the caption or the legend would not fit (small
+    // resolutions): nothing is cut off.
+    const int caption_w = 2 * stb_easy_font_width(const_cast<char*>(caption.c_str()));
+    Canvas canvas(std::max(r + 2 * margin + legend, caption_w + 2 * margin),
+                  std::max(r, legend_h) + 2 * margin + caption_h, {255, 255, 255});
     const Rgb background{235, 235, 235};
     for (int y = 0; y < r; ++y)
         for (int x = 0; x < r; ++x) {
@@ -81,12 +90,9 @@ std::string heatmap_png(const std::vector<uint32_t>& counts, unsigned resolution
         }
     canvas.text(margin, 10, caption, {0, 0, 0});
 
-    // Legend: one swatch per count value (or per evenly spaced value when there are many).
     const int x0 = margin + r + 24, top = margin + caption_h;
     canvas.text(x0, top - 2, "shaded", {0, 0, 0}, 1);
     canvas.text(x0, top + 8, "per pixel", {0, 0, 0}, 1);
-    const uint32_t steps = std::min<uint32_t>(max_count, 12);
-    const int swatch = std::max(12, std::min(28, (r - 30) / int(steps)));
     for (uint32_t i = 0; i < steps; ++i) {
         const uint32_t value =
             1 + uint32_t(std::lround(double(i) * (max_count - 1) / double(std::max<uint32_t>(1, steps - 1))));

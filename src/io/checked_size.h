@@ -25,12 +25,13 @@ inline size_t mul_or_throw(const std::string& what, size_t a, size_t b, size_t c
 }
 
 // Throws LoadError, before any allocation, when keyframes × vertices × 12 bytes of positions
-// exceed options.max_keyframe_bytes (or overflow).
+// exceed options.max_keyframe_bytes (or overflow); `what` names the count in the message (a
+// file's own frames, checked before they are resampled, are not its keyframes).
 inline void check_keyframe_budget(const std::string& path, size_t keyframes, size_t vertices,
-                                  const LoadOptions& options) {
+                                  const LoadOptions& options, const char* what = "keyframes") {
     size_t kv = 0, bytes = 0;
     if (!checked_mul(keyframes, vertices, kv) || !checked_mul(kv, 12, bytes) || bytes > options.max_keyframe_bytes)
-        throw LoadError(path + ": the animation needs " + std::to_string(keyframes) + " keyframes x " +
+        throw LoadError(path + ": the animation needs " + std::to_string(keyframes) + " " + what + " x " +
                         std::to_string(vertices) + " vertices x 12 bytes, more than the loading budget of " +
                         std::to_string(options.max_keyframe_bytes) + " bytes (raise it with --max-memory)");
 }

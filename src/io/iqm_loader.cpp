@@ -211,7 +211,8 @@ AnimatedMesh load_iqm(const std::string& path, const LoadOptions& options) {
         if (count == 0 || size_t(first) + count > num_frames)
             throw b.fail("animation " + std::to_string(a) + " names missing frames");
         if (!std::isfinite(rate)) throw b.fail("animation " + std::to_string(a) + " has an infinite frame rate");
-        io::check_keyframe_budget(path, count, num_vertexes, options);  // its frames, skinned before resampling
+        // Its frames, skinned before they are resampled into keyframes.
+        io::check_keyframe_budget(path, count, num_vertexes, options, "frames of the file");
         Clip clip;
         clip.name = b.text(ofs_text, num_text, b.u32(at));
         if (clip.name.empty()) clip.name = "animation" + std::to_string(a);

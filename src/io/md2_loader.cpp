@@ -61,7 +61,7 @@ AnimatedMesh load_md2(const std::string& path, const LoadOptions& options) {
         frames_end > d.size())
         throw fail("file is truncated (triangles or frames past its end)");
     // The file's own frames, then the resampled clips, must fit the loading budget.
-    io::check_keyframe_budget(path, size_t(frames), size_t(vertices), options);
+    io::check_keyframe_budget(path, size_t(frames), size_t(vertices), options, "frames of the file");
 
     AnimatedMesh mesh;
     mesh.name = path;

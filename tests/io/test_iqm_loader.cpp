@@ -140,6 +140,7 @@ TEST_F(IqmLoader, HostileFilesGiveOneLineErrors) {
         m.put<uint32_t>(kNumFrames, 0x7FFFFFFF);
         m.put<uint32_t>(kAnims + 8, 0x7FFFFFFF);
         expect_error("frames.iqm", m, "loading budget");
+        expect_error("frames.iqm", m, "needs 2147483647 frames of the file x");  // frames, not keyframes
     }
     expect_field_error(tiny_iqm(), "slow.iqm", kAnims + 12, float(1e-30f),
                        "absurdly long");  // 10^30 s at 30 keyframes per second

@@ -562,10 +562,22 @@ std::string stop_after_assignment(size_t iteration, const ClusteringIteration& l
     return {};
 }
 
-// The best state's buffers and assignment into the result.
+// The best state's buffers and assignment into the result. A cluster that no node chose (k above
+// the number of nodes, a clip of one keyframe say) gives no buffer: it would be written and never
+// drawn. The others keep their order, renumbered.
 void finish(ClusteringResult& result, const MeshPatches& patches, const BestState& best) {
-    result.patch_orders = best.patch_orders;
+    std::vector<uint32_t> renumbered(best.patch_orders.size(), UINT32_MAX);
+    for (const uint32_t c : best.assignment)
+        if (c < renumbered.size()) renumbered[c] = 0;
+    result.patch_orders.clear();
+    for (size_t c = 0; c < renumbered.size(); ++c)
+        if (renumbered[c] == 0) {
+            renumbered[c] = uint32_t(result.patch_orders.size());
+            result.patch_orders.push_back(best.patch_orders[c]);
+        }
     result.assignment = best.assignment;
+    for (uint32_t& c : result.assignment)
+        if (c < renumbered.size()) c = renumbered[c];
     result.triangle_orders = triangle_orders_of(patches, result.patch_orders);
 }
 

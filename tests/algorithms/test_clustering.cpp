@@ -201,7 +201,22 @@ TEST(Clustering, MeasuredOrdersAreMonotoneDeterministicAndBelowDistance) {
     for (const auto& o : one.triangle_orders) EXPECT_TRUE(test::is_permutation_of_iota(o));
 }
 
-TEST(Clustering, EmptyClustersAreReseededNotDropped) {
+namespace {
+// Every buffer of the result is the buffer of some node, and the assignment names only them.
+void expect_every_buffer_chosen(const ClusteringResult& r) {
+    std::vector<size_t> chosen(r.triangle_orders.size(), 0);
+    for (const uint32_t c : r.assignment) {
+        ASSERT_LT(c, chosen.size());
+        ++chosen[c];
+    }
+    for (size_t c = 0; c < chosen.size(); ++c) EXPECT_GT(chosen[c], 0u) << "buffer " << c << " is never drawn";
+    EXPECT_EQ(r.patch_orders.size(), r.triangle_orders.size());
+}
+}  // namespace
+
+// Empty clusters are re-seeded while k-means runs; a cluster still empty in the end (more clusters
+// than the nodes can fill) writes no buffer, which no node would ever draw.
+TEST(Clustering, EmptyClustersAreReseededAndUnchosenBuffersNotWritten) {
     // 12 views of one keyframe and 10 clusters: some clusters must end up empty at first.
     const AnimatedMesh& m = character();
     const MeshPatches patches = build_mesh_patches(m, 0.85);
@@ -218,8 +233,15 @@ TEST(Clustering, EmptyClustersAreReseededNotDropped) {
     bool logged = false;
     for (const auto& line : log) logged |= line.find("re-seeded") != std::string::npos;
     EXPECT_TRUE(logged);
-    EXPECT_EQ(r.triangle_orders.size(), 10u);
+    EXPECT_LE(r.triangle_orders.size(), 10u);
+    expect_every_buffer_chosen(r);
     for (const auto& o : r.triangle_orders) EXPECT_TRUE(test::is_permutation_of_iota(o));
+
+    // More clusters than nodes: at most one buffer per node (k = 20 wrote 20 buffers for 12 nodes).
+    s.clusters = 20;
+    const ClusteringResult over = cluster_nodes(m, patches, framing_of(m), {0}, s);
+    EXPECT_LE(over.triangle_orders.size(), 12u);
+    expect_every_buffer_chosen(over);
 }
 
 TEST(Clustering, RejectsAbsurdSettings) {

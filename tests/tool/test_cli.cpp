@@ -103,12 +103,12 @@ TEST_F(Cli, HeatmapKeepsItsCaptionAndLegendInsideAtSmallResolutions) {
 // The README's two heatmaps are what the command written beside them draws, byte for byte.
 TEST_F(Cli, TheReadmesHeatmapsAreWhatTheirCommandDraws) {
     const std::string readme = test::slurp(fs::path(ANIMORDER_SOURCE_DIR) / "README.md");
-    const std::string command = "heatmap -q --order original\n--frame 55 --view 0.5,0.3,-1 --resolution 384";
+    const std::string command = "heatmap -q --order original\n--frame 55 --view 5,3,-10 --resolution 384";
     ASSERT_NE(readme.find(command), std::string::npos) << "the README no longer gives the heatmaps' command";
     for (const char* order : {"original", "static-sander07"}) {
         const std::string png = path(std::string(order) + ".png").string();
         const test::Outcome o = run(std::string("heatmap -q --order ") + order +
-                                    " --frame 55 --view 0.5,0.3,-1 --resolution 384 -o " + png);
+                                    " --frame 55 --view 5,3,-10 --resolution 384 -o " + png);
         ASSERT_EQ(o.exit_code, 0) << o.err;
         EXPECT_TRUE(test::slurp(png) ==
                     test::slurp(fs::path(ANIMORDER_SOURCE_DIR) / "docs" / ("heatmap-" + std::string(order) + ".png")))

@@ -107,13 +107,57 @@ TEST_F(Cli, TheReadmesHeatmapsAreWhatTheirCommandDraws) {
     ASSERT_NE(readme.find(command), std::string::npos) << "the README no longer gives the heatmaps' command";
     for (const char* order : {"original", "static-sander07"}) {
         const std::string png = path(std::string(order) + ".png").string();
-        const test::Outcome o = run(std::string("heatmap -q --order ") + order +
-                                    " --frame 55 --view 5,3,-10 --resolution 384 -o " + png);
+        const test::Outcome o =
+            run(std::string("heatmap -q --order ") + order + " --frame 55 --view 5,3,-10 --resolution 384 -o " + png);
         ASSERT_EQ(o.exit_code, 0) << o.err;
         EXPECT_TRUE(test::slurp(png) ==
                     test::slurp(fs::path(ANIMORDER_SOURCE_DIR) / "docs" / ("heatmap-" + std::string(order) + ".png")))
             << order << ": docs/heatmap-" << order << ".png is not what the command draws now";
     }
+}
+
+namespace {
+// Every figure of the README's sample report (`sample`, "..." standing for what it leaves out)
+// against a real report: keys present, integers, strings and flags equal, decimals to the places
+// shown (within 0.005), times and output paths only present (they vary by machine and folder).
+void expect_sample_matches(const nlohmann::json& sample, const nlohmann::json& actual, const std::string& where) {
+    if (sample.is_object()) {
+        ASSERT_TRUE(actual.is_object()) << where;
+        for (auto it = sample.begin(); it != sample.end(); ++it) {
+            const std::string& key = it.key();
+            if (key == "...") continue;
+            ASSERT_TRUE(actual.contains(key)) << where << "." << key << " is not in the report";
+            const bool varies = key == "time_s" || key == "timings_s" || key == "stages_s" ||
+                                key.rfind("seconds", 0) == 0 || key == "outputs";
+            if (!varies) expect_sample_matches(it.value(), actual[key], where + "." + key);
+        }
+    } else if (sample.is_array()) {
+        ASSERT_TRUE(actual.is_array()) << where;
+        for (size_t i = 0; i < sample.size(); ++i)
+            if (sample[i] != "..." && i < actual.size())
+                expect_sample_matches(sample[i], actual[i], where + "[" + std::to_string(i) + "]");
+    } else if (sample.is_number_float()) {
+        ASSERT_TRUE(actual.is_number()) << where;
+        EXPECT_NEAR(actual.get<double>(), sample.get<double>(), 0.005 + 1e-9) << where;
+    } else {
+        EXPECT_EQ(actual, sample) << where;
+    }
+}
+}  // namespace
+
+// The README's sample report is the report of the command it names (the bundled character,
+// default settings), figure by figure except the times.
+TEST_F(Cli, TheReadmesSampleReportIsARealOne) {
+    const std::string readme = test::slurp(fs::path(ANIMORDER_SOURCE_DIR) / "README.md");
+    const size_t command = readme.find("report of `build/animorder optimize -o build/out/character --report R.json`");
+    ASSERT_NE(command, std::string::npos) << "the README no longer names the sample report's command";
+    const size_t open = readme.find("```json\n", command), close = readme.find("```", open + 8);
+    ASSERT_NE(open, std::string::npos);
+    const nlohmann::json sample = nlohmann::json::parse(readme.substr(open + 8, close - open - 8));
+    const test::Outcome o =
+        run("optimize -q -o " + path("character").string() + " --report " + path("r.json").string());
+    ASSERT_EQ(o.exit_code, 0) << o.err;
+    expect_sample_matches(sample, nlohmann::json::parse(test::slurp(path("r.json"))), "report");
 }
 
 TEST_F(Cli, SingleSidedCullsEveryMaterial) {

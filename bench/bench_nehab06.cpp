@@ -93,7 +93,12 @@ void row(const std::string& name, const AnimatedMesh& mesh, size_t views) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    const bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
+    const bool quick = argc == 2 && std::strcmp(argv[1], "--quick") == 0;
+    if (argc > 2 || (argc == 2 && !quick)) {  // --help included: say what it takes, run nothing
+        const bool help = std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0;
+        std::fprintf(help ? stdout : stderr, "usage: bench_nehab06 [--quick]  (--quick: knots of 2k and 10k only)\n");
+        return help ? 0 : 2;
+    }
     std::printf("static-nehab06 vs static-sander07 (automatic cluster count, 256², all hardware threads)\n\n");
     std::printf(
         "| mesh | tris | views | clusters | nehab06 s | clustering | raster | pairs | ordering | "

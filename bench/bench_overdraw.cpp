@@ -19,6 +19,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <functional>
 #include <random>
 #include <vector>
@@ -118,7 +119,13 @@ void compare_with_gl(const AnimatedMesh& mesh, size_t keyframe_step) {
 
 }  // namespace
 
-int main() {
+int main(int argc, char** argv) {
+    if (argc > 1) {  // it takes no option: --help says so, anything else is an error; neither runs it
+        const bool help = std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0;
+        std::fprintf(help ? stdout : stderr,
+                     "usage: bench_overdraw  (no options; Ganfaul from ../shared/data when present)\n");
+        return help ? 0 : 2;
+    }
     std::printf("machine: %s\n", animorder::bench::machine_description().c_str());
     std::printf("k = 5 orders per node, 256x256, 42 icosphere views per keyframe\n");
     compare_with_gl(make_procedural_character(), 8);

@@ -332,6 +332,21 @@ int append_indices(tinygltf::Model& model, const std::vector<uint32_t>& local, b
     return a;
 }
 
+// The processed file's animation for a clip of the optimised one: the animation of the clip's
+// name there (an unnamed one is "animationN", as the loader names clips), the clip's own index
+// first when several share the name; -1 when none has it. Pipelines drop, reorder and rename
+// animations, so an index copied as it was could name another animation.
+int animation_of_clip(const tinygltf::Model& model, const ExtensionClip& c) {
+    int found = -1;
+    for (size_t a = 0; a < model.animations.size(); ++a) {
+        const std::string& own = model.animations[a].name;
+        if ((own.empty() ? "animation" + std::to_string(a) : own) != c.name) continue;
+        if (int(a) == c.animation) return int(a);
+        if (found < 0) found = int(a);
+    }
+    return found;
+}
+
 }  // namespace
 
 std::string gltf_with_extension_orders(const std::string& input_path, const std::string& output_path,
@@ -373,8 +388,15 @@ std::string gltf_with_extension_orders(const std::string& input_path, const std:
             TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, c.centers.size() / 3, "animorder centres " + c.name);
         Object clip;
         clip["name"] = tinygltf::Value(c.name);
-        if (c.animation >= 0 && size_t(c.animation) < model.animations.size())
-            clip["animation"] = tinygltf::Value(c.animation);
+        if (c.animation >= 0) {
+            const int animation = animation_of_clip(model, c);
+            if (animation < 0)
+                throw LoadError(input_path + ": no animation '" + c.name + "' (the optimised file's clip " +
+                                std::to_string(&c - root.clips.data()) +
+                                "): the processed file dropped or renamed it, so its lookup table has no clip to "
+                                "follow");
+            clip["animation"] = tinygltf::Value(animation);
+        }
         clip["startTime"] = tinygltf::Value(c.start_time);
         clip["sampleRate"] = tinygltf::Value(c.sample_rate);
         clip["keyframes"] = tinygltf::Value(int(c.keyframes));

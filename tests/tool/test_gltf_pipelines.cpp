@@ -206,3 +206,34 @@ TEST_F(GltfPipelines, CheckAndReapplyRefuseBadInputInOneLine) {
     EXPECT_NE(o.err.find("nothing written"), std::string::npos) << o.err;
     EXPECT_FALSE(fs::exists(path("out.glb")));
 }
+
+// A pipeline may drop, reorder or rename animations: reapply finds each clip's animation by name in
+// the processed file (it copied the optimised file's index, which then named another animation, or
+// none), and refuses a file that lost a clip's animation.
+TEST_F(GltfPipelines, ReapplyFollowsEachClipsAnimationByName) {
+    const fs::path example = kSource / "docs" / "extension" / "example.gltf";
+    json g = json::parse(test::slurp(example));
+    ASSERT_EQ(g["extensions"]["ANIMORDER_animated_triangle_orders"]["clips"][0]["animation"], 0);
+    g.erase("extensions");
+    g.erase("extensionsUsed");
+    json other = g["animations"][0];
+    other["name"] = "other";
+    json shifted = g;
+    shifted["animations"] = json::array({other, g["animations"][0]});  // "still" is now animation 1
+    std::ofstream(path("shifted.gltf")) << shifted.dump();
+    test::Outcome o =
+        run(exe() + " reapply -q " + q(example) + " " + q(path("shifted.gltf")) + " -o " + q(path("shifted-out.gltf")));
+    ASSERT_EQ(o.exit_code, 0) << o.err;
+    const json out = json::parse(test::slurp(path("shifted-out.gltf")));
+    EXPECT_EQ(out["extensions"]["ANIMORDER_animated_triangle_orders"]["clips"][0]["animation"], 1);
+    EXPECT_EQ(run(exe() + " check " + q(path("shifted-out.gltf"))).exit_code, 0);
+
+    json renamed = g;
+    renamed["animations"][0]["name"] = "renamed";
+    std::ofstream(path("renamed.gltf")) << renamed.dump();
+    o = run(exe() + " reapply -q " + q(example) + " " + q(path("renamed.gltf")) + " -o " + q(path("renamed-out.gltf")));
+    EXPECT_EQ(o.exit_code, 1);
+    EXPECT_EQ(test::line_count(o.err), 1u) << o.err;
+    EXPECT_NE(o.err.find("no animation 'still'"), std::string::npos) << o.err;
+    EXPECT_FALSE(fs::exists(path("renamed-out.gltf")));
+}

@@ -11,6 +11,7 @@
 
 #include <cstddef>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <sstream>
 #include <string>
@@ -80,6 +81,63 @@ inline std::string magic_of(const std::string& path) {
     return magic;
 }
 
+// The JSON text of a glTF (.gltf: the file; .glb: its first chunk, which must be JSON); empty
+// when the file is not a regular file or its sizes do not hold; a LoadError when the text exceeds
+// 1 GiB (its external files could not be known).
+inline constexpr uint64_t kMaxJsonBytes = uint64_t(1) << 30;
+inline std::string gltf_json_text(const std::string& path) {
+    RegularFile file(path);
+    if (!file.ok()) return {};
+    const uint64_t size = file.size();
+    char header[20] = {};
+    const size_t got = file.read(header, sizeof header);
+    if (got >= 4 && std::memcmp(header, "glTF", 4) == 0) {
+        if (got < 20) return {};
+        uint32_t length = 0;
+        std::memcpy(&length, header + 12, 4);  // chunk 0: length, type "JSON", then the text
+        if (std::memcmp(header + 16, "JSON", 4) != 0 || uint64_t(length) > size - 20) return {};
+        if (length > kMaxJsonBytes) throw LoadError(path + ": its glTF JSON is larger than 1 GiB");
+        std::string text(length, '\0');
+        return file.read(text.data(), length) == length ? text : std::string();
+    }
+    if (size > kMaxJsonBytes) throw LoadError(path + ": its glTF JSON is larger than 1 GiB");
+    if (got < size_t(std::min<uint64_t>(size, sizeof header))) return {};
+    std::string text(header, got);
+    text.resize(size_t(size));
+    return file.read(text.data() + got, text.size() - got) == text.size() - got ? text : std::string();
+}
+
+// The deepest nesting of arrays and objects a glTF's JSON may have. tinygltf converts extension
+// and extras values recursively, and some tens of thousands of levels (a 1 MB file) overflow the
+// stack; real files nest a few levels.
+inline constexpr size_t kMaxJsonDepth = 512;
+
+// LoadError when the glTF's JSON nests arrays and objects deeper than kMaxJsonDepth (brackets
+// inside strings do not count); called before tinygltf reads the file. A file whose JSON cannot be
+// found is left to the loader to report.
+inline void check_json_depth(const std::string& path) {
+    const std::string text = gltf_json_text(path);
+    size_t depth = 0;
+    bool in_string = false;
+    for (size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (in_string) {
+            if (c == '\\')
+                ++i;
+            else if (c == '"')
+                in_string = false;
+        } else if (c == '"') {
+            in_string = true;
+        } else if (c == '[' || c == '{') {
+            if (++depth > kMaxJsonDepth)
+                throw LoadError(path + ": its JSON nests arrays and objects more than " +
+                                std::to_string(kMaxJsonDepth) + " levels deep");
+        } else if ((c == ']' || c == '}') && depth > 0) {
+            --depth;
+        }
+    }
+}
+
 // The glTF file at `path` (binary when it starts with "glTF"), images left undecoded; LoadError
 // when it is no readable glTF 2.0 file, or it or a file it references is no regular file.
 inline tinygltf::Model read_model(const std::string& path) {
@@ -93,6 +151,7 @@ inline tinygltf::Model read_model(const std::string& path) {
                           nullptr);
     std::string error, warning;
     const std::string magic = magic_of(path);
+    check_json_depth(path);
     const bool ok = magic == "glTF" ? loader.LoadBinaryFromFile(&model, &error, &warning, path)
                                     : loader.LoadASCIIFromFile(&model, &error, &warning, path);
     if (!ok) {

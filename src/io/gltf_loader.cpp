@@ -339,6 +339,7 @@ tinygltf::Model parse_file(const std::string& path, const LoadOptions& options) 
                           nullptr);
     std::string error, warning;
     const std::string magic = io::magic_of(path);
+    io::check_json_depth(path);
     const bool ok = magic == "glTF" ? loader.LoadBinaryFromFile(&model, &error, &warning, path)
                                     : loader.LoadASCIIFromFile(&model, &error, &warning, path);
     if (!ok) {

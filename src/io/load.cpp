@@ -10,6 +10,8 @@
 
 #include "animorder/regular_file.h"
 
+#include "gltf_buffer.h"
+
 #include <tiny_gltf.h>
 #include <nlohmann/json.hpp>
 
@@ -52,32 +54,6 @@ std::vector<std::string> expand_clip_files(const std::vector<std::string>& clip_
         files.insert(files.end(), inside.begin(), inside.end());
     }
     return files;
-}
-
-// The JSON text of a glTF (.gltf: the file; .glb: its first chunk, which must be JSON); empty
-// when the file is not a regular file or its sizes do not hold; a LoadError when the text exceeds
-// 1 GiB (its external files could not be known).
-constexpr uint64_t kMaxJsonBytes = uint64_t(1) << 30;
-std::string gltf_json_text(const std::string& path) {
-    RegularFile file(path);
-    if (!file.ok()) return {};
-    const uint64_t size = file.size();
-    char header[20] = {};
-    const size_t got = file.read(header, sizeof header);
-    if (got >= 4 && std::memcmp(header, "glTF", 4) == 0) {
-        if (got < 20) return {};
-        uint32_t length = 0;
-        std::memcpy(&length, header + 12, 4);  // chunk 0: length, type "JSON", then the text
-        if (std::memcmp(header + 16, "JSON", 4) != 0 || uint64_t(length) > size - 20) return {};
-        if (length > kMaxJsonBytes) throw LoadError(path + ": its glTF JSON is larger than 1 GiB");
-        std::string text(length, '\0');
-        return file.read(text.data(), length) == length ? text : std::string();
-    }
-    if (size > kMaxJsonBytes) throw LoadError(path + ": its glTF JSON is larger than 1 GiB");
-    if (got < size_t(std::min<uint64_t>(size, sizeof header))) return {};
-    std::string text(header, got);
-    text.resize(size_t(size));
-    return file.read(text.data() + got, text.size() - got) == text.size() - got ? text : std::string();
 }
 
 // tinygltf's urldecode: '+' is a space, %XY the byte XY (a digit that is not hex counts 0).
@@ -124,7 +100,7 @@ std::string find_file(const std::string& gltf, const std::string& name) {
 
 std::vector<std::string> gltf_external_files(const std::string& path) {
     std::vector<std::string> files;
-    const std::string text = gltf_json_text(path);
+    const std::string text = io::gltf_json_text(path);
     if (text.empty()) return files;
     const nlohmann::json doc = nlohmann::json::parse(text, nullptr, false);
     if (!doc.is_object()) return files;

@@ -160,6 +160,20 @@ TEST_F(GltfLoader, BrokenFilesGiveOneLineErrorsNamingTheFile) {
     expect_error("junk.gltf", "this is not json", "not a readable glTF");
     expect_error("truncated.glb", "glTF\x02\0\0\0\xff\xff\0\0", "not a readable glTF");
     {
+        // Arrays nested 20,000 deep inside an extension (a 40 KB file): tinygltf's recursive
+        // conversion of extension values overflowed the stack (SIGSEGV); now refused before it reads.
+        const std::string text = skinned_bar().text();
+        const std::string deep = std::string(20000, '[') + std::string(20000, ']');
+        expect_error("deep.gltf",
+                     text.substr(0, text.size() - 1) +
+                         R"(,"extensions":{"ANIMORDER_animated_triangle_orders":{"extras":)" + deep + "}}}",
+                     "more than 512 levels deep");
+        const std::string shallow = std::string(500, '[') + std::string(500, ']');
+        const std::string ok = write("shallow.gltf", text.substr(0, text.size() - 1) + R"(,"asset":{"version":"2.0",)" +
+                                                         R"("extras":)" + shallow + "}}");
+        EXPECT_NO_THROW(load_gltf(ok));  // 501 levels: still read
+    }
+    {
         Gltf g = skinned_bar();
         g.doc["buffers"] = json::array({{{"byteLength", 4000}, {"uri", "missing.bin"}}});
         json d = g.doc;

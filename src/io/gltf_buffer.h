@@ -6,6 +6,7 @@
 #include "animorder/regular_file.h"
 
 #include <tiny_gltf.h>
+#include <nlohmann/json.hpp>
 
 #include <sys/stat.h>
 
@@ -138,6 +139,35 @@ inline void check_json_depth(const std::string& path) {
     }
 }
 
+// LoadError when the file requires an extension that changes how its geometry is stored and
+// that tinygltf does not decode (compressed meshes or buffers): read as if plain, its bytes would
+// give garbage indices or a misleading size error. Other required extensions (quantised
+// attributes, materials, textures) leave the geometry readable.
+inline void refuse_undecodable_geometry(const std::vector<std::string>& required, const std::string& path) {
+    for (const std::string& e : required)
+        if (e == "KHR_draco_mesh_compression" || e == "EXT_meshopt_compression" || e == "KHR_meshopt_compression")
+            throw LoadError(path + ": requires " + e +
+                            ", compressed geometry that animorder cannot decode; give the file from before the "
+                            "compression (gltfpack without -c or -cc, say)");
+}
+
+// tinygltf's load of `path`, and its error made one line: a LoadError naming the undecodable
+// extension the file requires when there is one (tinygltf then fails on its compressed bytes, or
+// reads them as plain ones), else tinygltf's own message.
+inline void finish_load(bool ok, std::string error, const tinygltf::Model& model, const std::string& path) {
+    if (ok) return refuse_undecodable_geometry(model.extensionsRequired, path);
+    const nlohmann::json doc = nlohmann::json::parse(gltf_json_text(path), nullptr, false);
+    if (doc.is_object() && doc.contains("extensionsRequired") && doc["extensionsRequired"].is_array()) {
+        std::vector<std::string> required;
+        for (const nlohmann::json& e : doc["extensionsRequired"])
+            if (e.is_string()) required.push_back(e.get<std::string>());
+        refuse_undecodable_geometry(required, path);
+    }
+    for (char& c : error)
+        if (c == '\n' || c == '\r') c = ' ';
+    throw LoadError(path + ": not a readable glTF 2.0 file: " + error);
+}
+
 // The glTF file at `path` (binary when it starts with "glTF"), images left undecoded; LoadError
 // when it is no readable glTF 2.0 file, or it or a file it references is no regular file.
 inline tinygltf::Model read_model(const std::string& path) {
@@ -154,11 +184,7 @@ inline tinygltf::Model read_model(const std::string& path) {
     check_json_depth(path);
     const bool ok = magic == "glTF" ? loader.LoadBinaryFromFile(&model, &error, &warning, path)
                                     : loader.LoadASCIIFromFile(&model, &error, &warning, path);
-    if (!ok) {
-        for (char& c : error)
-            if (c == '\n' || c == '\r') c = ' ';
-        throw LoadError(path + ": not a readable glTF 2.0 file: " + error);
-    }
+    finish_load(ok, error, model, path);
     return model;
 }
 

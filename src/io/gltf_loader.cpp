@@ -342,10 +342,7 @@ tinygltf::Model parse_file(const std::string& path, const LoadOptions& options) 
     io::check_json_depth(path);
     const bool ok = magic == "glTF" ? loader.LoadBinaryFromFile(&model, &error, &warning, path)
                                     : loader.LoadASCIIFromFile(&model, &error, &warning, path);
-    if (!ok) {
-        std::replace(error.begin(), error.end(), '\n', ' ');
-        throw LoadError(path + ": not a readable glTF 2.0 file: " + error);
-    }
+    io::finish_load(ok, error, model, path);
     return model;
 }
 

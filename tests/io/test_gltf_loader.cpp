@@ -174,6 +174,20 @@ TEST_F(GltfLoader, BrokenFilesGiveOneLineErrorsNamingTheFile) {
         EXPECT_NO_THROW(load_gltf(ok));  // 501 levels: still read
     }
     {
+        // Compressed geometry (gltfpack -c / -cc, Draco) is named, not misread; a required
+        // extension that leaves the geometry readable is fine.
+        for (const char* compression : {"EXT_meshopt_compression", "KHR_draco_mesh_compression"}) {
+            Gltf g = skinned_bar();
+            g.doc["extensionsUsed"] = {compression};
+            g.doc["extensionsRequired"] = {compression};
+            expect_error("compressed.gltf", g.text(), std::string("requires ") + compression);
+        }
+        Gltf g = skinned_bar();
+        g.doc["extensionsUsed"] = {"KHR_mesh_quantization"};
+        g.doc["extensionsRequired"] = {"KHR_mesh_quantization"};
+        EXPECT_NO_THROW(load_gltf(write("quantised.gltf", g.text())));
+    }
+    {
         Gltf g = skinned_bar();
         g.doc["buffers"] = json::array({{{"byteLength", 4000}, {"uri", "missing.bin"}}});
         json d = g.doc;

@@ -245,6 +245,42 @@ void read_primitive(const tinygltf::Model& model, size_t m, size_t pi, const Obj
     out.push_back(std::move(e));
 }
 
+// Integers of the extension's JSON beyond what tinygltf keeps: it holds a JSON integer as an int
+// (32 bits), so 2^32 + 5 would read as 5 and pass. Each one found is a problem, quoted as written.
+void add_wrapped_integers(const nlohmann::json& value, const std::string& where, Problems& p) {
+    if (value.is_object()) {
+        for (auto it = value.begin(); it != value.end(); ++it)
+            add_wrapped_integers(it.value(), where + "." + it.key(), p);
+    } else if (value.is_array()) {
+        for (size_t i = 0; i < value.size(); ++i)
+            add_wrapped_integers(value[i], where + "[" + std::to_string(i) + "]", p);
+    } else if (value.is_number_unsigned() ? value.get<uint64_t>() > uint64_t(INT32_MAX)
+                                          : value.is_number_integer() && value.get<int64_t>() < INT32_MIN) {
+        p.add(where + " = " + value.dump() + " is out of range (an integer here is below 2^31)");
+    }
+}
+
+// add_wrapped_integers over the extension's objects as the file writes them: the root's and every
+// primitive's.
+void check_integers_as_written(const std::string& path, Problems& p) {
+    const nlohmann::json doc = nlohmann::json::parse(io::gltf_json_text(path), nullptr, false);
+    if (!doc.is_object()) return;
+    const auto extension_of = [](const nlohmann::json& owner) -> const nlohmann::json* {
+        if (!owner.is_object() || !owner.contains("extensions") || !owner["extensions"].is_object()) return nullptr;
+        const auto e = owner["extensions"].find(kOrdersExtensionName);
+        return e == owner["extensions"].end() ? nullptr : &*e;
+    };
+    if (const nlohmann::json* e = extension_of(doc)) add_wrapped_integers(*e, kOrdersExtensionName, p);
+    if (!doc.contains("meshes") || !doc["meshes"].is_array()) return;
+    for (size_t m = 0; m < doc["meshes"].size(); ++m) {
+        const nlohmann::json& mesh = doc["meshes"][m];
+        if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
+        for (size_t q = 0; q < mesh["primitives"].size(); ++q)
+            if (const nlohmann::json* e = extension_of(mesh["primitives"][q]))
+                add_wrapped_integers(*e, "mesh " + std::to_string(m) + " primitive " + std::to_string(q), p);
+    }
+}
+
 }  // namespace
 
 OrdersExtensionCheck check_orders_extension(const std::string& path) {
@@ -257,6 +293,7 @@ OrdersExtensionCheck check_orders_extension(const std::string& path) {
         return r;
     }
     r.present = true;
+    check_integers_as_written(path, p);
     if (std::find(model.extensionsUsed.begin(), model.extensionsUsed.end(), kOrdersExtensionName) ==
         model.extensionsUsed.end())
         p.add(std::string(kOrdersExtensionName) + " is not listed in extensionsUsed");

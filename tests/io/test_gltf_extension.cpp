@@ -157,6 +157,15 @@ TEST_F(GltfExtension, EveryCorruptionIsReportedOnOneLine) {
          buffer_bytes(), "is sparse"},
         {"view outside the buffer", [](json& g) { g["bufferViews"][2]["byteOffset"] = 1000; }, buffer_bytes(),
          "lies outside its buffer"},
+        // Integers past 32 bits, which tinygltf wraps (2^32 + 0 read as 0 passed): quoted as written.
+        {"bufferBase past 2^32", [&](json& g) { root(g)["clips"][0]["bufferBase"] = 4294967296ULL; }, buffer_bytes(),
+         "bufferBase = 4294967296 is out of range"},
+        {"orders past 2^32", [&](json& g) { prim(g)["orders"] = 4294967298ULL; }, buffer_bytes(),
+         "orders = 4294967298 is out of range"},
+        {"fallback below -2^31", [&](json& g) { root(g)["fallback"] = -4294967296LL; }, buffer_bytes(),
+         "fallback = -4294967296 is out of range"},
+        {"bufferCount 2^62", [&](json& g) { root(g)["bufferCount"] = 4611686018427387904ULL; }, buffer_bytes(),
+         "bufferCount = 4611686018427387904 is out of range"},
     };
     for (const Case& c : cases) {
         SCOPED_TRACE(c.what);

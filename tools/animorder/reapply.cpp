@@ -105,9 +105,16 @@ int run_reapply(const ReapplyOptions& options) {
     if (!options.quiet)
         std::fprintf(stderr, "animorder: matched %zu of %zu optimised triangles to %zu processed triangles\n",
                      m.matched, a_triangles.size(), b.triangle_count());
-    if (m.matched != a_triangles.size())
+    // A triangle with a repeated vertex draws nothing, and pipelines drop it (gltfpack does): its
+    // absence is no change of the mesh, and the orders skip it. Any other one must be found.
+    size_t dropped = 0;
+    for (const size_t t : a_triangles) {
+        const uint32_t* corner = &a.indices[3 * t];
+        dropped += b_of_a[t] < 0 && (corner[0] == corner[1] || corner[1] == corner[2] || corner[0] == corner[2]);
+    }
+    if (m.matched + dropped != a_triangles.size())
         throw std::runtime_error(options.processed + ": only " + std::to_string(m.matched) + " of " +
-                                 std::to_string(a_triangles.size()) +
+                                 std::to_string(a_triangles.size() - dropped) +
                                  " optimised triangles found (simplified or changed mesh?); nothing written");
 
     std::vector<PrimitiveOrders> out;

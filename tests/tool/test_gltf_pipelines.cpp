@@ -190,6 +190,18 @@ TEST_F(GltfPipelines, CheckAndReapplyRefuseBadInputInOneLine) {
     o = run(exe() + " check " + q(path("corrupt.gltf")));
     EXPECT_EQ(o.exit_code, 1);
     EXPECT_NE(o.err.find("table has 4 cells"), std::string::npos) << o.err;
+    // No glTF at all: the same one line, and still a report on stdout (it printed none).
+    std::ofstream(path("junk.glb")) << "glTF but not really";
+    for (const char* file : {"missing.glb", "junk.glb"}) {
+        o = run(exe() + " check " + q(path(file)));
+        EXPECT_EQ(o.exit_code, 1) << file;
+        EXPECT_EQ(test::line_count(o.err), 1u) << o.err;
+        const json report = json::parse(o.out, nullptr, false);
+        ASSERT_TRUE(report.is_object()) << file << ": " << o.out;
+        EXPECT_FALSE(report["readable"].get<bool>()) << file;
+        EXPECT_FALSE(report["ok"].get<bool>()) << file;
+        EXPECT_EQ(report["errors"].size(), 1u) << file;
+    }
     for (const char* optimised : {"plain.gltf", "corrupt.gltf"}) {
         o = run(exe() + " reapply " + q(path(optimised)) + " " + q(example) + " -o " + q(path("out.glb")));
         EXPECT_EQ(o.exit_code, 1);

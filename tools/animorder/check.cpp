@@ -2,10 +2,11 @@
 // (check_orders_extension: every reference and size, every order a permutation of the
 // primitive's current triangles with their winding, `indices` equal to the fallback, tables
 // covering every clip)? A JSON report on stdout; exit 0 when usable, else 1 with the first
-// problem on stderr.
+// problem on stderr (a file that is no readable glTF too: "readable" false, the error in "errors").
 #include "commands.h"
 
 #include "animorder/gltf_extension.h"
+#include "animorder/load.h"
 
 #include <nlohmann/json.hpp>
 
@@ -15,10 +16,21 @@
 namespace animorder::tool {
 
 int run_check(const CheckOptions& options) {
-    const OrdersExtensionCheck r = check_orders_extension(options.file);
+    OrdersExtensionCheck r;
+    bool readable = true;
+    try {
+        r = check_orders_extension(options.file);
+    } catch (const LoadError& e) {  // no glTF to check: the report says so too, for scripts reading it
+        readable = false;
+        std::string message = e.what();
+        const std::string prefix = options.file + ": ";
+        if (message.rfind(prefix, 0) == 0) message.erase(0, prefix.size());
+        r.errors.push_back(message);
+    }
     nlohmann::json j;
     j["file"] = options.file;
     j["extension"] = kOrdersExtensionName;
+    j["readable"] = readable;
     j["present"] = r.present;
     j["ok"] = r.errors.empty();
     if (r.present) {

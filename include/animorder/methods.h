@@ -18,6 +18,7 @@
 #include "animorder/vertex_cache.h"
 #include "animorder/viewpoints.h"
 
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -52,6 +53,10 @@ enum class Method {
 
 // The method a user gets without asking (the paper's method).
 constexpr Method kDefaultMethod = Method::Single;
+
+// The most keyframes a clip may have for tipsify-per-frame's buffers to be written: each keyframe
+// has its own buffer, and a lookup table's cells are bytes naming them.
+constexpr size_t kMaxPerKeyframeBuffers = 256;
 
 // All methods in DESIGN.md's order.
 const std::vector<Method>& all_methods();

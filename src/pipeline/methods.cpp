@@ -339,8 +339,8 @@ void run_clustered(MethodResult& result, const AnimatedMesh& mesh, const MethodS
 }
 
 // static-sander07 sorted at every keyframe: the paper's "Tipsify" column. A keyframe's table cell
-// names its own buffer, so the sidecar and glTF writers take it as they are (clips of up to 256
-// keyframes; the table cells are bytes).
+// names its own buffer, so the sidecar and glTF writers take it as they are (clips of up to
+// kMaxPerKeyframeBuffers keyframes; the table cells are bytes).
 void run_tipsify_per_frame(MethodResult& result, const AnimatedMesh& mesh, const MethodSettings& settings) {
     StaticMethodSettings s = static_settings(settings);
     for (size_t f = 0; f < mesh.keyframe_count(); ++f) {
@@ -352,7 +352,7 @@ void run_tipsify_per_frame(MethodResult& result, const AnimatedMesh& mesh, const
     }
     result.framing = frame_animated_mesh(mesh);
     bool fits = true;
-    for (const Clip& c : mesh.clips) fits = fits && c.keyframe_count <= 256;
+    for (const Clip& c : mesh.clips) fits = fits && c.keyframe_count <= kMaxPerKeyframeBuffers;
     for (size_t c = 0; fits && c < mesh.clips.size(); ++c) {
         result.buffers.tables.push_back(constant_table(mesh.clips[c].keyframe_count, true));
         result.buffers.table_base.push_back(uint32_t(mesh.clips[c].first_keyframe));

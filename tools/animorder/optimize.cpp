@@ -126,11 +126,12 @@ OptimizeProduct produce_optimize(const OptimizeOptions& options, const OptimizeP
     const AnimatedMesh& mesh = product.mesh;
     if (method == Method::TipsifyPerFrame && (!paths.gltf.empty() || !paths.sidecar.empty()))
         for (const Clip& clip : product.mesh.clips)
-            if (clip.keyframe_count > 256)  // its lookup table's cells are bytes, each naming its own buffer
+            if (clip.keyframe_count > kMaxPerKeyframeBuffers)
                 throw std::runtime_error("tipsify-per-frame writes one buffer per keyframe, and clip '" + clip.name +
                                          "' has " + std::to_string(clip.keyframe_count) +
-                                         " keyframes: a lookup table names at most 256; keep shorter clips "
-                                         "(--clip), or write only the report (no -o)");
+                                         " keyframes: a lookup table names at most " +
+                                         std::to_string(kMaxPerKeyframeBuffers) +
+                                         "; keep shorter clips (--clip), or write only the report (no -o)");
     const double load_s = seconds_since(start);
     note(options.common, "loaded " + input_name + ": " + std::to_string(mesh.triangle_count()) + " triangles, " +
                              std::to_string(mesh.vertex_count) + " vertices, " + std::to_string(mesh.keyframe_count()) +

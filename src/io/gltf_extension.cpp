@@ -7,6 +7,7 @@
 
 #include "checked_size.h"
 #include "gltf_buffer.h"
+#include "gltf_prune.h"
 
 #include <tiny_gltf.h>
 
@@ -392,6 +393,9 @@ std::string gltf_with_extension_orders(const std::string& input_path, const std:
     tinygltf::Model model = io::read_model(input_path);
     if (root.buffer_count == 0 || root.fallback >= root.buffer_count)
         throw LoadError(input_path + ": no fallback order");
+    std::vector<std::pair<int, int>> rewritten;
+    for (const PrimitiveOrders& po : primitives) rewritten.emplace_back(po.mesh, po.primitive);
+    const std::vector<int> replaced = io::accessors_to_replace(model, rewritten);
     for (tinygltf::Mesh& mesh : model.meshes)
         for (tinygltf::Primitive& prim : mesh.primitives) prim.extensions.erase(kOrdersExtensionName);
     for (const PrimitiveOrders& po : primitives) {
@@ -456,6 +460,7 @@ std::string gltf_with_extension_orders(const std::string& input_path, const std:
     model.extensionsRequired.erase(
         std::remove(model.extensionsRequired.begin(), model.extensionsRequired.end(), kOrdersExtensionName),
         model.extensionsRequired.end());
+    io::drop_replaced_accessors(model, replaced);  // the processed file's indices, any earlier orders
     return io::write_model(model, input_path, output_path, binary);
 }
 

@@ -7,7 +7,8 @@
 // The extension is used, never required: a loader that knows nothing of animorder still gets a
 // valid, better-ordered file. Everything else — materials, textures, skins,
 // animations, other extras and extensions, vertex arrays — is written back as read: the new
-// indices refer to the file's own vertices. New bytes are appended to buffer 0.
+// indices refer to the file's own vertices. New bytes are appended to buffer 0; what the new ones
+// replace (the drawn indices, orders a previous run wrote) leaves the file (gltf_prune.h).
 #include "animorder/gltf_writer.h"
 
 #include "animorder/animated_mesh.h"
@@ -18,6 +19,7 @@
 #include "animorder/viewpoints.h"
 
 #include "gltf_buffer.h"
+#include "gltf_prune.h"
 
 #include <tiny_gltf.h>
 
@@ -31,7 +33,6 @@ namespace animorder {
 namespace {
 
 const char* const kOrdersExtension = "ANIMORDER_animated_triangle_orders";
-
 
 int append_accessor(tinygltf::Model& model, int view, int component, int type, size_t count, const std::string& name) {
     tinygltf::Accessor a;
@@ -90,6 +91,9 @@ std::string gltf_with_orders(const std::string& input_path, const std::string& o
             throw LoadError(input_path + ": mesh " + std::to_string(p.source_mesh) +
                             " is drawn by several nodes; glTF output needs one node per mesh (use the sidecar)");
     }
+    std::vector<std::pair<int, int>> rewritten;
+    for (const Primitive& p : mesh.primitives) rewritten.emplace_back(p.source_mesh, p.source_primitive);
+    const std::vector<int> replaced = io::accessors_to_replace(model, rewritten);
     std::vector<std::vector<uint32_t>> index_buffers(buffers.orders.size(), std::vector<uint32_t>(mesh.indices.size()));
     for (size_t b = 0; b < buffers.orders.size(); ++b)
         apply_triangle_order(index_buffers[b].data(), mesh.indices.data(), buffers.orders[b].data(),
@@ -146,6 +150,7 @@ std::string gltf_with_orders(const std::string& input_path, const std::string& o
     root["clips"] = tinygltf::Value(clips);
     model.extensions[kOrdersExtension] = tinygltf::Value(root);
     add_extension_used(model, kOrdersExtension);
+    io::drop_replaced_accessors(model, replaced);  // the previous indices and orders: no growth run after run
     // Buffers embedded (the output stands alone); image files stay where they are, a relative URI
     // re-expressed from the output's folder (gltf_buffer.h).
     return io::write_model(model, input_path, output_path, binary);

@@ -13,6 +13,7 @@
 #include "animorder/sidecar.h"
 #include "animorder/triangle_order.h"
 #include "animorder/viewpoints.h"
+#include "support/gltf_builder.h"
 #include "support/meshes.h"
 
 #define ANIMORDER_RUNTIME_IMPLEMENTATION
@@ -30,6 +31,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 using namespace animorder;
@@ -43,6 +45,7 @@ struct Written {
     AnimatedMesh mesh;
     AnimatedMethodResult method;
     fs::path path;
+    uint32_t fallback = 1;  // the buffer drawn: 1, or 0 when the method found one
 };
 
 Written optimise_and_write(const std::string& input, const fs::path& output) {
@@ -55,8 +58,10 @@ Written optimise_and_write(const std::string& input, const fs::path& output) {
     s.max_iterations = 3;
     w.method = run_han_sander(w.mesh, false, 0.85, 16, s);
     w.path = output;
-    std::ofstream(output, std::ios::binary) << gltf_with_orders(
-        input, output.string(), w.mesh, w.method.buffers, 1, w.method.framing, "single", output.extension() == ".glb");
+    w.fallback = w.method.buffers.orders.size() > 1 ? 1 : 0;
+    std::ofstream(output, std::ios::binary)
+        << gltf_with_orders(input, output.string(), w.mesh, w.method.buffers, w.fallback, w.method.framing, "single",
+                            output.extension() == ".glb");
     return w;
 }
 
@@ -225,4 +230,184 @@ TEST_F(GltfWriter, TheExtensionAndTheSidecarAnswerAlike) {
                 ++probes;
             }
     EXPECT_EQ(probes, r.clips.size() * 1200);
+}
+
+// Writing orders over a file that already holds some (optimising an optimised file, as a pipeline
+// run twice does) replaces them: the previous orders, tables, centres and drawn indices leave the
+// file with their bytes, so it does not grow run after run; what the writer did not replace stays,
+// bytes another view shares included; and a file with an extension whose references are unknown
+// keeps every accessor where it was.
+namespace {
+
+struct Glb {
+    nlohmann::json doc;
+    std::string bin;
+};
+
+Glb read_glb(const fs::path& path) {
+    const std::string bytes = test::slurp(path);
+    Glb g;
+    uint32_t json_length = 0, bin_length = 0;
+    std::memcpy(&json_length, bytes.data() + 12, 4);
+    g.doc = nlohmann::json::parse(bytes.substr(20, json_length));
+    if (bytes.size() > 28 + json_length) {
+        std::memcpy(&bin_length, bytes.data() + 20 + json_length, 4);
+        g.bin = bytes.substr(28 + json_length, bin_length);
+    }
+    return g;
+}
+
+// The accessors and views something in the document names (core glTF and the orders extension),
+// counted independently of the writer's own bookkeeping.
+void expect_every_accessor_named_but(const nlohmann::json& doc, int unnamed) {
+    std::set<int> accessors, views;
+    for (const auto& mesh : doc["meshes"])
+        for (const auto& prim : mesh["primitives"]) {
+            for (const auto& a : prim["attributes"]) accessors.insert(a.get<int>());
+            if (prim.contains("indices")) accessors.insert(prim["indices"].get<int>());
+            if (prim.contains("targets"))
+                for (const auto& target : prim["targets"])
+                    for (const auto& a : target) accessors.insert(a.get<int>());
+            if (prim.contains("extensions"))
+                accessors.insert(prim["extensions"]["ANIMORDER_animated_triangle_orders"]["orders"].get<int>());
+        }
+    for (const auto& animation : doc["animations"])
+        for (const auto& sampler : animation["samplers"]) {
+            accessors.insert(sampler["input"].get<int>());
+            accessors.insert(sampler["output"].get<int>());
+        }
+    for (const auto& clip : doc["extensions"]["ANIMORDER_animated_triangle_orders"]["clips"]) {
+        accessors.insert(clip["table"].get<int>());
+        accessors.insert(clip["centers"].get<int>());
+    }
+    accessors.insert(unnamed);
+    for (int a = 0; a < int(doc["accessors"].size()); ++a) {
+        EXPECT_EQ(accessors.count(a), 1u) << "accessor " << a << " is named by nothing";
+        if (doc["accessors"][size_t(a)].contains("bufferView"))
+            views.insert(doc["accessors"][size_t(a)]["bufferView"].get<int>());
+    }
+    EXPECT_EQ(accessors.size(), doc["accessors"].size());
+    EXPECT_EQ(views.size(), doc["bufferViews"].size());  // every view is some accessor's
+}
+
+// A 16-triangle sheet bent by one animated morph target, drawn with 16-bit indices; accessor
+// `shared` (named by nothing) reads the index bytes through a second view of the same bytes.
+struct Sheet {
+    test::Gltf g;
+    int shared = -1;
+    std::string index_bytes;
+};
+
+Sheet morph_sheet() {
+    Sheet s;
+    std::vector<float> pos, offsets;
+    for (int y = 0; y <= 4; ++y)
+        for (int x = 0; x <= 4; ++x) {
+            pos.insert(pos.end(), {float(x), float(y), 0.0f});
+            offsets.insert(offsets.end(), {0.0f, 0.0f, float((x - 2) * (x - 2)) * 0.3f});
+        }
+    std::vector<uint16_t> idx;
+    for (int y = 0; y < 4; ++y)
+        for (int x = 0; x < 4; ++x) {
+            const uint16_t a = uint16_t(y * 5 + x), b = uint16_t(a + 1), c = uint16_t(a + 5), d = uint16_t(a + 6);
+            idx.insert(idx.end(), {a, b, d, a, d, c});
+        }
+    auto& g = s.g;
+    const int p = g.floats(pos, "VEC3", 3), i = g.u16(idx, "SCALAR", 1), m = g.floats(offsets, "VEC3", 3);
+    g.doc["accessors"][size_t(p)]["min"] = {0, 0, 0};  // bounds: the validator asks them of positions
+    g.doc["accessors"][size_t(p)]["max"] = {4, 4, 0};
+    g.doc["accessors"][size_t(m)]["min"] = {0, 0, 0};
+    g.doc["accessors"][size_t(m)]["max"] = {0, 0, 1.2};
+    const size_t index_view = g.doc["accessors"][size_t(i)]["bufferView"].get<size_t>();
+    g.doc["bufferViews"].push_back(g.doc["bufferViews"][index_view]);
+    s.shared = int(g.doc["accessors"].size());
+    g.doc["accessors"].push_back({{"bufferView", g.doc["bufferViews"].size() - 1},
+                                  {"componentType", 5123},
+                                  {"count", idx.size()},
+                                  {"type", "SCALAR"}});
+    s.index_bytes.assign(reinterpret_cast<const char*>(idx.data()), idx.size() * 2);
+    const std::vector<float> times = {0, 1, 2}, weights = {0, 1, 0};
+    const int t = g.floats(times, "SCALAR", 1), w = g.floats(weights, "SCALAR", 1);
+    g.doc["accessors"][size_t(t)]["min"] = {0};
+    g.doc["accessors"][size_t(t)]["max"] = {2};
+    nlohmann::json primitive = {
+        {"attributes", {{"POSITION", p}}}, {"indices", i}, {"targets", nlohmann::json::array({{{"POSITION", m}}})}};
+    g.doc["meshes"] = nlohmann::json::array(
+        {{{"primitives", nlohmann::json::array({primitive})}, {"weights", nlohmann::json::array({0.0})}}});
+    g.doc["nodes"] = nlohmann::json::array({{{"mesh", 0}}});
+    g.doc["scenes"] = nlohmann::json::array({{{"nodes", nlohmann::json::array({0})}}});
+    g.doc["scene"] = 0;
+    g.doc["animations"] = nlohmann::json::array(
+        {{{"name", "bend"},
+          {"samplers", nlohmann::json::array({{{"input", t}, {"output", w}}})},
+          {"channels", nlohmann::json::array({{{"sampler", 0}, {"target", {{"node", 0}, {"path", "weights"}}}}})}}});
+    return s;
+}
+
+std::string accessor_bytes(const Glb& g, int accessor, size_t bytes) {
+    const auto& a = g.doc["accessors"][size_t(accessor)];
+    const auto& v = g.doc["bufferViews"][a["bufferView"].get<size_t>()];
+    return g.bin.substr(v.value("byteOffset", size_t(0)) + a.value("byteOffset", size_t(0)), bytes);
+}
+
+}  // namespace
+
+TEST_F(GltfWriter, WritingOverAFileWithOrdersReplacesThem) {
+    Sheet sheet = morph_sheet();
+    const fs::path input = dir_ / "sheet.gltf";
+    std::ofstream(input) << sheet.g.text();
+    const Written first = optimise_and_write(input.string(), dir_ / "o1.glb");
+    const Written second = optimise_and_write(first.path.string(), dir_ / "o2.glb");
+    const Written third = optimise_and_write(second.path.string(), dir_ / "o3.glb");
+    const Glb in = read_glb(first.path), again = read_glb(second.path), last = read_glb(third.path);
+
+    // The first run replaced the drawn indices (one accessor out, the orders, the fallback, one
+    // table and its centres in); each later run replaced the previous run's: the same counts and
+    // bytes run after run.
+    const size_t input_accessors = sheet.g.doc["accessors"].size();
+    EXPECT_EQ(in.doc["accessors"].size(), input_accessors - 1 + 4);
+    EXPECT_EQ(again.doc["accessors"].size(), in.doc["accessors"].size());
+    EXPECT_EQ(last.doc["accessors"].size(), in.doc["accessors"].size());
+    EXPECT_EQ(again.doc["bufferViews"].size(), in.doc["bufferViews"].size());
+    EXPECT_EQ(again.bin.size(), in.bin.size());
+    EXPECT_EQ(last.bin.size(), in.bin.size());
+    EXPECT_EQ(test::slurp(third.path).size(), test::slurp(second.path).size());
+    for (const Glb* g : {&in, &again, &last}) {
+        SCOPED_TRACE(g == &in ? "first" : g == &again ? "second" : "third");
+        // The only accessor nothing names is the input's own, kept with the bytes it shares.
+        expect_every_accessor_named_but(g->doc, sheet.shared);
+        EXPECT_EQ(accessor_bytes(*g, sheet.shared, sheet.index_bytes.size()), sheet.index_bytes);
+    }
+
+    // The last file still reads as the character, drawing its fallback order, and checks clean.
+    const AnimatedMesh back = load_gltf(third.path.string());
+    EXPECT_EQ(back.keyframe_positions, first.mesh.keyframe_positions);
+    EXPECT_TRUE(test::same_triangles_same_winding(first.mesh.indices, back.indices));
+    const OrdersExtensionCheck r = check_orders_extension(third.path.string());
+    ASSERT_TRUE(r.errors.empty()) << r.errors.front();
+    std::vector<uint32_t> fallback(third.mesh.indices.size());
+    apply_triangle_order(fallback.data(), third.mesh.indices.data(), third.method.buffers.orders[third.fallback].data(),
+                         third.mesh.triangle_count());
+    EXPECT_EQ(back.indices, fallback);
+    std::string report, why;
+    ANIMORDER_REQUIRE_OR_SKIP("validator", test::validator_available(why), why);
+    EXPECT_TRUE(test::validate_gltf(third.path, report, dir_)) << report;
+}
+
+TEST_F(GltfWriter, AFileWithAnUnknownExtensionKeepsEveryAccessorWhereItWas) {
+    Sheet sheet = morph_sheet();
+    // An extension this tool does not know, naming the drawn indices' accessor (1) by number:
+    // renumbering the accessors could make it name another one.
+    sheet.g.doc["extensionsUsed"] = nlohmann::json::array({"VENDOR_names_an_accessor"});
+    sheet.g.doc["nodes"][0]["extensions"] = {{"VENDOR_names_an_accessor", {{"accessor", 1}}}};
+    const fs::path input = dir_ / "vendor.gltf";
+    std::ofstream(input) << sheet.g.text();
+    const Written first = optimise_and_write(input.string(), dir_ / "v1.glb");
+    const Written second = optimise_and_write(first.path.string(), dir_ / "v2.glb");
+    const Glb in = read_glb(first.path), again = read_glb(second.path);
+    EXPECT_EQ(in.doc["accessors"].size(), sheet.g.doc["accessors"].size() + 4);  // nothing left out
+    EXPECT_EQ(again.doc["accessors"].size(), in.doc["accessors"].size() + 4);
+    EXPECT_GT(again.bin.size(), in.bin.size());
+    EXPECT_EQ(again.doc["nodes"][0]["extensions"]["VENDOR_names_an_accessor"]["accessor"], 1);
+    EXPECT_EQ(accessor_bytes(again, 1, sheet.index_bytes.size()), sheet.index_bytes);  // still the indices
 }

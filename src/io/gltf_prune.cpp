@@ -1,0 +1,296 @@
+// What the glTF writers replaced, left out of the file they write (gltf_prune.h).
+#include "gltf_prune.h"
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <utility>
+
+namespace animorder::io {
+namespace {
+
+const char* const kOrders = "ANIMORDER_animated_triangle_orders";
+const char* const kInstancing = "EXT_mesh_gpu_instancing";
+
+// Extensions whose references to accessors and buffer views are known here: none, or (ours,
+// EXT_mesh_gpu_instancing) followed by for_each_accessor_reference.
+bool known_extension(const std::string& name) {
+    static const char* const kKnown[] = {kOrders,
+                                         kInstancing,
+                                         "KHR_texture_transform",
+                                         "KHR_texture_basisu",
+                                         "EXT_texture_webp",
+                                         "EXT_texture_avif",
+                                         "MSFT_texture_dds",
+                                         "KHR_mesh_quantization",
+                                         "KHR_lights_punctual",
+                                         "KHR_xmp_json_ld",
+                                         "KHR_animation_pointer"};
+    if (name.rfind("KHR_materials_", 0) == 0) return true;  // material properties and textures only
+    return std::find(std::begin(kKnown), std::end(kKnown), name) != std::end(kKnown);
+}
+
+bool only_known_extensions(const tinygltf::Model& model) {
+    const auto known = [](const tinygltf::ExtensionMap& map) {
+        for (const auto& entry : map)
+            if (!known_extension(entry.first)) return false;
+        return true;
+    };
+    for (const std::string& name : model.extensionsUsed)
+        if (!known_extension(name)) return false;
+    for (const std::string& name : model.extensionsRequired)
+        if (!known_extension(name)) return false;
+    if (!known(model.extensions)) return false;
+    for (const tinygltf::Mesh& mesh : model.meshes) {
+        if (!known(mesh.extensions)) return false;
+        for (const tinygltf::Primitive& prim : mesh.primitives)
+            if (!known(prim.extensions)) return false;
+    }
+    for (const tinygltf::Node& node : model.nodes)
+        if (!known(node.extensions)) return false;
+    for (const tinygltf::Accessor& a : model.accessors)
+        if (!known(a.extensions)) return false;
+    for (const tinygltf::BufferView& v : model.bufferViews)
+        if (!known(v.extensions)) return false;
+    for (const tinygltf::Buffer& b : model.buffers)
+        if (!known(b.extensions)) return false;
+    for (const tinygltf::Image& image : model.images)
+        if (!known(image.extensions)) return false;
+    for (const tinygltf::Skin& skin : model.skins)
+        if (!known(skin.extensions)) return false;
+    for (const tinygltf::Animation& animation : model.animations) {
+        if (!known(animation.extensions)) return false;
+        for (const tinygltf::AnimationSampler& sampler : animation.samplers)
+            if (!known(sampler.extensions)) return false;
+    }
+    return true;
+}
+
+// An integer member of an extension object, as a reference that can be read and rewritten.
+struct ValueReference {
+    tinygltf::Value* object;
+    std::string key;
+};
+
+void integer_members(tinygltf::Value& object, const char* key, std::vector<ValueReference>& out) {
+    if (!object.IsObject() || !object.Has(key) || !object.Get(key).IsNumber()) return;
+    out.push_back({&object, key});
+}
+
+// Every place of `model` that names an accessor: visit(index) for core glTF's int members (which
+// may rewrite it), and the integer members of the two known extensions that name accessors.
+void for_each_accessor_reference(tinygltf::Model& model, const std::function<void(int&)>& visit) {
+    std::vector<ValueReference> in_extensions;
+    for (tinygltf::Mesh& mesh : model.meshes)
+        for (tinygltf::Primitive& prim : mesh.primitives) {
+            for (auto& attribute : prim.attributes) visit(attribute.second);
+            visit(prim.indices);
+            for (auto& target : prim.targets)
+                for (auto& attribute : target) visit(attribute.second);
+            const auto ours = prim.extensions.find(kOrders);
+            if (ours != prim.extensions.end()) integer_members(ours->second, "orders", in_extensions);
+        }
+    for (tinygltf::Skin& skin : model.skins) visit(skin.inverseBindMatrices);
+    for (tinygltf::Animation& animation : model.animations)
+        for (tinygltf::AnimationSampler& sampler : animation.samplers) {
+            visit(sampler.input);
+            visit(sampler.output);
+        }
+    for (tinygltf::Node& node : model.nodes) {
+        const auto instancing = node.extensions.find(kInstancing);
+        if (instancing == node.extensions.end() || !instancing->second.Has("attributes")) continue;
+        tinygltf::Value& attributes = instancing->second.Get<tinygltf::Value::Object>()["attributes"];
+        if (!attributes.IsObject()) continue;
+        for (auto& entry : attributes.Get<tinygltf::Value::Object>())
+            if (entry.second.IsNumber()) in_extensions.push_back({&attributes, entry.first});
+    }
+    const auto root = model.extensions.find(kOrders);
+    if (root != model.extensions.end() && root->second.Has("clips") && root->second.Get("clips").IsArray()) {
+        tinygltf::Value& clips = root->second.Get<tinygltf::Value::Object>()["clips"];
+        for (tinygltf::Value& clip : clips.Get<tinygltf::Value::Array>()) {
+            integer_members(clip, "table", in_extensions);
+            integer_members(clip, "centers", in_extensions);
+        }
+    }
+    for (const ValueReference& r : in_extensions) {
+        tinygltf::Value& member = r.object->Get<tinygltf::Value::Object>()[r.key];
+        int index = member.GetNumberAsInt();
+        visit(index);
+        member = tinygltf::Value(index);
+    }
+}
+
+void for_each_view_reference(tinygltf::Model& model, const std::function<void(int&)>& visit) {
+    for (tinygltf::Accessor& a : model.accessors) {
+        visit(a.bufferView);
+        if (a.sparse.isSparse) {
+            visit(a.sparse.indices.bufferView);
+            visit(a.sparse.values.bufferView);
+        }
+    }
+    for (tinygltf::Image& image : model.images) visit(image.bufferView);
+}
+
+// Leaves the marked items out of `items`: the last unmarked ones move into the marked places
+// (fewest indices changed). Returns each old index's new one (-1: left out).
+template <typename T>
+std::vector<int> remove_marked(std::vector<T>& items, const std::vector<bool>& marked) {
+    std::vector<int> to(items.size());
+    for (size_t i = 0; i < items.size(); ++i) to[i] = int(i);
+    size_t end = items.size();
+    for (size_t i = 0; i < end; ++i) {
+        if (!marked[i]) continue;
+        to[i] = -1;
+        while (end > i + 1 && marked[end - 1]) to[--end] = -1;  // marked at the end: just dropped
+        if (end <= i + 1) {
+            end = i;
+            break;
+        }
+        items[i] = std::move(items[end - 1]);
+        to[end - 1] = int(i);
+        --end;
+    }
+    items.resize(end);
+    return to;
+}
+
+// [begin, end) ranges sorted and merged.
+std::vector<std::pair<size_t, size_t>> merged(std::vector<std::pair<size_t, size_t>> ranges) {
+    std::sort(ranges.begin(), ranges.end());
+    std::vector<std::pair<size_t, size_t>> out;
+    for (const auto& r : ranges) {
+        if (r.first >= r.second) continue;
+        if (!out.empty() && r.first <= out.back().second)
+            out.back().second = std::max(out.back().second, r.second);
+        else
+            out.push_back(r);
+    }
+    return out;
+}
+
+// Drops from each buffer the bytes of the left-out views that no kept view covers, the later
+// bytes moving down by a multiple of 4 (the byte offsets a view or accessor needs aligned keep
+// their alignment); the kept views' offsets follow.
+void drop_bytes(tinygltf::Model& model, const std::vector<tinygltf::BufferView>& dropped) {
+    for (size_t b = 0; b < model.buffers.size(); ++b) {
+        std::vector<unsigned char>& data = model.buffers[b].data;
+        std::vector<std::pair<size_t, size_t>> kept, gone;
+        const auto range = [&](const tinygltf::BufferView& v) {
+            const size_t begin = std::min(v.byteOffset, data.size());
+            return std::make_pair(begin, begin + std::min(v.byteLength, data.size() - begin));
+        };
+        for (const tinygltf::BufferView& v : model.bufferViews)
+            if (v.buffer == int(b)) kept.push_back(range(v));
+        for (const tinygltf::BufferView& v : dropped)  // with the padding to the next multiple of 4
+            if (v.buffer == int(b)) {
+                const auto r = range(v);
+                gone.emplace_back(r.first, std::min(data.size(), (r.second + 3) / 4 * 4));
+            }
+        kept = merged(kept);
+        gone = merged(gone);
+        // The runs to leave out: the dropped views' bytes less the kept ones', each run shortened
+        // to a multiple of 4 bytes (its last bytes stay).
+        std::vector<std::pair<size_t, size_t>> leave;
+        size_t k = 0;
+        for (auto [begin, end] : gone) {
+            while (begin < end) {
+                while (k < kept.size() && kept[k].second <= begin) ++k;
+                const size_t stop = k < kept.size() ? std::min(end, std::max(begin, kept[k].first)) : end;
+                const size_t length = (stop - begin) / 4 * 4;
+                if (length) leave.emplace_back(begin, begin + length);
+                begin = k < kept.size() && stop < end ? std::min(end, kept[k].second) : end;
+            }
+        }
+        if (leave.empty()) continue;
+        std::vector<unsigned char> out;
+        out.reserve(data.size());
+        size_t from = 0;
+        for (const auto& r : leave) {
+            out.insert(out.end(), data.begin() + std::ptrdiff_t(from), data.begin() + std::ptrdiff_t(r.first));
+            from = r.second;
+        }
+        out.insert(out.end(), data.begin() + std::ptrdiff_t(from), data.end());
+        for (tinygltf::BufferView& v : model.bufferViews) {
+            if (v.buffer != int(b)) continue;
+            size_t shift = 0;  // the bytes left out before the view (none inside it: it is kept)
+            for (const auto& r : leave)
+                if (r.second <= v.byteOffset) shift += r.second - r.first;
+            v.byteOffset -= shift;
+        }
+        data.swap(out);
+    }
+}
+
+}  // namespace
+
+std::vector<int> accessors_to_replace(const tinygltf::Model& model,
+                                      const std::vector<std::pair<int, int>>& primitives) {
+    std::vector<int> replaced;
+    for (const auto& [mesh, primitive] : primitives)
+        if (mesh >= 0 && size_t(mesh) < model.meshes.size() && primitive >= 0 &&
+            size_t(primitive) < model.meshes[size_t(mesh)].primitives.size())
+            replaced.push_back(model.meshes[size_t(mesh)].primitives[size_t(primitive)].indices);
+    // The extension's own members: the primitives' orders, the clips' tables and centres.
+    for (const tinygltf::Mesh& mesh : model.meshes)
+        for (const tinygltf::Primitive& prim : mesh.primitives) {
+            const auto ours = prim.extensions.find(kOrders);
+            if (ours != prim.extensions.end() && ours->second.Has("orders") && ours->second.Get("orders").IsNumber())
+                replaced.push_back(ours->second.Get("orders").GetNumberAsInt());
+        }
+    const auto root = model.extensions.find(kOrders);
+    if (root != model.extensions.end() && root->second.Has("clips") && root->second.Get("clips").IsArray())
+        for (const tinygltf::Value& clip : root->second.Get("clips").Get<tinygltf::Value::Array>())
+            for (const char* key : {"table", "centers"})
+                if (clip.IsObject() && clip.Has(key) && clip.Get(key).IsNumber())
+                    replaced.push_back(clip.Get(key).GetNumberAsInt());
+    return replaced;
+}
+
+bool drop_replaced_accessors(tinygltf::Model& model, const std::vector<int>& replaced) {
+    if (!only_known_extensions(model)) return false;
+    // Accessors: those replaced that nothing names any more.
+    std::vector<int> uses(model.accessors.size(), 0);
+    for_each_accessor_reference(model, [&](int& a) {
+        if (a >= 0 && size_t(a) < uses.size()) ++uses[size_t(a)];
+    });
+    std::vector<bool> drop_accessor(model.accessors.size(), false);
+    for (const int a : replaced)
+        if (a >= 0 && size_t(a) < uses.size() && uses[size_t(a)] == 0) drop_accessor[size_t(a)] = true;
+    if (std::find(drop_accessor.begin(), drop_accessor.end(), true) == drop_accessor.end()) return true;
+
+    // Views: those the dropped accessors read that nothing else names.
+    std::vector<bool> view_of_dropped(model.bufferViews.size(), false);
+    for (size_t a = 0; a < model.accessors.size(); ++a) {
+        if (!drop_accessor[a]) continue;
+        const tinygltf::Accessor& accessor = model.accessors[a];
+        for (const int v : {accessor.bufferView, accessor.sparse.isSparse ? accessor.sparse.indices.bufferView : -1,
+                            accessor.sparse.isSparse ? accessor.sparse.values.bufferView : -1})
+            if (v >= 0 && size_t(v) < view_of_dropped.size()) view_of_dropped[size_t(v)] = true;
+    }
+    const std::vector<int> accessor_to = remove_marked(model.accessors, drop_accessor);
+    for_each_accessor_reference(model, [&](int& a) {
+        if (a >= 0 && size_t(a) < accessor_to.size()) a = accessor_to[size_t(a)];
+    });
+
+    std::vector<bool> view_used(model.bufferViews.size(), false);
+    for_each_view_reference(model, [&](int& v) {
+        if (v >= 0 && size_t(v) < view_used.size()) view_used[size_t(v)] = true;
+    });
+    std::vector<bool> drop_view(model.bufferViews.size(), false);
+    std::vector<tinygltf::BufferView> dropped;
+    for (size_t v = 0; v < model.bufferViews.size(); ++v)
+        if (view_of_dropped[v] && !view_used[v]) {
+            drop_view[v] = true;
+            dropped.push_back(model.bufferViews[v]);
+        }
+    const std::vector<int> view_to = remove_marked(model.bufferViews, drop_view);
+    for_each_view_reference(model, [&](int& v) {
+        if (v >= 0 && size_t(v) < view_to.size()) v = view_to[size_t(v)];
+    });
+    drop_bytes(model, dropped);
+    return true;
+}
+
+}  // namespace animorder::io

@@ -1,0 +1,32 @@
+// What the glTF writers (gltf_writer.cpp, gltf_extension.cpp) replaced, left out of the file they
+// write: without it, every run over a file that already holds orders (optimising an optimised
+// file, reapply after a pipeline) would carry the previous orders, tables and index buffers on as
+// unused accessors and bytes, the file growing run after run. Internal to src/io.
+#pragma once
+
+#include <tiny_gltf.h>
+
+#include <vector>
+
+namespace animorder::io {
+
+// The accessors a writer is about to stop referring to: each primitive's `indices` in `primitives`
+// (mesh, primitive) and every accessor the ANIMORDER_animated_triangle_orders extension names in
+// `model` (its primitives' orders, its clips' tables and centres). Read before the writer replaces
+// them.
+std::vector<int> accessors_to_replace(const tinygltf::Model& model, const std::vector<std::pair<int, int>>& primitives);
+
+// Leaves out of `model` each accessor of `replaced` that nothing refers to any more, then the
+// buffer views only they used, then those views' bytes (bytes another view covers stay). Nothing
+// else is left out, whatever else is unused. The last accessors and views move into the freed
+// places (fewest indices changed) and every reference to a moved one follows it; later bytes of a
+// buffer move down by multiples of 4, so every alignment holds.
+//
+// A model that uses an extension whose references to accessors or buffer views this does not
+// know (anything beyond core glTF, the KHR material and texture extensions, KHR_mesh_quantization,
+// KHR_lights_punctual, KHR_materials_variants, KHR_xmp_json_ld, KHR_animation_pointer,
+// EXT_mesh_gpu_instancing, EXT_texture_webp/avif, MSFT_texture_dds and animorder's own) is left
+// as it is: renumbering could break what such an extension points at. Returns whether it pruned.
+bool drop_replaced_accessors(tinygltf::Model& model, const std::vector<int>& replaced);
+
+}  // namespace animorder::io

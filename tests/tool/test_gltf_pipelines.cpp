@@ -250,6 +250,33 @@ TEST_F(GltfPipelines, ReapplyFollowsEachClipsAnimationByName) {
     EXPECT_FALSE(fs::exists(path("renamed-out.gltf")));
 }
 
+// A processed primitive that matches no optimised triangle (here a copy of the example's primitive:
+// the first copy matched every triangle) is written in its own order; reapply says so on stdout
+// and stderr instead of leaving it unordered in silence.
+TEST_F(GltfPipelines, ReapplySaysWhichPrimitivesItLeftWithoutOrders) {
+    const fs::path example = kSource / "docs" / "extension" / "example.gltf";
+    json g = json::parse(test::slurp(example));
+    g.erase("extensions");
+    g.erase("extensionsUsed");
+    json& primitives = g["meshes"][0]["primitives"];
+    ASSERT_EQ(primitives.size(), 1u);
+    primitives[0].erase("extensions");
+    primitives.push_back(primitives[0]);
+    std::ofstream(path("twice.gltf")) << g.dump();
+    test::Outcome o =
+        run(exe() + " reapply " + q(example) + " " + q(path("twice.gltf")) + " -o " + q(path("twice-out.gltf")));
+    ASSERT_EQ(o.exit_code, 0) << o.err;
+    EXPECT_NE(o.out.find("1 primitive(s), 1 without orders"), std::string::npos) << o.out;
+    EXPECT_NE(o.err.find("written without orders"), std::string::npos) << o.err;
+    const json out = json::parse(test::slurp(path("twice-out.gltf")));
+    EXPECT_TRUE(out["meshes"][0]["primitives"][0].contains("extensions"));
+    EXPECT_FALSE(out["meshes"][0]["primitives"][1].contains("extensions"));
+    EXPECT_EQ(run(exe() + " check " + q(path("twice-out.gltf"))).exit_code, 0);
+    o = run(exe() + " reapply -q " + q(example) + " " + q(path("twice.gltf")) + " -o " + q(path("quiet.gltf")));
+    EXPECT_EQ(o.err, "");
+    EXPECT_NE(o.out.find("1 without orders"), std::string::npos) << o.out;
+}
+
 // RobotExpressive has three triangles with a repeated vertex (they draw nothing), which gltfpack
 // drops: reapply takes the packed file (it refused it, "only 3234 of 3237 optimised triangles
 // found"), its orders skip those three, and check accepts the result.

@@ -119,10 +119,19 @@ int run_reapply(const ReapplyOptions& options) {
 
     std::vector<PrimitiveOrders> out;
     std::map<std::pair<int, int>, size_t> seen;
+    // Processed primitives none of whose triangles is OPTIMIZED's (new geometry, or a copy of a
+    // primitive whose triangles the first copy matched): kept in their own order, and said so.
+    std::string unordered;
+    size_t unordered_primitives = 0, unordered_triangles = 0;
     for (const Primitive& p : b.primitives) {
         size_t hits = 0;
         for (size_t t = p.first_index / 3; t < (p.first_index + p.index_count) / 3; ++t) hits += m.from_of_to[t] >= 0;
-        if (hits == 0) continue;
+        if (hits == 0) {
+            unordered += (unordered.empty() ? "" : ", ") + p.name;
+            ++unordered_primitives;
+            unordered_triangles += p.index_count / 3;
+            continue;
+        }
         if (hits != p.index_count / 3)
             throw std::runtime_error(options.processed + ": primitive " + p.name + " holds " +
                                      std::to_string(p.index_count / 3 - hits) +
@@ -146,8 +155,17 @@ int run_reapply(const ReapplyOptions& options) {
     const std::string bytes =
         gltf_with_extension_orders(options.processed, options.output, orders, out, extension == ".glb");
     write_file_atomically(options.output, bytes);
-    std::printf("reapplied %u orders: %zu of %zu triangles matched, %zu primitive(s); wrote %s\n", orders.buffer_count,
-                m.matched, a_triangles.size(), out.size(), options.output.c_str());
+    if (unordered_primitives > 0 && !options.quiet)
+        std::fprintf(stderr,
+                     "animorder: note: %zu primitive(s) of %s (%s: %zu triangles) match no optimised triangle: "
+                     "written without orders\n",
+                     unordered_primitives, options.processed.c_str(), unordered.c_str(), unordered_triangles);
+    std::printf("reapplied %u orders: %zu of %zu triangles matched, %zu primitive(s)", orders.buffer_count, m.matched,
+                a_triangles.size(), out.size());
+    if (unordered_primitives > 0)
+        std::printf(", %zu without orders (%zu triangles no optimised one matches)", unordered_primitives,
+                    unordered_triangles);
+    std::printf("; wrote %s\n", options.output.c_str());
     return 0;
 }
 

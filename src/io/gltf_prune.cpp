@@ -172,8 +172,9 @@ std::vector<std::pair<size_t, size_t>> merged(std::vector<std::pair<size_t, size
 
 // Drops from each buffer the bytes of the left-out views that no kept view covers, the later
 // bytes moving down by a multiple of 4 (the byte offsets a view or accessor needs aligned keep
-// their alignment); the kept views' offsets follow.
-void drop_bytes(tinygltf::Model& model, const std::vector<tinygltf::BufferView>& dropped) {
+// their alignment); the kept views' offsets follow. Returns the buffers it left without a byte.
+std::vector<bool> drop_bytes(tinygltf::Model& model, const std::vector<tinygltf::BufferView>& dropped) {
+    std::vector<bool> emptied(model.buffers.size(), false);
     for (size_t b = 0; b < model.buffers.size(); ++b) {
         std::vector<unsigned char>& data = model.buffers[b].data;
         std::vector<std::pair<size_t, size_t>> kept, gone;
@@ -220,7 +221,9 @@ void drop_bytes(tinygltf::Model& model, const std::vector<tinygltf::BufferView>&
             v.byteOffset -= shift;
         }
         data.swap(out);
+        emptied[b] = data.empty();
     }
+    return emptied;
 }
 
 }  // namespace
@@ -289,7 +292,15 @@ bool drop_replaced_accessors(tinygltf::Model& model, const std::vector<int>& rep
     for_each_view_reference(model, [&](int& v) {
         if (v >= 0 && size_t(v) < view_to.size()) v = view_to[size_t(v)];
     });
-    drop_bytes(model, dropped);
+    // A buffer left without a byte (it held only dropped views, say the indices of a file whose
+    // every view has its own .bin) would be written with byteLength 0, which glTF forbids: it
+    // leaves too, when no view names it.
+    std::vector<bool> drop_buffer = drop_bytes(model, dropped);
+    for (const tinygltf::BufferView& v : model.bufferViews)
+        if (v.buffer >= 0 && size_t(v.buffer) < drop_buffer.size()) drop_buffer[size_t(v.buffer)] = false;
+    const std::vector<int> buffer_to = remove_marked(model.buffers, drop_buffer);
+    for (tinygltf::BufferView& v : model.bufferViews)
+        if (v.buffer >= 0 && size_t(v.buffer) < buffer_to.size()) v.buffer = buffer_to[size_t(v.buffer)];
     return true;
 }
 

@@ -17,7 +17,8 @@ namespace animorder::io {
 std::vector<int> accessors_to_replace(const tinygltf::Model& model, const std::vector<std::pair<int, int>>& primitives);
 
 // Leaves out of `model` each accessor of `replaced` that nothing refers to any more, then the
-// buffer views only they used, then those views' bytes (bytes another view covers stay). Nothing
+// buffer views only they used, then those views' bytes (bytes another view covers stay), then a
+// buffer left without a byte that no view names (glTF forbids an empty buffer). Nothing
 // else is left out, whatever else is unused. The last accessors and views move into the freed
 // places (fewest indices changed) and every reference to a moved one follows it; later bytes of a
 // buffer move down by multiples of 4, so every alignment holds.

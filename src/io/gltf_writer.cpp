@@ -94,6 +94,10 @@ std::string gltf_with_orders(const std::string& input_path, const std::string& o
     std::vector<std::pair<int, int>> rewritten;
     for (const Primitive& p : mesh.primitives) rewritten.emplace_back(p.source_mesh, p.source_primitive);
     const std::vector<int> replaced = io::accessors_to_replace(model, rewritten);
+    // Orders a previous run left on a primitive not rewritten now (one no node draws any more)
+    // would contradict the new root object: they leave, as reapply's do.
+    for (tinygltf::Mesh& m : model.meshes)
+        for (tinygltf::Primitive& prim : m.primitives) prim.extensions.erase(kOrdersExtension);
     std::vector<std::vector<uint32_t>> index_buffers(buffers.orders.size(), std::vector<uint32_t>(mesh.indices.size()));
     for (size_t b = 0; b < buffers.orders.size(); ++b)
         apply_triangle_order(index_buffers[b].data(), mesh.indices.data(), buffers.orders[b].data(),

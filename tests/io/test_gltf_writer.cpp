@@ -411,3 +411,54 @@ TEST_F(GltfWriter, AFileWithAnUnknownExtensionKeepsEveryAccessorWhereItWas) {
     EXPECT_EQ(again.doc["nodes"][0]["extensions"]["VENDOR_names_an_accessor"]["accessor"], 1);
     EXPECT_EQ(accessor_bytes(again, 1, sheet.index_bytes.size()), sheet.index_bytes);  // still the indices
 }
+
+// A buffer that held only the replaced indices (a .gltf whose views each have their own .bin, say)
+// leaves with them: written with byteLength 0, it made the output invalid glTF that no loader,
+// animorder's own included, reads back.
+TEST_F(GltfWriter, ABufferThatHeldOnlyTheReplacedIndicesLeavesWithThem) {
+    Sheet sheet = morph_sheet();
+    nlohmann::json doc = nlohmann::json::parse(sheet.g.text());
+    const size_t index_view = doc["accessors"][1]["bufferView"].get<size_t>();
+    doc["bufferViews"][index_view]["buffer"] = 1;
+    doc["bufferViews"][index_view]["byteOffset"] = 0;
+    doc["buffers"].push_back({{"byteLength", sheet.index_bytes.size()},
+                              {"uri", "data:application/octet-stream;base64," + test::base64(sheet.index_bytes)}});
+    const fs::path input = dir_ / "two-buffers.gltf";
+    std::ofstream(input) << doc.dump();
+    const Written first = optimise_and_write(input.string(), dir_ / "t1.gltf");
+    const nlohmann::json out = nlohmann::json::parse(test::slurp(first.path));
+    ASSERT_EQ(out["buffers"].size(), 1u);
+    EXPECT_GT(out["buffers"][0]["byteLength"].get<size_t>(), 0u);
+    for (const auto& view : out["bufferViews"]) EXPECT_EQ(view["buffer"], 0);
+    const AnimatedMesh back = load_gltf(first.path.string());  // reads back
+    EXPECT_TRUE(test::same_triangles_same_winding(first.mesh.indices, back.indices));
+    const Written second = optimise_and_write(first.path.string(), dir_ / "t2.gltf");
+    EXPECT_TRUE(check_orders_extension(second.path.string()).errors.empty());
+    std::string report, why;
+    ANIMORDER_REQUIRE_OR_SKIP("validator", test::validator_available(why), why);
+    EXPECT_TRUE(test::validate_gltf(first.path, report, dir_)) << report;
+}
+
+// Orders a previous run left on a primitive that is not rewritten now (its mesh drawn by no node)
+// leave with the rest: they named another buffer count than the new root object.
+TEST_F(GltfWriter, OrdersOnAPrimitiveNoNodeDrawsLeaveWithTheRest) {
+    Sheet sheet = morph_sheet();
+    const fs::path input = dir_ / "sheet.gltf";
+    std::ofstream(input) << sheet.g.text();
+    const Written first = optimise_and_write(input.string(), dir_ / "s1.gltf");
+    nlohmann::json doc = nlohmann::json::parse(test::slurp(first.path));
+    doc["meshes"].push_back(doc["meshes"][0]);  // drawn by no node: the loader never reads it
+    ASSERT_TRUE(doc["meshes"][1]["primitives"][0].contains("extensions"));
+    std::ofstream(dir_ / "undrawn.gltf") << doc.dump();
+    const Written second = optimise_and_write((dir_ / "undrawn.gltf").string(), dir_ / "s2.gltf");
+    const nlohmann::json out = nlohmann::json::parse(test::slurp(second.path));
+    EXPECT_FALSE(out["meshes"][1]["primitives"][0].contains("extensions"));
+    EXPECT_TRUE(check_orders_extension(second.path.string()).errors.empty());
+    // The stale orders accessor left too (the undrawn mesh keeps its indices, the old fallback).
+    size_t orders_accessors = 0;
+    for (const auto& a : out["accessors"]) orders_accessors += a.value("name", "") == "animorder orders";
+    EXPECT_EQ(orders_accessors, 1u);
+    const auto& undrawn = out["accessors"][out["meshes"][1]["primitives"][0]["indices"].get<size_t>()];
+    EXPECT_EQ(undrawn["name"], "animorder fallback order");
+    EXPECT_EQ(undrawn["count"], first.mesh.indices.size());
+}

@@ -64,10 +64,11 @@ struct PrimitiveOrders {
 
 // The glTF file `input_path` with the extension written from `root` (its method, buffer count,
 // fallback and clips with cells and centres) and `primitives` (each primitive's `indices` becomes
-// a copy of order `root.fallback`); any earlier extension objects of the file are replaced.
+// a copy of order `root.fallback`); any earlier extension objects of the file are replaced, and
+// what they and the new indices replace leaves the file as in gltf_with_orders (`note` the same).
 // Buffers embedded, image URIs re-pointed from output_path's folder. GLB bytes when `binary`.
 std::string gltf_with_extension_orders(const std::string& input_path, const std::string& output_path,
                                        const OrdersExtensionCheck& root, const std::vector<PrimitiveOrders>& primitives,
-                                       bool binary);
+                                       bool binary, std::string* note = nullptr);
 
 }  // namespace animorder

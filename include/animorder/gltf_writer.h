@@ -15,10 +15,12 @@ namespace animorder {
 // `indices` holds buffer `fallback`, its extension object names one accessor with the k orders one
 // after the other, and the root extension object holds the clips' lookup tables and frame centres
 // as accessors. All other content is written back unchanged; buffers are embedded; relative image
-// URIs are rewritten to point, from output_path's folder, at the same files. Returns GLB bytes
-// when `binary`, else glTF JSON text.
+// URIs are rewritten to point, from output_path's folder, at the same files. What the orders
+// replace (the drawn indices, orders an earlier run wrote) leaves the file, unless the file uses
+// an extension whose references are unknown here: then it stays, and `note` (when given) says
+// why. Returns GLB bytes when `binary`, else glTF JSON text.
 std::string gltf_with_orders(const std::string& input_path, const std::string& output_path, const AnimatedMesh& mesh,
                              const MethodBuffers& buffers, uint32_t fallback, const Framing& framing,
-                             const std::string& method, bool binary);
+                             const std::string& method, bool binary, std::string* note = nullptr);
 
 }  // namespace animorder

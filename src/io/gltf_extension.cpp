@@ -389,7 +389,7 @@ int animation_of_clip(const tinygltf::Model& model, const ExtensionClip& c) {
 
 std::string gltf_with_extension_orders(const std::string& input_path, const std::string& output_path,
                                        const OrdersExtensionCheck& root, const std::vector<PrimitiveOrders>& primitives,
-                                       bool binary) {
+                                       bool binary, std::string* note) {
     tinygltf::Model model = io::read_model(input_path);
     if (root.buffer_count == 0 || root.fallback >= root.buffer_count)
         throw LoadError(input_path + ": no fallback order");
@@ -460,7 +460,9 @@ std::string gltf_with_extension_orders(const std::string& input_path, const std:
     model.extensionsRequired.erase(
         std::remove(model.extensionsRequired.begin(), model.extensionsRequired.end(), kOrdersExtensionName),
         model.extensionsRequired.end());
-    io::drop_replaced_accessors(model, replaced);  // the processed file's indices, any earlier orders
+    std::string unknown;  // the processed file's indices, any earlier orders
+    if (!io::drop_replaced_accessors(model, replaced, &unknown) && note)
+        *note = io::kept_replaced_note(input_path, unknown);
     return io::write_model(model, input_path, output_path, binary);
 }
 

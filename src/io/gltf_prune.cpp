@@ -32,40 +32,45 @@ bool known_extension(const std::string& name) {
     return std::find(std::begin(kKnown), std::end(kKnown), name) != std::end(kKnown);
 }
 
-bool only_known_extensions(const tinygltf::Model& model) {
-    const auto known = [](const tinygltf::ExtensionMap& map) {
+// The first extension the model uses whose references are not known here, or "" when none.
+std::string unknown_extension(const tinygltf::Model& model) {
+    std::string first;
+    const auto known = [&first](const tinygltf::ExtensionMap& map) {
         for (const auto& entry : map)
-            if (!known_extension(entry.first)) return false;
+            if (!known_extension(entry.first)) {
+                first = entry.first;
+                return false;
+            }
         return true;
     };
     for (const std::string& name : model.extensionsUsed)
-        if (!known_extension(name)) return false;
+        if (!known_extension(name)) return name;
     for (const std::string& name : model.extensionsRequired)
-        if (!known_extension(name)) return false;
-    if (!known(model.extensions)) return false;
+        if (!known_extension(name)) return name;
+    if (!known(model.extensions)) return first;
     for (const tinygltf::Mesh& mesh : model.meshes) {
-        if (!known(mesh.extensions)) return false;
+        if (!known(mesh.extensions)) return first;
         for (const tinygltf::Primitive& prim : mesh.primitives)
-            if (!known(prim.extensions)) return false;
+            if (!known(prim.extensions)) return first;
     }
     for (const tinygltf::Node& node : model.nodes)
-        if (!known(node.extensions)) return false;
+        if (!known(node.extensions)) return first;
     for (const tinygltf::Accessor& a : model.accessors)
-        if (!known(a.extensions)) return false;
+        if (!known(a.extensions)) return first;
     for (const tinygltf::BufferView& v : model.bufferViews)
-        if (!known(v.extensions)) return false;
+        if (!known(v.extensions)) return first;
     for (const tinygltf::Buffer& b : model.buffers)
-        if (!known(b.extensions)) return false;
+        if (!known(b.extensions)) return first;
     for (const tinygltf::Image& image : model.images)
-        if (!known(image.extensions)) return false;
+        if (!known(image.extensions)) return first;
     for (const tinygltf::Skin& skin : model.skins)
-        if (!known(skin.extensions)) return false;
+        if (!known(skin.extensions)) return first;
     for (const tinygltf::Animation& animation : model.animations) {
-        if (!known(animation.extensions)) return false;
+        if (!known(animation.extensions)) return first;
         for (const tinygltf::AnimationSampler& sampler : animation.samplers)
-            if (!known(sampler.extensions)) return false;
+            if (!known(sampler.extensions)) return first;
     }
-    return true;
+    return "";
 }
 
 // An integer member of an extension object, as a reference that can be read and rewritten.
@@ -251,8 +256,14 @@ std::vector<int> accessors_to_replace(const tinygltf::Model& model,
     return replaced;
 }
 
-bool drop_replaced_accessors(tinygltf::Model& model, const std::vector<int>& replaced) {
-    if (!only_known_extensions(model)) return false;
+std::string kept_replaced_note(const std::string& path, const std::string& unknown) {
+    if (unknown.empty()) return "";
+    return path + " uses extension " + unknown +
+           ", whose references to accessors animorder does not know: the indices and orders the new orders replace "
+           "stay in the output, unused (renumbering could break what the extension names)";
+}
+
+bool drop_replaced_accessors(tinygltf::Model& model, const std::vector<int>& replaced, std::string* unknown) {
     // Accessors: those replaced that nothing names any more.
     std::vector<int> uses(model.accessors.size(), 0);
     for_each_accessor_reference(model, [&](int& a) {
@@ -262,6 +273,11 @@ bool drop_replaced_accessors(tinygltf::Model& model, const std::vector<int>& rep
     for (const int a : replaced)
         if (a >= 0 && size_t(a) < uses.size() && uses[size_t(a)] == 0) drop_accessor[size_t(a)] = true;
     if (std::find(drop_accessor.begin(), drop_accessor.end(), true) == drop_accessor.end()) return true;
+    const std::string first_unknown = unknown_extension(model);
+    if (!first_unknown.empty()) {  // what it names is unknown: drop_accessor may be in use
+        if (unknown) *unknown = first_unknown;
+        return false;
+    }
 
     // Views: those the dropped accessors read that nothing else names.
     std::vector<bool> view_of_dropped(model.bufferViews.size(), false);

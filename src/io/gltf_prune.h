@@ -27,7 +27,12 @@ std::vector<int> accessors_to_replace(const tinygltf::Model& model, const std::v
 // know (anything beyond core glTF, the KHR material and texture extensions, KHR_mesh_quantization,
 // KHR_lights_punctual, KHR_materials_variants, KHR_xmp_json_ld, KHR_animation_pointer,
 // EXT_mesh_gpu_instancing, EXT_texture_webp/avif, MSFT_texture_dds and animorder's own) is left
-// as it is: renumbering could break what such an extension points at. Returns whether it pruned.
-bool drop_replaced_accessors(tinygltf::Model& model, const std::vector<int>& replaced);
+// as it is: renumbering could break what such an extension points at. Returns whether it pruned;
+// when it did not, `unknown` (when given) gets the first such extension's name.
+bool drop_replaced_accessors(tinygltf::Model& model, const std::vector<int>& replaced, std::string* unknown = nullptr);
+
+// The note the writers give when drop_replaced_accessors left the model as it was: "" when it
+// pruned or had nothing to prune.
+std::string kept_replaced_note(const std::string& path, const std::string& unknown);
 
 }  // namespace animorder::io

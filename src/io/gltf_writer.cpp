@@ -80,7 +80,7 @@ void add_extension_used(tinygltf::Model& model, const std::string& name) {
 
 std::string gltf_with_orders(const std::string& input_path, const std::string& output_path, const AnimatedMesh& mesh,
                              const MethodBuffers& buffers, uint32_t fallback, const Framing& framing,
-                             const std::string& method, bool binary) {
+                             const std::string& method, bool binary, std::string* note) {
     if (fallback >= buffers.orders.size()) throw LoadError(input_path + ": no buffer " + std::to_string(fallback));
     tinygltf::Model model = io::read_model(input_path);
     std::map<std::pair<int, int>, size_t> seen;
@@ -154,7 +154,9 @@ std::string gltf_with_orders(const std::string& input_path, const std::string& o
     root["clips"] = tinygltf::Value(clips);
     model.extensions[kOrdersExtension] = tinygltf::Value(root);
     add_extension_used(model, kOrdersExtension);
-    io::drop_replaced_accessors(model, replaced);  // the previous indices and orders: no growth run after run
+    std::string unknown;  // the previous indices and orders leave: no growth run after run
+    if (!io::drop_replaced_accessors(model, replaced, &unknown) && note)
+        *note = io::kept_replaced_note(input_path, unknown);
     // Buffers embedded (the output stands alone); image files stay where they are, a relative URI
     // re-expressed from the output's folder (gltf_buffer.h).
     return io::write_model(model, input_path, output_path, binary);

@@ -410,6 +410,18 @@ TEST_F(GltfWriter, AFileWithAnUnknownExtensionKeepsEveryAccessorWhereItWas) {
     EXPECT_GT(again.bin.size(), in.bin.size());
     EXPECT_EQ(again.doc["nodes"][0]["extensions"]["VENDOR_names_an_accessor"]["accessor"], 1);
     EXPECT_EQ(accessor_bytes(again, 1, sheet.index_bytes.size()), sheet.index_bytes);  // still the indices
+    // The writer says why the file keeps them; a file it prunes gets no note.
+    std::string note = "unset";
+    gltf_with_orders(first.path.string(), (dir_ / "v3.glb").string(), second.mesh, second.method.buffers,
+                     second.fallback, second.method.framing, "single", true, &note);
+    EXPECT_NE(note.find("uses extension VENDOR_names_an_accessor"), std::string::npos) << note;
+    const Written plain = optimise_and_write(first.path.string(), dir_ / "v4.glb");
+    const fs::path sheet_path = dir_ / "plain.gltf";
+    std::ofstream(sheet_path) << morph_sheet().g.text();
+    note = "unset";
+    gltf_with_orders(sheet_path.string(), (dir_ / "p1.glb").string(), plain.mesh, plain.method.buffers, plain.fallback,
+                     plain.method.framing, "single", true, &note);
+    EXPECT_EQ(note, "unset");
 }
 
 // A buffer that held only the replaced indices (a .gltf whose views each have their own .bin, say)

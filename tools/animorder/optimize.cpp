@@ -145,8 +145,10 @@ OptimizeProduct produce_optimize(const OptimizeOptions& options, const OptimizeP
     nlohmann::ordered_json written = {{"gltf", nullptr}, {"sidecar", nullptr}, {"sidecar_json", nullptr}};
     if (!paths.gltf.empty()) {
         const bool binary = std::filesystem::path(paths.gltf).extension() == ".glb";
+        std::string kept;
         files.add(paths.gltf, gltf_with_orders(options.common.input, paths.gltf, mesh, run.buffers, run.fallback,
-                                               run.framing, method_name(method), binary));
+                                               run.framing, method_name(method), binary, &kept));
+        if (!kept.empty()) note(options.common, "note: " + kept);
         written["gltf"] = paths.gltf;
     }
     if (!paths.sidecar.empty()) {

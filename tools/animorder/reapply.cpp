@@ -152,8 +152,10 @@ int run_reapply(const ReapplyOptions& options) {
                 }
         out.push_back(std::move(po));
     }
+    std::string kept;
     const std::string bytes =
-        gltf_with_extension_orders(options.processed, options.output, orders, out, extension == ".glb");
+        gltf_with_extension_orders(options.processed, options.output, orders, out, extension == ".glb", &kept);
+    if (!kept.empty() && !options.quiet) std::fprintf(stderr, "animorder: note: %s\n", kept.c_str());
     write_file_atomically(options.output, bytes);
     if (unordered_primitives > 0 && !options.quiet)
         std::fprintf(stderr,

@@ -2,6 +2,8 @@
 #include "gltf_prune.h"
 
 #include <algorithm>
+#include <climits>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -69,8 +71,34 @@ std::string unknown_extension(const tinygltf::Model& model) {
         if (!known(animation.extensions)) return first;
         for (const tinygltf::AnimationSampler& sampler : animation.samplers)
             if (!known(sampler.extensions)) return first;
+        for (const tinygltf::AnimationChannel& channel : animation.channels)
+            if (!known(channel.extensions) || !known(channel.target_extensions)) return first;
     }
+    for (const tinygltf::Material& material : model.materials)
+        if (!known(material.extensions)) return first;
+    for (const tinygltf::Texture& texture : model.textures)
+        if (!known(texture.extensions)) return first;
+    for (const tinygltf::Sampler& sampler : model.samplers)
+        if (!known(sampler.extensions)) return first;
+    for (const tinygltf::Camera& camera : model.cameras)
+        if (!known(camera.extensions)) return first;
+    for (const tinygltf::Scene& scene : model.scenes)
+        if (!known(scene.extensions)) return first;
     return "";
+}
+
+// A JSON number as an index: an integer, or a real with an integer value, in [0, INT_MAX]; any
+// other value names nothing (and is never converted: a real beyond int is undefined behaviour).
+bool as_index(const tinygltf::Value& v, int& out) {
+    if (v.IsInt()) {
+        out = v.Get<int>();
+        return out >= 0;
+    }
+    if (!v.IsReal()) return false;
+    const double d = v.Get<double>();
+    if (!(d >= 0.0 && d <= double(INT_MAX) && d == std::floor(d))) return false;
+    out = int(d);
+    return true;
 }
 
 // An integer member of an extension object, as a reference that can be read and rewritten.
@@ -80,7 +108,8 @@ struct ValueReference {
 };
 
 void integer_members(tinygltf::Value& object, const char* key, std::vector<ValueReference>& out) {
-    if (!object.IsObject() || !object.Has(key) || !object.Get(key).IsNumber()) return;
+    int index;
+    if (!object.IsObject() || !object.Has(key) || !as_index(object.Get(key), index)) return;
     out.push_back({&object, key});
 }
 
@@ -109,7 +138,7 @@ void for_each_accessor_reference(tinygltf::Model& model, const std::function<voi
         tinygltf::Value& attributes = instancing->second.Get<tinygltf::Value::Object>()["attributes"];
         if (!attributes.IsObject()) continue;
         for (auto& entry : attributes.Get<tinygltf::Value::Object>())
-            if (entry.second.IsNumber()) in_extensions.push_back({&attributes, entry.first});
+            if (int index; as_index(entry.second, index)) in_extensions.push_back({&attributes, entry.first});
     }
     const auto root = model.extensions.find(kOrders);
     if (root != model.extensions.end() && root->second.Has("clips") && root->second.Get("clips").IsArray()) {
@@ -121,9 +150,11 @@ void for_each_accessor_reference(tinygltf::Model& model, const std::function<voi
     }
     for (const ValueReference& r : in_extensions) {
         tinygltf::Value& member = r.object->Get<tinygltf::Value::Object>()[r.key];
-        int index = member.GetNumberAsInt();
+        int index = 0;
+        as_index(member, index);  // true: listed so above
+        const int before = index;
         visit(index);
-        member = tinygltf::Value(index);
+        if (index != before) member = tinygltf::Value(index);  // a count leaves the model as it was
     }
 }
 
@@ -196,15 +227,16 @@ std::vector<bool> drop_bytes(tinygltf::Model& model, const std::vector<tinygltf:
             }
         kept = merged(kept);
         gone = merged(gone);
-        // The runs to leave out: the dropped views' bytes less the kept ones', each run shortened
-        // to a multiple of 4 bytes (its last bytes stay).
+        // The runs to leave out: the dropped views' bytes less the kept ones', each run but one
+        // ending the buffer shortened to a multiple of 4 bytes (its last bytes stay).
         std::vector<std::pair<size_t, size_t>> leave;
         size_t k = 0;
         for (auto [begin, end] : gone) {
             while (begin < end) {
                 while (k < kept.size() && kept[k].second <= begin) ++k;
                 const size_t stop = k < kept.size() ? std::min(end, std::max(begin, kept[k].first)) : end;
-                const size_t length = (stop - begin) / 4 * 4;
+                // Nothing after the buffer's last run moves: it leaves whole.
+                const size_t length = stop == data.size() ? stop - begin : (stop - begin) / 4 * 4;
                 if (length) leave.emplace_back(begin, begin + length);
                 begin = k < kept.size() && stop < end ? std::min(end, kept[k].second) : end;
             }
@@ -220,9 +252,9 @@ std::vector<bool> drop_bytes(tinygltf::Model& model, const std::vector<tinygltf:
         out.insert(out.end(), data.begin() + std::ptrdiff_t(from), data.end());
         for (tinygltf::BufferView& v : model.bufferViews) {
             if (v.buffer != int(b)) continue;
-            size_t shift = 0;  // the bytes left out before the view (none inside it: it is kept)
+            size_t shift = 0;  // the bytes left out before the view (inside it only when it is empty)
             for (const auto& r : leave)
-                if (r.second <= v.byteOffset) shift += r.second - r.first;
+                if (r.first < v.byteOffset) shift += std::min(r.second, v.byteOffset) - r.first;
             v.byteOffset -= shift;
         }
         data.swap(out);
@@ -244,15 +276,17 @@ std::vector<int> accessors_to_replace(const tinygltf::Model& model,
     for (const tinygltf::Mesh& mesh : model.meshes)
         for (const tinygltf::Primitive& prim : mesh.primitives) {
             const auto ours = prim.extensions.find(kOrders);
-            if (ours != prim.extensions.end() && ours->second.Has("orders") && ours->second.Get("orders").IsNumber())
-                replaced.push_back(ours->second.Get("orders").GetNumberAsInt());
+            int index;
+            if (ours != prim.extensions.end() && ours->second.Has("orders") &&
+                as_index(ours->second.Get("orders"), index))
+                replaced.push_back(index);
         }
     const auto root = model.extensions.find(kOrders);
     if (root != model.extensions.end() && root->second.Has("clips") && root->second.Get("clips").IsArray())
         for (const tinygltf::Value& clip : root->second.Get("clips").Get<tinygltf::Value::Array>())
             for (const char* key : {"table", "centers"})
-                if (clip.IsObject() && clip.Has(key) && clip.Get(key).IsNumber())
-                    replaced.push_back(clip.Get(key).GetNumberAsInt());
+                if (int index; clip.IsObject() && clip.Has(key) && as_index(clip.Get(key), index))
+                    replaced.push_back(index);
     return replaced;
 }
 

@@ -6,6 +6,8 @@
 
 #include <tiny_gltf.h>
 
+#include <string>
+#include <utility>
 #include <vector>
 
 namespace animorder::io {
@@ -27,8 +29,9 @@ std::vector<int> accessors_to_replace(const tinygltf::Model& model, const std::v
 // know (anything beyond core glTF, the KHR material and texture extensions, KHR_mesh_quantization,
 // KHR_lights_punctual, KHR_materials_variants, KHR_xmp_json_ld, KHR_animation_pointer,
 // EXT_mesh_gpu_instancing, EXT_texture_webp/avif, MSFT_texture_dds and animorder's own) is left
-// as it is: renumbering could break what such an extension points at. Returns whether it pruned;
-// when it did not, `unknown` (when given) gets the first such extension's name.
+// as it is: renumbering could break what such an extension points at. Returns false then, and
+// `unknown` (when given) gets the first such extension's name; true when it pruned or had
+// nothing to prune.
 bool drop_replaced_accessors(tinygltf::Model& model, const std::vector<int>& replaced, std::string* unknown = nullptr);
 
 // The note the writers give when drop_replaced_accessors left the model as it was: "" when it

@@ -2,7 +2,8 @@
 // of random models against rules stated here independently of the code: every reference names
 // the same object (by name) as before; every kept view reads the same bytes, moved by a multiple
 // of 4; an accessor leaves exactly when it was replaced and nothing names it; no buffer is left
-// empty. (A buffer emptied and left out: GltfWriter.ABufferThatHeldOnlyTheReplacedIndicesLeaves.)
+// empty. (A buffer emptied and left out: GltfWriter.ABufferThatHeldOnlyTheReplacedIndicesLeavesWithThem
+// and OddValuesAndATrailingRunOfIndices below.)
 #include "gltf_prune.h"
 
 #include <gtest/gtest.h>
@@ -221,11 +222,80 @@ TEST(GltfPrune, RandomModelsKeepEveryReferenceAndByteTheyStillUse) {
     EXPECT_GT(pruned_bytes, 1000u);
 }
 
+// A model using an extension whose references are unknown is left exactly as it was, even its
+// references written as reals, and says which extension; without it the same call prunes.
 TEST(GltfPrune, AnUnknownExtensionLeavesTheModelAsItWas) {
-    RandomModel random(7);
-    Model m = random.make();
-    m.extensionsUsed.push_back("VENDOR_unknown");
-    const size_t accessors = m.accessors.size();
-    EXPECT_FALSE(animorder::io::drop_replaced_accessors(m, {0}));
-    EXPECT_EQ(m.accessors.size(), accessors);
+    for (const bool vendor : {true, false}) {
+        SCOPED_TRACE(vendor ? "with the unknown extension" : "without");
+        RandomModel random(7);
+        Model m = random.make();
+        Accessor unused;  // named by nothing: prunable but for the extension
+        unused.name = "unused";
+        unused.bufferView = 0;
+        unused.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
+        unused.type = TINYGLTF_TYPE_SCALAR;
+        unused.count = 1;
+        m.accessors.push_back(unused);
+        Value::Object ours;
+        ours["orders"] = Value(0.0);  // a real with an integer value still names accessor 0
+        m.meshes[0].primitives[0].extensions[kOrders] = Value(ours);
+        if (vendor) m.extensionsUsed.push_back("VENDOR_unknown");
+        const Model before = m;
+        std::string unknown;
+        const bool pruned = animorder::io::drop_replaced_accessors(m, {int(m.accessors.size() - 1)}, &unknown);
+        const Value& orders = m.meshes[0].primitives[0].extensions[kOrders].Get("orders");
+        if (vendor) {
+            EXPECT_FALSE(pruned);
+            EXPECT_EQ(unknown, "VENDOR_unknown");
+            EXPECT_EQ(m.accessors.size(), before.accessors.size());
+            EXPECT_EQ(m.bufferViews.size(), before.bufferViews.size());
+            for (size_t b = 0; b < m.buffers.size(); ++b) EXPECT_EQ(m.buffers[b].data, before.buffers[b].data);
+            EXPECT_TRUE(orders.IsReal());  // not even rewritten as an integer
+        } else {
+            EXPECT_TRUE(pruned);
+            EXPECT_EQ(unknown, "");
+            EXPECT_EQ(m.accessors.size(), before.accessors.size() - 1);
+            EXPECT_EQ(m.accessors[size_t(orders.GetNumberAsInt())].name, before.accessors[0].name);
+        }
+    }
+}
+
+// Values that name no accessor (a fraction, a real beyond int, a negative number) are neither
+// followed nor rewritten; a buffer whose last bytes were the replaced indices (6 of them: no
+// multiple of 4) loses all of them, and leaves when nothing else was in it.
+TEST(GltfPrune, OddValuesAndATrailingRunOfIndices) {
+    Model m;
+    Buffer positions, indices;
+    positions.data.assign(16, 7);
+    indices.data.assign(6, 9);
+    m.buffers = {positions, indices};
+    BufferView pv, iv;
+    pv.buffer = 0, pv.byteLength = 16, pv.name = "positions";
+    iv.buffer = 1, iv.byteLength = 6, iv.name = "indices";
+    m.bufferViews = {pv, iv};
+    Accessor p, i;
+    p.bufferView = 0, p.count = 1, p.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT, p.type = TINYGLTF_TYPE_VEC3;
+    i.bufferView = 1, i.count = 3, i.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
+    i.type = TINYGLTF_TYPE_SCALAR;
+    m.accessors = {p, i};
+    Primitive prim;
+    prim.attributes["POSITION"] = 0;
+    Value::Object ours;
+    ours["orders"] = Value(1e20);
+    prim.extensions[kOrders] = Value(ours);
+    Mesh mesh;
+    mesh.primitives = {prim};
+    m.meshes = {mesh};
+    Value::Object clip, root;
+    clip["table"] = Value(2.5);
+    clip["centers"] = Value(-1);
+    root["clips"] = Value(Value::Array{Value(clip)});
+    m.extensions[kOrders] = Value(root);
+    EXPECT_EQ(animorder::io::accessors_to_replace(m, {{0, 0}}), std::vector<int>{-1});  // no indices, no orders
+    ASSERT_TRUE(animorder::io::drop_replaced_accessors(m, {1}));
+    ASSERT_EQ(m.accessors.size(), 1u);
+    ASSERT_EQ(m.buffers.size(), 1u);
+    EXPECT_EQ(m.buffers[0].data, positions.data);
+    EXPECT_EQ(m.meshes[0].primitives[0].extensions[kOrders].Get("orders").Get<double>(), 1e20);
+    EXPECT_EQ(m.extensions[kOrders].Get("clips").Get(0).Get("table").Get<double>(), 2.5);
 }

@@ -277,6 +277,29 @@ TEST_F(GltfPipelines, ReapplySaysWhichPrimitivesItLeftWithoutOrders) {
     EXPECT_NE(o.out.find("1 without orders"), std::string::npos) << o.out;
 }
 
+// reapply onto its own output replaces the orders it wrote (and the processed file's indices the
+// first time): the same file, byte for byte, from the second run on, and no bigger than the first.
+TEST_F(GltfPipelines, ReapplyingTwiceGivesTheSameFile) {
+    const fs::path example = kSource / "docs" / "extension" / "example.gltf";
+    json g = json::parse(test::slurp(example));
+    g.erase("extensions");
+    g.erase("extensionsUsed");
+    for (json& prim : g["meshes"][0]["primitives"]) prim.erase("extensions");
+    std::ofstream(path("bare.gltf")) << g.dump();
+    fs::path processed = path("bare.gltf");
+    std::vector<std::string> outputs;
+    for (int run_index = 1; run_index <= 3; ++run_index) {
+        const fs::path out = path("again" + std::to_string(run_index) + ".glb");
+        const test::Outcome o = run(exe() + " reapply -q " + q(example) + " " + q(processed) + " -o " + q(out));
+        ASSERT_EQ(o.exit_code, 0) << o.err;
+        EXPECT_EQ(run(exe() + " check " + q(out)).exit_code, 0);
+        outputs.push_back(test::slurp(out));
+        processed = out;
+    }
+    EXPECT_EQ(outputs[1], outputs[2]);
+    EXPECT_EQ(outputs[1].size(), outputs[0].size());
+}
+
 // RobotExpressive has three triangles with a repeated vertex (they draw nothing), which gltfpack
 // drops: reapply takes the packed file (it refused it, "only 3234 of 3237 optimised triangles
 // found"), its orders skip those three, and check accepts the result.

@@ -155,8 +155,8 @@ int run_reapply(const ReapplyOptions& options) {
     std::string kept;
     const std::string bytes =
         gltf_with_extension_orders(options.processed, options.output, orders, out, extension == ".glb", &kept);
-    if (!kept.empty() && !options.quiet) std::fprintf(stderr, "animorder: note: %s\n", kept.c_str());
     write_file_atomically(options.output, bytes);
+    if (!kept.empty() && !options.quiet) std::fprintf(stderr, "animorder: note: %s\n", kept.c_str());
     if (unordered_primitives > 0 && !options.quiet)
         std::fprintf(stderr,
                      "animorder: note: %zu primitive(s) of %s (%s: %zu triangles) match no optimised triangle: "

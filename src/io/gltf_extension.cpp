@@ -395,9 +395,7 @@ std::string gltf_with_extension_orders(const std::string& input_path, const std:
         throw LoadError(input_path + ": no fallback order");
     std::vector<std::pair<int, int>> rewritten;
     for (const PrimitiveOrders& po : primitives) rewritten.emplace_back(po.mesh, po.primitive);
-    const std::vector<int> replaced = io::accessors_to_replace(model, rewritten);
-    for (tinygltf::Mesh& mesh : model.meshes)
-        for (tinygltf::Primitive& prim : mesh.primitives) prim.extensions.erase(kOrdersExtensionName);
+    const std::vector<int> replaced = io::begin_replacing(model, rewritten);
     for (const PrimitiveOrders& po : primitives) {
         if (po.mesh < 0 || size_t(po.mesh) >= model.meshes.size() || po.primitive < 0 ||
             size_t(po.primitive) >= model.meshes[size_t(po.mesh)].primitives.size())
@@ -460,9 +458,7 @@ std::string gltf_with_extension_orders(const std::string& input_path, const std:
     model.extensionsRequired.erase(
         std::remove(model.extensionsRequired.begin(), model.extensionsRequired.end(), kOrdersExtensionName),
         model.extensionsRequired.end());
-    std::string unknown;  // the processed file's indices, any earlier orders
-    if (!io::drop_replaced_accessors(model, replaced, &unknown) && note)
-        *note = io::kept_replaced_note(input_path, unknown);
+    io::finish_replacing(model, replaced, input_path, note);  // the processed file's indices, earlier orders
     return io::write_model(model, input_path, output_path, binary);
 }
 

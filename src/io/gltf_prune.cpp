@@ -45,46 +45,27 @@ std::string unknown_extension(const tinygltf::Model& model) {
             }
         return true;
     };
+    const auto all_known = [&known](const auto& objects) {
+        return std::all_of(objects.begin(), objects.end(), [&known](const auto& o) { return known(o.extensions); });
+    };
     for (const std::string& name : model.extensionsUsed)
         if (!known_extension(name)) return name;
     for (const std::string& name : model.extensionsRequired)
         if (!known_extension(name)) return name;
     if (!known(model.extensions)) return first;
-    for (const tinygltf::Mesh& mesh : model.meshes) {
-        if (!known(mesh.extensions)) return first;
-        for (const tinygltf::Primitive& prim : mesh.primitives)
-            if (!known(prim.extensions)) return first;
-    }
-    for (const tinygltf::Node& node : model.nodes)
-        if (!known(node.extensions)) return first;
-    for (const tinygltf::Accessor& a : model.accessors)
-        if (!known(a.extensions)) return first;
-    for (const tinygltf::BufferView& v : model.bufferViews)
-        if (!known(v.extensions)) return first;
-    for (const tinygltf::Buffer& b : model.buffers)
-        if (!known(b.extensions)) return first;
-    for (const tinygltf::Image& image : model.images)
-        if (!known(image.extensions)) return first;
-    for (const tinygltf::Skin& skin : model.skins)
-        if (!known(skin.extensions)) return first;
+    for (const tinygltf::Mesh& mesh : model.meshes)
+        if (!known(mesh.extensions) || !all_known(mesh.primitives)) return first;
     for (const tinygltf::Animation& animation : model.animations) {
-        if (!known(animation.extensions)) return first;
-        for (const tinygltf::AnimationSampler& sampler : animation.samplers)
-            if (!known(sampler.extensions)) return first;
+        if (!known(animation.extensions) || !all_known(animation.samplers) || !all_known(animation.channels))
+            return first;
         for (const tinygltf::AnimationChannel& channel : animation.channels)
-            if (!known(channel.extensions) || !known(channel.target_extensions)) return first;
+            if (!known(channel.target_extensions)) return first;
     }
-    for (const tinygltf::Material& material : model.materials)
-        if (!known(material.extensions)) return first;
-    for (const tinygltf::Texture& texture : model.textures)
-        if (!known(texture.extensions)) return first;
-    for (const tinygltf::Sampler& sampler : model.samplers)
-        if (!known(sampler.extensions)) return first;
-    for (const tinygltf::Camera& camera : model.cameras)
-        if (!known(camera.extensions)) return first;
-    for (const tinygltf::Scene& scene : model.scenes)
-        if (!known(scene.extensions)) return first;
-    return "";
+    const bool rest_known = all_known(model.nodes) && all_known(model.accessors) && all_known(model.bufferViews) &&
+                            all_known(model.buffers) && all_known(model.images) && all_known(model.skins) &&
+                            all_known(model.materials) && all_known(model.textures) && all_known(model.samplers) &&
+                            all_known(model.cameras) && all_known(model.scenes);
+    return rest_known ? "" : first;
 }
 
 // A JSON number as an index: an integer, or a real with an integer value, in [0, INT_MAX]; any
@@ -290,11 +271,20 @@ std::vector<int> accessors_to_replace(const tinygltf::Model& model,
     return replaced;
 }
 
-std::string kept_replaced_note(const std::string& path, const std::string& unknown) {
-    if (unknown.empty()) return "";
-    return path + " uses extension " + unknown +
-           ", whose references to accessors animorder does not know: the indices and orders the new orders replace "
-           "stay in the output, unused (renumbering could break what the extension names)";
+std::vector<int> begin_replacing(tinygltf::Model& model, const std::vector<std::pair<int, int>>& primitives) {
+    std::vector<int> replaced = accessors_to_replace(model, primitives);
+    for (tinygltf::Mesh& mesh : model.meshes)
+        for (tinygltf::Primitive& prim : mesh.primitives) prim.extensions.erase(kOrders);
+    return replaced;
+}
+
+void finish_replacing(tinygltf::Model& model, const std::vector<int>& replaced, const std::string& path,
+                      std::string* note) {
+    std::string unknown;
+    if (drop_replaced_accessors(model, replaced, &unknown) || !note) return;
+    *note = path + " uses extension " + unknown +
+            ", whose references to accessors animorder does not know: the indices and orders the new orders replace "
+            "stay in the output, unused (renumbering could break what the extension names)";
 }
 
 bool drop_replaced_accessors(tinygltf::Model& model, const std::vector<int>& replaced, std::string* unknown) {

@@ -34,8 +34,13 @@ std::vector<int> accessors_to_replace(const tinygltf::Model& model, const std::v
 // nothing to prune.
 bool drop_replaced_accessors(tinygltf::Model& model, const std::vector<int>& replaced, std::string* unknown = nullptr);
 
-// The note the writers give when drop_replaced_accessors left the model as it was: "" when it
-// pruned or had nothing to prune.
-std::string kept_replaced_note(const std::string& path, const std::string& unknown);
+// The two ends of a writer's work on the model read from `path`. begin_replacing, before it
+// writes: accessors_to_replace for the primitives it rewrites, and every primitive's orders
+// extension object erased (the writer names its own; stale ones on a primitive it does not
+// rewrite would contradict them). finish_replacing, after: drop_replaced_accessors, and when that
+// left the model as it was, `note` (when given) says why.
+std::vector<int> begin_replacing(tinygltf::Model& model, const std::vector<std::pair<int, int>>& primitives);
+void finish_replacing(tinygltf::Model& model, const std::vector<int>& replaced, const std::string& path,
+                      std::string* note);
 
 }  // namespace animorder::io

@@ -93,11 +93,7 @@ std::string gltf_with_orders(const std::string& input_path, const std::string& o
     }
     std::vector<std::pair<int, int>> rewritten;
     for (const Primitive& p : mesh.primitives) rewritten.emplace_back(p.source_mesh, p.source_primitive);
-    const std::vector<int> replaced = io::accessors_to_replace(model, rewritten);
-    // Orders a previous run left on a primitive not rewritten now (one no node draws any more)
-    // would contradict the new root object: they leave, as reapply's do.
-    for (tinygltf::Mesh& m : model.meshes)
-        for (tinygltf::Primitive& prim : m.primitives) prim.extensions.erase(kOrdersExtension);
+    const std::vector<int> replaced = io::begin_replacing(model, rewritten);
     std::vector<std::vector<uint32_t>> index_buffers(buffers.orders.size(), std::vector<uint32_t>(mesh.indices.size()));
     for (size_t b = 0; b < buffers.orders.size(); ++b)
         apply_triangle_order(index_buffers[b].data(), mesh.indices.data(), buffers.orders[b].data(),
@@ -154,9 +150,7 @@ std::string gltf_with_orders(const std::string& input_path, const std::string& o
     root["clips"] = tinygltf::Value(clips);
     model.extensions[kOrdersExtension] = tinygltf::Value(root);
     add_extension_used(model, kOrdersExtension);
-    std::string unknown;  // the previous indices and orders leave: no growth run after run
-    if (!io::drop_replaced_accessors(model, replaced, &unknown) && note)
-        *note = io::kept_replaced_note(input_path, unknown);
+    io::finish_replacing(model, replaced, input_path, note);  // no growth run after run
     // Buffers embedded (the output stands alone); image files stay where they are, a relative URI
     // re-expressed from the output's folder (gltf_buffer.h).
     return io::write_model(model, input_path, output_path, binary);

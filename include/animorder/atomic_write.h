@@ -17,7 +17,9 @@ public:
 };
 
 // Throws OutputError unless every output path can be written as a new or replaced file: its folder
-// exists, it is not a folder, its name leaves room for its temporary's, it is not (after
+// exists and a file can be created in it (tried, not only asked of access()), it is not a folder,
+// its name leaves room for its temporary's, an existing file may be replaced (a sticky folder's
+// file of another user may not), it is not (after
 // resolving links) one of `inputs`, it does not lie in one of `input_folders` (folders every
 // file of which the run reads, such as a clip folder: a later run would read the output as an
 // input), and no two outputs are the same file. Call it before any long work, so a bad path fails
@@ -36,7 +38,10 @@ void check_output_stem(const std::string& stem);
 // The outputs of one run. add() writes each to a temporary beside its target; commit() renames
 // them all into place. If any add() or the commit fails, or the set is destroyed uncommitted,
 // every temporary is removed and no target has been touched (a rename that fails mid-commit
-// restores the files already replaced from their backups).
+// restores the files already replaced from their backups). A SIGINT, SIGTERM or SIGHUP (whose
+// action was the default one) removes the temporaries too before the process ends of it; only
+// SIGKILL, or a signal during the commit's renames (when removing them would leave targets
+// missing), leaves them (`batch` sweeps those of its items).
 class OutputSet {
 public:
     OutputSet() = default;
@@ -50,6 +55,7 @@ public:
 private:
     struct Pending {
         std::string target, temp;
+        size_t slot;  // where the signal handler finds temp (atomic_write.cpp)
     };
     std::vector<Pending> pending_;
     bool committed_ = false;

@@ -1,15 +1,24 @@
 // Outputs that appear all together or not at all: temporaries beside their targets, flushed to
-// disk, renamed into place only when every file of the run is written.
+// disk, renamed into place only when every file of the run is written, and removed when the run
+// is interrupted (SIGINT, SIGTERM, SIGHUP) or fails.
 #include "animorder/atomic_write.h"
 
+#include <fcntl.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <algorithm>
+#include <atomic>
 #include <cerrno>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <memory>
+#include <mutex>
 #include <unordered_map>
 #include <unordered_set>
+#include <vector>
 
 namespace animorder {
 namespace {
@@ -29,15 +38,106 @@ bool same_file(const std::string& a, const std::string& b) { return file_identit
 // What a temporary adds to its target's name: "." before, ".tmp" or ".old" and a process id after.
 constexpr size_t kTemporaryExtra = 1 + 4 + 10;
 
+std::string temporary_name(const fs::path& target, const char* kind) {
+    const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
+    // Unique per process, so concurrent runs never share a temporary.
+    return (folder / ("." + target.filename().string() + "." + kind + std::to_string(::getpid()))).string();
+}
+
+// The temporaries of the unfinished OutputSets, for the signal handler: a slot names one (and
+// the process that made it) while its file exists and is not being put in place. Each slot's name
+// is written into its own buffer, reused, while the slot names nothing.
+constexpr size_t kTrackedTemporaries = 256;
+struct TrackedTemporary {
+    std::atomic<const char*> name{nullptr};
+    std::atomic<pid_t> owner{0};
+};
+TrackedTemporary tracked_temporaries[kTrackedTemporaries];
+
+// SIGINT, SIGTERM, SIGHUP: this process's temporaries removed (unlink is async-signal-safe; a
+// forked child, such as isolated_import's, removes only its own), then the signal's default
+// action, so the run still ends as killed.
+void remove_temporaries_and_reraise(int sig) {
+    const pid_t self = ::getpid();
+    for (TrackedTemporary& slot : tracked_temporaries)
+        if (slot.owner.load() == self)
+            if (const char* name = slot.name.load()) ::unlink(name);
+    ::signal(sig, SIG_DFL);
+    ::raise(sig);
+}
+
+// Installed at the first temporary, for the signals whose action is the default one (one that is
+// ignored, as under nohup, or that the program handles itself is left as it is).
+void install_signal_cleanup() {
+    static std::once_flag once;
+    std::call_once(once, [] {
+        for (const int sig : {SIGINT, SIGTERM, SIGHUP}) {
+            struct sigaction previous {};
+            if (::sigaction(sig, nullptr, &previous) != 0 || (previous.sa_flags & SA_SIGINFO) ||
+                previous.sa_handler != SIG_DFL)
+                continue;
+            struct sigaction action {};
+            action.sa_handler = remove_temporaries_and_reraise;
+            sigemptyset(&action.sa_mask);
+            ::sigaction(sig, &action, nullptr);
+        }
+    });
+}
+
+constexpr size_t kNoSlot = SIZE_MAX;
+
+// The slot that names `temp` for the handler (kNoSlot when every slot is taken: that one
+// temporary is then not removed on a signal).
+size_t track_temporary(const std::string& temp) {
+    install_signal_cleanup();
+    static std::mutex mutex;
+    static std::unique_ptr<char[]> buffers[kTrackedTemporaries];
+    static size_t capacity[kTrackedTemporaries] = {};
+    const std::lock_guard<std::mutex> lock(mutex);
+    for (size_t i = 0; i < kTrackedTemporaries; ++i) {
+        if (tracked_temporaries[i].name.load() != nullptr) continue;
+        if (capacity[i] < temp.size() + 1) {
+            capacity[i] = std::max<size_t>(temp.size() + 1, 256);
+            buffers[i] = std::make_unique<char[]>(capacity[i]);
+        }
+        std::memcpy(buffers[i].get(), temp.c_str(), temp.size() + 1);
+        tracked_temporaries[i].owner.store(::getpid());
+        tracked_temporaries[i].name.store(buffers[i].get());
+        return i;
+    }
+    return kNoSlot;
+}
+
+// The handler no longer removes that temporary (put in place, or removed); slot becomes kNoSlot.
+void untrack_temporary(size_t& slot) {
+    if (slot < kTrackedTemporaries) tracked_temporaries[slot].name.store(nullptr);
+    slot = kNoSlot;
+}
+
+// Whether a file can be created in `folder` and removed again: access() answers yes to root
+// everywhere, /proc and /sys included, where creating fails; so the temporary's own name is
+// created (never one that exists) and removed.
+std::string creation_error(const fs::path& target) {
+    const std::string probe = temporary_name(target, "tmp");
+    const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+    if (fd < 0) return errno == EEXIST ? std::string() : std::strerror(errno);
+    ::close(fd);
+    ::unlink(probe.c_str());
+    return {};
+}
+
 void check_writable_target(const std::string& path) {
     const fs::path target(path);
     std::error_code error;
     if (path.empty()) throw OutputError("an output path is empty");
     if (fs::is_directory(target, error)) throw OutputError(path + ": is a directory, expected a file name");
     const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
-    if (!fs::is_directory(folder, error))
+    if (!fs::is_directory(folder, error)) {
+        if (error == std::errc::filename_too_long)
+            throw OutputError(path + ": the path is too long for this system (" + error.message() + ")");
         throw OutputError(path + ": folder " + folder.string() +
                           (fs::exists(folder, error) ? " is not a folder" : " does not exist"));
+    }
     if (::access(folder.c_str(), W_OK | X_OK) != 0)
         throw OutputError(path + ": folder " + folder.string() + " is not writable");
     const long name_max = ::pathconf(folder.c_str(), _PC_NAME_MAX);
@@ -45,12 +145,17 @@ void check_writable_target(const std::string& path) {
     if (target.filename().string().size() + kTemporaryExtra > limit)
         throw OutputError(path + ": the file name is too long (at most " + std::to_string(limit - kTemporaryExtra) +
                           " bytes here, so that its temporary fits)");
-}
-
-std::string temporary_name(const fs::path& target, const char* kind) {
-    const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
-    // Unique per process, so concurrent runs never share a temporary.
-    return (folder / ("." + target.filename().string() + "." + kind + std::to_string(::getpid()))).string();
+    const std::string why = creation_error(target);
+    if (!why.empty()) throw OutputError(path + ": folder " + folder.string() + " is not writable (" + why + ")");
+    // In a sticky folder (/tmp) only the file's owner, the folder's owner or root may replace a
+    // file: known now rather than when the outputs are put in place, after the work.
+    struct stat folder_stat {
+    }, target_stat{};
+    const uid_t user = ::geteuid();
+    if (user != 0 && ::stat(folder.c_str(), &folder_stat) == 0 && (folder_stat.st_mode & S_ISVTX) &&
+        folder_stat.st_uid != user && ::lstat(path.c_str(), &target_stat) == 0 && target_stat.st_uid != user)
+        throw OutputError(path + ": belongs to another user in a sticky folder (" + folder.string() +
+                          "), so it cannot be replaced; name another output");
 }
 
 }  // namespace
@@ -101,8 +206,10 @@ void check_output_paths(const std::vector<std::string>& outputs, const std::vect
 }
 
 OutputSet::~OutputSet() {
-    if (committed_) return;
-    for (const Pending& p : pending_) std::remove(p.temp.c_str());
+    for (Pending& p : pending_) {
+        if (!committed_) std::remove(p.temp.c_str());
+        untrack_temporary(p.slot);
+    }
 }
 
 void OutputSet::add(const std::string& path, const std::string& data) {
@@ -113,7 +220,7 @@ void OutputSet::add(const std::string& path, const std::string& data) {
     const std::string temp = temporary_name(path, "tmp");
     std::FILE* file = std::fopen(temp.c_str(), "wb");
     if (!file) throw OutputError(path + ": cannot create " + temp + ": " + std::strerror(errno));
-    pending_.push_back({path, temp});
+    pending_.push_back({path, temp, track_temporary(temp)});
     const bool written = std::fwrite(data.data(), 1, data.size(), file) == data.size();
     const bool flushed = std::fflush(file) == 0 && ::fsync(::fileno(file)) == 0;
     const bool closed = std::fclose(file) == 0;
@@ -121,6 +228,9 @@ void OutputSet::add(const std::string& path, const std::string& data) {
 }
 
 void OutputSet::commit() {
+    // From here a signal leaves the temporaries (and backups) where they are: removing those not
+    // yet in place would leave their targets missing. batch sweeps what is left.
+    for (Pending& p : pending_) untrack_temporary(p.slot);
     // Existing targets move aside first, so a failure part-way can put every one of them back.
     std::vector<std::pair<std::string, std::string>> backups;  // target, backup
     size_t placed = 0;

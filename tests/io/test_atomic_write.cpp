@@ -1,0 +1,134 @@
+// OutputSet and check_output_paths (src/io/atomic_write.cpp): a signal leaves no temporary, a
+// folder no file can be created in is refused up front (even for root, whom access() lets write
+// anywhere), and so is an output a sticky folder does not let this user replace.
+#include <gtest/gtest.h>
+
+#include "animorder/atomic_write.h"
+#include "support/files.h"
+
+#include <signal.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace fs = std::filesystem;
+namespace test = animorder::test;
+using animorder::OutputError;
+using animorder::OutputSet;
+
+namespace {
+
+class AtomicWrite : public test::ScratchFolderTest {
+protected:
+    AtomicWrite() : ScratchFolderTest("animorder-atomic-write") {}
+    std::string entries() const {
+        std::string names;
+        for (const auto& e : fs::directory_iterator(dir_)) names += e.path().filename().string() + " ";
+        return names;
+    }
+};
+
+}  // namespace
+
+// A run interrupted (Ctrl-C, a farm's SIGTERM) between writing its temporaries and putting them in
+// place leaves nothing behind, and still ends as killed by the signal.
+TEST_F(AtomicWrite, ASignalRemovesTheTemporariesAndStillKills) {
+    for (const int sig : {SIGTERM, SIGINT, SIGHUP}) {
+        const pid_t child = ::fork();
+        ASSERT_GE(child, 0);
+        if (child == 0) {
+            OutputSet files;
+            files.add(path("a.bin").string(), std::string(100000, 'a'));
+            files.add(path("b.json").string(), "{}");
+            ::raise(sig);
+            ::_exit(0);  // not reached: the signal's default action ends the process
+        }
+        int status = 0;
+        ASSERT_EQ(::waitpid(child, &status, 0), child);
+        EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == sig) << "signal " << sig << ", status " << status;
+        EXPECT_EQ(entries(), "") << "signal " << sig << " left files behind";
+    }
+}
+
+// A process that wrote outputs before forking: the child's own temporaries are still removed on a
+// signal (each temporary is the process's that made it), and the parent's outputs stay.
+TEST_F(AtomicWrite, AForkedChildRemovesItsOwnTemporaries) {
+    animorder::write_file_atomically(path("parent.json").string(), "{}");
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+        OutputSet files;
+        files.add(path("child.bin").string(), "c");
+        ::raise(SIGTERM);
+        ::_exit(0);
+    }
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    EXPECT_TRUE(WIFSIGNALED(status));
+    EXPECT_EQ(entries(), "parent.json ");
+}
+
+// What the handler must not do: remove the outputs once they are in place.
+TEST_F(AtomicWrite, ASignalAfterTheCommitKeepsTheOutputs) {
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+        OutputSet files;
+        files.add(path("a.bin").string(), "a");
+        files.commit();
+        ::raise(SIGTERM);
+        ::_exit(0);
+    }
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    EXPECT_TRUE(WIFSIGNALED(status));
+    EXPECT_EQ(entries(), "a.bin ");
+}
+
+// /proc lets no file be created, yet access(W_OK) says yes to root: refused before any work.
+TEST_F(AtomicWrite, AFolderNoFileCanBeCreatedInIsRefused) {
+    if (!fs::is_directory("/proc/self")) GTEST_SKIP() << "no /proc on this system";
+    try {
+        animorder::check_output_paths({"/proc/animorder-output.json"}, {});
+        FAIL() << "an output in /proc was accepted";
+    } catch (const OutputError& e) {
+        EXPECT_NE(std::string(e.what()).find("not writable"), std::string::npos) << e.what();
+    }
+    EXPECT_NO_THROW(animorder::check_output_paths({path("fine.json").string()}, {}));
+    EXPECT_EQ(entries(), "") << "the check leaves no file";
+}
+
+// In a sticky folder (like /tmp) only a file's owner may replace it: known at the check, not at
+// the commit after the work. Needs root, to make a file of another user.
+TEST_F(AtomicWrite, AnotherUsersFileInAStickyFolderIsRefusedAtTheCheck) {
+    if (::geteuid() != 0) GTEST_SKIP() << "needs root, to make a file that belongs to another user";
+    const fs::path sticky = path("sticky");
+    fs::create_directory(sticky);
+    ASSERT_EQ(::chmod(sticky.c_str(), 01777), 0);
+    std::ofstream(sticky / "theirs.json") << "{}";
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {  // as nobody (65534): the file is root's
+        if (::setresgid(65534, 65534, 65534) != 0 || ::setresuid(65534, 65534, 65534) != 0) ::_exit(3);
+        try {
+            animorder::check_output_paths({(sticky / "mine.json").string()}, {});  // a new file: fine
+        } catch (const OutputError&) {
+            ::_exit(4);
+        }
+        try {
+            animorder::check_output_paths({(sticky / "theirs.json").string()}, {});
+        } catch (const OutputError& e) {
+            ::_exit(std::string(e.what()).find("another user") != std::string::npos ? 0 : 2);
+        }
+        ::_exit(1);
+    }
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 0) << "1: accepted; 2: refused for another reason; 3: no user switch; 4: a new "
+                                         "file refused";
+    EXPECT_TRUE(fs::exists(sticky / "theirs.json"));
+}

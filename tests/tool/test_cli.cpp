@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -378,6 +379,7 @@ TEST_F(Cli, BadInputAndOptionsGiveOneLineErrors) {
         {"optimize --frame 100000", "keyframe 100000"},
         {"inspect " + path("missing.glb").string(), "missing.glb"},
         {"optimize -o " + path("no/such/folder/out").string(), "does not exist"},
+        {"optimize -o '" + path("no\nsuch/out").string() + "'", "no\\nsuch does not exist"},  // a line break shown
         {"optimize --method single --views 100", "icosphere"},
         {"optimize --method single --distance far", "--distance"},
         {"optimize --method single --update fast", "--update"},
@@ -598,4 +600,59 @@ TEST_F(CliOutputs, ReapplyOntoEitherInputIsRefused) {
         "reapply " + path("opt.glb").string() + " " + path("in.glb").string() + " -o " + path("opt.glb").string(),
         "opt.glb");
     EXPECT_EQ(test::slurp(path("opt.glb")), optimised);
+}
+
+// Every subcommand checks its outputs against every file its load reads, not only the file named
+// on the command line: evaluate's report or heatmap's image on a .gltf's own buffer replaced it
+// (exit 0), and a report in a clip folder broke every later run on that folder.
+TEST_F(CliOutputs, NoCommandWritesOverAFileItsLoadReadsOrIntoAClipFolder) {
+    // in.glb as a .gltf whose buffer is the file in.bin.
+    const std::string glb = original_;
+    uint32_t json_length = 0, bin_length = 0;
+    std::memcpy(&json_length, glb.data() + 12, 4);
+    std::memcpy(&bin_length, glb.data() + 20 + json_length, 4);
+    nlohmann::json gltf = nlohmann::json::parse(glb.substr(20, json_length));
+    gltf["buffers"][0]["uri"] = "in.bin";
+    std::ofstream(path("in.gltf"), std::ios::binary) << gltf.dump();
+    const std::string bin = glb.substr(20 + json_length + 8, bin_length);
+    std::ofstream(path("in.bin"), std::ios::binary) << bin;
+    const std::string in = path("in.gltf").string(), bin_path = path("in.bin").string();
+    ASSERT_EQ(run("inspect -q " + in).exit_code, 0) << "the split file loads";
+    const std::string small = " --eval-views 2 --eval-resolution 32 --methods original";
+    for (const std::string& args :
+         {"evaluate " + in + small + " -r " + bin_path, "evaluate " + in + small + " --csv " + bin_path,
+          "heatmap " + in + " -o " + bin_path}) {
+        expect_refused(args, "in.bin");
+        EXPECT_EQ(test::slurp(path("in.bin")), bin) << args << ": the buffer changed";
+    }
+    fs::create_directories(path("clips"));
+    fs::copy_file(path("in.glb"), path("clips/walk.glb"));
+    const std::string clips = " --clip " + path("clips").string();
+    expect_refused("evaluate " + path("in.glb").string() + clips + small + " --csv " + path("clips/t.csv").string(),
+                   "clip folder");
+    expect_refused("subdivide --levels 1 " + path("in.glb").string() + clips + " -o " + path("clips/s.glb").string(),
+                   "clip folder");
+    EXPECT_EQ(entries_of(path("clips")), "walk.glb ") << "nothing written";
+}
+
+// A folder where no file can be created (/proc, where access() still answers yes to root) is
+// refused before any work, by every subcommand that writes.
+TEST_F(CliOutputs, AFolderNoFileCanBeCreatedInIsRefusedFirst) {
+    if (!fs::is_directory("/proc/self")) GTEST_SKIP() << "no /proc on this system";
+    const std::string in = path("in.glb").string();
+    for (const std::string& args :
+         {"optimize " + in + " -o /proc/animorder-out", "evaluate " + in + " -r /proc/animorder-r.json",
+          "heatmap " + in + " -o /proc/animorder-h.png", "subdivide --levels 1 " + in + " -o /proc/animorder-s.glb",
+          "reapply " + in + " " + in + " -o /proc/animorder-r.glb"})
+        expect_refused(args, "not writable");
+}
+
+// evaluate --stored on a file without stored orders says so before running any method.
+TEST_F(CliOutputs, EvaluateStoredRefusesAFileWithoutOrdersBeforeTheMethods) {
+    const test::Outcome o = run("evaluate " + path("in.glb").string() +
+                                " --stored --methods original,single --views 12 --resolution 32 --eval-views 2 "
+                                "--eval-resolution 32");
+    EXPECT_EQ(o.exit_code, 1) << o.err;
+    EXPECT_NE(o.err.find("ANIMORDER_animated_triangle_orders"), std::string::npos) << o.err;
+    EXPECT_EQ(o.err.find("running"), std::string::npos) << "a method ran first: " << o.err;
 }

@@ -194,15 +194,20 @@ int run_evaluate(const EvaluateOptions& options) {
     std::vector<std::string> outputs;
     for (const std::string* p : {&options.report_path, &options.csv_path})
         if (!p->empty()) outputs.push_back(*p);
-    check_output_paths(outputs, {options.common.input});
+    check_outputs_before_loading(outputs, options.common);
 
     std::string input_name;
     CommonOptions common = options.common;
     common.threads = b.clustering.threads;
-    AnimatedMesh loaded = load_drawable_input(common, input_name);
+    std::vector<std::string> files_read;
+    AnimatedMesh loaded = load_drawable_input(common, input_name, &files_read);
+    check_output_paths(outputs, files_read);
     if (options.single_sided)  // the cost of double-sidedness: orders and OVR with every back face culled
         for (Primitive& p : loaded.primitives) p.double_sided = false;
     const AnimatedMesh& mesh = loaded;
+    // The stored orders read now, so that a file without them is refused before the methods run.
+    std::vector<MethodBuffers> stored;
+    if (options.stored) stored.push_back(stored_buffers(mesh, options.common.input));
     std::vector<Row> rows;
     for (const auto& [n, m] : plan) {
         std::string label = method_name(n);
@@ -223,7 +228,7 @@ int run_evaluate(const EvaluateOptions& options) {
                              " views, " + std::to_string(eval.resolution) + "^2)");
     std::vector<MethodBuffers> buffers;
     for (const Row& r : rows) buffers.push_back(r.result.buffers);
-    if (options.stored) buffers.push_back(stored_buffers(mesh, options.common.input));
+    for (MethodBuffers& m : stored) buffers.push_back(std::move(m));
     const Clock::time_point eval_start = Clock::now();
     const std::vector<OrderEvaluation> results = evaluate_methods(mesh, buffers, eval);
     const double eval_s = seconds_since(eval_start);

@@ -73,10 +73,12 @@ int run_heatmap(const HeatmapOptions& options) {
         throw std::runtime_error("--view must be a non-zero finite direction");
     if (options.output.empty()) throw std::runtime_error("heatmap needs an output file (-o out.png)");
     const Method method = parse_static_method(options.method);
-    check_output_paths({options.output}, {options.common.input});
+    check_outputs_before_loading({options.output}, options.common);
 
     std::string input_name;
-    const AnimatedMesh mesh = load_drawable_input(options.common, input_name);
+    std::vector<std::string> files_read;
+    const AnimatedMesh mesh = load_drawable_input(options.common, input_name, &files_read);
+    check_output_paths({options.output}, files_read);
     if (options.keyframe >= mesh.keyframe_count())
         throw std::runtime_error("keyframe " + std::to_string(options.keyframe) + " does not exist (the mesh has " +
                                  std::to_string(mesh.keyframe_count()) + ")");

@@ -1,5 +1,7 @@
 #include "input.h"
 
+#include "animorder/atomic_write.h"
+#include "animorder/load.h"
 #include "animorder/procedural_character.h"
 
 #include <chrono>
@@ -32,6 +34,32 @@ std::function<void(size_t, size_t)> progress_printer(const CommonOptions& common
 
 bool clip_is_file(const CommonOptions& common, const std::string& clip) {
     return common.clip_files_absolute ? std::filesystem::path(clip).is_absolute() : std::filesystem::exists(clip);
+}
+
+std::vector<std::string> input_files(const CommonOptions& common) {
+    std::vector<std::string> clip_files;
+    for (const std::string& c : common.clips)
+        if (clip_is_file(common, c)) clip_files.push_back(c);
+    if (common.input.empty()) return clip_files;  // the bundled character takes none (loading says so)
+    try {
+        return files_load_reads(common.input, clip_files);
+    } catch (const LoadError&) {  // an empty clip folder: loading says so
+        clip_files.insert(clip_files.begin(), common.input);
+        return clip_files;
+    }
+}
+
+std::vector<std::string> input_folders(const CommonOptions& common) {
+    std::vector<std::string> folders;
+    for (const std::string& c : common.clips) {
+        std::error_code error;
+        if (clip_is_file(common, c) && std::filesystem::is_directory(c, error)) folders.push_back(c);
+    }
+    return folders;
+}
+
+void check_outputs_before_loading(const std::vector<std::string>& outputs, const CommonOptions& common) {
+    check_output_paths(outputs, input_files(common), input_folders(common));
 }
 
 AnimatedMesh load_animated_input(const CommonOptions& common, std::string& input_name,

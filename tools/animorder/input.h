@@ -23,6 +23,19 @@ std::function<void(size_t, size_t)> progress_printer(const CommonOptions& common
 // Whether a --clip value names a clip file or folder (else the name of a clip to keep).
 bool clip_is_file(const CommonOptions& common, const std::string& clip);
 
+// Every file a run on these options reads, as far as known before loading (files_load_reads):
+// the character, a glTF's external buffers and images, the clip files and the files of clip
+// folders.
+std::vector<std::string> input_files(const CommonOptions& common);
+
+// The --clip values that are folders: a run reads every file in them.
+std::vector<std::string> input_folders(const CommonOptions& common);
+
+// check_output_paths of the outputs against input_files and input_folders: called before any
+// work, so that no output overwrites an input (a .gltf's .bin, a clip file) or lands in a clip
+// folder, whichever subcommand writes it.
+void check_outputs_before_loading(const std::vector<std::string>& outputs, const CommonOptions& common);
+
 // The input named on the command line (or the bundled character, saying so). --clip values that
 // exist on disk are clip files or folders (Mixamo style); the others name the clips to keep.
 // files_read, when given, receives every file the load read (LoadOptions::files_read).

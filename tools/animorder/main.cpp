@@ -162,6 +162,14 @@ animorder::tool::OptimizeOptions parse_batch_item(const std::vector<std::string>
 
 }  // namespace
 
+// An error message as one line: a line break inside it (a path with a newline in its name) shown
+// as \n or \r, so that a script reading stderr line by line sees one error.
+static std::string one_line(const char* message) {
+    std::string out;
+    for (const char* c = message; *c; ++c) out += *c == '\n' ? "\\n" : *c == '\r' ? "\\r" : std::string(1, *c);
+    return out;
+}
+
 int main(int argc, char** argv) {
     using namespace animorder::tool;
     CLI::App app{
@@ -317,7 +325,7 @@ int main(int argc, char** argv) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
         // Every option error the same way as every other error: one line, exit code 1.
-        std::fprintf(stderr, "animorder: error: %s\n", e.what());
+        std::fprintf(stderr, "animorder: error: %s\n", one_line(e.what()).c_str());
         return 1;
     }
 
@@ -332,7 +340,7 @@ int main(int argc, char** argv) {
         if (*check_cmd) return run_check(check);
         if (*reapply_cmd) return run_reapply(reapply);
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "animorder: error: %s\n", e.what());
+        std::fprintf(stderr, "animorder: error: %s\n", one_line(e.what()).c_str());
         return 1;
     }
     return 2;

@@ -40,21 +40,6 @@ void output_paths(const OptimizeOptions& options, OptimizePlan& paths) {
     paths.sidecar_json = stem + ".animorder.json";
 }
 
-// Every file this run reads, as far as known before loading (files_load_reads): the character,
-// a glTF's external buffers and images, the clip files and the files of clip folders.
-std::vector<std::string> input_paths(const CommonOptions& common) {
-    std::vector<std::string> clip_files;
-    for (const std::string& c : common.clips)
-        if (clip_is_file(common, c)) clip_files.push_back(c);
-    if (common.input.empty()) return clip_files;  // the bundled character takes none (loading says so)
-    try {
-        return files_load_reads(common.input, clip_files);
-    } catch (const LoadError&) {  // an empty clip folder: loading says so
-        clip_files.insert(clip_files.begin(), common.input);
-        return clip_files;
-    }
-}
-
 }  // namespace
 
 nlohmann::ordered_json optimize_settings_json(const OptimizeOptions& options, const OptimizePlan& plan,
@@ -102,11 +87,8 @@ OptimizePlan plan_optimize(const OptimizeOptions& options) {
     const std::string* named[] = {&plan.gltf, &plan.sidecar, &plan.sidecar_json, &options.report_path};
     for (const std::string* p : named)
         if (!p->empty()) plan.outputs.push_back(*p);
-    plan.inputs = input_paths(options.common);
-    for (const std::string& c : options.common.clips) {
-        std::error_code error;
-        if (clip_is_file(options.common, c) && std::filesystem::is_directory(c, error)) plan.input_folders.push_back(c);
-    }
+    plan.inputs = input_files(options.common);
+    plan.input_folders = input_folders(options.common);
     return plan;
 }
 

@@ -11,6 +11,7 @@
 #include "animorder/atomic_write.h"
 #include "animorder/gltf_extension.h"
 #include "animorder/gltf_loader.h"
+#include "animorder/load.h"
 #include "animorder/triangle_matching.h"
 
 #include <algorithm>
@@ -45,7 +46,17 @@ int run_reapply(const ReapplyOptions& options) {
     const std::string extension = std::filesystem::path(options.output).extension().string();
     if (extension != ".glb" && extension != ".gltf")
         throw std::runtime_error(options.output + ": the output must be a .glb or .gltf file");
-    check_output_paths({options.output}, {options.optimized, options.processed});
+    // Every file the two loads read (a .gltf's buffers and images too) is an input.
+    std::vector<std::string> inputs;
+    for (const std::string* file : {&options.optimized, &options.processed}) {
+        try {
+            const std::vector<std::string> reads = files_load_reads(*file, {});
+            inputs.insert(inputs.end(), reads.begin(), reads.end());
+        } catch (const LoadError&) {  // loading says what is wrong
+            inputs.push_back(*file);
+        }
+    }
+    check_output_paths({options.output}, inputs);
     const OrdersExtensionCheck orders = read_orders_extension(options.optimized);
     LoadOptions load;
     load.max_keyframe_bytes = options.max_memory;

@@ -33,10 +33,12 @@ int run_subdivide(const SubdivideOptions& options) {
     if (options.levels > kMaxSubdivisionLevels)
         throw std::runtime_error("--levels " + std::to_string(options.levels) + ": at most " +
                                  std::to_string(kMaxSubdivisionLevels) + " (each level multiplies the triangles by 4)");
-    check_output_paths({options.output}, {options.common.input});
+    check_outputs_before_loading({options.output}, options.common);
 
     std::string input_name;
-    const AnimatedMesh mesh = load_animated_input(options.common, input_name);
+    std::vector<std::string> files_read;
+    const AnimatedMesh mesh = load_animated_input(options.common, input_name, &files_read);
+    check_output_paths({options.output}, files_read);
     AnimatedMesh result = subdivide_animated_mesh(mesh, options.levels);
     if (!options.common.input.empty()) result.name = std::filesystem::path(options.common.input).stem().string();
     // Every keyframe is a morph target of 12 bytes per vertex: say how big before building it.

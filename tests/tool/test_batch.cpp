@@ -353,7 +353,8 @@ TEST_F(Batch, AChangedInputFileRerunsItsItemAndAGltfItemWritesTheGltf) {
     EXPECT_TRUE(fs::exists(path("out/sphere.gltf")));
     EXPECT_TRUE(fs::exists(path("out/sphere.animorder.bin")));
     const nlohmann::json report = nlohmann::json::parse(test::slurp(path("out/sphere.animorder.report.json")));
-    EXPECT_EQ(report["outputs"]["gltf"], path("out/sphere.gltf").string());
+    EXPECT_EQ(report["outputs"]["gltf"], "out/sphere.gltf");  // as the manifest writes it
+    EXPECT_EQ(report["outputs"]["sidecar"], "out/sphere.animorder.bin");
     EXPECT_NE(run("batch -q" + kEval + " " + manifest()).out.find("0 done, 2 up to date"), std::string::npos);
 
     // One bit of the first normal's lowest mantissa byte (bufferView 0: NORMAL floats): same size,
@@ -519,6 +520,61 @@ TEST_F(Batch, SpellingsEditsAndThreadCountsDoNotChangeWhatIsUpToDate) {
             files[t][e.path().filename().string()] = test::slurp(e.path());
     }
     EXPECT_EQ(files[0], files[1]);
+    // The reports name the paths as the manifest writes them: the same bytes from another folder.
+    ASSERT_EQ(run_from(path("lib"), "batch " + flags + "--force --threads 1 m.json", dir_).exit_code, 0);
+    std::map<std::string, std::string> from_lib;
+    for (const auto& e : fs::directory_iterator(path("lib/out")))
+        from_lib[e.path().filename().string()] = test::slurp(e.path());
+    EXPECT_EQ(from_lib, files[0]);
+    EXPECT_NE(from_lib["walk.animorder.report.json"].find(R"("sidecar": "out/walk.animorder.bin")"), std::string::npos)
+        << from_lib["walk.animorder.report.json"];
+}
+
+// The stamp covers the tool itself, not only its version string: another build (here the same
+// executable with one byte more) redoes the items, then finds them up to date.
+TEST_F(Batch, AnotherBuildOfTheToolRedoesTheItems) {
+    write("m.json",
+          R"({"items": [{"name": "walk", "clips": ["walk"],
+                  "options": "-k 2 --views 12 --resolution 32 --max-iterations 1", "output": "out/walk"}]})");
+    const std::string other = path("animorder-other").string();
+    fs::copy_file(ANIMORDER_EXE, other);
+    std::ofstream(other, std::ios::binary | std::ios::app) << '\0';
+    const std::string args = " batch -q --eval-views 0 " + manifest();
+    ASSERT_EQ(run(args.substr(1)).exit_code, 0);
+    EXPECT_NE(run(args.substr(1)).out.find("0 done, 1 up to date"), std::string::npos);
+    const test::Outcome rebuilt = run_shell(other + args);
+    EXPECT_EQ(rebuilt.exit_code, 0) << rebuilt.err;
+    EXPECT_NE(rebuilt.out.find("1 done, 0 up to date"), std::string::npos) << rebuilt.out;
+    EXPECT_NE(run_shell(other + args).out.find("0 done, 1 up to date"), std::string::npos);
+}
+
+// What a killed run left of an item (its temporaries) is removed on the next run even when the
+// item is up to date, once the process that wrote it is gone: exited, or a zombie (killed, its
+// parent not yet told); a running process's temporaries stay.
+TEST_F(Batch, ATemporaryOfAGoneProcessIsRemovedWhenItsItemIsUpToDate) {
+    write("m.json",
+          R"({"items": [{"name": "walk", "clips": ["walk"],
+                  "options": "-k 2 --views 12 --resolution 32 --max-iterations 1", "output": "out/walk"}]})");
+    const std::string args = "batch -q --eval-views 0 " + manifest();
+    ASSERT_EQ(run(args).exit_code, 0);
+    const pid_t exited = ::fork();
+    ASSERT_GE(exited, 0);
+    if (exited == 0) ::_exit(0);
+    ASSERT_EQ(::waitpid(exited, nullptr, 0), exited);
+    const pid_t zombie = ::fork();
+    ASSERT_GE(zombie, 0);
+    if (zombie == 0) ::_exit(0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));  // it exits; not waited for: a zombie
+    const std::string gone = ".walk.animorder.bin.tmp" + std::to_string(exited);
+    const std::string dead = ".walk.animorder.json.tmp" + std::to_string(zombie);
+    const std::string alive = ".walk.animorder.report.json.tmp" + std::to_string(::getpid());
+    for (const std::string& name : {gone, dead, alive}) write("out/" + name, "half written");
+    const test::Outcome again = run(args);
+    ::waitpid(zombie, nullptr, 0);
+    EXPECT_NE(again.out.find("0 done, 1 up to date"), std::string::npos) << again.out;
+    EXPECT_FALSE(fs::exists(path("out/" + gone)));
+    EXPECT_FALSE(fs::exists(path("out/" + dead))) << "a zombie writes nothing more";
+    EXPECT_TRUE(fs::exists(path("out/" + alive))) << "a running process's temporary was removed";
 }
 
 // Manifest mistakes found before any work, each one line: text the JSON reports cannot hold, an
@@ -547,7 +603,11 @@ TEST_F(Batch, ManifestMistakesAreRefusedBeforeAnyWork) {
         {"m.json", R"({"items": [{"method": "original", "options": ["-q", "-oevil"], "output": "out/a"}]})"},
         {"m.json", R"({"items": [{"method": "original", "options": "-qrevil.json", "output": "out/a"}]})"},
         // a key the manifest does not know, beside "items"
-        {"m.json", R"({"items": [{"method": "original", "output": "out/a"}], "defaults": {"method": "joint"}})"}};
+        {"m.json", R"({"items": [{"method": "original", "output": "out/a"}], "defaults": {"method": "joint"}})"},
+        // a NUL, which would cut the path short (another file read, or an output nobody named)
+        {"m.json", R"({"items": [{"method": "original", "input": "in.glb\u0000.x", "output": "out/a"}]})"},
+        {"m.json", R"({"items": [{"method": "original", "output": "out/a\u0000b"}]})"},
+        {"m.csv", std::string("method,output\noriginal,out/a\0b\n", 31)}};
     for (const auto& [name, text] : bad) {
         write(name, text);
         const test::Outcome o = run("batch -q --eval-views 0 " + path(name).string());

@@ -33,6 +33,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <numeric>
 #include <sstream>
 #include <stdexcept>
@@ -107,8 +108,12 @@ bool is_utf8(const std::string& text) {
     }
 }
 
+// Valid UTF-8 without a NUL (JSON's \u0000, or one in a CSV field): a path or an option is used
+// as a C string, which a NUL would cut short, so that another file than the one named is read.
 void require_utf8(const std::string& text, const std::string& where) {
     if (!is_utf8(text)) throw std::runtime_error(where + " is not valid UTF-8 (the reports are JSON)");
+    if (text.find('\0') != std::string::npos)
+        throw std::runtime_error(where + " holds a NUL character, which no path or option may hold");
 }
 
 // "options" as a string of optimize arguments, a list of them, or an object {"lambda": 3, "joint": true}.
@@ -443,13 +448,26 @@ private:
 };
 
 // The stamp of an item: everything its outputs depend on (not --threads, which changes nothing):
-// the tool version, the settings, the manifest's spellings of its paths, and the bytes of every
+// the tool (version and executable), the settings, the manifest's spellings of its paths, and the bytes of every
 // file it reads as far as known before loading (OptimizePlan::inputs: the character, a glTF's
 // external buffers and images, clip files, the files of clip folders).
 std::string item_stamp(const PlannedItem& p, const BatchOptions& batch) {
+    // The tool: its version and the bytes of its executable, since a rebuild that changes the
+    // outputs may keep the version string.
+    static const std::string tool = [] {
+        Sha256 hash;
+        hash.add(ANIMORDER_VERSION);
+        std::error_code error;
+        const fs::path executable = fs::read_symlink("/proc/self/exe", error);
+        if (error)
+            hash.add("executable unknown");
+        else
+            hash.add_file(executable);
+        return hash.hex();
+    }();
     Sha256 hash;
-    hash.add("animorder batch stamp 2");
-    hash.add(ANIMORDER_VERSION);
+    hash.add("animorder batch stamp 3");
+    hash.add(tool);
     hash.add(optimize_settings_json(p.options, p.plan, false).dump());
     hash.add("max_memory:" + std::to_string(p.options.common.max_memory));
     hash.add("input:" + p.item.input_as_written);
@@ -598,8 +616,20 @@ void drop_timings(json& value) {
     }
 }
 
+// Whether process `pid` may still be running: it exists (or is not ours to judge) and is not a
+// zombie (killed, its parent not yet told: it writes nothing more).
+bool process_may_run(const std::string& pid) {
+    if (::kill(pid_t(std::stol(pid)), 0) != 0 && errno == ESRCH) return false;
+    std::ifstream stat("/proc/" + pid + "/stat");
+    std::string line;
+    if (!std::getline(stat, line)) return true;
+    const size_t name_end = line.rfind(')');  // "pid (name) state ...": the name may hold anything
+    return !(name_end != std::string::npos && name_end + 2 < line.size() && line[name_end + 2] == 'Z');
+}
+
 // What a run killed part-way leaves of an item (atomic_write.cpp's temporaries ".NAME.tmpPID" and
-// backups ".NAME.oldPID") is removed before the item is redone, when that process is gone.
+// backups ".NAME.oldPID") is removed when the item is redone or found up to date, once that
+// process is gone.
 void remove_stale_temporaries(const std::vector<std::string>& outputs) {
     std::error_code error;
     for (const std::string& out : outputs) {
@@ -614,8 +644,7 @@ void remove_stale_temporaries(const std::vector<std::string>& outputs) {
             if ((kind != "tmp" && kind != "old") || pid.empty() || pid.size() > 9 ||
                 !std::all_of(pid.begin(), pid.end(), [](char c) { return std::isdigit(uint8_t(c)); }))
                 continue;
-            if (::kill(pid_t(std::stol(pid)), 0) == 0 || errno != ESRCH)
-                continue;  // still running (or not ours to judge)
+            if (process_may_run(pid)) continue;
             std::error_code ignored;
             fs::remove(it->path(), ignored);
         }
@@ -678,6 +707,13 @@ void run_item(const PlannedItem& p, const std::string& stamp, const BatchOptions
     }
     const size_t buffers = run.buffers.orders.size();
     json& report = product.report;
+    // Paths as the manifest writes them (relative to its folder), so that the report is the same
+    // bytes whatever folder the batch starts in and however the manifest's path is spelled.
+    if (p.item.input_given && report["input"] == p.options.common.input) report["input"] = p.item.input_as_written;
+    const std::string stem = stem_of(p.item.output), stem_as_written = stem_of(p.item.output_as_written);
+    for (auto& [kind, path] : report["outputs"].items())  // OUT.glb, OUT.animorder.bin, ...: all from the stem
+        if (path.is_string() && path.get<std::string>().rfind(stem, 0) == 0)
+            path = stem_as_written + path.get<std::string>().substr(stem.size());
     report["batch"] = {{"stamp", stamp},
                        {"item", p.item.name},
                        {"status", "ok"},
@@ -695,6 +731,10 @@ void run_item(const PlannedItem& p, const std::string& stamp, const BatchOptions
                        {"side_files", side},
                        {"time_s", std::chrono::duration<double>(Clock::now() - start).count()}};
     if (batch.no_timings) drop_timings(report);
+    // An input edited while the item ran (between its stamp and its load): the outputs may come
+    // from other bytes than the stamp's, so none is kept and the next run redoes the item.
+    if (item_stamp(p, batch) != stamp)
+        throw std::runtime_error("an input changed while the item ran; run the batch again to redo it");
     files.add(p.report, report_text(report));
     files.commit();
     std::error_code error;
@@ -740,7 +780,7 @@ std::string cell(const json& v, int digits) {
     if (v.is_string()) {
         std::string s = v.get<std::string>();
         for (char& c : s)
-            if (c == '|' || c == '\n') c = c == '|' ? '/' : ' ';
+            if (c == '|' || c == '\n' || c == '\r') c = c == '|' ? '/' : ' ';
         return s;
     }
     return v.dump();
@@ -855,13 +895,14 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
     OutputsByPlace outputs_by_place;
     for (const std::string& output : outputs) outputs_by_place.emplace(place_of(output), output);
 
-    // A shard reads the files of its own items only (a farm's pods would each read the library);
-    // the merge, and an unsharded run, stamp every item.
+    // A shard stamps its own items only, each when its turn comes (so that an input edited while
+    // earlier items run is read as it is then); the merge stamps every item.
     std::vector<std::string> stamps(items.size());
-    for (size_t i = 0; i < items.size(); ++i)
-        if (batch.merge || i % shard.second == shard.first) stamps[i] = item_stamp(items[i], batch);
     const bool sharded = shard.second > 1 || !batch.shard.empty();
-    if (batch.merge) return write_summary(items, stamps, summary, batch.manifest, batch);
+    if (batch.merge) {
+        for (size_t i = 0; i < items.size(); ++i) stamps[i] = item_stamp(items[i], batch);
+        return write_summary(items, stamps, summary, batch.manifest, batch);
+    }
 
     size_t done = 0, skipped = 0, failed = 0, mine = 0;
     for (size_t i = 0; i < items.size(); ++i) mine += i % shard.second == shard.first;
@@ -869,10 +910,15 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
     for (size_t i = 0; i < items.size(); ++i) {
         if (i % shard.second != shard.first) continue;
         const PlannedItem& p = items[i];
-        const std::string label =
-            "batch [" + std::to_string(++position) + "/" + std::to_string(mine) + "] " + p.item.name;
+        std::string label = "batch [" + std::to_string(++position) + "/" + std::to_string(mine) + "] " + p.item.name;
+        for (char& c : label)  // progress and failure lines stay one line each
+            if (c == '\n' || c == '\r') c = ' ';
+        stamps[i] = item_stamp(p, batch);
         if (!batch.force && current_report(p, stamps[i]).is_object()) {
             ++skipped;
+            std::vector<std::string> files_of_item = p.plan.outputs;
+            files_of_item.push_back(p.error);
+            remove_stale_temporaries(files_of_item);
             note(p.options.common, label + ": up to date, skipped");
             continue;
         }

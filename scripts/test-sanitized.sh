@@ -1,8 +1,7 @@
 #!/usr/bin/env bash
 # The loaders, the glTF writers (and their pruning of replaced accessors), the output sets (their
 # signal handler) and the sidecar reader under AddressSanitizer and UBSan: every bad-input test
-# runs with memory errors and undefined
-# behaviour turned into failures.
+# runs with memory errors and undefined behaviour turned into failures.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh

@@ -145,6 +145,16 @@ void check_writable_target(const std::string& path) {
     if (target.filename().string().size() + kTemporaryExtra > limit)
         throw OutputError(path + ": the file name is too long (at most " + std::to_string(limit - kTemporaryExtra) +
                           " bytes here, so that its temporary fits)");
+    // A commit renames over the target: a device (-r /dev/full), a FIFO or a link would be replaced
+    // by a plain file, for every other user of it too.
+    struct stat existing {};
+    if (::lstat(path.c_str(), &existing) == 0 && !S_ISREG(existing.st_mode))
+        throw OutputError(path + ": is " +
+                          (S_ISLNK(existing.st_mode)    ? "a symbolic link (name the file it leads to)"
+                           : S_ISFIFO(existing.st_mode) ? "a FIFO"
+                           : S_ISCHR(existing.st_mode) || S_ISBLK(existing.st_mode) ? "a device"
+                                                                                    : "not a regular file") +
+                          ": refusing to replace it with a file; name another output");
     const std::string why = creation_error(target);
     if (!why.empty()) throw OutputError(path + ": folder " + folder.string() + " is not writable (" + why + ")");
     // In a sticky folder (/tmp) only the file's owner, the folder's owner or root may replace a

@@ -165,7 +165,27 @@ inline void finish_load(bool ok, std::string error, const tinygltf::Model& model
     }
     for (char& c : error)
         if (c == '\n' || c == '\r') c = ' ';
+    // tinygltf quotes what it could not read, a whole data: URI included: the start of it says enough.
+    constexpr size_t kShown = 300;
+    if (error.size() > kShown) {
+        size_t cut = kShown;
+        while (cut > 0 && (uint8_t(error[cut]) & 0xC0) == 0x80) --cut;  // not inside a UTF-8 character
+        error = error.substr(0, cut) + "... (" + std::to_string(error.size()) + " characters)";
+    }
     throw LoadError(path + ": not a readable glTF 2.0 file: " + error);
+}
+
+// tinygltf's load of `path` into `model`, an exception it throws (a buffer of byteLength 0 makes
+// it index an empty vector) taken as a failed load with that message.
+inline bool load_gltf_file(tinygltf::TinyGLTF& loader, tinygltf::Model& model, std::string& error, std::string& warning,
+                           const std::string& path, bool binary) {
+    try {
+        return binary ? loader.LoadBinaryFromFile(&model, &error, &warning, path)
+                      : loader.LoadASCIIFromFile(&model, &error, &warning, path);
+    } catch (const std::exception& e) {
+        error = e.what();
+        return false;
+    }
 }
 
 // The glTF file at `path` (binary when it starts with "glTF"), images left undecoded; LoadError
@@ -182,8 +202,7 @@ inline tinygltf::Model read_model(const std::string& path) {
     std::string error, warning;
     const std::string magic = magic_of(path);
     check_json_depth(path);
-    const bool ok = magic == "glTF" ? loader.LoadBinaryFromFile(&model, &error, &warning, path)
-                                    : loader.LoadASCIIFromFile(&model, &error, &warning, path);
+    const bool ok = load_gltf_file(loader, model, error, warning, path, magic == "glTF");
     finish_load(ok, error, model, path);
     return model;
 }

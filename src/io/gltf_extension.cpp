@@ -137,6 +137,14 @@ void read_clip(const tinygltf::Model& model, const tinygltf::Value& value, size_
     if (o.count("animation")) {
         if (!bounded(o, "animation", 0, int64_t(model.animations.size()) - 1, where, p, v)) return;
         clip.animation = int(v);
+        // The clip's name is its animation's (an unnamed one's "animationN", as the loader names
+        // it): the runtime and reapply find a clip's table by name, so a name of another
+        // animation would put one clip's table on another.
+        const std::string& own = model.animations[size_t(v)].name;
+        const std::string expected = own.empty() ? "animation" + std::to_string(v) : own;
+        if (o.count("name") && clip.name != expected)
+            return p.add(where + ".name '" + clip.name + "' is not the name of animation " + std::to_string(v) + " ('" +
+                         expected + "')");
     }
     if (o.count("startTime") && !number(o, "startTime", clip.start_time))
         return p.add(where + ".startTime is not a finite number");

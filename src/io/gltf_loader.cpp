@@ -143,6 +143,10 @@ private:
         size_t view_end = 0;
         if (!io::checked_add(view.byteOffset, view.byteLength, view_end) || view_end > data.size())
             fail("buffer view " + std::to_string(view_index) + " runs past the end of its buffer (truncated file?)");
+        if (strided && view.byteStride && view.byteStride < element)
+            fail("buffer view " + std::to_string(view_index) + " has a byteStride of " +
+                 std::to_string(view.byteStride) + ", less than the " + std::to_string(element) +
+                 " bytes of accessor " + std::to_string(accessor) + "'s elements");
         stride = strided && view.byteStride ? view.byteStride : element;
         size_t end = offset, last = 0;  // offset + stride · (count − 1) + element
         if (count > 0 && (!io::checked_mul(stride, count - 1, last) || !io::checked_add(end, last, end) ||
@@ -340,8 +344,7 @@ tinygltf::Model parse_file(const std::string& path, const LoadOptions& options) 
     std::string error, warning;
     const std::string magic = io::magic_of(path);
     io::check_json_depth(path);
-    const bool ok = magic == "glTF" ? loader.LoadBinaryFromFile(&model, &error, &warning, path)
-                                    : loader.LoadASCIIFromFile(&model, &error, &warning, path);
+    const bool ok = io::load_gltf_file(loader, model, error, warning, path, magic == "glTF");
     io::finish_load(ok, error, model, path);
     return model;
 }
@@ -388,6 +391,20 @@ void parse_morph_targets(const Scene& s, const tinygltf::Primitive& prim, const 
     }
 }
 
+// Indices and joints are unsigned integers, not normalized (glTF 2.0, 3.7.2.1 and 3.7.3.3): any
+// other type would be truncated into other vertices or joints.
+void require_unsigned_integers(const Scene& s, int accessor, const std::string& what) {
+    if (accessor < 0 || size_t(accessor) >= s.model.accessors.size()) return;  // read() says so
+    const tinygltf::Accessor& a = s.model.accessors[size_t(accessor)];
+    const bool unsigned_integer = a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+                                  a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ||
+                                  a.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+    if (!unsigned_integer || a.normalized)
+        s.reader.fail(what + " (accessor " + std::to_string(accessor) + ") are " +
+                      (a.normalized ? "normalized" : "not unsigned integers") +
+                      ": glTF asks for unsigned bytes, shorts or ints");
+}
+
 // JOINTS_n / WEIGHTS_n sets of a skinned primitive, interleaved per vertex (4 influences per
 // set); every joint with weight is checked against the skin's joint_count.
 void parse_skin_weights(const Scene& s, const tinygltf::Primitive& prim, size_t joint_count, const std::string& where,
@@ -396,6 +413,7 @@ void parse_skin_weights(const Scene& s, const tinygltf::Primitive& prim, size_t 
         const auto j = prim.attributes.find("JOINTS_" + std::to_string(set));
         const auto w = prim.attributes.find("WEIGHTS_" + std::to_string(set));
         if (j == prim.attributes.end() || w == prim.attributes.end()) break;
+        require_unsigned_integers(s, j->second, where + ": JOINTS_" + std::to_string(set));
         const std::vector<double> jv = s.reader.read(j->second, 4), wv = s.reader.read(w->second, 4);
         if (jv.size() != 4 * d.vertex_count || wv.size() != 4 * d.vertex_count)
             s.reader.fail(where + ": joints or weights do not match the vertex count");
@@ -411,6 +429,9 @@ void parse_skin_weights(const Scene& s, const tinygltf::Primitive& prim, size_t 
                 if (joint < 0 || (joint >= double(joint_count) && wv[4 * v + i] > 0))
                     s.reader.fail(where + ": vertex " + std::to_string(v) + " names joint " + number_text(joint) +
                                   ", the skin has " + std::to_string(joint_count));
+                if (joint > 65535.0 && wv[4 * v + i] > 0)
+                    s.reader.fail(where + ": vertex " + std::to_string(v) + " names joint " + number_text(joint) +
+                                  "; at most 65,536 joints a skin are supported");
                 joints[v * (d.influences + 4) + d.influences + i] = uint16_t(std::min(joint, 65535.0));
                 weights[v * (d.influences + 4) + d.influences + i] = float(wv[4 * v + i]);
             }
@@ -440,9 +461,10 @@ PrimitiveData parse_primitive(const Scene& s, size_t n, size_t p, AnimatedMesh& 
     d.vertex_count = d.positions.size() / 3;
     d.vertex_base = mesh.vertex_count;
     std::vector<double> raw;
-    if (prim.indices >= 0)
+    if (prim.indices >= 0) {
+        require_unsigned_integers(s, prim.indices, where + ": the indices");
         raw = s.reader.read(prim.indices, 1);
-    else
+    } else
         for (size_t i = 0; i < d.vertex_count; ++i) raw.push_back(double(i));  // non-indexed
     const std::vector<uint32_t> local = triangle_list(raw, prim.mode, d.vertex_count, s.reader, where);
     Primitive out;
@@ -509,8 +531,16 @@ void parse_rest_pose(Scene& s) {
         if (node.translation.size() == 3) std::copy(node.translation.begin(), node.translation.end(), p.t.begin());
         if (node.rotation.size() == 4) std::copy(node.rotation.begin(), node.rotation.end(), p.r.begin());
         if (node.scale.size() == 3) std::copy(node.scale.begin(), node.scale.end(), p.s.begin());
-        if (node.mesh >= 0 && size_t(node.mesh) < s.model.meshes.size())
-            p.weights = s.model.meshes[size_t(node.mesh)].weights;
+        if (node.mesh >= 0 && size_t(node.mesh) < s.model.meshes.size()) {
+            const tinygltf::Mesh& mesh = s.model.meshes[size_t(node.mesh)];
+            p.weights = mesh.weights;
+            if (p.weights.empty()) {  // optional: one zero per morph target
+                size_t targets = 0;
+                for (const tinygltf::Primitive& prim : mesh.primitives)
+                    targets = std::max(targets, prim.targets.size());
+                p.weights.assign(targets, 0.0);
+            }
+        }
         if (!node.weights.empty()) p.weights = node.weights;
     }
 }

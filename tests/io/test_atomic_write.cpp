@@ -132,3 +132,24 @@ TEST_F(AtomicWrite, AnotherUsersFileInAStickyFolderIsRefusedAtTheCheck) {
                                          "file refused";
     EXPECT_TRUE(fs::exists(sticky / "theirs.json"));
 }
+
+// A commit renames over its target: a device (-r /dev/full), a FIFO or a link would have become a
+// plain file, for every other user of it too. Refused at the check, and left as it was.
+TEST_F(AtomicWrite, AnOutputThatIsNoRegularFileIsRefused) {
+    ASSERT_EQ(::mkfifo(path("fifo").c_str(), 0600), 0);
+    std::ofstream(path("target.json")) << "{}";
+    fs::create_symlink(path("target.json"), path("link.json"));
+    const std::pair<std::string, std::string> cases[] = {
+        {path("fifo").string(), "a FIFO"}, {path("link.json").string(), "a symbolic link"}, {"/dev/null", "a device"}};
+    for (const auto& [output, what] : cases) {
+        try {
+            animorder::check_output_paths({output}, {});
+            ADD_FAILURE() << output << " was accepted";
+        } catch (const OutputError& e) {
+            EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+        }
+    }
+    EXPECT_TRUE(fs::is_fifo(path("fifo")));
+    EXPECT_TRUE(fs::is_symlink(path("link.json")));
+    EXPECT_TRUE(fs::is_character_file("/dev/null"));
+}

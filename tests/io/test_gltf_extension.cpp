@@ -147,6 +147,9 @@ TEST_F(GltfExtension, EveryCorruptionIsReportedOnOneLine) {
          "centers (accessor 3) has the wrong type"},
         {"animation out of range", [&](json& g) { root(g)["clips"][0]["animation"] = 5; }, buffer_bytes(),
          "animation = 5 is out of range"},
+        // A clip named after another animation: reapply put its table on that one.
+        {"name of another animation", [&](json& g) { root(g)["clips"][0]["name"] = "walk"; }, buffer_bytes(),
+         "clips[0].name 'walk' is not the name of animation 0 ('still')"},
         {"no clips", [&](json& g) { root(g)["clips"] = json::array(); }, buffer_bytes(), "clips is missing or empty"},
         {"sparse orders",
          [](json& g) {

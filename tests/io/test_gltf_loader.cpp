@@ -117,38 +117,43 @@ TEST_F(GltfLoader, StepAndCubicSplineInterpolation) {
     EXPECT_GT(p[0], -0.99);
 }
 
+// Also without the mesh's weights, which glTF makes optional (zeros, one per target).
 TEST_F(GltfLoader, SparseMorphTargetWithAnimatedWeights) {
-    Gltf g;
-    const std::vector<float> pos = {0, 0, 0, 1, 0, 0, 0, 1, 0};
-    const std::vector<uint16_t> idx = {0, 1, 2};
-    const int p = g.floats(pos, "VEC3", 3), i = g.u16(idx, "SCALAR", 1);
-    // Sparse target: only vertex 2 moves, by (0, 0, 2).
-    const std::vector<uint16_t> sparse_index = {2};
-    const std::vector<float> sparse_value = {0, 0, 2};
-    g.u16(sparse_index, "SCALAR", 1);
-    g.floats(sparse_value, "VEC3", 3);
-    json sparse = {
-        {"count", 1}, {"indices", {{"bufferView", 2}, {"componentType", 5123}}}, {"values", {{"bufferView", 3}}}};
-    g.doc["accessors"].push_back({{"componentType", 5126}, {"count", 3}, {"type", "VEC3"}, {"sparse", sparse}});
-    const int target = int(g.doc["accessors"].size() - 1);
-    const std::vector<float> times = {0, 2}, weights = {0, 1};
-    const int t = g.floats(times, "SCALAR", 1), w = g.floats(weights, "SCALAR", 1);
-    json primitive = {
-        {"attributes", {{"POSITION", p}}}, {"indices", i}, {"targets", json::array({json{{"POSITION", target}}})}};
-    g.doc["meshes"] = json::array({json{{"primitives", json::array({primitive})}, {"weights", json::array({0.0})}}});
-    g.doc["nodes"] = json::array({json{{"mesh", 0}, {"translation", {0, 0, 5}}}});
-    g.doc["scenes"] = json::array({json{{"nodes", json::array({0})}}});
-    json sampler = {{"input", t}, {"output", w}};
-    json channel = {{"sampler", 0}, {"target", {{"node", 0}, {"path", "weights"}}}};
-    g.doc["animations"] =
-        json::array({json{{"samplers", json::array({sampler})}, {"channels", json::array({channel})}}});
-    const AnimatedMesh m = load_gltf(write("morph.gltf", g.text()));
-    EXPECT_EQ(m.morph_target_count, 1u);
-    EXPECT_EQ(m.clips[0].keyframe_count, 61u);
-    expect_position(m, 0, 2, 0, 1, 5);   // node translation applies (not skinned)
-    expect_position(m, 30, 2, 0, 1, 6);  // weight 0.5 → +1
-    expect_position(m, 60, 2, 0, 1, 7);
-    expect_position(m, 60, 1, 1, 0, 5);  // untouched by the sparse target
+    for (const bool mesh_weights : {true, false}) {
+        SCOPED_TRACE(mesh_weights ? "with mesh weights" : "without mesh weights");
+        Gltf g;
+        const std::vector<float> pos = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+        const std::vector<uint16_t> idx = {0, 1, 2};
+        const int p = g.floats(pos, "VEC3", 3), i = g.u16(idx, "SCALAR", 1);
+        // Sparse target: only vertex 2 moves, by (0, 0, 2).
+        const std::vector<uint16_t> sparse_index = {2};
+        const std::vector<float> sparse_value = {0, 0, 2};
+        g.u16(sparse_index, "SCALAR", 1);
+        g.floats(sparse_value, "VEC3", 3);
+        json sparse = {
+            {"count", 1}, {"indices", {{"bufferView", 2}, {"componentType", 5123}}}, {"values", {{"bufferView", 3}}}};
+        g.doc["accessors"].push_back({{"componentType", 5126}, {"count", 3}, {"type", "VEC3"}, {"sparse", sparse}});
+        const int target = int(g.doc["accessors"].size() - 1);
+        const std::vector<float> times = {0, 2}, weights = {0, 1};
+        const int t = g.floats(times, "SCALAR", 1), w = g.floats(weights, "SCALAR", 1);
+        json primitive = {
+            {"attributes", {{"POSITION", p}}}, {"indices", i}, {"targets", json::array({json{{"POSITION", target}}})}};
+        g.doc["meshes"] = json::array({json{{"primitives", json::array({primitive})}}});
+        if (mesh_weights) g.doc["meshes"][0]["weights"] = json::array({0.0});
+        g.doc["nodes"] = json::array({json{{"mesh", 0}, {"translation", {0, 0, 5}}}});
+        g.doc["scenes"] = json::array({json{{"nodes", json::array({0})}}});
+        json sampler = {{"input", t}, {"output", w}};
+        json channel = {{"sampler", 0}, {"target", {{"node", 0}, {"path", "weights"}}}};
+        g.doc["animations"] =
+            json::array({json{{"samplers", json::array({sampler})}, {"channels", json::array({channel})}}});
+        const AnimatedMesh m = load_gltf(write("morph.gltf", g.text()));
+        EXPECT_EQ(m.morph_target_count, 1u);
+        EXPECT_EQ(m.clips[0].keyframe_count, 61u);
+        expect_position(m, 0, 2, 0, 1, 5);   // node translation applies (not skinned)
+        expect_position(m, 30, 2, 0, 1, 6);  // weight 0.5 → +1
+        expect_position(m, 60, 2, 0, 1, 7);
+        expect_position(m, 60, 1, 1, 0, 5);  // untouched by the sparse target
+    }
 }
 
 TEST_F(GltfLoader, BrokenFilesGiveOneLineErrorsNamingTheFile) {
@@ -226,6 +231,28 @@ TEST_F(GltfLoader, BrokenFilesGiveOneLineErrorsNamingTheFile) {
         g.doc["meshes"][0]["primitives"][0]["attributes"]["JOINTS_0"] = g.u16(joints, "VEC4", 4);
         expect_error("joint.gltf", g.text(), "names joint 7");
     }
+    {
+        // tinygltf threw std::out_of_range ("vector::_M_range_check", naming no file) on a buffer of
+        // byteLength 0 with a URI.
+        Gltf g = skinned_bar();
+        json doc = json::parse(g.text());
+        doc["buffers"][0]["byteLength"] = 0;
+        expect_error("empty-buffer.gltf", doc.dump(), "not a readable glTF");
+    }
+    {
+        // A data URI of the wrong length: tinygltf's message quoted all of it (a 700 KB line).
+        Gltf g = skinned_bar();
+        json doc = json::parse(g.text());
+        doc["buffers"][0]["uri"] = "data:application/octet-stream;base64," + std::string(200000, 'A');
+        const std::string path = write("long-uri.gltf", doc.dump());
+        try {
+            load_gltf(path);
+            ADD_FAILURE() << "loaded";
+        } catch (const LoadError& e) {
+            EXPECT_LT(std::string(e.what()).size(), 1000u) << std::string(e.what()).substr(0, 200);
+            EXPECT_EQ(std::string(e.what()).rfind(path, 0), 0u);
+        }
+    }
     try {
         load_gltf((dir_ / "nowhere.glb").string());
         ADD_FAILURE();
@@ -285,14 +312,14 @@ TEST_F(GltfLoader, HostileAccessorsGiveOneLineErrors) {
         Gltf g = skinned_bar();
         const std::vector<int8_t> bad = {0, 1, 2, 0, 2, -1};
         g.doc["meshes"][0]["primitives"][0]["indices"] = g.add(bad.data(), bad.size(), bad.size(), "SCALAR", 5120);
-        expect_load_error("negative-index.gltf", g.text(), "is -1, but there are 4 vertices");
+        expect_load_error("negative-index.gltf", g.text(), "are not unsigned integers");
     }
     {
         Gltf g = skinned_bar();
         const std::vector<int8_t> joints = {0, 0, 0, 0, 0, 0, 0, 0, -1, 0, 0, 0, 1, 0, 0, 0};
         g.doc["meshes"][0]["primitives"][0]["attributes"]["JOINTS_0"] =
             g.add(joints.data(), joints.size(), 4, "VEC4", 5120);
-        expect_load_error("negative-joint.gltf", g.text(), "names joint -1");
+        expect_load_error("negative-joint.gltf", g.text(), "are not unsigned integers");
     }
     {
         Gltf g = skinned_bar();
@@ -320,6 +347,42 @@ TEST_F(GltfLoader, HostileAccessorsGiveOneLineErrors) {
 // set in turn to values a hostile file would use (negative, zero, just past a limit, near 2^31,
 // 2^32, 2^63, 2^64): each file loads or fails with a LoadError, nothing else (under
 // scripts/test-sanitized.sh: no memory error, no undefined behaviour).
+// Data glTF lays out or types otherwise than the loader would read it: refused, not misread.
+TEST_F(GltfLoader, LayoutsAndTypesThatWouldBeMisreadAreRefused) {
+    {
+        Gltf g = skinned_bar();  // positions (12-byte elements) 4 bytes apart would overlap
+        g.doc["bufferViews"][0]["byteStride"] = 4;
+        expect_load_error("stride.gltf", g.text(), "has a byteStride of 4, less than the 12 bytes");
+    }
+    {
+        Gltf g = skinned_bar();  // 0.7 and 1.7 were truncated into other vertices
+        g.doc["meshes"][0]["primitives"][0]["indices"] = g.floats({0, 1.7f, 2, 0, 2, 3.2f}, "SCALAR", 1);
+        expect_load_error("float-indices.gltf", g.text(), "are not unsigned integers");
+    }
+    {
+        Gltf g = skinned_bar();
+        g.doc["accessors"][1]["normalized"] = true;
+        expect_load_error("normalized-indices.gltf", g.text(), "are normalized: glTF asks for unsigned");
+    }
+    {
+        Gltf g = skinned_bar();
+        g.doc["meshes"][0]["primitives"][0]["attributes"]["JOINTS_0"] =
+            g.floats({0, 0, 0, 0, 0, 0, 0, 0, 0.5f, 0, 0, 0, 1.7f, 0, 0, 0}, "VEC4", 4);
+        expect_load_error("float-joints.gltf", g.text(), "are not unsigned integers");
+    }
+    {
+        Gltf g = skinned_bar();  // joints are kept in 16 bits: joint 66,000 became 65,535
+        std::vector<int> joints(70000, 1);
+        joints[0] = 0;
+        g.doc["skins"][0]["joints"] = joints;
+        g.doc["skins"][0].erase("inverseBindMatrices");
+        const std::vector<uint32_t> far = {0, 0, 0, 0, 0, 0, 0, 0, 66000, 0, 0, 0, 1, 0, 0, 0};
+        g.doc["meshes"][0]["primitives"][0]["attributes"]["JOINTS_0"] =
+            g.add(far.data(), far.size() * 4, 4, "VEC4", 5125);
+        expect_load_error("many-joints.gltf", g.text(), "names joint 66000; at most 65,536 joints");
+    }
+}
+
 TEST_F(GltfLoader, HostileNumbersLoadOrFailCleanly) {
     Gltf bar = skinned_bar();
     bar.doc["accessors"][0]["sparse"] = {

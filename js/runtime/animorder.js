@@ -49,7 +49,8 @@ export class AnimorderRuntime {
         this.method = method;
         this.fallback = fallback;
         this.indexCount = indexCount;
-        this._buffers = buffers; // sidecar only: the bytes' Uint32 view per buffer, or null
+        this._buffers = buffers; // sidecar only: b → the bytes' Uint32 view of buffer b, or null
+        this._bufferViews = new Map();
         this.clips = clips.map((c, index) => checkClip(c, index, bufferCount));
     }
 
@@ -91,7 +92,8 @@ export class AnimorderRuntime {
     // Sidecar only: buffer b's indexCount indices (Uint32Array), or null.
     buffer(b) {
         if (!this._buffers || !Number.isInteger(b) || b < 0 || b >= this.bufferCount) return null;
-        return this._buffers[b];
+        if (!this._bufferViews.has(b)) this._bufferViews.set(b, this._buffers(b));
+        return this._bufferViews.get(b);
     }
 
     // ---- sources ----
@@ -130,29 +132,36 @@ export class AnimorderRuntime {
                 bufferBase, cells: u8.subarray(cells, cells + cellBytes), centres: centreValues,
             });
         }
-        const buffers = [];
+        // Each buffer's view made when first asked for: opening costs nothing per buffer (a header
+        // may claim 2^31 buffers of 0 indices).
         const base = u8.byteOffset + 20 + clipCount * 32;
-        for (let b = 0; b < bufferCount; ++b) {
+        const buffers = (b) => {
             const start = base + b * indexCount * 4;
-            buffers.push(start % 4 === 0 ? new Uint32Array(u8.buffer, start, indexCount)
-                                         : new Uint32Array(u8.slice(start - u8.byteOffset, start - u8.byteOffset + indexCount * 4).buffer));
-        }
+            return start % 4 === 0 ? new Uint32Array(u8.buffer, start, indexCount)
+                                   : new Uint32Array(u8.slice(start - u8.byteOffset, start - u8.byteOffset + indexCount * 4).buffer);
+        };
         return new AnimorderRuntime({ bufferCount, clips, method: null, fallback: 0, buffers, indexCount });
     }
 
     // A .glb's bytes. Returns null when the file does not use the extension.
     static fromGlb(bytes) {
-        const { json, bin } = parseGlb(bytes);
-        return AnimorderRuntime.fromGltf(json, bin);
+        return asAnimorderError(() => {
+            const { json, bin } = parseGlb(bytes);
+            return AnimorderRuntime.fromGltf(json, bin);
+        });
     }
 
     // A glTF JSON object and the GLB binary chunk (a Uint8Array, or null for a .gltf whose buffers are
     // data URIs). Returns null when the file does not use the extension.
     static fromGltf(json, bin = null) {
-        const root = json && json.extensions && json.extensions[EXTENSION_NAME];
-        if (!root) return null;
-        const reader = new AccessorReader(json, bin);
-        return AnimorderRuntime.fromExtension(root, (index) => reader.read(index));
+        return asAnimorderError(() => {
+            const root = json && json.extensions && json.extensions[EXTENSION_NAME];
+            if (!root) return null;
+            const reader = new AccessorReader(json, bin);
+            const runtime = AnimorderRuntime.fromExtension(root, (index) => reader.read(index));
+            checkPrimitives(json, runtime.bufferCount);
+            return runtime;
+        });
     }
 
     // The root extension object, with `readAccessor(index)` returning { array, itemSize, count,
@@ -178,6 +187,37 @@ export class AnimorderRuntime {
             fail(`${EXTENSION_NAME}: fallback ${fallback} is not a buffer`);
         return new AnimorderRuntime({ bufferCount: root.bufferCount, clips, method: root.method ?? null, fallback });
     }
+}
+
+// Any failure as an AnimorderError (a TypeError from a null clip, a SyntaxError from the JSON...),
+// so that a caller catches one kind of error.
+function asAnimorderError(make) {
+    try {
+        return make();
+    } catch (error) {
+        if (error instanceof AnimorderError) throw error;
+        fail(`${EXTENSION_NAME}: ${error && error.message ? error.message : String(error)}`);
+    }
+}
+
+// What the extension asks of each primitive that carries orders (the checks of `animorder check`
+// an engine needs before binding them): triangles with indices, orderCount = bufferCount, an
+// orders accessor of orderCount × the indices' count unsigned shorts or ints in a buffer view.
+function checkPrimitives(json, bufferCount) {
+    const accessors = json.accessors || [];
+    (json.meshes || []).forEach((mesh, m) => (mesh && mesh.primitives || []).forEach((primitive, p) => {
+        const ext = primitive && primitive.extensions && primitive.extensions[EXTENSION_NAME];
+        if (!ext) return;
+        const where = `mesh ${m} primitive ${p}`;
+        if (primitive.mode !== undefined && primitive.mode !== 4) fail(`${where}: orders on a primitive that is not triangles`);
+        const indices = accessors[primitive.indices];
+        if (!Number.isInteger(primitive.indices) || !indices || !isCount(indices.count)) fail(`${where}: orders on a primitive without indices`);
+        if (ext.orderCount !== bufferCount) fail(`${where}: orderCount ${ext.orderCount} != bufferCount ${bufferCount}`);
+        const orders = Number.isInteger(ext.orders) ? accessors[ext.orders] : undefined;
+        if (!orders || orders.type !== 'SCALAR' || (orders.componentType !== 5123 && orders.componentType !== 5125) ||
+            orders.count !== ext.orderCount * indices.count || orders.bufferView === undefined || orders.sparse)
+            fail(`${where}: orders must be ${ext.orderCount}×${indices.count} unsigned short or int indices in a buffer view`);
+    }));
 }
 
 function checkClip(c, index, bufferCount) {
@@ -269,6 +309,7 @@ export class AccessorReader {
         this.json = json;
         this.bin = bin;
         this.buffers = [];
+        this.read_ = new Map(); // accessor → what read() gave: one accessor named by many clips is read once
     }
 
     bufferBytes(index) {
@@ -290,22 +331,33 @@ export class AccessorReader {
     }
 
     read(index) {
-        const accessor = (this.json.accessors || [])[index];
+        if (!this.read_.has(index)) this.read_.set(index, this.readOnce(index));
+        return this.read_.get(index);
+    }
+
+    // Every number checked before any allocation: the extension's accessors lie in buffer views
+    // (one without would be `count` zeros, any count), at offsets that are counts, inside the view.
+    readOnce(index) {
+        const accessor = Number.isInteger(index) ? (this.json.accessors || [])[index] : undefined;
         if (!accessor) fail(`accessor ${index} does not exist`);
         if (accessor.sparse) fail(`accessor ${index} is sparse`);
         const Type = TYPES[accessor.componentType], itemSize = COMPONENTS[accessor.type];
         if (!Type || !itemSize) fail(`accessor ${index}: unknown type`);
         if (!isCount(accessor.count)) fail(`accessor ${index}: bad count`);
-        const count = accessor.count, array = new Type(count * itemSize);
-        if (accessor.bufferView === undefined) return { array, itemSize, count, componentType: accessor.componentType };
-        const view = (this.json.bufferViews || [])[accessor.bufferView];
+        const count = accessor.count;
+        if (accessor.bufferView === undefined) fail(`accessor ${index} has no buffer view`);
+        const view = Number.isInteger(accessor.bufferView) ? (this.json.bufferViews || [])[accessor.bufferView] : undefined;
         if (!view) fail(`accessor ${index}: buffer view ${accessor.bufferView} does not exist`);
+        const element = Type.BYTES_PER_ELEMENT * itemSize;
+        const viewOffset = view.byteOffset ?? 0, offset = accessor.byteOffset ?? 0, stride = view.byteStride || element;
+        if (!isCount(viewOffset) || !isCount(offset) || !isCount(view.byteLength) || !isCount(stride) || stride < element)
+            fail(`accessor ${index}: its buffer view's offsets, length or stride are not counts that fit its elements`);
         const bytes = this.bufferBytes(view.buffer);
-        const element = Type.BYTES_PER_ELEMENT * itemSize, stride = view.byteStride || element;
-        const start = (view.byteOffset || 0) + (accessor.byteOffset || 0);
+        const start = viewOffset + offset;
         const end = count === 0 ? start : start + (count - 1) * stride + element;
-        if (end > (view.byteOffset || 0) + view.byteLength || (view.byteOffset || 0) + view.byteLength > bytes.length)
+        if (end > viewOffset + view.byteLength || viewOffset + view.byteLength > bytes.length)
             fail(`accessor ${index} reaches past its buffer view or buffer`);
+        const array = new Type(count * itemSize);
         const data = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
         const get = {
             5120: (o) => data.getInt8(o), 5121: (o) => data.getUint8(o), 5122: (o) => data.getInt16(o, true),

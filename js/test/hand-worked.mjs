@@ -51,4 +51,36 @@ assert.equal(AnimorderRuntime.fromGltf({ asset: { version: '2.0' } }), null);   
 assert.throws(() => AnimorderRuntime.fromSidecar(new Uint8Array(10)), AnimorderError);
 assert.throws(() => AnimorderRuntime.fromSidecar(new TextEncoder().encode('AOR2'.padEnd(20, '\0'))), AnimorderError);
 assert.throws(() => AnimorderRuntime.fromGlb(new Uint8Array(30)), AnimorderError);
+// The primitives (what an engine binds): orders that do not fit are refused, as `animorder check` does.
+const prim = (g) => g.meshes[0].primitives[0];
+assert.throws(broken((g) => { prim(g).extensions.ANIMORDER_animated_triangle_orders.orderCount = 3; }), AnimorderError);
+assert.throws(broken((g) => { g.accessors[2].count = 9; }), AnimorderError);          // orders of 1.5 buffers
+assert.throws(broken((g) => { g.accessors[2].componentType = 5126; }), AnimorderError);  // float orders
+assert.throws(broken((g) => { delete prim(g).indices; }), AnimorderError);
+assert.throws(broken((g) => { prim(g).mode = 5; }), AnimorderError);                   // a strip
+// Accessors: never read outside their view, never `count` zeros without one (4 GB for a big count).
+const table = (g) => g.accessors[ext(g).clips[0].table];
+assert.throws(broken((g) => { table(g).byteOffset = -1; }), AnimorderError);
+assert.throws(broken((g) => { delete g.bufferViews[table(g).bufferView].byteLength; }), AnimorderError);
+assert.throws(broken((g) => { delete table(g).bufferView; table(g).count = 4294967295; }), AnimorderError);
+// Anything else wrong is an AnimorderError too, not a TypeError or a SyntaxError.
+assert.throws(broken((g) => { ext(g).clips[0] = null; }), AnimorderError);
+const glb = (text) => {
+    const json = new TextEncoder().encode(text.padEnd(Math.ceil(text.length / 4) * 4, ' '));
+    const out = new Uint8Array(20 + json.length), view = new DataView(out.buffer);
+    view.setUint32(0, 0x46546c67, true), view.setUint32(4, 2, true), view.setUint32(8, out.length, true);
+    view.setUint32(12, json.length, true), view.setUint32(16, 0x4e4f534a, true);
+    out.set(json, 20);
+    return out;
+};
+assert.throws(() => AnimorderRuntime.fromGlb(glb('{"asset": NaN}')), AnimorderError);
+// A sidecar claiming 2^31 − 1 buffers of no indices opens at once (its views are made when asked).
+const bomb = new Uint8Array(20), bombView = new DataView(bomb.buffer);
+bomb.set(new TextEncoder().encode('AOR1'));
+bombView.setUint32(4, 1, true), bombView.setUint32(8, 0x7fffffff, true);
+const started = Date.now();
+const empty = AnimorderRuntime.fromSidecar(bomb);  // before: 2^31 views made, out of memory
+assert.ok(Date.now() - started < 5000, 'the sidecar took seconds to open');
+assert.equal(empty.buffer(123456).length, 0);
+assert.equal(empty.buffer(0x7fffffff), null);
 console.log('hand-worked: all checks passed');

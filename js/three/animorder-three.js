@@ -43,6 +43,8 @@ export class AnimorderGLTFPlugin {
         const json = this.parser.json;
         const def = (json.accessors || [])[index];
         if (!def) throw new AnimorderError(`accessor ${index} does not exist`);
+        // Without a buffer view three.js makes `count` zeros, whatever the count: none of ours is so.
+        if (def.bufferView === undefined) throw new AnimorderError(`accessor ${index} has no buffer view`);
         const attribute = await this.parser.getDependency('accessor', index);
         const Type = COMPONENT[def.componentType];
         if (!Type) throw new AnimorderError(`accessor ${index} has an unexpected component type`);
@@ -64,6 +66,7 @@ export class AnimorderGLTFPlugin {
         const runtime = AnimorderRuntime.fromExtension(root, (index) => needed.get(index));
         const meshes = [];
         const done = new Map(); // geometry → index count n (geometries GLTFLoader shares)
+        const toIndex = [];     // geometries and their orders, set once all are checked
         const objects = [];
         for (const scene of gltf.scenes || [gltf.scene]) scene.traverse((o) => { if (o.isMesh) objects.push(o); });
         let primitiveOrder = 0;
@@ -86,11 +89,16 @@ export class AnimorderGLTFPlugin {
                 const vertices = geometry.attributes.position.count;
                 for (let k = 0; k < orders.array.length; ++k)
                     if (orders.array[k] >= vertices) throw new AnimorderError(`mesh ${where.meshes} primitive ${where.primitives}: an order names vertex ${orders.array[k]} of ${vertices}`);
-                geometry.userData.animorderFallbackIndex = geometry.index;
-                geometry.setIndex(new BufferAttribute(orders.array, 1));
+                toIndex.push({ geometry, array: orders.array });
                 done.set(geometry, n);
             }
             meshes.push({ mesh, n, mesh_index: where.meshes, primitive_index: where.primitives, drawOrder: primitiveOrder++ });
+        }
+        // Only once every primitive checks out: a later one that does not leaves every geometry
+        // drawing its own indices (the spec's fallback), none half switched to the orders.
+        for (const { geometry, array } of toIndex) {
+            geometry.userData.animorderFallbackIndex = geometry.index;
+            geometry.setIndex(new BufferAttribute(array, 1));
         }
         const character = new AnimorderCharacter(runtime, gltf.scene, meshes, gltf.animations || []);
         character.setBuffer(runtime.fallback);

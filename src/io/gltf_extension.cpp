@@ -148,7 +148,9 @@ void read_clip(const tinygltf::Model& model, const tinygltf::Value& value, size_
     }
     if (o.count("startTime") && !number(o, "startTime", clip.start_time))
         return p.add(where + ".startTime is not a finite number");
-    if (!number(o, "sampleRate", clip.sample_rate) || !(clip.sample_rate > 0))
+    // Positive as the runtimes keep it too (a float: 1e-300 is 0 there).
+    if (!number(o, "sampleRate", clip.sample_rate) || !(clip.sample_rate > 0) || !(float(clip.sample_rate) > 0) ||
+        !std::isfinite(float(clip.sample_rate)))
         return p.add(where + ".sampleRate is missing or not a positive number");
     bool ok = bounded(o, "keyframes", 1, 100000, where, p, v);
     clip.keyframes = uint32_t(v);
@@ -279,7 +281,24 @@ void check_integers_as_written(const std::string& path, Problems& p) {
         const auto e = owner["extensions"].find(kOrdersExtensionName);
         return e == owner["extensions"].end() ? nullptr : &*e;
     };
-    if (const nlohmann::json* e = extension_of(doc)) add_wrapped_integers(*e, kOrdersExtensionName, p);
+    if (const nlohmann::json* e = extension_of(doc)) {
+        add_wrapped_integers(*e, kOrdersExtensionName, p);
+        // tinygltf drops a null from an array: clip numbers would shift silently.
+        if (e->is_object() && e->contains("clips") && (*e)["clips"].is_array())
+            for (size_t c = 0; c < (*e)["clips"].size(); ++c)
+                if (!(*e)["clips"][c].is_object()) p.add("clips[" + std::to_string(c) + "] is not an object");
+    }
+    // Offsets tinygltf reads as it can (a negative one wraps, a fractional one truncates): where
+    // the orders, tables and centres lie must be what the file says.
+    for (const char* list : {"accessors", "bufferViews"})
+        if (doc.contains(list) && doc[list].is_array())
+            for (size_t i = 0; i < doc[list].size(); ++i) {
+                const nlohmann::json& item = doc[list][i];
+                if (item.is_object() && item.contains("byteOffset") && !item["byteOffset"].is_number_unsigned() &&
+                    !(item["byteOffset"].is_number_integer() && item["byteOffset"].get<int64_t>() >= 0))
+                    p.add(std::string(list) + "[" + std::to_string(i) + "].byteOffset " + item["byteOffset"].dump() +
+                          " is not a non-negative integer");
+            }
     if (!doc.contains("meshes") || !doc["meshes"].is_array()) return;
     for (size_t m = 0; m < doc["meshes"].size(); ++m) {
         const nlohmann::json& mesh = doc["meshes"][m];

@@ -147,6 +147,14 @@ TEST_F(GltfExtension, EveryCorruptionIsReportedOnOneLine) {
          "centers (accessor 3) has the wrong type"},
         {"animation out of range", [&](json& g) { root(g)["clips"][0]["animation"] = 5; }, buffer_bytes(),
          "animation = 5 is out of range"},
+        // A null clip, which tinygltf drops (the clips after it were renumbered), an offset tinygltf
+        // wraps, a sample rate that is 0 as the runtimes' float.
+        {"null clip", [&](json& g) { root(g)["clips"].push_back(nullptr); }, buffer_bytes(),
+         "clips[1] is not an object"},
+        {"negative byteOffset", [](json& g) { g["accessors"][2]["byteOffset"] = -4; }, buffer_bytes(),
+         "accessors[2].byteOffset -4 is not a non-negative integer"},
+        {"sampleRate 0 as a float", [&](json& g) { root(g)["clips"][0]["sampleRate"] = 1e-300; }, buffer_bytes(),
+         "sampleRate is missing or not a positive"},
         // A clip named after another animation: reapply put its table on that one.
         {"name of another animation", [&](json& g) { root(g)["clips"][0]["name"] = "walk"; }, buffer_bytes(),
          "clips[0].name 'walk' is not the name of animation 0 ('still')"},

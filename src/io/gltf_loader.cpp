@@ -575,6 +575,9 @@ Channel parse_channel(const Scene& s, const tinygltf::Animation& anim, const tin
     c.node = size_t(ch.target_node);
     c.path = ch.target_path;
     c.interpolation = sampler.interpolation;
+    if (c.interpolation != "LINEAR" && c.interpolation != "STEP" && c.interpolation != "CUBICSPLINE")
+        s.reader.fail("clip '" + name + "' has a sampler of interpolation '" + c.interpolation +
+                      "' (glTF has LINEAR, STEP and CUBICSPLINE)");
     c.times = s.reader.read(sampler.input, 1);
     c.values = s.reader.read(sampler.output);
     if (c.times.empty()) s.reader.fail("clip '" + name + "' has a channel without keys");
@@ -682,7 +685,8 @@ std::vector<NodePose> pose_at(const Scene& s, const std::vector<Channel>& channe
             std::copy(v.begin(), v.end(), p.s.begin());
         else if (c.path == "weights")
             p.weights = v;
-        p.has_matrix = p.has_matrix && c.path == "weights";  // an animated TRS replaces a matrix
+        if (c.path == "translation" || rotation || c.path == "scale")
+            p.has_matrix = false;  // an animated TRS replaces a matrix (another path leaves it)
     }
     return pose;
 }

@@ -232,6 +232,11 @@ TEST_F(GltfLoader, BrokenFilesGiveOneLineErrorsNamingTheFile) {
         expect_error("joint.gltf", g.text(), "names joint 7");
     }
     {
+        Gltf g = skinned_bar();  // was sampled as LINEAR
+        g.doc["animations"][0]["samplers"][0]["interpolation"] = "QUADRATIC";
+        expect_error("quadratic.gltf", g.text(), "interpolation 'QUADRATIC'");
+    }
+    {
         // tinygltf threw std::out_of_range ("vector::_M_range_check", naming no file) on a buffer of
         // byteLength 0 with a URI.
         Gltf g = skinned_bar();

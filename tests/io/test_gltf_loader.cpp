@@ -156,6 +156,28 @@ TEST_F(GltfLoader, SparseMorphTargetWithAnimatedWeights) {
     }
 }
 
+// A channel of a path the loader does not animate (an extension's, say) leaves its node's matrix
+// in place: before, any channel but weights dropped it.
+TEST_F(GltfLoader, AChannelOfAnotherPathKeepsTheNodesMatrix) {
+    Gltf g;
+    const int p = g.floats({0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3", 3), i = g.u16({0, 1, 2}, "SCALAR", 1);
+    const int t = g.floats({0, 1}, "SCALAR", 1), v = g.floats({0, 0, 0, 0, 3, 0}, "VEC3", 3);
+    g.doc["meshes"] =
+        json::array({json{{"primitives", json::array({json{{"attributes", {{"POSITION", p}}}, {"indices", i}}})}}});
+    g.doc["nodes"] = json::array(
+        {json{{"mesh", 0}, {"matrix", {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 5, 1}}}, json{{"name", "moved"}}});
+    g.doc["scenes"] = json::array({json{{"nodes", json::array({0, 1})}}});
+    json sampler = {{"input", t}, {"output", v}};
+    g.doc["animations"] = json::array(
+        {json{{"samplers", json::array({sampler})},
+              {"channels", json::array({json{{"sampler", 0}, {"target", {{"node", 1}, {"path", "translation"}}}},
+                                        json{{"sampler", 0}, {"target", {{"node", 0}, {"path", "pointer"}}}}})}}});
+    const AnimatedMesh m = load_gltf(write("pointer.gltf", g.text()));
+    ASSERT_EQ(m.clips.size(), 1u);
+    expect_position(m, 0, 1, 1, 0, 5);  // the matrix's translation
+    expect_position(m, m.keyframe_count() - 1, 1, 1, 0, 5);
+}
+
 TEST_F(GltfLoader, BrokenFilesGiveOneLineErrorsNamingTheFile) {
     auto expect_error = [&](const std::string& name, const std::string& content, const std::string& message) {
         const std::string path = write(name, content);

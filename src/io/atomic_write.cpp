@@ -126,7 +126,8 @@ std::string creation_error(const fs::path& target) {
     return {};
 }
 
-void check_writable_target(const std::string& path) {
+// `probe`: also create and remove the temporary (OutputSet::add, which creates it next, does not).
+void check_writable_target(const std::string& path, bool probe = true) {
     const fs::path target(path);
     std::error_code error;
     if (path.empty()) throw OutputError("an output path is empty");
@@ -148,22 +149,22 @@ void check_writable_target(const std::string& path) {
     // A commit renames over the target: a device (-r /dev/full), a FIFO or a link would be replaced
     // by a plain file, for every other user of it too.
     struct stat existing {};
-    if (::lstat(path.c_str(), &existing) == 0 && !S_ISREG(existing.st_mode))
+    const bool exists = ::lstat(path.c_str(), &existing) == 0;
+    if (exists && !S_ISREG(existing.st_mode))
         throw OutputError(path + ": is " +
                           (S_ISLNK(existing.st_mode)    ? "a symbolic link (name the file it leads to)"
                            : S_ISFIFO(existing.st_mode) ? "a FIFO"
                            : S_ISCHR(existing.st_mode) || S_ISBLK(existing.st_mode) ? "a device"
                                                                                     : "not a regular file") +
                           ": refusing to replace it with a file; name another output");
-    const std::string why = creation_error(target);
+    const std::string why = probe ? creation_error(target) : std::string();
     if (!why.empty()) throw OutputError(path + ": folder " + folder.string() + " is not writable (" + why + ")");
     // In a sticky folder (/tmp) only the file's owner, the folder's owner or root may replace a
     // file: known now rather than when the outputs are put in place, after the work.
-    struct stat folder_stat {
-    }, target_stat{};
+    struct stat folder_stat {};
     const uid_t user = ::geteuid();
-    if (user != 0 && ::stat(folder.c_str(), &folder_stat) == 0 && (folder_stat.st_mode & S_ISVTX) &&
-        folder_stat.st_uid != user && ::lstat(path.c_str(), &target_stat) == 0 && target_stat.st_uid != user)
+    if (exists && user != 0 && existing.st_uid != user && ::stat(folder.c_str(), &folder_stat) == 0 &&
+        (folder_stat.st_mode & S_ISVTX) && folder_stat.st_uid != user)
         throw OutputError(path + ": belongs to another user in a sticky folder (" + folder.string() +
                           "), so it cannot be replaced; name another output");
 }
@@ -224,7 +225,7 @@ OutputSet::~OutputSet() {
 
 void OutputSet::add(const std::string& path, const std::string& data) {
     if (committed_) throw OutputError(path + ": the output set is already committed");
-    check_writable_target(path);
+    check_writable_target(path, false);  // creating the temporary below is the probe
     for (const Pending& p : pending_)
         if (same_file(p.target, path)) throw OutputError(path + ": named twice as an output (" + p.target + ")");
     const std::string temp = temporary_name(path, "tmp");

@@ -271,9 +271,10 @@ void add_wrapped_integers(const nlohmann::json& value, const std::string& where,
     }
 }
 
-// add_wrapped_integers over the extension's objects as the file writes them: the root's and every
-// primitive's.
-void check_integers_as_written(const std::string& path, Problems& p) {
+// What tinygltf's model hides, checked on the JSON as the file writes it: integers it wraps
+// (add_wrapped_integers over the extension's root and every primitive's object), a clip it drops,
+// offsets it wraps or truncates.
+void check_json_as_written(const std::string& path, Problems& p) {
     const nlohmann::json doc = nlohmann::json::parse(io::gltf_json_text(path), nullptr, false);
     if (!doc.is_object()) return;
     const auto extension_of = [](const nlohmann::json& owner) -> const nlohmann::json* {
@@ -321,7 +322,7 @@ OrdersExtensionCheck check_orders_extension(const std::string& path) {
         return r;
     }
     r.present = true;
-    check_integers_as_written(path, p);
+    check_json_as_written(path, p);
     if (std::find(model.extensionsUsed.begin(), model.extensionsUsed.end(), kOrdersExtensionName) ==
         model.extensionsUsed.end())
         p.add(std::string(kOrdersExtensionName) + " is not listed in extensionsUsed");

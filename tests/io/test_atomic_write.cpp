@@ -12,6 +12,7 @@
 #include <unistd.h>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <string>
 
 namespace fs = std::filesystem;
@@ -31,23 +32,30 @@ protected:
     }
 };
 
+// The wait status of a child process that runs `body`, then exits with 0 (unless body ends it).
+int status_of_child(const std::function<void()>& body) {
+    const pid_t child = ::fork();
+    if (child < 0) return -1;
+    if (child == 0) {
+        body();
+        ::_exit(0);
+    }
+    int status = -1;
+    return ::waitpid(child, &status, 0) == child ? status : -1;
+}
+
 }  // namespace
 
 // A run interrupted (Ctrl-C, a farm's SIGTERM) between writing its temporaries and putting them in
 // place leaves nothing behind, and still ends as killed by the signal.
 TEST_F(AtomicWrite, ASignalRemovesTheTemporariesAndStillKills) {
     for (const int sig : {SIGTERM, SIGINT, SIGHUP}) {
-        const pid_t child = ::fork();
-        ASSERT_GE(child, 0);
-        if (child == 0) {
+        const int status = status_of_child([&] {
             OutputSet files;
             files.add(path("a.bin").string(), std::string(100000, 'a'));
             files.add(path("b.json").string(), "{}");
-            ::raise(sig);
-            ::_exit(0);  // not reached: the signal's default action ends the process
-        }
-        int status = 0;
-        ASSERT_EQ(::waitpid(child, &status, 0), child);
+            ::raise(sig);  // its default action ends the process
+        });
         EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == sig) << "signal " << sig << ", status " << status;
         EXPECT_EQ(entries(), "") << "signal " << sig << " left files behind";
     }
@@ -57,33 +65,23 @@ TEST_F(AtomicWrite, ASignalRemovesTheTemporariesAndStillKills) {
 // signal (each temporary is the process's that made it), and the parent's outputs stay.
 TEST_F(AtomicWrite, AForkedChildRemovesItsOwnTemporaries) {
     animorder::write_file_atomically(path("parent.json").string(), "{}");
-    const pid_t child = ::fork();
-    ASSERT_GE(child, 0);
-    if (child == 0) {
+    const int status = status_of_child([&] {
         OutputSet files;
         files.add(path("child.bin").string(), "c");
         ::raise(SIGTERM);
-        ::_exit(0);
-    }
-    int status = 0;
-    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    });
     EXPECT_TRUE(WIFSIGNALED(status));
     EXPECT_EQ(entries(), "parent.json ");
 }
 
 // What the handler must not do: remove the outputs once they are in place.
 TEST_F(AtomicWrite, ASignalAfterTheCommitKeepsTheOutputs) {
-    const pid_t child = ::fork();
-    ASSERT_GE(child, 0);
-    if (child == 0) {
+    const int status = status_of_child([&] {
         OutputSet files;
         files.add(path("a.bin").string(), "a");
         files.commit();
         ::raise(SIGTERM);
-        ::_exit(0);
-    }
-    int status = 0;
-    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    });
     EXPECT_TRUE(WIFSIGNALED(status));
     EXPECT_EQ(entries(), "a.bin ");
 }
@@ -109,9 +107,7 @@ TEST_F(AtomicWrite, AnotherUsersFileInAStickyFolderIsRefusedAtTheCheck) {
     fs::create_directory(sticky);
     ASSERT_EQ(::chmod(sticky.c_str(), 01777), 0);
     std::ofstream(sticky / "theirs.json") << "{}";
-    const pid_t child = ::fork();
-    ASSERT_GE(child, 0);
-    if (child == 0) {  // as nobody (65534): the file is root's
+    const int status = status_of_child([&] {  // as nobody (65534): the file is root's
         if (::setresgid(65534, 65534, 65534) != 0 || ::setresuid(65534, 65534, 65534) != 0) ::_exit(3);
         try {
             animorder::check_output_paths({(sticky / "mine.json").string()}, {});  // a new file: fine
@@ -124,9 +120,7 @@ TEST_F(AtomicWrite, AnotherUsersFileInAStickyFolderIsRefusedAtTheCheck) {
             ::_exit(std::string(e.what()).find("another user") != std::string::npos ? 0 : 2);
         }
         ::_exit(1);
-    }
-    int status = 0;
-    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    });
     ASSERT_TRUE(WIFEXITED(status));
     EXPECT_EQ(WEXITSTATUS(status), 0) << "1: accepted; 2: refused for another reason; 3: no user switch; 4: a new "
                                          "file refused";

@@ -37,6 +37,12 @@ struct Primitive {
     // Formats without materials (MD2, IQM, procedural shapes) give single-sided opaque.
     bool double_sided = false;
     AlphaMode alpha_mode = AlphaMode::Opaque;
+    // The file's node transform mirrors it (a negative determinant), so the file's front faces are
+    // clockwise (glTF 2.0: "the determinant of the node's global transform defines the winding
+    // order"; engines flip their culling for it): the loader swaps the last two
+    // corners of each of its triangles, so that `indices` keeps counter-clockwise front faces, and
+    // writers of the file's own index data swap them back (to_file_winding).
+    bool mirrored = false;
 };
 
 struct Clip {
@@ -73,6 +79,13 @@ void validate_animated_mesh(const AnimatedMesh& mesh);
 // Per triangle of mesh.indices: 1 where its primitive is double-sided (drawn without culling).
 // Empty when no primitive is, so that callers pass nullptr and keep the culling-only path.
 std::vector<uint8_t> double_sided_triangles(const AnimatedMesh& mesh);
+
+// Swaps the last two corners of every triangle of the mirrored primitives in `indices` (a triangle
+// list as long as mesh.indices, each primitive's triangles within its own range, as every order
+// keeps them): from mesh.indices' counter-clockwise front faces to the file's winding, and back.
+void to_file_winding(const AnimatedMesh& mesh, uint32_t* indices);
+// True when some primitive is mirrored.
+bool has_mirrored_primitives(const AnimatedMesh& mesh);
 
 // True when some primitive blends (AlphaMode::Blend).
 bool has_blended_primitives(const AnimatedMesh& mesh);

@@ -316,8 +316,20 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
             global[n] = flat.parent[n] >= 0 ? global[size_t(flat.parent[n])] * local[n] : local[n];
         return global;
     };
+    // Per part, whether its node's global transform mirrored it (a negative determinant) in some
+    // keyframe and whether it did not in some (0, flattened, says neither): as in the glTF loader,
+    // a mirrored mesh's file winding is clockwise-front (engines flip their culling for it).
+    std::vector<uint8_t> mirrored_in_some(parts.size(), 0), upright_in_some(parts.size(), 0);
     auto add_keyframe = [&](const aiAnimation* anim, double tick) {
         const std::vector<aiMatrix4x4> global = globals(anim, tick);
+        for (size_t i = 0; i < parts.size(); ++i) {
+            const aiMatrix4x4& g = global[parts[i].node];
+            const double det = double(g.a1) * (double(g.b2) * g.c3 - double(g.b3) * g.c2) -
+                               double(g.a2) * (double(g.b1) * g.c3 - double(g.b3) * g.c1) +
+                               double(g.a3) * (double(g.b1) * g.c2 - double(g.b2) * g.c1);
+            mirrored_in_some[i] |= det < 0;
+            upright_in_some[i] |= det > 0;
+        }
         const size_t first = mesh.keyframe_positions.size();
         mesh.keyframe_positions.resize(first + mesh.vertex_count * 3);
         float* out = mesh.keyframe_positions.data() + first;
@@ -467,6 +479,14 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
                          std::min(at.first + double(f) / options.sample_rate * at.ticks_per_second, at.last));
         mesh.clips.push_back(clip);
     }
+    for (size_t i = 0; i < parts.size(); ++i) {
+        if (mirrored_in_some[i] && upright_in_some[i])
+            throw LoadError(path + ": node '" + std::string(flat.nodes[parts[i].node]->mName.C_Str()) +
+                            "' mirrors its mesh in some keyframes and not in others (a scale that changes sign), " +
+                            "but one index buffer has one winding");
+        mesh.primitives[i].mirrored = mirrored_in_some[i] != 0;
+    }
+    to_file_winding(mesh, mesh.indices.data());  // to counter-clockwise front faces
     try {
         validate_animated_mesh(mesh);
     } catch (const InvalidInput& e) {

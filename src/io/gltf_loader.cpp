@@ -618,13 +618,20 @@ std::vector<ClipChannels> parse_animations(const Scene& s, const std::string& pa
 
 // Positions of every vertex in `pose` into out (vertex_count × 3 floats): node transforms down
 // the hierarchy, then per primitive morph targets, then its skin (joint matrix = joint's global
-// transform · inverse bind matrix) or, unskinned, its node's global transform.
-void evaluate_pose(const Scene& s, const std::vector<NodePose>& pose, float* out) {
+// transform · inverse bind matrix) or, unskinned, its node's global transform. Per primitive,
+// winding[i] gets the sign of its node's global determinant (−1 mirrors; 0: flattened, or not a
+// number), which gives the file's winding even where a skin ignores the node's transform (as
+// engines cull: three.js flips by the mesh object's world matrix).
+void evaluate_pose(const Scene& s, const std::vector<NodePose>& pose, float* out, int8_t* winding) {
     std::vector<Mat> global(s.model.nodes.size(), identity());
     for (size_t n : s.order) {
         const NodePose& p = pose[n];
         const Mat local = p.has_matrix ? p.matrix : trs(p.t, p.r, p.s);
         global[n] = s.parent[n] >= 0 ? mul(global[size_t(s.parent[n])], local) : local;
+    }
+    for (size_t i = 0; i < s.prims.size(); ++i) {
+        const double det = io::determinant3(global[s.prims[i].node]);
+        winding[i] = int8_t(det < 0 ? -1 : det > 0 ? 1 : 0);
     }
     for (const PrimitiveData& d : s.prims) {
         const tinygltf::Node& node = s.model.nodes[d.node];
@@ -661,11 +668,12 @@ void evaluate_pose(const Scene& s, const std::vector<NodePose>& pose, float* out
     }
 }
 
-// One more keyframe of the mesh: the vertices in `pose`.
-void add_keyframe(const Scene& s, const std::vector<NodePose>& pose, AnimatedMesh& mesh) {
+// One more keyframe of the mesh: the vertices in `pose`; `winding` gets evaluate_pose's signs.
+void add_keyframe(const Scene& s, const std::vector<NodePose>& pose, AnimatedMesh& mesh, std::vector<int8_t>& winding) {
     const size_t first = mesh.keyframe_positions.size();
     mesh.keyframe_positions.resize(first + mesh.vertex_count * 3);
-    evaluate_pose(s, pose, mesh.keyframe_positions.data() + first);
+    winding.resize(winding.size() + s.prims.size());
+    evaluate_pose(s, pose, mesh.keyframe_positions.data() + first, winding.data() + winding.size() - s.prims.size());
 }
 
 // The rest pose with every channel of a clip sampled at time t (an animated T, R or S replaces a
@@ -697,7 +705,7 @@ std::vector<NodePose> pose_at(const Scene& s, const std::vector<Channel>& channe
 // front; the first failing keyframe's error (in keyframe order) is the one thrown, whatever the
 // threads.
 void sample_keyframes(const Scene& s, std::vector<ClipChannels>& clips, size_t keyframes, const LoadOptions& options,
-                      AnimatedMesh& mesh) {
+                      AnimatedMesh& mesh, std::vector<int8_t>& winding) {
     if (clips.empty()) return;
     struct Sample {
         const ClipChannels* clip;
@@ -712,12 +720,14 @@ void sample_keyframes(const Scene& s, std::vector<ClipChannels>& clips, size_t k
     }
     const size_t floats = mesh.vertex_count * 3;
     mesh.keyframe_positions.resize(samples.size() * floats);
+    winding.resize(samples.size() * s.prims.size());
     std::vector<std::exception_ptr> errors(samples.size());
     const auto evaluate = [&](size_t k) {
         try {
             const ClipChannels& c = *samples[k].clip;
             const double t = std::min(c.t0 + double(samples[k].f) / options.sample_rate, c.t1);
-            evaluate_pose(s, pose_at(s, c.channels, t), mesh.keyframe_positions.data() + k * floats);
+            evaluate_pose(s, pose_at(s, c.channels, t), mesh.keyframe_positions.data() + k * floats,
+                          winding.data() + k * s.prims.size());
         } catch (...) {
             errors[k] = std::current_exception();
         }
@@ -727,6 +737,28 @@ void sample_keyframes(const Scene& s, std::vector<ClipChannels>& clips, size_t k
     });
     for (const std::exception_ptr& e : errors)
         if (e) std::rethrow_exception(e);
+}
+
+// Gives each primitive the winding its node's transform gives it in the file (evaluate_pose's
+// signs, keyframe after keyframe): a mirrored one is marked and its triangles flipped to
+// counter-clockwise front faces (Primitive::mirrored). One index buffer has one winding, so a
+// primitive mirrored in some keyframes and not in others (a scale that changes sign) is refused.
+void apply_mirroring(const Scene& s, const std::vector<int8_t>& winding, AnimatedMesh& mesh) {
+    const size_t prims = s.prims.size();
+    for (size_t i = 0; i < prims; ++i) {
+        bool mirrored = false, upright = false;
+        for (size_t k = i; k < winding.size(); k += prims) {
+            mirrored = mirrored || winding[k] < 0;
+            upright = upright || winding[k] > 0;
+        }
+        const size_t n = s.prims[i].node;
+        if (mirrored && upright)
+            s.reader.fail("node " + std::to_string(n) + " ('" + s.model.nodes[n].name + "') mirrors its mesh in some " +
+                          "keyframes and not in others (a scale that changes sign), but one index buffer has one " +
+                          "winding");
+        mesh.primitives[i].mirrored = mirrored;
+    }
+    to_file_winding(mesh, mesh.indices.data());  // its own inverse: from the file's winding too
 }
 
 // Only the clips named in `asked` (LoadOptions::clips), when each name is one of them; every
@@ -766,11 +798,13 @@ AnimatedMesh load_gltf(const std::string& path, const LoadOptions& options) {
     size_t keyframes = clips.empty() ? 1 : 0;  // without animation: one static keyframe
     for (const ClipChannels& c : clips) keyframes += c.clip.keyframe_count;
     io::check_keyframe_budget(path, keyframes, mesh.vertex_count, options);
+    std::vector<int8_t> winding;
     if (clips.empty()) {
-        add_keyframe(scene, scene.rest, mesh);
+        add_keyframe(scene, scene.rest, mesh, winding);
         mesh.clips.push_back({"static", 0.0, options.sample_rate, 0, 1});
     }
-    sample_keyframes(scene, clips, keyframes, options, mesh);
+    sample_keyframes(scene, clips, keyframes, options, mesh, winding);
+    apply_mirroring(scene, winding, mesh);
     try {
         validate_animated_mesh(mesh);
     } catch (const InvalidInput& e) {

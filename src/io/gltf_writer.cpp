@@ -95,9 +95,11 @@ std::string gltf_with_orders(const std::string& input_path, const std::string& o
     for (const Primitive& p : mesh.primitives) rewritten.emplace_back(p.source_mesh, p.source_primitive);
     const std::vector<int> replaced = io::begin_replacing(model, rewritten);
     std::vector<std::vector<uint32_t>> index_buffers(buffers.orders.size(), std::vector<uint32_t>(mesh.indices.size()));
-    for (size_t b = 0; b < buffers.orders.size(); ++b)
+    for (size_t b = 0; b < buffers.orders.size(); ++b) {
         apply_triangle_order(index_buffers[b].data(), mesh.indices.data(), buffers.orders[b].data(),
                              mesh.triangle_count());
+        to_file_winding(mesh, index_buffers[b].data());  // a mirrored primitive's triangles as the file has them
+    }
 
     const size_t k = buffers.orders.size();
     for (const Primitive& p : mesh.primitives) {

@@ -143,7 +143,7 @@ void write_mesh(Writer& w, const AnimatedMesh& m, const std::vector<std::string>
         w.i64(p.source_primitive);
         w.u64(p.vertex_base);
         w.u64(p.vertex_count);
-        w.u64(uint64_t(p.double_sided) | uint64_t(p.alpha_mode) << 1);
+        w.u64(uint64_t(p.double_sided) | uint64_t(p.alpha_mode) << 1 | uint64_t(p.mirrored) << 3);
     }
     w.u64(m.clips.size());
     for (const Clip& c : m.clips) {
@@ -290,9 +290,10 @@ AnimatedMesh read_mesh(Reader& r, const std::string& path, const LoadOptions& op
         p.vertex_base = r.u64();
         p.vertex_count = r.u64();
         const uint64_t material = r.u64();
-        if (material > 5) throw LoadError(path + ": the importer's material flags are corrupt");
+        if ((material & 7) > 5 || material > 15) throw LoadError(path + ": the importer's material flags are corrupt");
         p.double_sided = (material & 1) != 0;
-        p.alpha_mode = AlphaMode(material >> 1);
+        p.alpha_mode = AlphaMode((material >> 1) & 3);
+        p.mirrored = (material & 8) != 0;
     }
     m.clips.resize(r.count(4 * 8));
     for (Clip& c : m.clips) {

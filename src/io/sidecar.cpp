@@ -57,6 +57,7 @@ std::string serialize_sidecar(const AnimatedMesh& mesh, const MethodBuffers& buf
     std::vector<uint32_t> indices(mesh.indices.size());
     for (const auto& order : buffers.orders) {
         apply_triangle_order(indices.data(), mesh.indices.data(), order.data(), mesh.triangle_count());
+        to_file_winding(mesh, indices.data());  // a mirrored primitive's triangles as the input file has them
         for (uint32_t i : indices) put_u32(out, i);
     }
     for (size_t c = 0; c < mesh.clips.size(); ++c) {

@@ -37,10 +37,16 @@ inline Mat trs(const std::array<double, 3>& t, const Quat& q, const std::array<d
     return m;
 }
 
+// Determinant of the upper-left 3 × 3 block: negative for a transform that mirrors.
+inline double determinant3(const Mat& m) {
+    const double a = m[0], b = m[4], c = m[8], d = m[1], e = m[5], f = m[9], g = m[2], h = m[6], i = m[10];
+    return a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g);
+}
+
 // Inverse of an affine transform (rotation/scale/shear + translation), as bind poses are.
 inline Mat invert_affine(const Mat& m) {
     const double a = m[0], b = m[4], c = m[8], d = m[1], e = m[5], f = m[9], g = m[2], h = m[6], i = m[10];
-    const double det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g);
+    const double det = determinant3(m);
     const double k = det != 0 ? 1.0 / det : 0.0;
     Mat r = identity();
     r[0] = (e * i - f * h) * k, r[4] = (c * h - b * i) * k, r[8] = (b * f - c * e) * k;

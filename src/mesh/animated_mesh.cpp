@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstring>
 #include <string>
+#include <utility>
 
 namespace animorder {
 
@@ -30,6 +31,19 @@ std::vector<uint8_t> double_sided_triangles(const AnimatedMesh& mesh) {
             for (size_t t = p.first_index / 3; t < (p.first_index + p.index_count) / 3 && t < flags.size(); ++t)
                 flags[t] = 1;
     return flags;
+}
+
+void to_file_winding(const AnimatedMesh& mesh, uint32_t* indices) {
+    for (const Primitive& p : mesh.primitives)
+        if (p.mirrored)
+            for (size_t i = p.first_index; i + 2 < p.first_index + p.index_count; i += 3)
+                std::swap(indices[i + 1], indices[i + 2]);
+}
+
+bool has_mirrored_primitives(const AnimatedMesh& mesh) {
+    for (const Primitive& p : mesh.primitives)
+        if (p.mirrored) return true;
+    return false;
 }
 
 bool has_blended_primitives(const AnimatedMesh& mesh) {

@@ -196,11 +196,19 @@ StaticMethodResult run_static_method(const AnimatedMesh& mesh, StaticMethod meth
 
 VertexCacheStats analyze_mesh_vertex_cache(const AnimatedMesh& mesh, const std::vector<uint32_t>& indices,
                                            unsigned cache_size) {
+    // The cache sees the corners in the order the file's index data lists them: a mirrored
+    // primitive's as written (to_file_winding), not as flipped for the rasteriser.
+    std::vector<uint32_t> as_written;
+    if (has_mirrored_primitives(mesh)) {
+        as_written = indices;
+        to_file_winding(mesh, as_written.data());
+    }
+    const uint32_t* drawn = as_written.empty() ? indices.data() : as_written.data();
     VertexCacheStats total;
     size_t referenced = 0;
     for (const Primitive& primitive : mesh.primitives) {
-        const VertexCacheStats s = analyze_vertex_cache(indices.data() + primitive.first_index, primitive.index_count,
-                                                        mesh.vertex_count, cache_size);
+        const VertexCacheStats s =
+            analyze_vertex_cache(drawn + primitive.first_index, primitive.index_count, mesh.vertex_count, cache_size);
         total.misses += s.misses;
         total.triangles += s.triangles;
         referenced += s.referenced_vertices;

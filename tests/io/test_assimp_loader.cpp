@@ -303,6 +303,23 @@ TEST_F(AssimpHostile, AGoodFileComesBackFromTheChildWhole) {
         for (size_t i = 0; i < 9; ++i) EXPECT_NEAR(s.keyframe(k)[i], s.keyframe(0)[i], 1e-6);
 }
 
+// As in glTF (test_gltf_loader): a node transform that mirrors (here the root frame's x → −x) makes
+// the file's front faces clockwise, as engines cull them; the loader flips the corners back to
+// counter-clockwise, and the flag crosses from the importer's child process.
+TEST_F(AssimpHostile, AMirroringFrameFlipsTheWindingAcrossTheIsolatedReader) {
+    const AnimatedMesh upright = load_character(write("triangle.x", x_file(x_mesh())));
+    ASSERT_EQ(upright.indices.size(), 3u);
+    EXPECT_FALSE(upright.primitives[0].mirrored);
+    std::string mirrored_file = x_file(x_mesh());
+    const std::string identity = kIdentity;
+    mirrored_file.replace(mirrored_file.find(identity), 3, "-1.");
+    const AnimatedMesh m = load_character(write("mirrored.x", mirrored_file));
+    ASSERT_EQ(m.primitives.size(), 1u);
+    EXPECT_TRUE(m.primitives[0].mirrored);
+    EXPECT_EQ(m.indices, (std::vector<uint32_t>{upright.indices[0], upright.indices[2], upright.indices[1]}));
+    for (size_t v = 0; v < 3; ++v) EXPECT_EQ(m.keyframe(0)[3 * v], -upright.keyframe(0)[3 * v]) << v;
+}
+
 TEST_F(AssimpHostile, LongClipsAreCheckedAgainstTheBudgetBeforeSampling) {
     // Two keys 83,000 ticks apart at 25 ticks per second: 3,320 s, 99,601 keyframes at 30/s —
     // under the 100,000 cap, so only the budget stops a big character's 2.5 GB.

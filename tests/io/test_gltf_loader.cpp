@@ -614,6 +614,86 @@ TEST(GltfCharacters, GanfaulSkinsWithoutStretching) {
 
 // Material flags: each primitive carries its material's doubleSided and alphaMode (glTF's
 // defaults, single-sided OPAQUE, without a material); an unknown alphaMode is a one-line error.
+// glTF 2.0: "the determinant of the node's global transform defines the winding order" (clockwise
+// front faces when it is negative), and engines flip their culling for it (three.js: frontFaceCW
+// from the mesh object's world matrix, which for a skinned mesh is its node's, though the skin
+// ignores it for positions). Worked out by hand for one triangle, counter-clockwise seen from +Z in
+// the file: mirrored in x it lies clockwise seen from +Z, and the engine draws it from +Z; the
+// loader flips its corners so that, as everywhere, front faces are counter-clockwise.
+TEST_F(GltfLoader, AMirroringNodeTransformGivesClockwiseFrontFacesAsEnginesDrawThem) {
+    const auto build = [](const json& parent, const json& node, bool skinned) {
+        Gltf g;
+        const int p = g.floats({0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3", 3), i = g.u16({0, 1, 2}, "SCALAR", 1);
+        json primitive = {{"attributes", {{"POSITION", p}}}, {"indices", i}};
+        json mesh_node = node;
+        mesh_node["mesh"] = 0;
+        if (skinned) {
+            primitive["attributes"]["JOINTS_0"] = g.u16({0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0}, "VEC4", 4);
+            primitive["attributes"]["WEIGHTS_0"] = g.floats({1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0}, "VEC4", 4);
+            mesh_node["skin"] = 0;
+            g.doc["skins"] = json::array({json{{"joints", {2}}}});
+        }
+        g.doc["meshes"] = json::array({json{{"primitives", json::array({primitive})}}});
+        json holder = parent;
+        holder["children"] = {1};
+        g.doc["nodes"] = json::array({holder, mesh_node, json{{"name", "joint"}}});
+        g.doc["scenes"] = json::array({json{{"nodes", {0, 2}}}});
+        return g;
+    };
+    // The loaded triangle's orientation seen from +Z: + counter-clockwise, − clockwise.
+    const auto seen_from_z = [](const AnimatedMesh& m) {
+        const float* k = m.keyframe(0);
+        const float* a = k + 3 * m.indices[0];
+        const float* b = k + 3 * m.indices[1];
+        const float* c = k + 3 * m.indices[2];
+        return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+    };
+    const json mirror_x = {{"scale", {-1, 1, 1}}};
+    // Upright: kept as the file has it.
+    AnimatedMesh m = load_gltf(write("upright.gltf", build(json::object(), json::object(), false).text()));
+    EXPECT_FALSE(m.primitives[0].mirrored);
+    EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 2}));
+    EXPECT_GT(seen_from_z(m), 0);
+    // Mirrored by its parent: vertex 1 at (−1, 0, 0), corners 0, 2, 1, counter-clockwise from +Z.
+    m = load_gltf(write("mirrored.gltf", build(mirror_x, json::object(), false).text()));
+    EXPECT_TRUE(m.primitives[0].mirrored);
+    EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 2, 1}));
+    expect_position(m, 0, 1, -1, 0, 0);
+    EXPECT_GT(seen_from_z(m), 0);
+    std::vector<uint32_t> as_written = m.indices;
+    to_file_winding(m, as_written.data());
+    EXPECT_EQ(as_written, (std::vector<uint32_t>{0, 1, 2}));
+    // Two mirrors make a rotation: upright. A matrix mirrors as TRS does.
+    m = load_gltf(write("twice.gltf", build(mirror_x, json{{"scale", {1, -1, 1}}}, false).text()));
+    EXPECT_FALSE(m.primitives[0].mirrored);
+    EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 2}));
+    m = load_gltf(write(
+        "matrix.gltf",
+        build(json{{"matrix", {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, -2, 0, 0, 0, 0, 1}}}, json::object(), false).text()));
+    EXPECT_TRUE(m.primitives[0].mirrored);
+    // Skinned: the skin ignores the node's transform for positions (the triangle stays where it
+    // is, clockwise from +Z as loaded), but the node's determinant still sets the file's winding.
+    m = load_gltf(write("skinned.gltf", build(mirror_x, json::object(), true).text()));
+    EXPECT_TRUE(m.primitives[0].mirrored);
+    expect_position(m, 0, 1, 1, 0, 0);
+    EXPECT_LT(seen_from_z(m), 0);
+
+    // A scale animated through zero to −1: one index buffer cannot have both windings.
+    Gltf g = build(json::object(), json::object(), false);
+    const int t = g.floats({0, 1}, "SCALAR", 1), v = g.floats({1, 1, 1, -1, 1, 1}, "VEC3", 3);
+    g.doc["animations"] = json::array(
+        {json{{"samplers", json::array({json{{"input", t}, {"output", v}}})},
+              {"channels", json::array({json{{"sampler", 0}, {"target", {{"node", 0}, {"path", "scale"}}}}})}}});
+    expect_load_error("flips.gltf", g.text(), "mirrors its mesh in some keyframes and not in others");
+    // Flattened on the way (a scale of 0 says neither) and mirrored after: mirrored.
+    g.doc["accessors"][size_t(v)]["count"] = 2;
+    const int v0 = g.floats({0, 1, 1, -1, 1, 1}, "VEC3", 3);
+    g.doc["animations"][0]["samplers"][0]["output"] = v0;
+    m = load_gltf(write("flattened.gltf", g.text()));
+    EXPECT_TRUE(m.primitives[0].mirrored);
+    EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 2, 1}));
+}
+
 TEST_F(GltfLoader, PrimitivesCarryTheirMaterialFlags) {
     Gltf g;
     const std::vector<float> pos = {0, 0, 0, 1, 0, 0, 1, 1, 0};

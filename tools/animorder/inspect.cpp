@@ -31,8 +31,9 @@ void print_inspect_text(const AnimatedMesh& mesh, const std::string& input_name,
                 mesh.vertex_count, mesh.joint_count, mesh.morph_target_count, mesh.keyframe_count());
     std::printf("  ACMR %.4f  ATVR %.4f  (FIFO cache of %u, current order)\n", cache.acmr, cache.atvr, cache_size);
     for (const Primitive& p : mesh.primitives)
-        std::printf("  primitive %-12s triangles %zu  %s  %s\n", p.name.c_str(), p.index_count / 3,
-                    p.double_sided ? "double-sided" : "single-sided", alpha_mode_name(p.alpha_mode));
+        std::printf("  primitive %-12s triangles %zu  %s  %s%s\n", p.name.c_str(), p.index_count / 3,
+                    p.double_sided ? "double-sided" : "single-sided", alpha_mode_name(p.alpha_mode),
+                    p.mirrored ? "  mirrored (clockwise front faces in the file)" : "");
     const std::vector<float> radii = clip_radii(mesh);
     for (size_t i = 0; i < mesh.clips.size(); ++i) {
         const Clip& c = mesh.clips[i];
@@ -66,7 +67,8 @@ int run_inspect(const InspectOptions& options) {
                                         {"triangles", p.index_count / 3},
                                         {"vertices", vertices},
                                         {"double_sided", p.double_sided},
-                                        {"alpha_mode", alpha_mode_name(p.alpha_mode)}});
+                                        {"alpha_mode", alpha_mode_name(p.alpha_mode)},
+                                        {"mirrored", p.mirrored}});
     }
     const std::vector<float> radii = clip_radii(mesh);
     for (size_t i = 0; i < mesh.clips.size(); ++i)

@@ -8,6 +8,7 @@
 // matches one triangle of PROCESSED and every processed primitive is wholly matched or untouched.
 #include "commands.h"
 
+#include "animorder/animated_mesh.h"
 #include "animorder/atomic_write.h"
 #include "animorder/gltf_extension.h"
 #include "animorder/gltf_loader.h"
@@ -62,6 +63,10 @@ int run_reapply(const ReapplyOptions& options) {
     load.max_keyframe_bytes = options.max_memory;
     const AnimatedMesh a = load_gltf(options.optimized, load);
     const AnimatedMesh b = load_gltf(options.processed, load);
+    // The triangles as the files have them (a mirrored primitive's are flipped on loading).
+    std::vector<uint32_t> a_file = a.indices, b_file = b.indices;
+    to_file_winding(a, a_file.data());
+    to_file_winding(b, b_file.data());
 
     // The keyframes compared: the first of every clip both files have (by name), else keyframe 0.
     std::vector<size_t> ka, kb;
@@ -85,7 +90,7 @@ int run_reapply(const ReapplyOptions& options) {
                     throw std::runtime_error(options.optimized + ": primitive " + std::to_string(e.mesh) + "/" +
                                              std::to_string(e.primitive) + " reads back with another index count");
                 for (size_t i = 0; i < p.index_count; ++i)
-                    if (a.indices[p.first_index + i] != e.indices[i] + p.vertex_base)
+                    if (a_file[p.first_index + i] != e.indices[i] + p.vertex_base)
                         throw std::runtime_error(options.optimized + ": primitive " + std::to_string(e.mesh) + "/" +
                                                  std::to_string(e.primitive) + " reads back with other indices");
                 Source s{&e, p.first_index / 3, p.index_count / 3, {}};
@@ -159,7 +164,7 @@ int run_reapply(const ReapplyOptions& options) {
                     const int64_t t = b_of_a[s.first_triangle + q];
                     if (t < int64_t(first) || t >= int64_t(last)) continue;
                     for (size_t c = 0; c < 3; ++c)
-                        po.orders.push_back(uint32_t(b.indices[3 * size_t(t) + c] - p.vertex_base));
+                        po.orders.push_back(uint32_t(b_file[3 * size_t(t) + c] - p.vertex_base));
                 }
         out.push_back(std::move(po));
     }

@@ -191,6 +191,7 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
         std::vector<float> weights;
         std::vector<size_t> bone_node;  // per bone: its node
         std::vector<aiMatrix4x4> offset;
+        std::vector<unsigned> unweighted;  // of a skinned mesh: the vertices no bone weighs (rigid with its node)
     };
     constexpr size_t kInfluences = 8;
     AnimatedMesh mesh;
@@ -205,7 +206,7 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
                 stand_in = true;
                 continue;
             }
-            Part part{m, n, mesh.vertex_count, {}, {}, {}, {}};
+            Part part{m, n, mesh.vertex_count, {}, {}, {}, {}, {}};
             Primitive prim;
             prim.name = m->mName.length ? m->mName.C_Str() : "mesh" + std::to_string(parts.size());
             prim.first_index = mesh.indices.size();
@@ -256,6 +257,10 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
                     }
                 }
                 mesh.joint_count = std::max<size_t>(mesh.joint_count, m->mNumBones);
+                for (unsigned v = 0; v < m->mNumVertices; ++v) {
+                    const float* ws = &part.weights[size_t(v) * kInfluences];
+                    if (!(*std::max_element(ws, ws + kInfluences) > 0.0f)) part.unweighted.push_back(v);
+                }
             }
             mesh.vertex_count += m->mNumVertices;
             mesh.primitives.push_back(prim);
@@ -356,6 +361,13 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
                 } catch (const InvalidInput& e) {
                     throw LoadError(path + ": " + e.what());
                 }
+                // A vertex no bone weighs (FBX and .X allow it) stays with its mesh's node, as at
+                // the bind pose, rather than at its mesh-space coordinates.
+                for (const unsigned v : part.unweighted) {
+                    const aiVector3D p = global[part.node] * m->mVertices[v];
+                    float* o = out + 3 * (part.vertex_base + v);
+                    o[0] = p.x, o[1] = p.y, o[2] = p.z;
+                }
             } else {
                 const aiMatrix4x4& g = global[part.node];
                 for (unsigned v = 0; v < m->mNumVertices; ++v) {
@@ -449,6 +461,8 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
                 first = std::min(first, ch->mPositionKeys[k].mTime), last = std::max(last, ch->mPositionKeys[k].mTime);
             for (unsigned k = 0; k < ch->mNumRotationKeys; ++k)
                 first = std::min(first, ch->mRotationKeys[k].mTime), last = std::max(last, ch->mRotationKeys[k].mTime);
+            for (unsigned k = 0; k < ch->mNumScalingKeys; ++k)
+                first = std::min(first, ch->mScalingKeys[k].mTime), last = std::max(last, ch->mScalingKeys[k].mTime);
         }
         if (!(first <= last)) throw LoadError(path + ": clip '" + source.name + "' animates nothing");
         const double keyframes = std::round((last - first) / ticks_per_second * options.sample_rate) + 1;

@@ -320,6 +320,42 @@ TEST_F(AssimpHostile, AMirroringFrameFlipsTheWindingAcrossTheIsolatedReader) {
     for (size_t v = 0; v < 3; ++v) EXPECT_EQ(m.keyframe(0)[3 * v], -upright.keyframe(0)[3 * v]) << v;
 }
 
+// A clip that only scales (the .X AnimationKey of type 1) lasts to its last scaling key: 50 ticks at
+// 25 per second are 2 s, 61 keyframes at 30/s, the last one at twice the size (it had been cut to
+// the position and rotation keys: none, so "animates nothing", or shorter).
+TEST_F(AssimpHostile, AClipOfScalingKeysLastsToItsLastKey) {
+    std::string file = x_file(x_mesh()) +
+                       "AnimationSet grow {\n Animation {\n  { Root }\n  AnimationKey {\n   1;\n   2;\n"
+                       "   0;3;1.0,1.0,1.0;;,\n   50;3;2.0,2.0,2.0;;;\n  }\n }\n}\n";
+    file.insert(file.find('\n') + 1, "AnimTicksPerSecond { 25; }\n");
+    const AnimatedMesh m = load_character(write("grow.x", file));
+    ASSERT_EQ(m.clips.size(), 1u);
+    EXPECT_NEAR(m.clips[0].duration_s, 2.0, 1e-9);
+    EXPECT_EQ(m.clips[0].keyframe_count, 61u);
+    float x_max = 0;
+    for (size_t v = 0; v < 3; ++v) x_max = std::max(x_max, std::fabs(m.keyframe(60)[3 * v]));
+    EXPECT_NEAR(x_max, 2.0f, 1e-5);
+}
+
+// A skinned mesh's vertex that no bone weighs stays with the mesh's node: here the root frame sits
+// at x = 10 and only vertex 0 is weighed (to Bone1, offset identity, so it too sits 10 along x), and
+// all three corners are moved by 10 (vertices 1 and 2 had stayed at their mesh-space coordinates,
+// tearing the triangle 10 units long).
+TEST_F(AssimpHostile, AVertexNoBoneWeighsStaysWithItsMeshsNode) {
+    const std::string translated = "1.0,0.0,0.0,0.0,0.0,1.0,0.0,0.0,0.0,0.0,1.0,0.0,10.0,0.0,0.0,1.0;;";
+    const std::string file =
+        std::string("xof 0303txt 0032\nFrame Root {\nFrameTransformMatrix { ") + translated +
+        " }\nFrame Bone1 {\nFrameTransformMatrix { " + kIdentity + " }\n}\n" +
+        x_mesh("3;0,1,2;;", std::string(" SkinWeights {\n \"Bone1\";\n 1;\n 0;\n 1.0;\n ") + kIdentity + "\n }\n") +
+        "}\n";
+    const AnimatedMesh m = load_character(write("partial.x", file));
+    ASSERT_EQ(m.vertex_count, 3u);
+    EXPECT_EQ(m.joint_count, 1u);
+    std::set<std::array<float, 2>> corners;
+    for (size_t v = 0; v < 3; ++v) corners.insert({m.keyframe(0)[3 * v], m.keyframe(0)[3 * v + 1]});
+    EXPECT_EQ(corners, (std::set<std::array<float, 2>>{{10, 0}, {11, 0}, {10, 1}}));
+}
+
 TEST_F(AssimpHostile, LongClipsAreCheckedAgainstTheBudgetBeforeSampling) {
     // Two keys 83,000 ticks apart at 25 ticks per second: 3,320 s, 99,601 keyframes at 30/s —
     // under the 100,000 cap, so only the budget stops a big character's 2.5 GB.

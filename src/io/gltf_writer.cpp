@@ -78,21 +78,27 @@ void add_extension_used(tinygltf::Model& model, const std::string& name) {
 
 }  // namespace
 
-std::string gltf_with_orders(const std::string& input_path, const std::string& output_path, const AnimatedMesh& mesh,
-                             const MethodBuffers& buffers, uint32_t fallback, const Framing& framing,
-                             const std::string& method, bool binary, std::string* note) {
-    if (fallback >= buffers.orders.size()) throw LoadError(input_path + ": no buffer " + std::to_string(fallback));
-    tinygltf::Model model = io::read_model(input_path);
+void check_gltf_output(const std::string& input_path, const AnimatedMesh& mesh) {
     std::map<std::pair<int, int>, size_t> seen;
     for (size_t i = 0; i < mesh.primitives.size(); ++i) {
         const Primitive& p = mesh.primitives[i];
         if (p.source_mesh < 0) throw LoadError(input_path + ": the mesh was not read from this file");
         if (!seen.emplace(std::make_pair(p.source_mesh, p.source_primitive), i).second)
             throw LoadError(input_path + ": mesh " + std::to_string(p.source_mesh) +
-                            " is drawn by several nodes; glTF output needs one node per mesh (use the sidecar)");
+                            " is drawn by several nodes; glTF output needs one node per mesh (write the sidecar: "
+                            "-o OUT without .glb or .gltf)");
     }
+}
+
+std::string gltf_with_orders(const std::string& input_path, const std::string& output_path, const AnimatedMesh& mesh,
+                             const MethodBuffers& buffers, uint32_t fallback, const Framing& framing,
+                             const std::string& method, bool binary, std::string* note) {
+    if (fallback >= buffers.orders.size()) throw LoadError(input_path + ": no buffer " + std::to_string(fallback));
+    check_gltf_output(input_path, mesh);
+    tinygltf::Model model = io::read_model(input_path);
     std::vector<std::pair<int, int>> rewritten;
-    for (const Primitive& p : mesh.primitives) rewritten.emplace_back(p.source_mesh, p.source_primitive);
+    for (const Primitive& p : mesh.primitives)
+        if (p.index_count > 0) rewritten.emplace_back(p.source_mesh, p.source_primitive);
     const std::vector<int> replaced = io::begin_replacing(model, rewritten);
     std::vector<std::vector<uint32_t>> index_buffers(buffers.orders.size(), std::vector<uint32_t>(mesh.indices.size()));
     for (size_t b = 0; b < buffers.orders.size(); ++b) {
@@ -103,6 +109,7 @@ std::string gltf_with_orders(const std::string& input_path, const std::string& o
 
     const size_t k = buffers.orders.size();
     for (const Primitive& p : mesh.primitives) {
+        if (p.index_count == 0) continue;  // nothing to order, and glTF has no empty accessor
         tinygltf::Primitive& prim = model.meshes[size_t(p.source_mesh)].primitives[size_t(p.source_primitive)];
         // Order b of the primitive is elements [b·n, (b+1)·n) of one accessor (docs/extension).
         std::vector<uint32_t> all(k * p.index_count);

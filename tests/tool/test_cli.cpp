@@ -317,6 +317,47 @@ TEST_F(Cli, ZeroAreaMeshIsAnError) {
     EXPECT_NE(o.err.find("zero area"), std::string::npos) << o.err;
 }
 
+// A mesh two nodes draw cannot take one set of orders per file primitive: glTF output is refused
+// before the method runs (it was refused after all of it), and the sidecar is written. A strip of
+// two indices (no triangle) is left as the file has it: the output had an empty accessor, which
+// glTF forbids, and `check` passes the output.
+TEST_F(Cli, GltfOutputRefusesAnInstancedMeshFirstAndLeavesAnEmptyPrimitiveAlone) {
+    test::Gltf g;
+    const int positions = g.floats({0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0}, "VEC3", 3);
+    const int indices = g.u16({0, 1, 2, 2, 1, 3}, "SCALAR", 1), two = g.u16({0, 1}, "SCALAR", 1);
+    g.doc["meshes"] = {{{"primitives",
+                         {{{"attributes", {{"POSITION", positions}}}, {"indices", indices}},
+                          {{"attributes", {{"POSITION", positions}}}, {"indices", two}, {"mode", 5}}}}}};
+    g.doc["nodes"] = {{{"mesh", 0}}, {{"mesh", 0}, {"translation", {3, 0, 0}}}};
+    g.doc["scenes"] = {{{"nodes", {0, 1}}}};
+    std::ofstream(path("twice.gltf")) << g.text();
+    test::Outcome o = run("optimize --views 12 --resolution 32 " + path("twice.gltf").string() + " -o " +
+                          path("twice-out.glb").string());
+    EXPECT_EQ(o.exit_code, 1);
+    EXPECT_NE(o.err.find("drawn by several nodes"), std::string::npos) << o.err;
+    EXPECT_EQ(o.err.find("single:"), std::string::npos) << "the method ran first: " << o.err;
+    EXPECT_FALSE(fs::exists(path("twice-out.glb")));
+    o = run("optimize -q --views 12 --resolution 32 " + path("twice.gltf").string() + " -o " +
+            path("twice-out").string());
+    EXPECT_EQ(o.exit_code, 0) << o.err;
+    EXPECT_TRUE(fs::exists(path("twice-out.animorder.bin")));
+
+    g.doc["nodes"] = {{{"mesh", 0}}};
+    g.doc["scenes"] = {{{"nodes", {0}}}};
+    std::ofstream(path("once.gltf")) << g.text();
+    o = run("optimize -q --views 12 --resolution 32 " + path("once.gltf").string() + " -o " +
+            path("once-out.gltf").string());
+    ASSERT_EQ(o.exit_code, 0) << o.err;
+    using nlohmann::json;
+    const json out = json::parse(test::slurp(path("once-out.gltf")));
+    const json& strip = out["meshes"][0]["primitives"][1];
+    EXPECT_EQ(strip["mode"], 5);
+    EXPECT_FALSE(strip.contains("extensions")) << strip;
+    EXPECT_EQ(out["accessors"][strip["indices"].get<size_t>()]["count"], 2);
+    for (const json& a : out["accessors"]) EXPECT_GT(a["count"].get<size_t>(), 0u) << a;
+    EXPECT_EQ(run("check " + path("once-out.gltf").string()).exit_code, 0);
+}
+
 // tipsify-per-frame writes one buffer per keyframe, which a clip's lookup table names in byte-sized
 // cells: a clip of more than 256 keyframes cannot be written. The run says so, naming the clip,
 // before the method runs (it used to fail after all of it with "the sidecar needs one lookup table

@@ -104,6 +104,7 @@ OptimizeProduct produce_optimize(const OptimizeOptions& options, const OptimizeP
     common.threads = settings.clustering.threads;
     product.mesh = load_drawable_input(common, input_name, &product.files_read);
     check_output_paths(plan.outputs, product.files_read);
+    if (!plan.gltf.empty()) check_gltf_output(options.common.input, product.mesh);  // before the work
     if (loaded) loaded(product.files_read);
     const AnimatedMesh& mesh = product.mesh;
     if (method == Method::TipsifyPerFrame && (!paths.gltf.empty() || !paths.sidecar.empty()))

@@ -68,11 +68,21 @@ int run_reapply(const ReapplyOptions& options) {
     to_file_winding(a, a_file.data());
     to_file_winding(b, b_file.data());
 
-    // The keyframes compared: the first of every clip both files have (by name), else keyframe 0.
+    // The keyframes compared: the first of up to four clips both files have, else keyframe 0. A clip
+    // pairs with the clip of its name in the other file; where several share that name (Mixamo's
+    // "mixamo.com", "Take 001"), with the one of its animation index, else none.
     std::vector<size_t> ka, kb;
-    for (const Clip& ca : a.clips)
+    for (const Clip& ca : a.clips) {
+        const Clip* pair = nullptr;
+        size_t named = 0;
         for (const Clip& cb : b.clips)
-            if (ca.name == cb.name && ka.size() < 4) ka.push_back(ca.first_keyframe), kb.push_back(cb.first_keyframe);
+            if (cb.name == ca.name) {
+                ++named;
+                if (!pair || cb.source_animation == ca.source_animation) pair = &cb;
+            }
+        if (named > 1 && pair && pair->source_animation != ca.source_animation) pair = nullptr;
+        if (pair && ka.size() < 4) ka.push_back(ca.first_keyframe), kb.push_back(pair->first_keyframe);
+    }
     if (ka.empty()) ka = {0}, kb = {0};
 
     // OPTIMIZED's primitives with orders, and each order as a permutation of its drawn triangles.

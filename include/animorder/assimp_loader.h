@@ -15,7 +15,9 @@ namespace animorder {
 // channels drive the character's joints by node name; each adds its animations as clips (named
 // after the file), and a file none of whose joints the character has is an error. Clip files whose
 // rest skeleton differs from the character's by more than 2% of its size are refused, naming the
-// joint. assimp runs in a child process, so a crash inside it is a LoadError, never a signal.
+// joint (except an .md5anim, whose baseframe is no bind pose). A mesh's vertex no bone weighs stays
+// with its node. A mesh whose node transform mirrors it is flipped to counter-clockwise front
+// faces (Primitive::mirrored). assimp runs in a child process, so a crash inside it is a LoadError, never a signal.
 AnimatedMesh load_assimp(const std::string& path, const std::vector<std::string>& clip_files = {},
                          const LoadOptions& options = {});
 

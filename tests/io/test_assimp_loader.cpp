@@ -398,6 +398,27 @@ TEST(AssimpCharacters, AnotherCharactersMixamoClipIsRefused) {
     EXPECT_NO_THROW(load_character(witch, {kData + "pg-witch/anims/Run.fbx"}));
 }
 
+// A Doom 3 character's own .md5anim under another name, given as a clip file, loads as the same
+// clip as when it sits beside the mesh under the mesh's name: the skeleton rule does not apply to
+// an .md5anim (its baseframe is no bind pose; it refused Bob's own walk for its 'lamp' joint).
+TEST_F(AssimpHostile, AnMd5CharactersOwnAnimationLoadsAsAClipFile) {
+    const std::string mesh = kData + "md5-bob/Bob.md5mesh", anim = kData + "md5-bob/Bob.md5anim";
+    ANIMORDER_REQUIRE_DATA(mesh);
+    ANIMORDER_REQUIRE_DATA(anim);
+    fs::copy_file(mesh, path("Bob.md5mesh"));
+    fs::copy_file(anim, path("walk.md5anim"));
+    const AnimatedMesh own = load_character(mesh);
+    const AnimatedMesh m = load_character(path("Bob.md5mesh").string(), {path("walk.md5anim").string()});
+    ASSERT_EQ(m.clips.size(), 1u);
+    EXPECT_EQ(m.clips[0].name, "walk");
+    EXPECT_EQ(m.keyframe_count(), own.keyframe_count());
+    ASSERT_EQ(m.keyframe_positions.size(), own.keyframe_positions.size());
+    float worst = 0;  // the clip file's importer rounds the joints' transforms its own way
+    for (size_t i = 0; i < m.keyframe_positions.size(); ++i)
+        worst = std::max(worst, std::fabs(m.keyframe_positions[i] - own.keyframe_positions[i]));
+    EXPECT_LT(worst, 1e-3f);  // Bob is about 100 units tall
+}
+
 // Material flags through assimp and the isolated reader's serialisation: OBJ's `d` (dissolve)
 // below 1 is BLEND; a material without it OPAQUE; OBJ has no two-sided flag.
 TEST_F(AssimpHostile, MaterialFlagsTravelThroughTheIsolatedReader) {

@@ -164,6 +164,17 @@ AnimatedMesh load_iqm(const std::string& path, const LoadOptions& options) {
             if (j >= num_joints)
                 throw b.fail("a vertex names joint " + std::to_string(j) + ", there are " + std::to_string(num_joints));
 
+    // A frame holds one value per set mask bit of every pose: fewer channels in the header would
+    // read each frame's last poses from the next frame.
+    if (num_frames > 0) {
+        size_t keyed = 0;
+        for (size_t j = 0; j < num_poses; ++j)
+            keyed += size_t(__builtin_popcount(b.u32(ofs_poses + 88 * j + 4) & 0x3FFu));
+        if (keyed != num_channels)
+            throw b.fail("its poses animate " + std::to_string(keyed) + " channels a frame, its header says " +
+                         std::to_string(num_channels));
+    }
+
     // Positions at one frame (or the bind pose when frame < 0).
     auto frame_positions = [&](long frame) {
         std::vector<float> out(positions);
@@ -211,8 +222,6 @@ AnimatedMesh load_iqm(const std::string& path, const LoadOptions& options) {
         if (count == 0 || size_t(first) + count > num_frames)
             throw b.fail("animation " + std::to_string(a) + " names missing frames");
         if (!std::isfinite(rate)) throw b.fail("animation " + std::to_string(a) + " has an infinite frame rate");
-        // Its frames, skinned before they are resampled into keyframes.
-        io::check_keyframe_budget(path, count, num_vertexes, options, "frames of the file");
         Clip clip;
         clip.name = b.text(ofs_text, num_text, b.u32(at));
         if (clip.name.empty()) clip.name = "animation" + std::to_string(a);
@@ -227,16 +236,31 @@ AnimatedMesh load_iqm(const std::string& path, const LoadOptions& options) {
     io::check_keyframe_budget(path, total_keyframes, num_vertexes, options);
     mesh.keyframe_positions.reserve(total_keyframes * positions.size());  // no regrowth
 
+    // Each keyframe interpolates the two frames around it; only those frames are skinned, each once
+    // (keyframes move forward, so the pair slides along), whatever the file's frame count.
     for (size_t a = 0; a < anims.size(); ++a) {
         const auto [first, count, rate] = anims[a];
-        std::vector<std::vector<float>> frames;
-        for (uint32_t f = 0; f < count; ++f) frames.push_back(frame_positions(long(first + f)));
+        std::vector<float> p0, p1;  // the positions of frames k0 and k1
+        size_t k0 = SIZE_MAX, k1 = SIZE_MAX;
         for (size_t k = 0; k < mesh.clips[a].keyframe_count; ++k) {
             const double at_frame = std::min(double(k) / options.sample_rate * rate, double(count - 1));
             const size_t f0 = size_t(at_frame), f1 = std::min<size_t>(f0 + 1, count - 1);
             const float u = float(at_frame - double(f0));
+            if (f0 != k0) {
+                if (f0 == k1)
+                    p0.swap(p1), std::swap(k0, k1);
+                else
+                    p0 = frame_positions(long(first + f0)), k0 = f0;
+            }
+            if (f1 != k1) {
+                if (f1 == k0)
+                    p1 = p0;
+                else
+                    p1 = frame_positions(long(first + f1));
+                k1 = f1;
+            }
             for (size_t i = 0; i < positions.size(); ++i)
-                mesh.keyframe_positions.push_back(frames[f0][i] + u * (frames[f1][i] - frames[f0][i]));
+                mesh.keyframe_positions.push_back(p0[i] + u * (p1[i] - p0[i]));
         }
     }
     if (mesh.clips.empty()) {

@@ -6,6 +6,7 @@
 #include "animorder/load.h"
 #include "support/binary_loader.h"
 #include "support/files.h"
+#include "support/meshes.h"
 
 #include "support/require.h"
 
@@ -117,6 +118,23 @@ protected:
 
 }  // namespace
 
+// An animation of 20 million frames at 20 million frames a second is one second: 31 keyframes, each
+// the interpolation of its two frames, which alone are skinned (every frame was skinned and kept
+// first: 20 million small arrays, 1.6 GB, where a 110-million-frame file of 420 bytes ran out of
+// memory within the loading budget). No channel is keyed, so every keyframe is the bind pose.
+TEST_F(IqmLoader, OnlyTheFramesTheKeyframesInterpolateAreSkinned) {
+    test::ByteImage m = tiny_iqm();
+    m.put<uint32_t>(kPoses + 4, 0);
+    m.put<uint32_t>(kNumChannels, 0);
+    m.put<uint32_t>(kNumFrames, 20000000);
+    m.put<uint32_t>(kAnims + 8, 20000000);
+    m.put<float>(kAnims + 12, 2e7f);
+    const AnimatedMesh a = load_iqm(write("many.iqm", m));
+    ASSERT_EQ(a.clips.size(), 1u);
+    EXPECT_EQ(a.clips[0].keyframe_count, 31u);
+    for (size_t k = 0; k < a.keyframe_count(); ++k) test::expect_position(a, k, 1, 1, 0, 0);
+}
+
 TEST_F(IqmLoader, TinyModelSlidesAsWorkedOutByHand) {
     const AnimatedMesh m = load_iqm(write("tiny.iqm", tiny_iqm()));
     ASSERT_EQ(m.clips.size(), 1u);
@@ -139,8 +157,15 @@ TEST_F(IqmLoader, HostileFilesGiveOneLineErrors) {
         m.put<uint32_t>(kNumChannels, 0);
         m.put<uint32_t>(kNumFrames, 0x7FFFFFFF);
         m.put<uint32_t>(kAnims + 8, 0x7FFFFFFF);
-        expect_error("frames.iqm", m, "loading budget");
-        expect_error("frames.iqm", m, "needs 2147483647 frames of the file x");  // frames, not keyframes
+        expect_error("frames.iqm", m, "is absurdly long");  // 89 million seconds at 30 keyframes a second
+    }
+    {
+        // The pose keys two channels a frame (translate x and y), the header says one: each frame's
+        // second value would be read from the next frame.
+        test::ByteImage m = tiny_iqm();
+        m.put<uint32_t>(kPoses + 4, 3);
+        m.put<float>(kPoses + 52, 1.0f);
+        expect_error("mask.iqm", m, "its poses animate 2 channels a frame, its header says 1");
     }
     expect_field_error(tiny_iqm(), "slow.iqm", kAnims + 12, float(1e-30f),
                        "absurdly long");  // 10^30 s at 30 keyframes per second

@@ -256,7 +256,6 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
                         if (vw.mWeight > ws[weakest]) ws[weakest] = vw.mWeight, js[weakest] = uint16_t(b);
                     }
                 }
-                mesh.joint_count = std::max<size_t>(mesh.joint_count, m->mNumBones);
                 for (unsigned v = 0; v < m->mNumVertices; ++v) {
                     const float* ws = &part.weights[size_t(v) * kInfluences];
                     if (!(*std::max_element(ws, ws + kInfluences) > 0.0f)) part.unweighted.push_back(v);
@@ -271,6 +270,12 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
                         ": no mesh in the file, only a skeleton and its animation (an .md5anim, a .bvh): give "
                         "the character's mesh file as the input and this one as --clip");
     if (parts.empty()) throw LoadError(path + ": no triangle mesh in the file");
+    {  // the skeleton's joints: every node some mesh's bone names, once (meshes share them)
+        std::vector<size_t> bones;
+        for (const Part& part : parts) bones.insert(bones.end(), part.bone_node.begin(), part.bone_node.end());
+        std::sort(bones.begin(), bones.end());
+        mesh.joint_count = size_t(std::unique(bones.begin(), bones.end()) - bones.begin());
+    }
 
     // Clips: the file's own animations, then those of every clip file (matched by node name).
     struct ClipSource {

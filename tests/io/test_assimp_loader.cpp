@@ -384,6 +384,17 @@ TEST_F(AssimpHostile, ClipFilesOfAnotherSkeletonAreRefusedNamingTheJoint) {
     EXPECT_NE(what.find("50.0% of its size 1 "), std::string::npos) << what;
 }
 
+// The joint count is the skeleton's (every node a bone of some mesh names, once), not the largest
+// mesh's bone count: BCN_Epileptic's three meshes have 24, 20 and 10 bones of its 54 joints
+// (../shared/data/README.md), and it reported 24.
+TEST(AssimpCharacters, TheJointCountIsTheSkeletonsAcrossMeshes) {
+    const std::string file = kData + "x-bcn-epileptic/BCN_Epileptic.X";
+    ANIMORDER_REQUIRE_DATA(file);
+    const AnimatedMesh m = load_character(file);
+    EXPECT_EQ(m.primitives.size(), 3u);
+    EXPECT_EQ(m.joint_count, 54u);
+}
+
 TEST(AssimpCharacters, AnotherCharactersMixamoClipIsRefused) {
     const std::string witch = kData + "pg-witch/model.fbx", walk = kData + "pg-barbarian/anims/Dwarf Walk.fbx";
     ANIMORDER_REQUIRE_DATA(witch);

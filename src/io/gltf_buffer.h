@@ -175,13 +175,68 @@ inline void finish_load(bool ok, std::string error, const tinygltf::Model& model
     throw LoadError(path + ": not a readable glTF 2.0 file: " + error);
 }
 
-// tinygltf's load of `path` into `model`, an exception it throws (a buffer of byteLength 0 makes
-// it index an empty vector) taken as a failed load with that message.
+// glTF 2.0 lets an animation channel's target name no node (KHR_animation_pointer's animate what
+// their pointer names: a material, a light, a camera). tinygltf 2.7 drops such a channel, and an
+// animation left without one, renumbering the animations after it; its writer would then leave
+// them out of the output. The file's JSON with "node": 0 put into each such target (a placeholder
+// tinygltf keeps: the loader reads only the times of a path it does not animate, and
+// restore_what_tinygltf_drops takes it out again on writing), or "" when it has none (or no node,
+// or is no JSON).
+inline constexpr const char* kPlaceholderNode = "node";
+inline std::string json_with_placeholder_nodes(const std::string& text) {
+    nlohmann::ordered_json j = nlohmann::ordered_json::parse(text, nullptr, false);
+    if (!j.is_object() || !j.contains("animations") || !j["animations"].is_array() || !j.contains("nodes") ||
+        !j["nodes"].is_array() || j["nodes"].empty())
+        return {};
+    bool changed = false;
+    for (nlohmann::ordered_json& animation : j["animations"])
+        if (animation.is_object() && animation.contains("channels") && animation["channels"].is_array())
+            for (nlohmann::ordered_json& channel : animation["channels"])
+                if (channel.is_object() && channel.contains("target") && channel["target"].is_object() &&
+                    !channel["target"].contains(kPlaceholderNode)) {
+                    channel["target"][kPlaceholderNode] = 0;
+                    changed = true;
+                }
+    return changed ? j.dump() : std::string();
+}
+
+// tinygltf's load of `path` into `model` (with json_with_placeholder_nodes' JSON when it has
+// channels without a node; `budget` bounds the file then read whole, as the loader's file
+// callbacks do), an exception it throws (a buffer of byteLength 0 makes it index an empty vector)
+// taken as a failed load with that message.
 inline bool load_gltf_file(tinygltf::TinyGLTF& loader, tinygltf::Model& model, std::string& error, std::string& warning,
-                           const std::string& path, bool binary) {
+                           const std::string& path, bool binary, const uint64_t* budget) {
     try {
-        return binary ? loader.LoadBinaryFromFile(&model, &error, &warning, path)
-                      : loader.LoadASCIIFromFile(&model, &error, &warning, path);
+        const std::string patched = json_with_placeholder_nodes(gltf_json_text(path));
+        if (patched.empty())
+            return binary ? loader.LoadBinaryFromFile(&model, &error, &warning, path)
+                          : loader.LoadASCIIFromFile(&model, &error, &warning, path);
+        const size_t slash = path.find_last_of("/\\");
+        const std::string base = slash == std::string::npos ? std::string() : path.substr(0, slash);  // tinygltf's
+        constexpr size_t kMost = UINT32_MAX;  // tinygltf takes an unsigned length
+        if (!binary) {
+            if (patched.size() > kMost) return error = path + " is too large", false;
+            return loader.LoadASCIIFromString(&model, &error, &warning, patched.data(), unsigned(patched.size()), base);
+        }
+        std::vector<unsigned char> bytes;
+        if (!read_regular_file(&bytes, &error, path, const_cast<uint64_t*>(budget))) return false;
+        uint32_t json_length = 0;
+        if (bytes.size() >= 20) std::memcpy(&json_length, bytes.data() + 12, 4);
+        if (bytes.size() < 20 || size_t(json_length) > bytes.size() - 20)
+            return loader.LoadBinaryFromFile(&model, &error, &warning, path);  // its own error
+        std::string text = patched;
+        while (text.size() % 4) text.push_back(' ');
+        std::vector<unsigned char> glb(bytes.begin(), bytes.begin() + 12);
+        const uint32_t length = uint32_t(text.size());
+        glb.insert(glb.end(), reinterpret_cast<const unsigned char*>(&length),
+                   reinterpret_cast<const unsigned char*>(&length) + 4);
+        glb.insert(glb.end(), bytes.begin() + 16, bytes.begin() + 20);  // "JSON"
+        glb.insert(glb.end(), text.begin(), text.end());
+        glb.insert(glb.end(), bytes.begin() + 20 + ptrdiff_t(json_length), bytes.end());
+        if (glb.size() > kMost) return error = path + " is too large", false;
+        const uint32_t total = uint32_t(glb.size());
+        std::memcpy(glb.data() + 8, &total, 4);
+        return loader.LoadBinaryFromMemory(&model, &error, &warning, glb.data(), unsigned(glb.size()), base);
     } catch (const std::exception& e) {
         error = e.what();
         return false;
@@ -202,14 +257,84 @@ inline tinygltf::Model read_model(const std::string& path) {
     std::string error, warning;
     const std::string magic = magic_of(path);
     check_json_depth(path);
-    const bool ok = load_gltf_file(loader, model, error, warning, path, magic == "glTF");
+    const bool ok = load_gltf_file(loader, model, error, warning, path, magic == "glTF", &budget);
     finish_load(ok, error, model, path);
     return model;
 }
 
+// What tinygltf 2.7 changes between reading and writing a file, put back from the input's JSON:
+// - the placeholder node of each animation channel whose target had none (json_with_placeholder_
+//   nodes; the writer keeps every animation and channel in place), taken out again;
+// - a perspective camera's absent zfar (an infinite projection), written as 0, which glTF forbids.
+// Returns whether `output` changed.
+inline bool restore_what_tinygltf_drops(const nlohmann::ordered_json& input, nlohmann::ordered_json& output) {
+    bool changed = false;
+    const auto array = [](const nlohmann::ordered_json& j, const char* key) {
+        return j.is_object() && j.contains(key) && j[key].is_array();
+    };
+    const auto object = [](const nlohmann::ordered_json& j, const char* key) {
+        return j.is_object() && j.contains(key) && j[key].is_object();
+    };
+    if (array(input, "animations") && array(output, "animations"))
+        for (size_t a = 0; a < input["animations"].size() && a < output["animations"].size(); ++a) {
+            const nlohmann::ordered_json& in = input["animations"][a];
+            nlohmann::ordered_json& out = output["animations"][a];
+            if (!array(in, "channels") || !array(out, "channels")) continue;
+            for (size_t c = 0; c < in["channels"].size() && c < out["channels"].size(); ++c)
+                if (object(in["channels"][c], "target") && !in["channels"][c]["target"].contains(kPlaceholderNode) &&
+                    object(out["channels"][c], "target") && out["channels"][c]["target"].contains(kPlaceholderNode)) {
+                    out["channels"][c]["target"].erase(kPlaceholderNode);
+                    changed = true;
+                }
+        }
+    if (array(input, "cameras") && array(output, "cameras"))
+        for (size_t c = 0; c < input["cameras"].size() && c < output["cameras"].size(); ++c) {
+            const nlohmann::ordered_json& in = input["cameras"][c];
+            nlohmann::ordered_json& out = output["cameras"][c];
+            if (object(in, "perspective") && !in["perspective"].contains("zfar") && object(out, "perspective") &&
+                out["perspective"].contains("zfar")) {
+                out["perspective"].erase("zfar");
+                changed = true;
+            }
+        }
+    return changed;
+}
+
+// `written` (tinygltf's output: GLB bytes when `binary`, else JSON text) with
+// restore_what_tinygltf_drops applied against the input file's JSON.
+inline std::string restore_from_input(const std::string& input_path, std::string written, bool binary) {
+    const std::string input_text = gltf_json_text(input_path);
+    const nlohmann::ordered_json input = nlohmann::ordered_json::parse(input_text, nullptr, false);
+    if (input.is_discarded()) return written;
+    std::string json_text = written;
+    uint32_t json_length = 0;
+    if (binary) {
+        if (written.size() < 20 || std::memcmp(written.data() + 16, "JSON", 4) != 0) return written;
+        std::memcpy(&json_length, written.data() + 12, 4);
+        if (size_t(json_length) > written.size() - 20) return written;
+        json_text = written.substr(20, json_length);
+    }
+    nlohmann::ordered_json output = nlohmann::ordered_json::parse(json_text, nullptr, false);
+    if (output.is_discarded() || !restore_what_tinygltf_drops(input, output)) return written;
+    if (!binary) return output.dump(2);
+    std::string text = output.dump();
+    while (text.size() % 4) text.push_back(' ');  // chunks are 4-byte aligned, JSON padded with spaces
+    const std::string rest = written.substr(20 + json_length);
+    std::string glb = written.substr(0, 12);
+    const uint32_t length = uint32_t(text.size());
+    glb.append(reinterpret_cast<const char*>(&length), 4);
+    glb.append("JSON", 4);
+    glb += text;
+    glb += rest;
+    const uint32_t total = uint32_t(glb.size());
+    std::memcpy(&glb[8], &total, 4);
+    return glb;
+}
+
 // The model read from input_path as a file at output_path: buffers embedded (every buffer's URI
-// cleared), relative image URIs re-pointed from output_path's folder, images never re-encoded.
-// GLB bytes when `binary`, else glTF JSON text.
+// cleared), relative image URIs re-pointed from output_path's folder, images never re-encoded,
+// and what tinygltf drops put back (restore_from_input). GLB bytes when `binary`, else glTF JSON
+// text.
 inline std::string write_model(tinygltf::Model& model, const std::string& input_path, const std::string& output_path,
                                bool binary) {
     for (tinygltf::Buffer& b : model.buffers) b.uri.clear();
@@ -230,7 +355,7 @@ inline std::string write_model(tinygltf::Model& model, const std::string& input_
     std::ostringstream out;
     if (!writer.WriteGltfSceneToStream(&model, out, !binary, binary))
         throw LoadError(input_path + ": writing the glTF output failed");
-    return out.str();
+    return restore_from_input(input_path, out.str(), binary);
 }
 
 }  // namespace animorder::io

@@ -303,6 +303,7 @@ struct Channel {
     std::string path;
     std::vector<double> times, values;
     std::string interpolation;
+    bool geometry = true;  // translation, rotation, scale or weights; else only its times are read
 };
 
 // A clip and its channels, read before any clip is sampled, so that the keyframes of every clip
@@ -344,7 +345,7 @@ tinygltf::Model parse_file(const std::string& path, const LoadOptions& options) 
     std::string error, warning;
     const std::string magic = io::magic_of(path);
     io::check_json_depth(path);
-    const bool ok = io::load_gltf_file(loader, model, error, warning, path, magic == "glTF");
+    const bool ok = io::load_gltf_file(loader, model, error, warning, path, magic == "glTF", &budget);
     io::finish_load(ok, error, model, path);
     return model;
 }
@@ -579,10 +580,12 @@ Channel parse_channel(const Scene& s, const tinygltf::Animation& anim, const tin
         s.reader.fail("clip '" + name + "' has a sampler of interpolation '" + c.interpolation +
                       "' (glTF has LINEAR, STEP and CUBICSPLINE)");
     c.times = s.reader.read(sampler.input, 1);
-    c.values = s.reader.read(sampler.output);
     if (c.times.empty()) s.reader.fail("clip '" + name + "' has a channel without keys");
     if (!std::is_sorted(c.times.begin(), c.times.end()))
         s.reader.fail("clip '" + name + "' has key times out of order");
+    c.geometry = c.path == "translation" || c.path == "rotation" || c.path == "scale" || c.path == "weights";
+    if (!c.geometry) return c;  // another path (KHR_animation_pointer's): its times only, the clip's length
+    c.values = s.reader.read(sampler.output);
     const size_t components = channel_components(s, c.node, c.path);
     const size_t per_key = (c.interpolation == "CUBICSPLINE" ? 3 : 1) * components;
     if (components == 0 || c.values.size() != per_key * c.times.size())
@@ -681,6 +684,7 @@ void add_keyframe(const Scene& s, const std::vector<NodePose>& pose, AnimatedMes
 std::vector<NodePose> pose_at(const Scene& s, const std::vector<Channel>& channels, double t) {
     std::vector<NodePose> pose = s.rest;
     for (const Channel& c : channels) {
+        if (!c.geometry) continue;
         const bool rotation = c.path == "rotation";
         const std::vector<double> v =
             sample(c.times, c.values, channel_components(s, c.node, c.path), c.interpolation, rotation, t);

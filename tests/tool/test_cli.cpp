@@ -358,6 +358,71 @@ TEST_F(Cli, GltfOutputRefusesAnInstancedMeshFirstAndLeavesAnEmptyPrimitiveAlone)
     EXPECT_EQ(run("check " + path("once-out.gltf").string()).exit_code, 0);
 }
 
+// glTF 2.0 lets a channel name no node (KHR_animation_pointer animates a material, a light, a
+// camera), and a perspective camera leave out zfar (infinite). tinygltf drops such channels when
+// reading (and an animation left without any, renumbering the rest), and writes an absent zfar as
+// 0 (invalid). A clip of only such channels is a clip of a still mesh for its keys' length (it was
+// refused: "animates nothing"); the output has every animation and channel of the input, as the
+// input has them (they had vanished, so the animation did less), and no zfar.
+TEST_F(Cli, ChannelsWithoutANodeAndAnInfiniteCameraSurviveTheOutput) {
+    using nlohmann::json;
+    test::Gltf g;
+    const int positions = g.floats({0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3", 3);
+    const int indices = g.u16({0, 1, 2}, "SCALAR", 1);
+    const int times = g.floats({0.0f, 1.0f}, "SCALAR", 1);
+    const int moves = g.floats({0, 0, 0, 1, 0, 0}, "VEC3", 3);
+    const int colours = g.floats({1, 1, 1, 1, 0, 0, 0, 1}, "VEC4", 4);
+    g.doc["accessors"][size_t(times)]["min"] = {0.0};
+    g.doc["accessors"][size_t(times)]["max"] = {1.0};
+    g.doc["materials"] = {{{"name", "skin"}}};
+    g.doc["meshes"] = {
+        {{"primitives", {{{"attributes", {{"POSITION", positions}}}, {"indices", indices}, {"material", 0}}}}}};
+    g.doc["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", 0.8}, {"znear", 0.1}}}}};
+    g.doc["nodes"] = {{{"mesh", 0}}, {{"camera", 0}, {"translation", {0, 0, 5}}}};
+    g.doc["scenes"] = {{{"nodes", {0, 1}}}};
+    g.doc["extensionsUsed"] = {"KHR_animation_pointer"};
+    const json pointer = {
+        {"sampler", 1},
+        {"target",
+         {{"path", "pointer"},
+          {"extensions",
+           {{"KHR_animation_pointer", {{"pointer", "/materials/0/pbrMetallicRoughness/baseColorFactor"}}}}}}}};
+    const json move = {{"sampler", 0}, {"target", {{"node", 0}, {"path", "translation"}}}};
+    const json samplers = {{{"input", times}, {"output", moves}}, {{"input", times}, {"output", colours}}};
+    g.doc["animations"] = {{{"name", "move"}, {"samplers", samplers}, {"channels", {move}}},
+                           {{"name", "blink"}, {"samplers", samplers}, {"channels", {pointer}}},
+                           {{"name", "both"}, {"samplers", samplers}, {"channels", {move, pointer}}}};
+    std::ofstream(path("pointer.gltf")) << g.text();
+    test::Outcome o = run("inspect --json -q " + path("pointer.gltf").string());
+    ASSERT_EQ(o.exit_code, 0) << o.err;
+    const json clips = json::parse(o.out)["clips"];
+    ASSERT_EQ(clips.size(), 3u) << clips;
+    EXPECT_EQ(clips[1]["name"], "blink");
+    EXPECT_EQ(clips[1]["keyframes"], 31);  // 1 s at 30 a second
+    EXPECT_EQ(clips[2]["name"], "both");
+    for (const std::string out : {"pointer-out.gltf", "pointer-out.glb"}) {
+        SCOPED_TRACE(out);
+        o = run("optimize -q --views 12 --resolution 32 " + path("pointer.gltf").string() + " -o " +
+                path(out).string());
+        ASSERT_EQ(o.exit_code, 0) << o.err;
+        o = run("check " + path(out).string());
+        EXPECT_EQ(o.exit_code, 0) << o.out << o.err;
+        o = run("subdivide -q --levels 0 " + path(out).string() + " -o " + path("copy.gltf").string());
+        EXPECT_EQ(o.exit_code, 0) << o.err;  // the output reads back
+    }
+    const json written = json::parse(test::slurp(path("pointer-out.gltf")));
+    ASSERT_EQ(written["animations"].size(), 3u) << written["animations"];
+    for (size_t a = 0; a < 3; ++a) {
+        EXPECT_EQ(written["animations"][a]["name"], g.doc["animations"][a]["name"]);
+        EXPECT_EQ(written["animations"][a]["channels"], g.doc["animations"][a]["channels"]) << a;
+    }
+    const json ours = written["extensions"]["ANIMORDER_animated_triangle_orders"]["clips"];
+    ASSERT_EQ(ours.size(), 3u);
+    for (size_t c = 0; c < 3; ++c) EXPECT_EQ(ours[c]["animation"], c);
+    EXPECT_FALSE(written["cameras"][0]["perspective"].contains("zfar")) << written["cameras"];
+    EXPECT_NEAR(written["cameras"][0]["perspective"]["znear"].get<double>(), 0.1, 1e-12);
+}
+
 // tipsify-per-frame writes one buffer per keyframe, which a clip's lookup table names in byte-sized
 // cells: a clip of more than 256 keyframes cannot be written. The run says so, naming the clip,
 // before the method runs (it used to fail after all of it with "the sidecar needs one lookup table

@@ -90,7 +90,8 @@ bool has_mirrored_primitives(const AnimatedMesh& mesh);
 // True when some primitive blends (AlphaMode::Blend).
 bool has_blended_primitives(const AnimatedMesh& mesh);
 
-// The mesh with only the named clips (in the order named) and their keyframes. Throws
+// The mesh with only the named clips (in the order named; several clips of one name all, in the
+// mesh's order) and their keyframes. Throws
 // InvalidInput naming a clip that does not exist and the clips that do.
 AnimatedMesh select_clips(const AnimatedMesh& mesh, const std::vector<std::string>& names);
 

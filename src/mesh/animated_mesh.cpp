@@ -107,20 +107,24 @@ AnimatedMesh select_clips(const AnimatedMesh& mesh, const std::vector<std::strin
     out.keyframe_positions.clear();
     const size_t frame_floats = mesh.vertex_count * 3;
     for (const std::string& name : names) {
-        const Clip* found = nullptr;
-        for (const Clip& c : mesh.clips) found = c.name == name ? &c : found;
+        bool found = false;  // every clip of that name, in the mesh's order (Mixamo names each "mixamo.com")
+        for (const Clip& clip : mesh.clips) {
+            if (clip.name != name) continue;
+            found = true;
+            Clip c = clip;
+            c.first_keyframe = out.keyframe_count();
+            out.keyframe_positions.insert(
+                out.keyframe_positions.end(),
+                mesh.keyframe_positions.begin() + ptrdiff_t(clip.first_keyframe * frame_floats),
+                mesh.keyframe_positions.begin() +
+                    ptrdiff_t((clip.first_keyframe + clip.keyframe_count) * frame_floats));
+            out.clips.push_back(c);
+        }
         if (!found) {
             std::string known;
             for (const Clip& c : mesh.clips) known += (known.empty() ? "" : ", ") + c.name;
             throw InvalidInput("no clip named '" + name + "' (clips: " + known + ")");
         }
-        Clip c = *found;
-        c.first_keyframe = out.keyframe_count();
-        out.keyframe_positions.insert(out.keyframe_positions.end(),
-                                      mesh.keyframe_positions.begin() + ptrdiff_t(found->first_keyframe * frame_floats),
-                                      mesh.keyframe_positions.begin() +
-                                          ptrdiff_t((found->first_keyframe + found->keyframe_count) * frame_floats));
-        out.clips.push_back(c);
     }
     return out;
 }

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <string>
@@ -77,4 +78,23 @@ TEST(AnimatedMesh, NamesTheFirstPositionThatIsNotFinite) {
     extreme.keyframe_positions[2] = 1e-45f;
     extreme.keyframe_positions[3] = -0.0f;
     EXPECT_NO_THROW(validate_animated_mesh(extreme));
+}
+
+// Clips that share a name (Mixamo names every animation "mixamo.com") are all kept when that name
+// is asked, in the mesh's order, each with its own keyframes (the last of them alone was kept).
+TEST(AnimatedMesh, SelectingANameSeveralClipsShareKeepsThemAll) {
+    AnimatedMesh m = good();
+    m.keyframe_positions.resize(4 * 4 * 3);
+    for (size_t k = 0; k < 4; ++k)
+        std::fill(m.keyframe_positions.begin() + ptrdiff_t(k * 12),
+                  m.keyframe_positions.begin() + ptrdiff_t(k * 12 + 12), float(k));
+    m.clips = {{"mixamo.com", 0, 30, 0, 1}, {"idle", 1.0 / 30, 30, 1, 2}, {"mixamo.com", 0, 30, 3, 1}};
+    const AnimatedMesh s = select_clips(m, {"mixamo.com"});
+    ASSERT_EQ(s.clips.size(), 2u);
+    EXPECT_EQ(s.clips[0].first_keyframe, 0u);
+    EXPECT_EQ(s.clips[1].first_keyframe, 1u);
+    ASSERT_EQ(s.keyframe_count(), 2u);
+    EXPECT_EQ(s.keyframe(0)[0], 0.0f);
+    EXPECT_EQ(s.keyframe(1)[0], 3.0f);
+    EXPECT_NO_THROW(validate_animated_mesh(s));
 }

@@ -32,8 +32,8 @@ std::string lower_extension(const std::string& path) {
     return extension;
 }
 
-// A clip folder stands for its regular files, in name order. Filesystem errors (a link loop, a
-// folder that cannot be listed) are LoadErrors naming the path.
+// A clip folder stands for its regular files but hidden ones (.DS_Store), in name order.
+// Filesystem errors (a link loop, a folder that cannot be listed) are LoadErrors naming the path.
 std::vector<std::string> expand_clip_files(const std::vector<std::string>& clip_files) {
     namespace fs = std::filesystem;
     std::vector<std::string> files;
@@ -46,7 +46,9 @@ std::vector<std::string> expand_clip_files(const std::vector<std::string>& clip_
         std::vector<std::string> inside;
         for (fs::directory_iterator it(c, error); !error && it != fs::directory_iterator(); it.increment(error)) {
             std::error_code entry_error;
-            if (it->is_regular_file(entry_error)) inside.push_back(it->path().string());
+            // A hidden file (.DS_Store, an editor's swap file) is no clip; any other file is read.
+            if (it->is_regular_file(entry_error) && it->path().filename().string().rfind('.', 0) != 0)
+                inside.push_back(it->path().string());
         }
         if (error) throw LoadError(c + ": cannot list the clip folder: " + error.message());
         std::sort(inside.begin(), inside.end());

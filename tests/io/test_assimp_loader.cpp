@@ -356,6 +356,20 @@ TEST_F(AssimpHostile, AVertexNoBoneWeighsStaysWithItsMeshsNode) {
     EXPECT_EQ(corners, (std::set<std::array<float, 2>>{{10, 0}, {11, 0}, {10, 1}}));
 }
 
+// A clip folder's hidden files (macOS leaves .DS_Store in every folder it shows) are no clips: the
+// folder loads (it failed on assimp's "No suitable reader"); another stray file still fails.
+TEST_F(AssimpHostile, AClipFoldersHiddenFilesAreNoClips) {
+    const std::string character = write("character.x", x_skinned("1.0"));
+    fs::create_directories(path("clips"));
+    write("clips/run.x", x_skinned("1.0", 20));
+    write("clips/.DS_Store", std::string("\0\0\0\1Bud1", 8));
+    const AnimatedMesh m = load_character(character, {path("clips").string()});
+    ASSERT_EQ(m.clips.size(), 2u);
+    EXPECT_EQ(m.clips[1].name, "run");
+    write("clips/notes.txt", "not a clip");
+    EXPECT_NE(load_error(character, {path("clips").string()}).find("notes.txt"), std::string::npos);
+}
+
 TEST_F(AssimpHostile, LongClipsAreCheckedAgainstTheBudgetBeforeSampling) {
     // Two keys 83,000 ticks apart at 25 ticks per second: 3,320 s, 99,601 keyframes at 30/s —
     // under the 100,000 cap, so only the budget stops a big character's 2.5 GB.

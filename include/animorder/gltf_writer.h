@@ -11,8 +11,9 @@
 namespace animorder {
 
 // Throws LoadError when gltf_with_orders cannot write `mesh`'s orders into `input_path`: a
-// primitive not read from that file, or a mesh several nodes draw (one set of orders per file
-// primitive). Callers run it before the method, so that the refusal comes before the work.
+// primitive not read from that file. Callers run it before the method, so that the refusal comes
+// before the work. (A mesh several nodes draw is written once, from its first instance: run_method
+// gives the instances one order.)
 void check_gltf_output(const std::string& input_path, const AnimatedMesh& mesh);
 
 // The glTF file `input_path` (which `mesh` was loaded from) with the method's orders in the

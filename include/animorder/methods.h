@@ -152,7 +152,16 @@ struct MethodResult {
 };
 
 // Runs the method on the whole mesh. Throws InvalidInput for an invalid mesh or settings.
+// Primitives loaded from one file primitive (a glTF mesh several nodes draw) share its one index
+// buffer, so every buffer gives them the first one's order (tie_instances; the k-means runs'
+// statistics are of the orders before that step, ACMR after).
 MethodResult run_method(const AnimatedMesh& mesh, Method method, const MethodSettings& settings = {});
+
+// In `order` (a permutation of the mesh's triangles that keeps each primitive's in its range), each
+// later primitive of a file primitive (same source_mesh and source_primitive, source_mesh ≥ 0)
+// takes the first one's order, triangle for triangle. Throws InvalidInput when they differ in size
+// or the order moves triangles between primitives.
+void tie_instances(const AnimatedMesh& mesh, std::vector<uint32_t>& order);
 
 // ---------------------------------------------------------------------------------------------
 // The building blocks run_method composes (tests and benchmarks call them alone)

@@ -79,15 +79,8 @@ void add_extension_used(tinygltf::Model& model, const std::string& name) {
 }  // namespace
 
 void check_gltf_output(const std::string& input_path, const AnimatedMesh& mesh) {
-    std::map<std::pair<int, int>, size_t> seen;
-    for (size_t i = 0; i < mesh.primitives.size(); ++i) {
-        const Primitive& p = mesh.primitives[i];
+    for (const Primitive& p : mesh.primitives)
         if (p.source_mesh < 0) throw LoadError(input_path + ": the mesh was not read from this file");
-        if (!seen.emplace(std::make_pair(p.source_mesh, p.source_primitive), i).second)
-            throw LoadError(input_path + ": mesh " + std::to_string(p.source_mesh) +
-                            " is drawn by several nodes; glTF output needs one node per mesh (write the sidecar: "
-                            "-o OUT without .glb or .gltf)");
-    }
 }
 
 std::string gltf_with_orders(const std::string& input_path, const std::string& output_path, const AnimatedMesh& mesh,
@@ -96,9 +89,26 @@ std::string gltf_with_orders(const std::string& input_path, const std::string& o
     if (fallback >= buffers.orders.size()) throw LoadError(input_path + ": no buffer " + std::to_string(fallback));
     check_gltf_output(input_path, mesh);
     tinygltf::Model model = io::read_model(input_path);
+    // A file primitive several nodes draw (instances) is written once, from its first instance:
+    // run_method gave them one order (tie_instances), which is checked here.
+    std::map<std::pair<int, int>, const Primitive*> first;
+    std::vector<const Primitive*> written;
+    for (const Primitive& p : mesh.primitives) {
+        const auto [at, inserted] = first.emplace(std::make_pair(p.source_mesh, p.source_primitive), &p);
+        if (inserted) {
+            if (p.index_count > 0) written.push_back(&p);
+            continue;
+        }
+        const Primitive& f = *at->second;
+        for (const std::vector<uint32_t>& order : buffers.orders)
+            for (size_t i = 0; f.index_count == p.index_count && i < p.index_count / 3; ++i)
+                if (order[p.first_index / 3 + i] - p.first_index / 3 !=
+                    order[f.first_index / 3 + i] - f.first_index / 3)
+                    throw LoadError(input_path + ": mesh " + std::to_string(p.source_mesh) +
+                                    " is drawn by several nodes in different orders; glTF has one per primitive");
+    }
     std::vector<std::pair<int, int>> rewritten;
-    for (const Primitive& p : mesh.primitives)
-        if (p.index_count > 0) rewritten.emplace_back(p.source_mesh, p.source_primitive);
+    for (const Primitive* p : written) rewritten.emplace_back(p->source_mesh, p->source_primitive);
     const std::vector<int> replaced = io::begin_replacing(model, rewritten);
     std::vector<std::vector<uint32_t>> index_buffers(buffers.orders.size(), std::vector<uint32_t>(mesh.indices.size()));
     for (size_t b = 0; b < buffers.orders.size(); ++b) {
@@ -108,8 +118,8 @@ std::string gltf_with_orders(const std::string& input_path, const std::string& o
     }
 
     const size_t k = buffers.orders.size();
-    for (const Primitive& p : mesh.primitives) {
-        if (p.index_count == 0) continue;  // nothing to order, and glTF has no empty accessor
+    for (const Primitive* written_primitive : written) {  // no empty one: glTF has no empty accessor
+        const Primitive& p = *written_primitive;
         tinygltf::Primitive& prim = model.meshes[size_t(p.source_mesh)].primitives[size_t(p.source_primitive)];
         // Order b of the primitive is elements [b·n, (b+1)·n) of one accessor (docs/extension).
         std::vector<uint32_t> all(k * p.index_count);

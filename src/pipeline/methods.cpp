@@ -30,6 +30,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <string>
 
 namespace animorder {
@@ -411,6 +412,26 @@ void reverse_blended_primitives(const AnimatedMesh& mesh, std::vector<uint32_t>&
     }
 }
 
+void tie_instances(const AnimatedMesh& mesh, std::vector<uint32_t>& order) {
+    if (order.size() != mesh.triangle_count()) throw InvalidInput("an order does not cover the mesh's triangles");
+    std::map<std::pair<int, int>, const Primitive*> first;
+    for (const Primitive& p : mesh.primitives) {
+        if (p.source_mesh < 0) continue;
+        const auto [at, inserted] = first.emplace(std::make_pair(p.source_mesh, p.source_primitive), &p);
+        if (inserted) continue;
+        const Primitive& f = *at->second;
+        if (f.index_count != p.index_count)
+            throw InvalidInput("two primitives from one file primitive have different triangle counts ('" + p.name +
+                               "')");
+        const size_t from = f.first_index / 3, to = p.first_index / 3, n = p.index_count / 3;
+        for (size_t i = 0; i < n; ++i) {
+            if (order[from + i] < from || order[from + i] >= from + n)
+                throw InvalidInput("an order moves triangles between primitives ('" + f.name + "')");
+            order[to + i] = uint32_t(to + (order[from + i] - from));
+        }
+    }
+}
+
 MethodResult run_method(const AnimatedMesh& mesh, Method method, const MethodSettings& settings) {
     validate_method_settings(settings);
     validate_animated_mesh(mesh);
@@ -440,6 +461,7 @@ MethodResult run_method(const AnimatedMesh& mesh, Method method, const MethodSet
     // original; single and joint sort them per cluster in run_han_sander).
     if (method != Method::Original && method != Method::Single && method != Method::Joint)
         for (std::vector<uint32_t>& order : result.buffers.orders) reverse_blended_primitives(mesh, order);
+    for (std::vector<uint32_t>& order : result.buffers.orders) tie_instances(mesh, order);
     // The time covers the method, not its ACMR (the oracle's ACMR sampling is part of its run).
     result.seconds = seconds_since(start);
     std::vector<uint32_t> indices(mesh.indices.size());

@@ -42,3 +42,31 @@ TEST(StaticMethods, MeshoptIsExactlyMeshoptimizersBuffer) {
         meshopt_order(mesh.indices.data(), mesh.indices.size(), mesh.keyframe(0), mesh.vertex_count, 16);
     EXPECT_EQ(test::applied(mesh.indices, order), expected);
 }
+
+// Primitives from one file primitive (a glTF mesh two nodes draw) share its one index buffer: each
+// later one takes the first one's order, triangle for triangle, worked out by hand; primitives of
+// other sources (or generated ones, source −1) keep theirs. Orders that move triangles between
+// primitives, or instances of different sizes, are refused.
+TEST(Methods, InstancesOfAFilePrimitiveTakeTheFirstOnesOrder) {
+    AnimatedMesh mesh;
+    mesh.vertex_count = 3;
+    mesh.indices = std::vector<uint32_t>(3 * 8, 0);
+    mesh.primitives = {{"a", 0, 9}, {"b", 9, 6}, {"a again", 15, 9}};
+    for (Primitive& p : mesh.primitives) p.source_primitive = 0;
+    mesh.primitives[0].source_mesh = 0, mesh.primitives[1].source_mesh = 1, mesh.primitives[2].source_mesh = 0;
+    std::vector<uint32_t> order = {2, 0, 1, 4, 3, 5, 6, 7};
+    tie_instances(mesh, order);
+    EXPECT_EQ(order, (std::vector<uint32_t>{2, 0, 1, 4, 3, 7, 5, 6}));
+    mesh.primitives[2].source_mesh = -1;  // generated: its own order
+    order = {2, 0, 1, 4, 3, 5, 6, 7};
+    tie_instances(mesh, order);
+    EXPECT_EQ(order, (std::vector<uint32_t>{2, 0, 1, 4, 3, 5, 6, 7}));
+    mesh.primitives[2].source_mesh = 0;
+    order = {3, 0, 1, 2, 4, 5, 6, 7};  // a triangle of b in a's range
+    EXPECT_THROW(tie_instances(mesh, order), InvalidInput);
+    mesh.primitives[1] = {"b", 9, 3};
+    mesh.primitives[2] = {"a again", 12, 12};
+    mesh.primitives[2].source_mesh = 0, mesh.primitives[2].source_primitive = 0;
+    order = {0, 1, 2, 3, 4, 5, 6, 7};
+    EXPECT_THROW(tie_instances(mesh, order), InvalidInput);
+}

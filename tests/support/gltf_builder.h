@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdint>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,20 @@ inline std::string base64(const std::string& in) {
     } else if (i + 2 == in.size()) {
         const uint32_t v = uint32_t(uint8_t(in[i])) << 16 | uint32_t(uint8_t(in[i + 1])) << 8;
         out += {table[(v >> 18) & 63], table[(v >> 12) & 63], table[(v >> 6) & 63], '='};
+    }
+    return out;
+}
+
+inline std::string base64_decode(const std::string& text) {
+    static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    uint32_t bits = 0;
+    int count = 0;
+    for (const char c : text) {
+        const char* at = c ? std::strchr(table, c) : nullptr;
+        if (!at) break;  // '=' or the end
+        bits = bits << 6 | uint32_t(at - table);
+        if ((count += 6) >= 8) out.push_back(char((bits >> (count -= 8)) & 0xff));
     }
     return out;
 }

@@ -7,6 +7,7 @@
 // 0.001. Every output passes the Khronos glTF Validator without errors. A simplified file is
 // refused by `reapply` with one line and nothing written.
 #include "support/files.h"
+#include "support/gltf_builder.h"
 #include "support/require.h"
 
 #include <gtest/gtest.h>
@@ -225,20 +226,6 @@ TEST_F(GltfPipelines, CheckAndReapplyRefuseBadInputInOneLine) {
 // A pipeline may drop, reorder or rename animations: reapply finds each clip's animation by name in
 // the processed file (it copied the optimised file's index, which then named another animation, or
 // none), and refuses a file that lost a clip's animation.
-std::string from_base64(const std::string& text) {
-    std::string out;
-    uint32_t bits = 0;
-    int count = 0;
-    for (const char c : text) {
-        const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-        const char* at = std::strchr(table, c);
-        if (c == '=' || !at || !c) break;
-        bits = bits << 6 | uint32_t(at - table);
-        if ((count += 6) >= 8) out.push_back(char((bits >> (count -= 8)) & 0xff));
-    }
-    return out;
-}
-
 // The triangles of every primitive of a .gltf (buffers in files or data URIs), each rotated to start at
 // its smallest index (its winding kept), sorted: equal for two files that draw the same triangles
 // with the same winding, whatever their order.
@@ -250,7 +237,7 @@ std::vector<std::array<uint32_t, 4>> triangles_as_written(const fs::path& gltf) 
             const json& a = g["accessors"][prim["indices"].get<size_t>()];
             const json& view = g["bufferViews"][a["bufferView"].get<size_t>()];
             const std::string uri = g["buffers"][view["buffer"].get<size_t>()]["uri"].get<std::string>();
-            const std::string bytes = uri.rfind("data:", 0) == 0 ? from_base64(uri.substr(uri.find(',') + 1))
+            const std::string bytes = uri.rfind("data:", 0) == 0 ? test::base64_decode(uri.substr(uri.find(',') + 1))
                                                                  : test::slurp(gltf.parent_path() / uri);
             const size_t size = a["componentType"] == 5125 ? 4 : 2;
             const size_t at = view.value("byteOffset", size_t(0)) + a.value("byteOffset", size_t(0));

@@ -178,23 +178,21 @@ inline void finish_load(bool ok, std::string error, const tinygltf::Model& model
 // glTF 2.0 lets an animation channel's target name no node (KHR_animation_pointer's animate what
 // their pointer names: a material, a light, a camera). tinygltf 2.7 drops such a channel, and an
 // animation left without one, renumbering the animations after it; its writer would then leave
-// them out of the output. The file's JSON with "node": 0 put into each such target (a placeholder
-// tinygltf keeps: the loader reads only the times of a path it does not animate, and
-// restore_what_tinygltf_drops takes it out again on writing), or "" when it has none (or no node,
-// or is no JSON).
-inline constexpr const char* kPlaceholderNode = "node";
+// them out of the output. The file's JSON with a placeholder "node" put into each such target: the
+// file's node count, one past the last node (tinygltf keeps it; the glTF loader knows it as no
+// node, see pointed_channel; restore_what_tinygltf_drops takes it out again on writing), or ""
+// when it has none (or is no JSON).
 inline std::string json_with_placeholder_nodes(const std::string& text) {
     nlohmann::ordered_json j = nlohmann::ordered_json::parse(text, nullptr, false);
-    if (!j.is_object() || !j.contains("animations") || !j["animations"].is_array() || !j.contains("nodes") ||
-        !j["nodes"].is_array() || j["nodes"].empty())
-        return {};
+    if (!j.is_object() || !j.contains("animations") || !j["animations"].is_array()) return {};
+    const size_t placeholder = j.contains("nodes") && j["nodes"].is_array() ? j["nodes"].size() : 0;
     bool changed = false;
     for (nlohmann::ordered_json& animation : j["animations"])
         if (animation.is_object() && animation.contains("channels") && animation["channels"].is_array())
             for (nlohmann::ordered_json& channel : animation["channels"])
                 if (channel.is_object() && channel.contains("target") && channel["target"].is_object() &&
-                    !channel["target"].contains(kPlaceholderNode)) {
-                    channel["target"][kPlaceholderNode] = 0;
+                    !channel["target"].contains("node")) {
+                    channel["target"]["node"] = placeholder;
                     changed = true;
                 }
     return changed ? j.dump() : std::string();
@@ -264,7 +262,7 @@ inline tinygltf::Model read_model(const std::string& path) {
 
 // What tinygltf 2.7 changes between reading and writing a file, put back from the input's JSON:
 // - the placeholder node of each animation channel whose target had none (json_with_placeholder_
-//   nodes; the writer keeps every animation and channel in place), taken out again;
+//   nodes: the input's node count, which no node of the output has either), taken out again;
 // - a perspective camera's absent zfar (an infinite projection), written as 0, which glTF forbids.
 // Returns whether `output` changed.
 inline bool restore_what_tinygltf_drops(const nlohmann::ordered_json& input, nlohmann::ordered_json& output) {
@@ -275,15 +273,15 @@ inline bool restore_what_tinygltf_drops(const nlohmann::ordered_json& input, nlo
     const auto object = [](const nlohmann::ordered_json& j, const char* key) {
         return j.is_object() && j.contains(key) && j[key].is_object();
     };
-    if (array(input, "animations") && array(output, "animations"))
-        for (size_t a = 0; a < input["animations"].size() && a < output["animations"].size(); ++a) {
-            const nlohmann::ordered_json& in = input["animations"][a];
-            nlohmann::ordered_json& out = output["animations"][a];
-            if (!array(in, "channels") || !array(out, "channels")) continue;
-            for (size_t c = 0; c < in["channels"].size() && c < out["channels"].size(); ++c)
-                if (object(in["channels"][c], "target") && !in["channels"][c]["target"].contains(kPlaceholderNode) &&
-                    object(out["channels"][c], "target") && out["channels"][c]["target"].contains(kPlaceholderNode)) {
-                    out["channels"][c]["target"].erase(kPlaceholderNode);
+    const size_t placeholder = array(input, "nodes") ? input["nodes"].size() : 0;
+    if (array(output, "animations"))
+        for (nlohmann::ordered_json& animation : output["animations"]) {
+            if (!array(animation, "channels")) continue;
+            for (nlohmann::ordered_json& channel : animation["channels"])
+                if (object(channel, "target") && channel["target"].contains("node") &&
+                    channel["target"]["node"].is_number_unsigned() &&
+                    channel["target"]["node"].get<size_t>() == placeholder) {
+                    channel["target"].erase("node");
                     changed = true;
                 }
         }

@@ -594,6 +594,32 @@ Channel parse_channel(const Scene& s, const tinygltf::Animation& anim, const tin
     return c;
 }
 
+// A channel whose target names no node in the file (read with io::json_with_placeholder_nodes'
+// placeholder, one past the last node) as the loader takes it: KHR_animation_pointer's pointer to
+// a node's translation, rotation, scale or weights ("/nodes/3/rotation") as that node's channel;
+// any other (a material's colour, a light's intensity, a node-less TRS channel, which glTF says to
+// ignore) a channel of no path, whose times alone count (the clip's length).
+tinygltf::AnimationChannel pointed_channel(const Scene& s, const tinygltf::AnimationChannel& ch) {
+    tinygltf::AnimationChannel out = ch;
+    out.target_node = 0;
+    out.target_path.clear();
+    const auto extension = ch.target_extensions.find("KHR_animation_pointer");
+    if (extension == ch.target_extensions.end() || !extension->second.IsObject() || !extension->second.Has("pointer") ||
+        !extension->second.Get("pointer").IsString())
+        return out;
+    const std::string pointer = extension->second.Get("pointer").Get<std::string>();
+    const std::string prefix = "/nodes/";
+    if (pointer.rfind(prefix, 0) != 0) return out;
+    size_t at = prefix.size(), node = 0;
+    for (; at < pointer.size() && at < prefix.size() + 9 && pointer[at] >= '0' && pointer[at] <= '9'; ++at)
+        node = 10 * node + size_t(pointer[at] - '0');
+    if (at == prefix.size() || at >= pointer.size() || pointer[at] != '/' || node >= s.model.nodes.size()) return out;
+    const std::string path = pointer.substr(at + 1);
+    if (path == "translation" || path == "rotation" || path == "scale" || path == "weights")
+        out.target_node = int(node), out.target_path = path;
+    return out;
+}
+
 // Every animation as a clip of channels, from its first to its last key time, with its keyframe
 // count at the sample rate (no more than kMaxClipKeyframes); channels of missing nodes are skipped.
 std::vector<ClipChannels> parse_animations(const Scene& s, const std::string& path, const LoadOptions& options) {
@@ -605,6 +631,8 @@ std::vector<ClipChannels> parse_animations(const Scene& s, const std::string& pa
         for (const tinygltf::AnimationChannel& ch : anim.channels)
             if (ch.target_node >= 0 && size_t(ch.target_node) < s.model.nodes.size())
                 c.channels.push_back(parse_channel(s, anim, ch, c.clip.name));
+            else if (size_t(ch.target_node) == s.model.nodes.size())  // no node in the file
+                c.channels.push_back(parse_channel(s, anim, pointed_channel(s, ch), c.clip.name));
         if (c.channels.empty()) s.reader.fail("clip '" + c.clip.name + "' animates nothing");
         c.t0 = INFINITY, c.t1 = -INFINITY;
         for (const Channel& ch : c.channels)

@@ -694,6 +694,49 @@ TEST_F(GltfLoader, AMirroringNodeTransformGivesClockwiseFrontFacesAsEnginesDrawT
     EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 2, 1}));
 }
 
+// Channels whose target names no node (glTF 2.0 allows it; tinygltf dropped them, and an animation
+// left without any, renumbering the others): a KHR_animation_pointer pointer to a node's
+// translation animates that node; a node-less TRS channel is ignored, as the spec says (a
+// placeholder had applied it to node 0); a pointer elsewhere (a material) counts for the clip's
+// length only. Every animation stays a clip, in the file's numbering.
+TEST_F(GltfLoader, ChannelsWithoutANodeFollowTheirPointerOrAreIgnored) {
+    Gltf g;
+    const int p = g.floats({0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3", 3), i = g.u16({0, 1, 2}, "SCALAR", 1);
+    const int t = g.floats({0, 1}, "SCALAR", 1), t2 = g.floats({0, 2}, "SCALAR", 1);
+    const int moved = g.floats({0, 0, 0, 1, 0, 0}, "VEC3", 3), big = g.floats({3, 3, 3, 3, 3, 3}, "VEC3", 3);
+    const int colour = g.floats({1, 1, 1, 1, 0, 0, 0, 1}, "VEC4", 4);
+    g.doc["meshes"] =
+        json::array({json{{"primitives", json::array({json{{"attributes", {{"POSITION", p}}}, {"indices", i}}})}}});
+    g.doc["materials"] = json::array({json{{"name", "m"}}});
+    g.doc["nodes"] = json::array({json{{"mesh", 0}}, json{{"name", "other"}}});
+    g.doc["scenes"] = json::array({json{{"nodes", json::array({0, 1})}}});
+    const auto pointer = [](int sampler, const std::string& to) {
+        return json{{"sampler", sampler},
+                    {"target", {{"path", "pointer"}, {"extensions", {{"KHR_animation_pointer", {{"pointer", to}}}}}}}};
+    };
+    const json samplers = json::array({json{{"input", t}, {"output", moved}}, json{{"input", t}, {"output", big}},
+                                       json{{"input", t2}, {"output", colour}}});
+    g.doc["animations"] =
+        json::array({json{{"name", "colour"},
+                          {"samplers", samplers},
+                          {"channels", json::array({pointer(2, "/materials/0/pbrMetallicRoughness/baseColorFactor")})}},
+                     json{{"name", "ignored"},
+                          {"samplers", samplers},
+                          {"channels", json::array({json{{"sampler", 1}, {"target", {{"path", "scale"}}}}})}},
+                     json{{"name", "slide"},
+                          {"samplers", samplers},
+                          {"channels", json::array({pointer(0, "/nodes/0/translation")})}}});
+    const AnimatedMesh m = load_gltf(write("pointers.gltf", g.text()));
+    ASSERT_EQ(m.clips.size(), 3u);
+    EXPECT_EQ(m.clips[0].name, "colour");
+    EXPECT_EQ(m.clips[0].keyframe_count, 61u);  // the colour's 2 s
+    EXPECT_EQ(m.clips[2].source_animation, 2);
+    for (size_t k = 0; k < m.clips[0].keyframe_count + m.clips[1].keyframe_count; ++k)
+        expect_position(m, k, 1, 1, 0, 0);  // still
+    const size_t last = m.clips[2].first_keyframe + m.clips[2].keyframe_count - 1;
+    expect_position(m, last, 1, 2, 0, 0);  // slid by 1 in x
+}
+
 TEST_F(GltfLoader, PrimitivesCarryTheirMaterialFlags) {
     Gltf g;
     const std::vector<float> pos = {0, 0, 0, 1, 0, 0, 1, 1, 0};

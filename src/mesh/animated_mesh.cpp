@@ -106,7 +106,10 @@ AnimatedMesh select_clips(const AnimatedMesh& mesh, const std::vector<std::strin
     out.clips.clear();
     out.keyframe_positions.clear();
     const size_t frame_floats = mesh.vertex_count * 3;
-    for (const std::string& name : names) {
+    for (size_t n = 0; n < names.size(); ++n) {
+        const std::string& name = names[n];
+        if (std::find(names.begin(), names.begin() + ptrdiff_t(n), name) != names.begin() + ptrdiff_t(n))
+            continue;        // named twice: kept once
         bool found = false;  // every clip of that name, in the mesh's order (Mixamo names each "mixamo.com")
         for (const Clip& clip : mesh.clips) {
             if (clip.name != name) continue;

@@ -97,4 +97,5 @@ TEST(AnimatedMesh, SelectingANameSeveralClipsShareKeepsThemAll) {
     EXPECT_EQ(s.keyframe(0)[0], 0.0f);
     EXPECT_EQ(s.keyframe(1)[0], 3.0f);
     EXPECT_NO_THROW(validate_animated_mesh(s));
+    EXPECT_EQ(select_clips(m, {"mixamo.com", "idle", "mixamo.com"}).clips.size(), 3u);  // a name twice: once
 }

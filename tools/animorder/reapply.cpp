@@ -69,19 +69,21 @@ int run_reapply(const ReapplyOptions& options) {
     to_file_winding(b, b_file.data());
 
     // The keyframes compared: the first of up to four clips both files have, else keyframe 0. A clip
-    // pairs with the clip of its name in the other file; where several share that name (Mixamo's
-    // "mixamo.com", "Take 001"), with the one of its animation index, else none.
+    // pairs with the clip of its name in the other file; where several share a name (Mixamo's
+    // "mixamo.com", "Take 001"), the n-th of that name in one with the n-th in the other, when both
+    // files have as many of it (else, one of them dropped, none of that name is compared).
     std::vector<size_t> ka, kb;
+    const auto named = [](const AnimatedMesh& m, const std::string& name) {
+        std::vector<const Clip*> out;
+        for (const Clip& c : m.clips)
+            if (c.name == name) out.push_back(&c);
+        return out;
+    };
     for (const Clip& ca : a.clips) {
-        const Clip* pair = nullptr;
-        size_t named = 0;
-        for (const Clip& cb : b.clips)
-            if (cb.name == ca.name) {
-                ++named;
-                if (!pair || cb.source_animation == ca.source_animation) pair = &cb;
-            }
-        if (named > 1 && pair && pair->source_animation != ca.source_animation) pair = nullptr;
-        if (pair && ka.size() < 4) ka.push_back(ca.first_keyframe), kb.push_back(pair->first_keyframe);
+        const std::vector<const Clip*> in_a = named(a, ca.name), in_b = named(b, ca.name);
+        if (in_a.size() != in_b.size()) continue;
+        const size_t rank = size_t(std::find(in_a.begin(), in_a.end(), &ca) - in_a.begin());
+        if (ka.size() < 4) ka.push_back(ca.first_keyframe), kb.push_back(in_b[rank]->first_keyframe);
     }
     if (ka.empty()) ka = {0}, kb = {0};
 

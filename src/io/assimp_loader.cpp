@@ -52,8 +52,10 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <memory>
+#include <sstream>
 #include <unordered_set>
 
 namespace animorder {
@@ -161,6 +163,46 @@ const aiScene* import(Assimp::Importer& importer, const std::string& path, std::
     return scene;
 }
 
+// assimp reads a cut .md5mesh without a word, keeping what came before the cut. Its header's
+// numMeshes against the mesh blocks the text holds, and each block's numverts, numtris and
+// numweights against its vert, tri and weight lines (outside comments), say so.
+void refuse_truncated_md5mesh(const std::string& path) {
+    std::string extension = std::filesystem::path(path).extension().string();
+    for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (extension != ".md5mesh") return;
+    std::ifstream in(path, std::ios::binary);
+    long declared = -1, blocks = 0;
+    std::map<std::string, long> said, seen;  // in the current mesh block
+    const auto close_block = [&] {
+        for (const char* what : {"vert", "tri", "weight"})
+            if (said.count(what) && seen[what] < said[what])
+                throw LoadError(path + ": cut short or damaged: mesh " + std::to_string(blocks) + " says " +
+                                std::to_string(said[what]) + " " + what + "s, it holds " + std::to_string(seen[what]));
+        said.clear(), seen.clear();
+    };
+    std::string line;
+    bool in_mesh = false;
+    while (std::getline(in, line)) {
+        std::istringstream words(line.substr(0, line.find("//")));
+        std::string word, next;
+        if (!(words >> word)) continue;
+        if (word == "numMeshes" && !(words >> declared)) declared = -1;
+        if (word == "mesh" && words >> next && next == "{") ++blocks, in_mesh = true;
+        if (!in_mesh) continue;
+        long n = 0;
+        if (word.rfind("num", 0) == 0 && words >> n) said[word.substr(3, word.size() - 4)] = n;  // numverts: vert
+        if (word == "vert" || word == "tri" || word == "weight") ++seen[word];
+        if (word == "}") close_block(), in_mesh = false;
+    }
+    if (in_mesh) {
+        close_block();
+        throw LoadError(path + ": cut short or damaged: mesh " + std::to_string(blocks) + " does not end");
+    }
+    if (declared >= 0 && blocks < declared)
+        throw LoadError(path + ": cut short or damaged: its header says " + std::to_string(declared) +
+                        " meshes, it holds " + std::to_string(blocks));
+}
+
 // For a file with bones and no geometry (an .md5anim, a .bvh), assimp's SkeletonMeshBuilder adds a
 // mesh of its own that draws the bones, with a material it names "SkeletonMaterial": not the
 // character.
@@ -179,6 +221,7 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
     reading(0);
     Assimp::Importer importer;
     const aiScene* scene = import(importer, path, child.opened, options.file_budget());
+    refuse_truncated_md5mesh(path);
     Flat flat;
     flatten(scene->mRootNode, flat);
 

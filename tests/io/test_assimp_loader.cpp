@@ -272,6 +272,19 @@ TEST_F(AssimpHostile, CraftedFilesThatCrashAssimpGiveOneLineErrors) {
         }
 }
 
+// A cut .md5mesh: assimp 5.2 loads what came before the cut without a word (Bob cut at 30% gave
+// one mesh of its six). Its header's mesh count and each mesh's vert, tri and weight counts say
+// what it should hold; a file that holds less is refused, naming what is missing.
+TEST_F(AssimpHostile, ACutMd5MeshIsRefused) {
+    const std::string whole = md5_mesh("0 1 2");
+    EXPECT_NO_THROW(load_character(write("whole.md5mesh", whole)));
+    std::string two = whole;
+    two.replace(two.find("numMeshes 1"), 11, "numMeshes 2");
+    EXPECT_NE(load_error(write("two.md5mesh", two)).find("its header says 2 meshes, it holds 1"), std::string::npos);
+    const std::string cut = whole.substr(0, whole.rfind("\tweight 2"));
+    EXPECT_NE(load_error(write("cut.md5mesh", cut)).find("mesh 1 says 3 weights, it holds 2"), std::string::npos);
+}
+
 TEST_F(AssimpHostile, ACrashInAClipFileNamesTheClipFile) {
     const std::string character = write("character.x", x_skinned("1.0"));
     const std::string skin_weight =

@@ -11,6 +11,7 @@
 #include <sys/stat.h>
 
 #include <cstddef>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -178,14 +179,15 @@ inline void finish_load(bool ok, std::string error, const tinygltf::Model& model
 // glTF 2.0 lets an animation channel's target name no node (KHR_animation_pointer's animate what
 // their pointer names: a material, a light, a camera). tinygltf 2.7 drops such a channel, and an
 // animation left without one, renumbering the animations after it; its writer would then leave
-// them out of the output. The file's JSON with a placeholder "node" put into each such target: the
-// file's node count, one past the last node (tinygltf keeps it; the glTF loader knows it as no
-// node, see pointed_channel; restore_what_tinygltf_drops takes it out again on writing), or ""
-// when it has none (or is no JSON).
+// them out of the output. The file's JSON with a placeholder "node" put into each such target,
+// kPlaceholderNode (tinygltf keeps it; the glTF loader knows it as no node, see pointed_channel;
+// restore_what_tinygltf_drops takes it out again on writing), or "" when it has none (or is no
+// JSON). The placeholder is no index a file could mean: a channel naming a missing node stays that.
+inline constexpr int kPlaceholderNode = INT32_MAX;
 inline std::string json_with_placeholder_nodes(const std::string& text) {
     nlohmann::ordered_json j = nlohmann::ordered_json::parse(text, nullptr, false);
     if (!j.is_object() || !j.contains("animations") || !j["animations"].is_array()) return {};
-    const size_t placeholder = j.contains("nodes") && j["nodes"].is_array() ? j["nodes"].size() : 0;
+    const int placeholder = kPlaceholderNode;
     bool changed = false;
     for (nlohmann::ordered_json& animation : j["animations"])
         if (animation.is_object() && animation.contains("channels") && animation["channels"].is_array())
@@ -262,7 +264,7 @@ inline tinygltf::Model read_model(const std::string& path) {
 
 // What tinygltf 2.7 changes between reading and writing a file, put back from the input's JSON:
 // - the placeholder node of each animation channel whose target had none (json_with_placeholder_
-//   nodes: the input's node count, which no node of the output has either), taken out again;
+//   nodes), taken out again;
 // - a perspective camera's absent zfar (an infinite projection), written as 0, which glTF forbids.
 // Returns whether `output` changed.
 inline bool restore_what_tinygltf_drops(const nlohmann::ordered_json& input, nlohmann::ordered_json& output) {
@@ -273,7 +275,7 @@ inline bool restore_what_tinygltf_drops(const nlohmann::ordered_json& input, nlo
     const auto object = [](const nlohmann::ordered_json& j, const char* key) {
         return j.is_object() && j.contains(key) && j[key].is_object();
     };
-    const size_t placeholder = array(input, "nodes") ? input["nodes"].size() : 0;
+    const size_t placeholder = size_t(kPlaceholderNode);
     if (array(output, "animations"))
         for (nlohmann::ordered_json& animation : output["animations"]) {
             if (!array(animation, "channels")) continue;

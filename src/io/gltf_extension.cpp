@@ -399,18 +399,21 @@ int append_indices(tinygltf::Model& model, const std::vector<uint32_t>& local, b
 }
 
 // The processed file's animation for a clip of the optimised one: the animation of the clip's
-// name there (an unnamed one is "animationN", as the loader names clips), the clip's own index
-// first when several share the name; -1 when none has it. Pipelines drop, reorder and rename
-// animations, so an index copied as it was could name another animation.
-int animation_of_clip(const tinygltf::Model& model, const ExtensionClip& c) {
-    int found = -1;
+// name there (an unnamed one is "animationN", as the loader names clips). Where several clips share
+// the name (Mixamo's "mixamo.com"), the n-th of them follows the n-th animation of that name, when
+// the processed file has as many; else it is ambiguous (-2). -1 when none has the name. Pipelines
+// drop, reorder and rename animations, so an index copied as it was could name another animation.
+int animation_of_clip(const tinygltf::Model& model, const std::vector<ExtensionClip>& clips, const ExtensionClip& c) {
+    std::vector<int> theirs;
     for (size_t a = 0; a < model.animations.size(); ++a) {
         const std::string& own = model.animations[a].name;
-        if ((own.empty() ? "animation" + std::to_string(a) : own) != c.name) continue;
-        if (int(a) == c.animation) return int(a);
-        if (found < 0) found = int(a);
+        if ((own.empty() ? "animation" + std::to_string(a) : own) == c.name) theirs.push_back(int(a));
     }
-    return found;
+    size_t rank = 0, ours = 0;
+    for (const ExtensionClip& o : clips)
+        if (o.name == c.name) rank += &o < &c, ++ours;
+    if (theirs.empty()) return -1;
+    return ours == theirs.size() ? theirs[rank] : -2;
 }
 
 }  // namespace
@@ -456,7 +459,11 @@ std::string gltf_with_extension_orders(const std::string& input_path, const std:
         Object clip;
         clip["name"] = tinygltf::Value(c.name);
         if (c.animation >= 0) {
-            const int animation = animation_of_clip(model, c);
+            const int animation = animation_of_clip(model, root.clips, c);
+            if (animation == -2)
+                throw LoadError(input_path + ": the optimised file has clips named '" + c.name +
+                                "' that the processed file has other numbers of animations of: it dropped some, "
+                                "and which lookup table follows which animation cannot be told");
             if (animation < 0)
                 throw LoadError(input_path + ": no animation '" + c.name + "' (the optimised file's clip " +
                                 std::to_string(&c - root.clips.data()) +

@@ -595,7 +595,7 @@ Channel parse_channel(const Scene& s, const tinygltf::Animation& anim, const tin
 }
 
 // A channel whose target names no node in the file (read with io::json_with_placeholder_nodes'
-// placeholder, one past the last node) as the loader takes it: KHR_animation_pointer's pointer to
+// placeholder) as the loader takes it: KHR_animation_pointer's pointer to
 // a node's translation, rotation, scale or weights ("/nodes/3/rotation") as that node's channel;
 // any other (a material's colour, a light's intensity, a node-less TRS channel, which glTF says to
 // ignore) a channel of no path, whose times alone count (the clip's length).
@@ -631,7 +631,7 @@ std::vector<ClipChannels> parse_animations(const Scene& s, const std::string& pa
         for (const tinygltf::AnimationChannel& ch : anim.channels)
             if (ch.target_node >= 0 && size_t(ch.target_node) < s.model.nodes.size())
                 c.channels.push_back(parse_channel(s, anim, ch, c.clip.name));
-            else if (size_t(ch.target_node) == s.model.nodes.size())  // no node in the file
+            else if (ch.target_node == io::kPlaceholderNode)  // no node in the file
                 c.channels.push_back(parse_channel(s, anim, pointed_channel(s, ch), c.clip.name));
         if (c.channels.empty()) s.reader.fail("clip '" + c.clip.name + "' animates nothing");
         c.t0 = INFINITY, c.t1 = -INFINITY;

@@ -85,7 +85,8 @@ int run_reapply(const ReapplyOptions& options) {
         const size_t rank = size_t(std::find(in_a.begin(), in_a.end(), &ca) - in_a.begin());
         if (ka.size() < 4) ka.push_back(ca.first_keyframe), kb.push_back(in_b[rank]->first_keyframe);
     }
-    if (ka.empty()) ka = {0}, kb = {0};
+    const bool unpaired = ka.empty();
+    if (unpaired) ka = {0}, kb = {0};
 
     // OPTIMIZED's primitives with orders, and each order as a permutation of its drawn triangles.
     struct Source {
@@ -124,6 +125,20 @@ int run_reapply(const ReapplyOptions& options) {
             hi[c] = std::max(hi[c], a.keyframe(ka[0])[3 * v + size_t(c)]);
     const float diagonal = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                                      (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    if (unpaired) {
+        // No clip pairs by name (a pipeline dropped some animations, or all of them): the first
+        // keyframes of the pair of clips, one of each file, that matches most triangles (a still
+        // copy's one keyframe included), among the first 8 clips of each.
+        size_t best = 0;
+        for (size_t i = 0; i < a.clips.size() && i < 8; ++i)
+            for (size_t j = 0; j < b.clips.size() && j < 8; ++j) {
+                const TriangleMatch trial = match_triangles(corners(a, a_triangles, {a.clips[i].first_keyframe}),
+                                                            corners(b, b_triangles, {b.clips[j].first_keyframe}), 3,
+                                                            float(options.tolerance) * diagonal);
+                if (trial.matched > best)
+                    best = trial.matched, ka = {a.clips[i].first_keyframe}, kb = {b.clips[j].first_keyframe};
+            }
+    }
     const TriangleMatch m = match_triangles(corners(a, a_triangles, ka), corners(b, b_triangles, kb), 3 * ka.size(),
                                             float(options.tolerance) * diagonal);
     // Per triangle of OPTIMIZED (global index): its triangle of PROCESSED.
@@ -164,9 +179,6 @@ int run_reapply(const ReapplyOptions& options) {
             throw std::runtime_error(options.processed + ": primitive " + p.name + " holds " +
                                      std::to_string(p.index_count / 3 - hits) +
                                      " triangles that are not OPTIMIZED's (changed mesh?); nothing written");
-        if (!seen.emplace(std::make_pair(p.source_mesh, p.source_primitive), 0).second)
-            throw std::runtime_error(options.processed + ": mesh " + std::to_string(p.source_mesh) +
-                                     " is drawn by several nodes; reapply needs one node per mesh");
         PrimitiveOrders po;
         po.mesh = p.source_mesh, po.primitive = p.source_primitive;
         const size_t first = p.first_index / 3, last = first + p.index_count / 3;
@@ -178,7 +190,16 @@ int run_reapply(const ReapplyOptions& options) {
                     for (size_t c = 0; c < 3; ++c)
                         po.orders.push_back(uint32_t(b_file[3 * size_t(t) + c] - p.vertex_base));
                 }
-        out.push_back(std::move(po));
+        // A mesh several nodes draw (instances) has one index buffer: written once, when every
+        // instance's orders agree (OPTIMIZED's instances share theirs, so they do unless the
+        // pipeline changed one of them).
+        const auto [at, first_instance] = seen.emplace(std::make_pair(p.source_mesh, p.source_primitive), out.size());
+        if (first_instance)
+            out.push_back(std::move(po));
+        else if (out[at->second].orders != po.orders)
+            throw std::runtime_error(options.processed + ": mesh " + std::to_string(p.source_mesh) +
+                                     " is drawn by several nodes whose optimised triangles come in different orders; "
+                                     "nothing written");
     }
     std::string kept;
     const std::string bytes =

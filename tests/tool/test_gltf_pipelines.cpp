@@ -88,6 +88,31 @@ protected:
         return j["methods"].back()["ovr_mean"].get<double>();
     }
 
+    // The bundled character as glTF JSON (subdivide --levels 0), to edit into a test's input.
+    json bundled_character() {
+        const test::Outcome o = run(exe() + " subdivide -q --levels 0 -o " + q(path("character.gltf")));
+        EXPECT_EQ(o.exit_code, 0) << o.err;
+        return json::parse(test::slurp(path("character.gltf")));
+    }
+
+    // `g` written as NAME.gltf, optimised cheaply into NAME-optimised.glb, through gltfpack, then
+    // reapplied: both the optimised and the reapplied file pass `check`.
+    void optimise_pack_reapply(const json& g, const std::string& name) {
+        SCOPED_TRACE(name);
+        std::ofstream(path(name + ".gltf")) << g.dump();
+        const fs::path optimised = path(name + "-optimised.glb"), pack = path(name + "-gltfpack.glb");
+        test::Outcome o =
+            run(exe() + " optimize -q --method single -k 2 --views 12 --resolution 64 --max-iterations 2 " +
+                q(path(name + ".gltf")) + " -o " + q(optimised));
+        ASSERT_EQ(o.exit_code, 0) << o.err;
+        EXPECT_EQ(check(optimised), 0);
+        o = run("gltfpack -i " + q(optimised) + " -o " + q(pack));
+        ASSERT_EQ(o.exit_code, 0) << o.out << o.err;
+        o = run(exe() + " reapply " + q(optimised) + " " + q(pack) + " -o " + q(path(name + "-reapplied.glb")));
+        ASSERT_EQ(o.exit_code, 0) << o.err;
+        EXPECT_EQ(check(path(name + "-reapplied.glb")), 0);
+    }
+
     void round_trip(const fs::path& input, const std::string& name) {
         SCOPED_TRACE(name);
         const fs::path optimised = path(name + ".glb");
@@ -304,21 +329,10 @@ TEST_F(GltfPipelines, AMirroredCharacterKeepsItsFilesWindingThroughOptimizeAndRe
 TEST_F(GltfPipelines, ReapplyPairsClipsOfOneNameByTheirAnimation) {
     std::string why;
     ANIMORDER_REQUIRE_OR_SKIP("gltf-tools", tools_present(why), why);
-    test::Outcome o = run(exe() + " subdivide -q --levels 0 -o " + q(path("character.gltf")));
-    ASSERT_EQ(o.exit_code, 0) << o.err;
-    json g = json::parse(test::slurp(path("character.gltf")));
+    json g = bundled_character();
     ASSERT_GE(g["animations"].size(), 2u);
     for (json& a : g["animations"]) a["name"] = "mixamo.com";
-    std::ofstream(path("same-names.gltf")) << g.dump();
-    const fs::path optimised = path("same-names-optimised.glb"), pack = path("same-names-gltfpack.glb");
-    o = run(exe() + " optimize -q --method single -k 2 --views 12 --resolution 64 --max-iterations 2 " +
-            q(path("same-names.gltf")) + " -o " + q(optimised));
-    ASSERT_EQ(o.exit_code, 0) << o.err;
-    o = run("gltfpack -i " + q(optimised) + " -o " + q(pack));
-    ASSERT_EQ(o.exit_code, 0) << o.out << o.err;
-    o = run(exe() + " reapply " + q(optimised) + " " + q(pack) + " -o " + q(path("same-names-reapplied.glb")));
-    ASSERT_EQ(o.exit_code, 0) << o.err;
-    EXPECT_EQ(check(path("same-names-reapplied.glb")), 0);
+    optimise_pack_reapply(g, "same-names");
 }
 
 // A character drawn twice (a second node with its mesh: instances) keeps one order per buffer
@@ -327,9 +341,7 @@ TEST_F(GltfPipelines, ReapplyPairsClipsOfOneNameByTheirAnimation) {
 TEST_F(GltfPipelines, ReapplyWritesAnInstancedMeshOnce) {
     std::string why;
     ANIMORDER_REQUIRE_OR_SKIP("gltf-tools", tools_present(why), why);
-    test::Outcome o = run(exe() + " subdivide -q --levels 0 -o " + q(path("character.gltf")));
-    ASSERT_EQ(o.exit_code, 0) << o.err;
-    json g = json::parse(test::slurp(path("character.gltf")));
+    json g = bundled_character();
     const size_t scene = g.value("scene", 0);
     size_t mesh_node = 0;
     while (!g["nodes"][mesh_node].contains("mesh")) ++mesh_node;
@@ -337,31 +349,19 @@ TEST_F(GltfPipelines, ReapplyWritesAnInstancedMeshOnce) {
     twin["translation"] = {2, 0, 0};
     g["nodes"].push_back(twin);
     g["scenes"][scene]["nodes"].push_back(g["nodes"].size() - 1);
-    std::ofstream(path("twins.gltf")) << g.dump();
-    const fs::path optimised = path("twins-optimised.glb"), pack = path("twins-gltfpack.glb");
-    o = run(exe() + " optimize -q --method single -k 2 --views 12 --resolution 64 --max-iterations 2 " +
-            q(path("twins.gltf")) + " -o " + q(optimised));
-    ASSERT_EQ(o.exit_code, 0) << o.err;
-    EXPECT_EQ(check(optimised), 0);
-    o = run("gltfpack -i " + q(optimised) + " -o " + q(pack));
-    ASSERT_EQ(o.exit_code, 0) << o.out << o.err;
-    o = run(exe() + " reapply " + q(optimised) + " " + q(pack) + " -o " + q(path("twins-reapplied.glb")));
-    ASSERT_EQ(o.exit_code, 0) << o.err;
-    EXPECT_EQ(check(path("twins-reapplied.glb")), 0);
+    optimise_pack_reapply(g, "twins");
 }
 
 // A processed copy that dropped one of two animations of a shared name: which lookup table follows
 // which animation cannot be told, and reapply says so in one line and writes nothing (it attached
 // the first clip's table to the other animation, which `check` then refused).
 TEST_F(GltfPipelines, ReapplyRefusesCopiesThatDroppedAnAnimationOfASharedName) {
-    test::Outcome o = run(exe() + " subdivide -q --levels 0 -o " + q(path("character.gltf")));
-    ASSERT_EQ(o.exit_code, 0) << o.err;
-    json g = json::parse(test::slurp(path("character.gltf")));
+    json g = bundled_character();
     ASSERT_GE(g["animations"].size(), 2u);
     for (json& a : g["animations"]) a["name"] = "mixamo.com";
     std::ofstream(path("same-names.gltf")) << g.dump();
-    o = run(exe() + " optimize -q --method single -k 2 --views 12 --resolution 64 --max-iterations 2 " +
-            q(path("same-names.gltf")) + " -o " + q(path("optimised.gltf")));
+    test::Outcome o = run(exe() + " optimize -q --method single -k 2 --views 12 --resolution 64 --max-iterations 2 " +
+                          q(path("same-names.gltf")) + " -o " + q(path("optimised.gltf")));
     ASSERT_EQ(o.exit_code, 0) << o.err;
     json processed = json::parse(test::slurp(path("same-names.gltf")));
     processed["animations"].erase(0);

@@ -504,18 +504,30 @@ PrimitiveData parse_primitive(const Scene& s, size_t n, size_t p, AnimatedMesh& 
     return d;
 }
 
-// Every primitive of the mesh nodes, in scene order (node, then primitive): at least one.
+// Every triangle primitive of the mesh nodes, in scene order (node, then primitive): at least one.
+// Points and lines are left out: they draw as the file has them, and writers leave them alone.
 void parse_primitives(Scene& s, AnimatedMesh& mesh) {
     mesh.joint_count = 0;
+    bool points_or_lines = false;
     for (size_t n : s.order) {
         const tinygltf::Node& node = s.model.nodes[n];
         if (node.mesh < 0) continue;
         if (size_t(node.mesh) >= s.model.meshes.size())
             s.reader.fail("node " + std::to_string(n) + " names a missing mesh");
-        for (size_t p = 0; p < s.model.meshes[size_t(node.mesh)].primitives.size(); ++p)
+        for (size_t p = 0; p < s.model.meshes[size_t(node.mesh)].primitives.size(); ++p) {
+            const int mode = s.model.meshes[size_t(node.mesh)].primitives[p].mode;
+            if (mode == TINYGLTF_MODE_POINTS || mode == TINYGLTF_MODE_LINE || mode == TINYGLTF_MODE_LINE_LOOP ||
+                mode == TINYGLTF_MODE_LINE_STRIP) {
+                points_or_lines = true;  // drawn as the file has them (as assimp's loader drops them too)
+                continue;
+            }
             s.prims.push_back(parse_primitive(s, n, p, mesh));
+        }
     }
-    if (s.prims.empty()) s.reader.fail("no triangle mesh in the scene");
+    if (s.prims.empty())
+        s.reader.fail(points_or_lines
+                          ? "no triangle mesh in the scene (points and lines cannot be reordered for overdraw)"
+                          : "no triangle mesh in the scene");
 }
 
 // Every node's pose without animation: matrix or T, R, S, and morph weights (the node's, else

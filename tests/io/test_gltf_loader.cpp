@@ -239,8 +239,15 @@ TEST_F(GltfLoader, BrokenFilesGiveOneLineErrorsNamingTheFile) {
     }
     {
         Gltf g = skinned_bar();
-        g.doc["meshes"][0]["primitives"][0]["mode"] = 1;  // LINES
-        expect_error("lines.gltf", g.text(), "points and lines");
+        g.doc["meshes"][0]["primitives"][0]["mode"] = 1;  // LINES, and nothing else
+        expect_error("lines.gltf", g.text(), "no triangle mesh in the scene (points and lines");
+        // Next to triangles, a lines primitive is left out (it was refused, and the file with it).
+        g.doc["meshes"][0]["primitives"].push_back(g.doc["meshes"][0]["primitives"][0]);
+        g.doc["meshes"][0]["primitives"][1].erase("mode");
+        const AnimatedMesh m = load_gltf(write("lines-and-triangles.gltf", g.text()));
+        ASSERT_EQ(m.primitives.size(), 1u);
+        EXPECT_EQ(m.primitives[0].source_primitive, 1);
+        EXPECT_EQ(m.triangle_count(), 2u);
     }
     {
         Gltf g = skinned_bar();

@@ -376,10 +376,7 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
     auto add_keyframe = [&](const aiAnimation* anim, double tick) {
         const std::vector<aiMatrix4x4> global = globals(anim, tick);
         for (size_t i = 0; i < parts.size(); ++i) {
-            const aiMatrix4x4& g = global[parts[i].node];
-            const double det = double(g.a1) * (double(g.b2) * g.c3 - double(g.b3) * g.c2) -
-                               double(g.a2) * (double(g.b1) * g.c3 - double(g.b3) * g.c1) +
-                               double(g.a3) * (double(g.b1) * g.c2 - double(g.b2) * g.c1);
+            const ai_real det = global[parts[i].node].Determinant();  // an affine transform's: its 3 × 3 block's
             mirrored_in_some[i] |= det < 0;
             upright_in_some[i] |= det > 0;
         }

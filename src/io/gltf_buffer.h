@@ -187,17 +187,37 @@ inline constexpr int kPlaceholderNode = INT32_MAX;
 inline std::string json_with_placeholder_nodes(const std::string& text) {
     nlohmann::ordered_json j = nlohmann::ordered_json::parse(text, nullptr, false);
     if (!j.is_object() || !j.contains("animations") || !j["animations"].is_array()) return {};
-    const int placeholder = kPlaceholderNode;
     bool changed = false;
     for (nlohmann::ordered_json& animation : j["animations"])
         if (animation.is_object() && animation.contains("channels") && animation["channels"].is_array())
             for (nlohmann::ordered_json& channel : animation["channels"])
                 if (channel.is_object() && channel.contains("target") && channel["target"].is_object() &&
                     !channel["target"].contains("node")) {
-                    channel["target"]["node"] = placeholder;
+                    channel["target"]["node"] = kPlaceholderNode;
                     changed = true;
                 }
     return changed ? j.dump() : std::string();
+}
+
+// `glb` (a whole GLB file) with its JSON chunk replaced by `json` (padded with spaces to 4 bytes),
+// its lengths set; "" when `glb` has no readable JSON chunk first, or the result exceeds the 32-bit
+// lengths GLB has.
+inline std::string glb_with_json(const std::string& glb, std::string json) {
+    uint32_t json_length = 0;
+    if (glb.size() < 20 || std::memcmp(glb.data() + 16, "JSON", 4) != 0) return {};
+    std::memcpy(&json_length, glb.data() + 12, 4);
+    if (size_t(json_length) > glb.size() - 20) return {};
+    while (json.size() % 4) json.push_back(' ');
+    const size_t total = glb.size() - json_length + json.size();
+    if (total > UINT32_MAX) return {};
+    const uint32_t length = uint32_t(json.size()), whole = uint32_t(total);
+    std::string out = glb.substr(0, 12);
+    std::memcpy(&out[8], &whole, 4);
+    out.append(reinterpret_cast<const char*>(&length), 4);
+    out.append("JSON", 4);
+    out += json;
+    out.append(glb, 20 + size_t(json_length), std::string::npos);
+    return out;
 }
 
 // tinygltf's load of `path` into `model` (with json_with_placeholder_nodes' JSON when it has
@@ -220,23 +240,10 @@ inline bool load_gltf_file(tinygltf::TinyGLTF& loader, tinygltf::Model& model, s
         }
         std::vector<unsigned char> bytes;
         if (!read_regular_file(&bytes, &error, path, const_cast<uint64_t*>(budget))) return false;
-        uint32_t json_length = 0;
-        if (bytes.size() >= 20) std::memcpy(&json_length, bytes.data() + 12, 4);
-        if (bytes.size() < 20 || size_t(json_length) > bytes.size() - 20)
-            return loader.LoadBinaryFromFile(&model, &error, &warning, path);  // its own error
-        std::string text = patched;
-        while (text.size() % 4) text.push_back(' ');
-        std::vector<unsigned char> glb(bytes.begin(), bytes.begin() + 12);
-        const uint32_t length = uint32_t(text.size());
-        glb.insert(glb.end(), reinterpret_cast<const unsigned char*>(&length),
-                   reinterpret_cast<const unsigned char*>(&length) + 4);
-        glb.insert(glb.end(), bytes.begin() + 16, bytes.begin() + 20);  // "JSON"
-        glb.insert(glb.end(), text.begin(), text.end());
-        glb.insert(glb.end(), bytes.begin() + 20 + ptrdiff_t(json_length), bytes.end());
-        if (glb.size() > kMost) return error = path + " is too large", false;
-        const uint32_t total = uint32_t(glb.size());
-        std::memcpy(glb.data() + 8, &total, 4);
-        return loader.LoadBinaryFromMemory(&model, &error, &warning, glb.data(), unsigned(glb.size()), base);
+        const std::string glb = glb_with_json(std::string(bytes.begin(), bytes.end()), patched);
+        if (glb.empty()) return loader.LoadBinaryFromFile(&model, &error, &warning, path);  // its own error
+        return loader.LoadBinaryFromMemory(&model, &error, &warning, reinterpret_cast<const unsigned char*>(glb.data()),
+                                           unsigned(glb.size()), base);
     } catch (const std::exception& e) {
         error = e.what();
         return false;
@@ -307,8 +314,8 @@ inline std::string restore_from_input(const std::string& input_path, std::string
     const nlohmann::ordered_json input = nlohmann::ordered_json::parse(input_text, nullptr, false);
     if (input.is_discarded()) return written;
     std::string json_text = written;
-    uint32_t json_length = 0;
     if (binary) {
+        uint32_t json_length = 0;
         if (written.size() < 20 || std::memcmp(written.data() + 16, "JSON", 4) != 0) return written;
         std::memcpy(&json_length, written.data() + 12, 4);
         if (size_t(json_length) > written.size() - 20) return written;
@@ -317,18 +324,8 @@ inline std::string restore_from_input(const std::string& input_path, std::string
     nlohmann::ordered_json output = nlohmann::ordered_json::parse(json_text, nullptr, false);
     if (output.is_discarded() || !restore_what_tinygltf_drops(input, output)) return written;
     if (!binary) return output.dump(2);
-    std::string text = output.dump();
-    while (text.size() % 4) text.push_back(' ');  // chunks are 4-byte aligned, JSON padded with spaces
-    const std::string rest = written.substr(20 + json_length);
-    std::string glb = written.substr(0, 12);
-    const uint32_t length = uint32_t(text.size());
-    glb.append(reinterpret_cast<const char*>(&length), 4);
-    glb.append("JSON", 4);
-    glb += text;
-    glb += rest;
-    const uint32_t total = uint32_t(glb.size());
-    std::memcpy(&glb[8], &total, 4);
-    return glb;
+    const std::string glb = glb_with_json(written, output.dump());
+    return glb.empty() ? written : glb;
 }
 
 // The model read from input_path as a file at output_path: buffers embedded (every buffer's URI

@@ -451,9 +451,6 @@ PrimitiveData parse_primitive(const Scene& s, size_t n, size_t p, AnimatedMesh& 
     const tinygltf::Mesh& m = s.model.meshes[size_t(node.mesh)];
     const tinygltf::Primitive& prim = m.primitives[p];
     const std::string where = "mesh '" + m.name + "' primitive " + std::to_string(p);
-    if (prim.mode == TINYGLTF_MODE_POINTS || prim.mode == TINYGLTF_MODE_LINE || prim.mode == TINYGLTF_MODE_LINE_LOOP ||
-        prim.mode == TINYGLTF_MODE_LINE_STRIP)
-        s.reader.fail(where + ": points and lines cannot be reordered for overdraw");
     const auto position = prim.attributes.find("POSITION");
     if (position == prim.attributes.end()) s.reader.fail(where + " has no POSITION");
     PrimitiveData d;
@@ -517,8 +514,8 @@ void parse_primitives(Scene& s, AnimatedMesh& mesh) {
         for (size_t p = 0; p < s.model.meshes[size_t(node.mesh)].primitives.size(); ++p) {
             const int mode = s.model.meshes[size_t(node.mesh)].primitives[p].mode;
             if (mode == TINYGLTF_MODE_POINTS || mode == TINYGLTF_MODE_LINE || mode == TINYGLTF_MODE_LINE_LOOP ||
-                mode == TINYGLTF_MODE_LINE_STRIP) {
-                points_or_lines = true;  // drawn as the file has them (as assimp's loader drops them too)
+                mode == TINYGLTF_MODE_LINE_STRIP) {  // parse_primitive then sees triangles only
+                points_or_lines = true;              // drawn as the file has them (as assimp's loader drops them too)
                 continue;
             }
             s.prims.push_back(parse_primitive(s, n, p, mesh));

@@ -159,22 +159,22 @@ export class AnimorderRuntime {
             if (!root) return null;
             const reader = new AccessorReader(json, bin);
             const runtime = AnimorderRuntime.fromExtension(root, (index) => reader.read(index));
-            checkPrimitives(json, runtime.bufferCount);
+            checkPrimitives(json, runtime.bufferCount, reader);
             return runtime;
         });
     }
 
     // The root extension object, with `readAccessor(index)` returning { array, itemSize, count,
-    // componentType } for an accessor (a typed array of count·itemSize values, tightly packed).
+    // componentType, normalized } for an accessor (a typed array of count·itemSize values, tightly packed).
     // three.js's GLTFLoader gives such arrays (parser.getDependency('accessor', i)).
     static fromExtension(root, readAccessor) {
         if (!isCount(root.bufferCount)) fail(`${EXTENSION_NAME}: bufferCount must be a count`);
         if (!Array.isArray(root.clips)) fail(`${EXTENSION_NAME}: clips must be an array`);
         const clips = root.clips.map((c, index) => {
             const table = readAccessor(c.table), centres = readAccessor(c.centers);
-            if (!table || table.componentType !== 5121 || table.itemSize !== 1)
-                fail(`${EXTENSION_NAME}: clip ${index}'s table must be a SCALAR UNSIGNED_BYTE accessor`);
-            if (!centres || centres.componentType !== 5126 || centres.itemSize !== 3)
+            if (!table || table.componentType !== 5121 || table.itemSize !== 1 || table.normalized)
+                fail(`${EXTENSION_NAME}: clip ${index}'s table must be a SCALAR UNSIGNED_BYTE accessor, not normalized`);
+            if (!centres || centres.componentType !== 5126 || centres.itemSize !== 3 || centres.normalized)
                 fail(`${EXTENSION_NAME}: clip ${index}'s centers must be a VEC3 FLOAT accessor`);
             return {
                 name: c.name, animation: c.animation, startTime: c.startTime ?? 0, sampleRate: c.sampleRate,
@@ -182,7 +182,7 @@ export class AnimorderRuntime {
                 cells: table.array, centres: centres.array,
             };
         });
-        const fallback = root.fallback ?? 0;
+        const fallback = root.fallback;  // required (the schema): the order a reader draws without a pick
         if (!Number.isInteger(fallback) || fallback < 0 || fallback >= root.bufferCount)
             fail(`${EXTENSION_NAME}: fallback ${fallback} is not a buffer`);
         return new AnimorderRuntime({ bufferCount: root.bufferCount, clips, method: root.method ?? null, fallback });
@@ -202,8 +202,10 @@ function asAnimorderError(make) {
 
 // What the extension asks of each primitive that carries orders (the checks of `animorder check`
 // an engine needs before binding them): triangles with indices, orderCount = bufferCount, an
-// orders accessor of orderCount × the indices' count unsigned shorts or ints in a buffer view.
-function checkPrimitives(json, bufferCount) {
+// orders accessor of orderCount × the indices' count unsigned shorts or ints, not normalized,
+// inside its buffer view and buffer (`reader`), each naming one of the primitive's vertices (an
+// unsigned short never 65535, WebGL 2's primitive restart).
+function checkPrimitives(json, bufferCount, reader) {
     const accessors = json.accessors || [];
     (json.meshes || []).forEach((mesh, m) => (mesh && mesh.primitives || []).forEach((primitive, p) => {
         const ext = primitive && primitive.extensions && primitive.extensions[EXTENSION_NAME];
@@ -217,6 +219,15 @@ function checkPrimitives(json, bufferCount) {
         if (!orders || orders.type !== 'SCALAR' || (orders.componentType !== 5123 && orders.componentType !== 5125) ||
             orders.count !== ext.orderCount * indices.count || orders.bufferView === undefined || orders.sparse)
             fail(`${where}: orders must be ${ext.orderCount}×${indices.count} unsigned short or int indices in a buffer view`);
+        if (orders.normalized) fail(`${where}: orders must not be normalized`);
+        const position = primitive.attributes ? accessors[primitive.attributes.POSITION] : undefined;
+        if (!position || !isCount(position.count)) fail(`${where}: orders on a primitive without positions`);
+        const at = reader.locate(ext.orders);
+        const wide = orders.componentType === 5125, vertices = wide ? position.count : Math.min(position.count, 65535);
+        for (let e = 0; e < at.count; ++e) {
+            const v = wide ? at.data.getUint32(at.start + e * at.stride, true) : at.data.getUint16(at.start + e * at.stride, true);
+            if (v >= vertices) fail(`${where}: an order names vertex ${v} of ${position.count}${v === 65535 ? ' (primitive restart)' : ''}`);
+        }
     }));
 }
 
@@ -225,8 +236,8 @@ function checkClip(c, index, bufferCount) {
     for (const key of ['keyframes', 'thetaSteps', 'phiSteps', 'bufferBase'])
         if (!isCount(c[key])) fail(`${where}: ${key} must be a count`);
     if (c.keyframes === 0 || c.thetaSteps < 2 || c.phiSteps === 0) fail(`${where}: impossible table dimensions`);
-    const sampleRate = f32(c.sampleRate);
-    if (!(sampleRate > 0 && Number.isFinite(sampleRate))) fail(`${where}: sample rate must be positive`);
+    const sampleRate = typeof c.sampleRate === 'number' ? f32(c.sampleRate) : NaN;  // f32("30") would be 30
+    if (!(sampleRate > 0 && Number.isFinite(sampleRate))) fail(`${where}: sample rate must be a positive number`);
     if (c.bufferBase >= bufferCount) fail(`${where}: bufferBase ${c.bufferBase} >= bufferCount ${bufferCount}`);
     const cellCount = c.keyframes * c.thetaSteps * c.phiSteps;
     if (!c.cells || c.cells.length !== cellCount) fail(`${where}: the table has ${c.cells ? c.cells.length : 0} cells, not ${cellCount}`);
@@ -313,6 +324,7 @@ export class AccessorReader {
     }
 
     bufferBytes(index) {
+        if (!Number.isInteger(index)) fail(`buffer ${index} does not exist`);  // buffers['0'] is buffers[0]
         if (this.buffers[index]) return this.buffers[index];
         const buffer = (this.json.buffers || [])[index];
         if (!buffer) fail(`buffer ${index} does not exist`);
@@ -335,9 +347,11 @@ export class AccessorReader {
         return this.read_.get(index);
     }
 
-    // Every number checked before any allocation: the extension's accessors lie in buffer views
-    // (one without would be `count` zeros, any count), at offsets that are counts, inside the view.
-    readOnce(index) {
+    // Where accessor `index`'s elements lie, every number checked before any allocation: the
+    // extension's accessors lie in buffer views (one without would be `count` zeros, any count), at
+    // offsets that are counts, inside the view and its buffer. Returns { accessor, Type, itemSize,
+    // count, start, stride, data } (data: a DataView of the buffer; element e at start + e·stride).
+    locate(index) {
         const accessor = Number.isInteger(index) ? (this.json.accessors || [])[index] : undefined;
         if (!accessor) fail(`accessor ${index} does not exist`);
         if (accessor.sparse) fail(`accessor ${index} is sparse`);
@@ -357,14 +371,19 @@ export class AccessorReader {
         const end = count === 0 ? start : start + (count - 1) * stride + element;
         if (end > viewOffset + view.byteLength || viewOffset + view.byteLength > bytes.length)
             fail(`accessor ${index} reaches past its buffer view or buffer`);
-        const array = new Type(count * itemSize);
         const data = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
+        return { accessor, Type, itemSize, count, start, stride, data };
+    }
+
+    readOnce(index) {
+        const { accessor, Type, itemSize, count, start, stride, data } = this.locate(index);
+        const array = new Type(count * itemSize);
         const get = {
             5120: (o) => data.getInt8(o), 5121: (o) => data.getUint8(o), 5122: (o) => data.getInt16(o, true),
             5123: (o) => data.getUint16(o, true), 5125: (o) => data.getUint32(o, true), 5126: (o) => data.getFloat32(o, true),
         }[accessor.componentType];
         for (let e = 0; e < count; ++e)
             for (let k = 0; k < itemSize; ++k) array[e * itemSize + k] = get(start + e * stride + k * Type.BYTES_PER_ELEMENT);
-        return { array, itemSize, count, componentType: accessor.componentType };
+        return { array, itemSize, count, componentType: accessor.componentType, normalized: accessor.normalized === true };
     }
 }

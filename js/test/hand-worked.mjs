@@ -58,8 +58,24 @@ assert.throws(broken((g) => { g.accessors[2].count = 9; }), AnimorderError);    
 assert.throws(broken((g) => { g.accessors[2].componentType = 5126; }), AnimorderError);  // float orders
 assert.throws(broken((g) => { delete prim(g).indices; }), AnimorderError);
 assert.throws(broken((g) => { prim(g).mode = 5; }), AnimorderError);                   // a strip
-// Accessors: never read outside their view, never `count` zeros without one (4 GB for a big count).
 const table = (g) => g.accessors[ext(g).clips[0].table];
+// The orders accessor as `animorder check` reads it: inside its view and buffer, not normalized,
+// every value one of the primitive's 4 vertices.
+assert.throws(broken((g) => { g.accessors[2].bufferView = 99; }), AnimorderError);
+assert.throws(broken((g) => { g.accessors[2].byteOffset = 1000; }), AnimorderError);
+assert.throws(broken((g) => { g.bufferViews[2].byteOffset = 4096; }), AnimorderError);  // the view past the buffer
+assert.throws(broken((g) => { g.bufferViews[2].byteStride = 4; }), /reaches past/);     // 12 values 4 bytes apart
+assert.throws(broken((g) => { g.accessors[2].normalized = true; }), AnimorderError);
+assert.throws(broken((g) => { g.accessors[0].count = 3; }), /names vertex 3 of 3/);     // the orders name vertex 3
+assert.throws(broken((g) => { g.bufferViews[2].buffer = '0'; }), AnimorderError);
+// Fields of the wrong type, which numeric conversion would let through ("30" → 30), and the
+// required fallback.
+assert.throws(broken((g) => { ext(g).clips[0].sampleRate = '30'; }), /sample rate/);
+assert.throws(broken((g) => { ext(g).clips[0].sampleRate = [30]; }), /sample rate/);
+assert.throws(broken((g) => { ext(g).clips[0].sampleRate = true; }), /sample rate/);
+assert.throws(broken((g) => { delete ext(g).fallback; }), /fallback/);
+assert.throws(broken((g) => { table(g).normalized = true; }), /not normalized/);
+// Accessors: never read outside their view, never `count` zeros without one (4 GB for a big count).
 assert.throws(broken((g) => { table(g).byteOffset = -1; }), AnimorderError);
 assert.throws(broken((g) => { delete g.bufferViews[table(g).bufferView].byteLength; }), AnimorderError);
 assert.throws(broken((g) => { delete table(g).bufferView; table(g).count = 4294967295; }), AnimorderError);

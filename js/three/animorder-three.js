@@ -11,12 +11,10 @@
 //   const gltf = await loader.loadAsync('character.glb');
 //   const orders = gltf.userData.animorder;              // AnimorderCharacter, or null
 //   ... each frame: mixer.update(dt); orders?.update(camera, mixer); renderer.render(scene, camera);
-import { BufferAttribute, Vector3 } from 'three';
-import { AnimorderError, AnimorderRuntime, EXTENSION_NAME } from '../runtime/animorder.js';
+import { BufferAttribute, BufferGeometry, Vector3 } from 'three';
+import { AccessorReader, AnimorderError, AnimorderRuntime, EXTENSION_NAME } from '../runtime/animorder.js';
 
 export { AnimorderRuntime, EXTENSION_NAME };
-
-const COMPONENT = { 5121: Uint8Array, 5123: Uint16Array, 5125: Uint32Array, 5126: Float32Array };
 
 export class AnimorderGLTFPlugin {
     constructor(parser) {
@@ -39,22 +37,18 @@ export class AnimorderGLTFPlugin {
         }
     }
 
+    // An extension accessor as the runtime reads it (AccessorReader: every index, offset and count
+    // checked against the JSON and the buffer's bytes before anything is allocated; sparse and
+    // view-less accessors refused), its buffer's bytes from GLTFLoader.
     async accessor(index) {
         const json = this.parser.json;
-        const def = (json.accessors || [])[index];
-        if (!def) throw new AnimorderError(`accessor ${index} does not exist`);
-        // Without a buffer view three.js makes `count` zeros, whatever the count: none of ours is so.
-        if (def.bufferView === undefined) throw new AnimorderError(`accessor ${index} has no buffer view`);
-        const attribute = await this.parser.getDependency('accessor', index);
-        const Type = COMPONENT[def.componentType];
-        if (!Type) throw new AnimorderError(`accessor ${index} has an unexpected component type`);
-        let array = attribute.array;
-        if (attribute.isInterleavedBufferAttribute || !(array instanceof Type) || array.length !== def.count * attribute.itemSize) {
-            array = new Type(def.count * attribute.itemSize);
-            for (let e = 0; e < def.count; ++e)
-                for (let k = 0; k < attribute.itemSize; ++k) array[e * attribute.itemSize + k] = attribute.getComponent(e, k);
-        }
-        return { array, itemSize: attribute.itemSize, count: def.count, componentType: def.componentType };
+        this.reader = this.reader || new AccessorReader(json, null);
+        const def = Number.isInteger(index) ? (json.accessors || [])[index] : undefined;
+        const view = def && Number.isInteger(def.bufferView) ? (json.bufferViews || [])[def.bufferView] : undefined;
+        const b = view ? view.buffer : undefined;
+        if (Number.isInteger(b) && (json.buffers || [])[b] && !this.reader.buffers[b])
+            this.reader.buffers[b] = new Uint8Array(await this.parser.getDependency('buffer', b));
+        return this.reader.read(index);
     }
 
     async read(gltf, root) {
@@ -64,9 +58,19 @@ export class AnimorderGLTFPlugin {
             for (const index of [clip.table, clip.centers])
                 if (!needed.has(index)) needed.set(index, await this.accessor(index));
         const runtime = AnimorderRuntime.fromExtension(root, (index) => needed.get(index));
+        // Orders on points or lines (which three.js draws as Points and Lines, not meshes) refuse the
+        // file, as the runtime does.
+        (json.meshes || []).forEach((mesh, m) => ((mesh && mesh.primitives) || []).forEach((primitive, p) => {
+            const ext = primitive && primitive.extensions && primitive.extensions[EXTENSION_NAME];
+            if (ext && primitive.mode !== undefined && primitive.mode !== 4)
+                throw new AnimorderError(`mesh ${m} primitive ${p}: orders on a primitive that is not triangles`);
+        }));
         const meshes = [];
-        const done = new Map(); // geometry → index count n (geometries GLTFLoader shares)
+        // geometry → { n: index count, orders: accessor }: GLTFLoader shares one geometry between
+        // primitives of equal attributes and indices, whatever their extensions.
+        const done = new Map();
         const toIndex = [];     // geometries and their orders, set once all are checked
+        const plain = [];       // meshes whose primitive has no orders: they keep the file's indices
         const objects = [];
         for (const scene of gltf.scenes || [gltf.scene]) scene.traverse((o) => { if (o.isMesh) objects.push(o); });
         let primitiveOrder = 0;
@@ -75,25 +79,38 @@ export class AnimorderGLTFPlugin {
             if (!where || where.meshes === undefined || where.primitives === undefined) continue;
             const primitive = json.meshes[where.meshes].primitives[where.primitives];
             const ext = primitive.extensions && primitive.extensions[EXTENSION_NAME];
-            if (!ext) continue;
-            const geometry = mesh.geometry;
-            let n = done.get(geometry);
-            if (n === undefined) {
-                if (!geometry.index) throw new AnimorderError(`mesh ${where.meshes} primitive ${where.primitives} has no indices`);
+            if (!ext) {
+                plain.push(mesh);
+                continue;
+            }
+            const geometry = mesh.geometry, at = `mesh ${where.meshes} primitive ${where.primitives}`;
+            if (ext.orderCount !== runtime.bufferCount)
+                throw new AnimorderError(`${at}: orderCount ${ext.orderCount} != bufferCount ${runtime.bufferCount}`);
+            const seen = done.get(geometry);
+            if (seen !== undefined && seen.orders !== ext.orders)
+                throw new AnimorderError(`${at}: orders ${ext.orders}, where a primitive of the same geometry has ${seen.orders}`);
+            let n = seen && seen.n;
+            if (seen === undefined) {
+                if (!geometry.index) throw new AnimorderError(`${at} has no indices`);
                 n = geometry.index.count;
-                if (ext.orderCount !== runtime.bufferCount)
-                    throw new AnimorderError(`mesh ${where.meshes} primitive ${where.primitives}: orderCount ${ext.orderCount} != bufferCount ${runtime.bufferCount}`);
                 const orders = await this.accessor(ext.orders);
-                if (orders.itemSize !== 1 || orders.count !== ext.orderCount * n || (orders.componentType !== 5123 && orders.componentType !== 5125))
-                    throw new AnimorderError(`mesh ${where.meshes} primitive ${where.primitives}: orders must be ${ext.orderCount}×${n} unsigned indices`);
+                if (orders.itemSize !== 1 || orders.count !== ext.orderCount * n || orders.normalized ||
+                    (orders.componentType !== 5123 && orders.componentType !== 5125))
+                    throw new AnimorderError(`${at}: orders must be ${ext.orderCount}×${n} unsigned indices, not normalized`);
+                // Every value a vertex; an unsigned short never 65535 (WebGL 2's primitive restart).
                 const vertices = geometry.attributes.position.count;
+                const limit = orders.componentType === 5123 ? Math.min(vertices, 65535) : vertices;
                 for (let k = 0; k < orders.array.length; ++k)
-                    if (orders.array[k] >= vertices) throw new AnimorderError(`mesh ${where.meshes} primitive ${where.primitives}: an order names vertex ${orders.array[k]} of ${vertices}`);
+                    if (orders.array[k] >= limit) throw new AnimorderError(`${at}: an order names vertex ${orders.array[k]} of ${vertices}`);
                 toIndex.push({ geometry, array: orders.array });
-                done.set(geometry, n);
+                done.set(geometry, { n, orders: ext.orders });
             }
             meshes.push({ mesh, n, mesh_index: where.meshes, primitive_index: where.primitives, drawOrder: primitiveOrder++ });
         }
+        // A primitive without orders whose geometry GLTFLoader shares with one that has them keeps
+        // the file's indices in a geometry of its own (the same attributes, not copied).
+        for (const mesh of plain)
+            if (done.has(mesh.geometry)) mesh.geometry = withOwnIndex(mesh.geometry);
         // Only once every primitive checks out: a later one that does not leaves every geometry
         // drawing its own indices (the spec's fallback), none half switched to the orders.
         for (const { geometry, array } of toIndex) {
@@ -104,6 +121,22 @@ export class AnimorderGLTFPlugin {
         character.setBuffer(runtime.fallback);
         return character;
     }
+}
+
+// A geometry with `geometry`'s attributes, morph targets, groups and bounds (shared, not copied)
+// and its index.
+function withOwnIndex(geometry) {
+    const copy = new BufferGeometry();
+    copy.setIndex(geometry.index);
+    for (const name of Object.keys(geometry.attributes)) copy.setAttribute(name, geometry.attributes[name]);
+    for (const name of Object.keys(geometry.morphAttributes)) copy.morphAttributes[name] = geometry.morphAttributes[name];
+    copy.morphTargetsRelative = geometry.morphTargetsRelative;
+    for (const group of geometry.groups) copy.addGroup(group.start, group.count, group.materialIndex);
+    copy.boundingBox = geometry.boundingBox ? geometry.boundingBox.clone() : null;
+    copy.boundingSphere = geometry.boundingSphere ? geometry.boundingSphere.clone() : null;
+    copy.name = geometry.name;
+    copy.userData = { ...geometry.userData };
+    return copy;
 }
 
 // One loaded character: its runtime, its scene root (the glTF scene's model space), its meshes.
@@ -217,10 +250,18 @@ export class AnimorderCharacter {
             if (!index || index.count !== n) throw new AnimorderError(`the other file's mesh ${mesh_index} primitive ${primitive_index} does not match`);
             const geometry = mesh.geometry;
             if (updated.has(geometry)) continue;
+            const vertices = geometry.attributes.position.count, added = index.array.subarray(0, n);
+            let largest = 0;
+            for (const v of added) {
+                if (v >= vertices) throw new AnimorderError(`the other file's mesh ${mesh_index} primitive ${primitive_index} names vertex ${v} of ${vertices}`);
+                largest = Math.max(largest, v);
+            }
             const old = geometry.index.array;
-            const grown = new (old.constructor)(old.length + n);
+            // Unsigned shorts hold the other order's vertices below 65535 only (65535 restarts a strip).
+            const Type = old instanceof Uint16Array && largest >= 65535 ? Uint32Array : old.constructor;
+            const grown = new Type(old.length + n);
             grown.set(old);
-            grown.set(index.array.subarray(0, n), old.length);
+            grown.set(added, old.length);
             geometry.setIndex(new BufferAttribute(grown, 1));
             updated.add(geometry);
         }

@@ -141,4 +141,23 @@ TEST_F(JsTest, RuntimeHandWorkedOnTheSpecExample) {
     EXPECT_NE(o.out.find("hand-worked: all checks passed"), std::string::npos) << o.out << o.err;
 }
 
+// The three.js plugin in node with three.js's GLTFLoader on the extension's example, broken as a
+// hostile file is (js/test/three-plugin.mjs): it refuses what the runtime refuses, with one clear
+// line, and never draws a primitive without orders from another's.
+bool have_three(std::string& why) {
+    const fs::path three = fs::path(source_dir) / "viewer" / "node_modules" / "three";
+    if (!have_node(why)) return false;
+    if (fs::exists(three)) return true;
+    why = "three is not installed in " + three.string() + " (run scripts/install-deps.sh)";
+    return false;
+}
+
+TEST_F(JsTest, ThreePluginRefusesWhatTheRuntimeRefuses) {
+    std::string why;
+    ANIMORDER_REQUIRE_OR_SKIP("node", have_three(why), why);
+    const test::Outcome o = run("node " + sh(source_dir + "/js/test/three-plugin.mjs"));
+    EXPECT_EQ(o.exit_code, 0) << o.out << o.err;
+    EXPECT_NE(o.out.find("three plugin: all checks passed"), std::string::npos) << o.out << o.err;
+}
+
 }  // namespace

@@ -45,8 +45,9 @@ typedef struct animorder_runtime {
  *   -2 truncated (header, clip records or index buffers past the end; NULL rt or data),
  *   -3 a clip's table or centres out of bounds, overlapping, or with impossible dimensions
  *      (keyframes 0, theta_steps < 2, phi_steps 0),
- *   -4 a value out of range: more than INT_MAX buffers, a clip's buffer set or a cell naming a
- *      buffer >= buffer_count, a sample rate that is not a positive finite number.
+ *   -4 a value out of range: no buffer or more than INT_MAX buffers, an index count that is not
+ *      whole triangles (a multiple of 3), a clip's buffer set or a cell naming a buffer >=
+ *      buffer_count, a sample rate that is not a positive finite number.
  * Every size and offset is checked without overflow, whatever the header says. On failure `rt` is
  * zeroed (no clips, no buffers), so the queries below answer -1 / NULL for it. The bytes are not
  * copied: they must outlive `rt`. */
@@ -168,7 +169,9 @@ int animorder_runtime_open(animorder_runtime* rt, const void* data, size_t size)
     clip_count = animorder__u32(p + 16);
     buffers_end = animorder__buffers_end((uint64_t)size, clip_count, buffer_count, index_count);
     if (buffers_end == 0) return -2;
-    if (buffer_count > (uint32_t)INT_MAX) return -4;
+    /* No buffer would leave the fallback (buffer 0) unbound; a partial triangle, a draw call's
+     * count that is not whole triangles. */
+    if (buffer_count == 0 || buffer_count > (uint32_t)INT_MAX || index_count % 3 != 0) return -4;
     for (c = 0; c < clip_count; ++c) {
         animorder__clip_info info;
         uint64_t k;

@@ -111,6 +111,10 @@ export class AnimorderRuntime {
         const buffersEnd = 20 + clipCount * 32 + bufferCount * indexCount * 4; // < 2^67: exact enough to compare
         if (buffersEnd > size) fail('sidecar truncated: clip records or index buffers past the end');
         if (bufferCount > INT_MAX) fail('sidecar: too many buffers');
+        // As the C runtime: no buffer would leave the fallback (buffer 0) unbound, and an index
+        // count that is not whole triangles is a partial triangle.
+        if (bufferCount === 0) fail('sidecar: no buffer');
+        if (indexCount % 3 !== 0) fail(`sidecar: ${indexCount} indices are not whole triangles`);
         const clips = [];
         let tables = 0;
         for (let c = 0; c < clipCount; ++c) {

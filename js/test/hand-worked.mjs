@@ -51,6 +51,16 @@ assert.equal(AnimorderRuntime.fromGltf({ asset: { version: '2.0' } }), null);   
 assert.throws(() => AnimorderRuntime.fromSidecar(new Uint8Array(10)), AnimorderError);
 assert.throws(() => AnimorderRuntime.fromSidecar(new TextEncoder().encode('AOR2'.padEnd(20, '\0'))), AnimorderError);
 assert.throws(() => AnimorderRuntime.fromGlb(new Uint8Array(30)), AnimorderError);
+// As the C runtime: a sidecar without a buffer (no fallback to bind) or of partial triangles.
+const sidecar = (buffers, indices) => {
+    const bytes = new Uint8Array(20 + 4 * buffers * indices), header = new DataView(bytes.buffer);
+    bytes.set(new TextEncoder().encode('AOR1'));
+    header.setUint32(4, 1, true), header.setUint32(8, buffers, true), header.setUint32(12, indices, true);
+    return bytes;
+};
+assert.equal(AnimorderRuntime.fromSidecar(sidecar(1, 3)).buffer(0).length, 3);
+assert.throws(() => AnimorderRuntime.fromSidecar(sidecar(0, 0)), /no buffer/);
+assert.throws(() => AnimorderRuntime.fromSidecar(sidecar(1, 4)), /not whole triangles/);
 // The primitives (what an engine binds): orders that do not fit are refused, as `animorder check` does.
 const prim = (g) => g.meshes[0].primitives[0];
 assert.throws(broken((g) => { prim(g).extensions.ANIMORDER_animated_triangle_orders.orderCount = 3; }), AnimorderError);

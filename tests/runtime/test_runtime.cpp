@@ -259,12 +259,24 @@ TEST(RuntimeHostile, BufferSizeThatWrapsIsTruncated) {
     EXPECT_EQ(open_bytes(header(0x40000000u, 0x40000000u, 0)), -2);  // 2^62, no wrap, too big
     EXPECT_EQ(open_bytes(header(0xffffffffu, 0xffffffffu, 0xffffffffu)), -2);
     EXPECT_EQ(open_bytes(header(1, 1, 0)), -2);  // 4 bytes of indices missing
-    std::string one = header(1, 1, 0);
-    put_u32(one, 7);
+    std::string one = header(1, 3, 0);
+    for (uint32_t v : {7u, 8u, 9u}) put_u32(one, v);
     EXPECT_EQ(open_bytes(one), 0);
     // Any number of empty buffers fits, but buffer ids are ints.
     EXPECT_EQ(open_bytes(header(0x80000000u, 0, 0)), -4);
     EXPECT_EQ(open_bytes(header(0x7fffffffu, 0, 0)), 0);
+}
+
+// A sidecar without a buffer opened with success and animorder_buffer(rt, 0), the fallback, was
+// NULL; one of 1 or 2 indices a buffer drew a partial triangle.
+TEST(RuntimeHostile, NoBufferOrPartialTrianglesAreRefused) {
+    EXPECT_EQ(open_bytes(header(0, 0, 0)), -4);
+    EXPECT_EQ(open_bytes(header(0, 3, 0)), -4);
+    for (uint32_t indices : {1u, 2u, 4u}) {
+        std::string bytes = header(1, indices, 0);
+        for (uint32_t i = 0; i < indices; ++i) put_u32(bytes, i);
+        EXPECT_EQ(open_bytes(bytes), -4) << indices << " indices";
+    }
 }
 
 // keyframes × theta × phi = 4 · 2^31 · 2^31 = 2^64 wrapped to 0: the table passed the bounds check

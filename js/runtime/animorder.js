@@ -169,8 +169,8 @@ export class AnimorderRuntime {
     }
 
     // The root extension object, with `readAccessor(index)` returning { array, itemSize, count,
-    // componentType, normalized } for an accessor (a typed array of count·itemSize values, tightly packed).
-    // three.js's GLTFLoader gives such arrays (parser.getDependency('accessor', i)).
+    // componentType, normalized } for an accessor (a typed array of count·itemSize values, tightly
+    // packed): AccessorReader's read, which the three.js plugin uses too.
     static fromExtension(root, readAccessor) {
         if (!isCount(root.bufferCount)) fail(`${EXTENSION_NAME}: bufferCount must be a count`);
         if (!Array.isArray(root.clips)) fail(`${EXTENSION_NAME}: clips must be an array`);
@@ -179,7 +179,7 @@ export class AnimorderRuntime {
             if (!table || table.componentType !== 5121 || table.itemSize !== 1 || table.normalized)
                 fail(`${EXTENSION_NAME}: clip ${index}'s table must be a SCALAR UNSIGNED_BYTE accessor, not normalized`);
             if (!centres || centres.componentType !== 5126 || centres.itemSize !== 3 || centres.normalized)
-                fail(`${EXTENSION_NAME}: clip ${index}'s centers must be a VEC3 FLOAT accessor`);
+                fail(`${EXTENSION_NAME}: clip ${index}'s centers must be a VEC3 FLOAT accessor, not normalized`);
             return {
                 name: c.name, animation: c.animation, startTime: c.startTime ?? 0, sampleRate: c.sampleRate,
                 keyframes: c.keyframes, thetaSteps: c.thetaSteps, phiSteps: c.phiSteps, bufferBase: c.bufferBase,

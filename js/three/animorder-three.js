@@ -244,26 +244,24 @@ export class AnimorderCharacter {
                 if (where && where.primitives !== undefined) byPrimitive.set(`${where.meshes}/${where.primitives}`, o.geometry.index);
             });
         const id = this.orderCount;
-        const updated = new Set();
+        // Every primitive checked before any geometry grows: a refusal leaves the character as it was.
+        const grow = new Map();  // geometry → the other file's order of it
         for (const { mesh, n, mesh_index, primitive_index } of this.meshes) {
             const index = byPrimitive.get(`${mesh_index}/${primitive_index}`);
-            if (!index || index.count !== n) throw new AnimorderError(`the other file's mesh ${mesh_index} primitive ${primitive_index} does not match`);
-            const geometry = mesh.geometry;
-            if (updated.has(geometry)) continue;
-            const vertices = geometry.attributes.position.count, added = index.array.subarray(0, n);
-            let largest = 0;
-            for (const v of added) {
-                if (v >= vertices) throw new AnimorderError(`the other file's mesh ${mesh_index} primitive ${primitive_index} names vertex ${v} of ${vertices}`);
-                largest = Math.max(largest, v);
-            }
+            const at = `the other file's mesh ${mesh_index} primitive ${primitive_index}`;
+            if (!index || index.count !== n) throw new AnimorderError(`${at} does not match`);
+            const vertices = mesh.geometry.attributes.position.count, added = index.array.subarray(0, n);
+            for (const v of added) if (v >= vertices) throw new AnimorderError(`${at} names vertex ${v} of ${vertices}`);
+            grow.set(mesh.geometry, added);
+        }
+        for (const [geometry, added] of grow) {
             const old = geometry.index.array;
             // Unsigned shorts hold the other order's vertices below 65535 only (65535 restarts a strip).
-            const Type = old instanceof Uint16Array && largest >= 65535 ? Uint32Array : old.constructor;
-            const grown = new Type(old.length + n);
+            const Type = old instanceof Uint16Array && added.some((v) => v >= 65535) ? Uint32Array : old.constructor;
+            const grown = new Type(old.length + added.length);
             grown.set(old);
             grown.set(added, old.length);
             geometry.setIndex(new BufferAttribute(grown, 1));
-            updated.add(geometry);
         }
         this.orderCount = id + 1;
         return id;

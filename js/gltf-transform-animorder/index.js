@@ -8,8 +8,12 @@
 // triangle is found again by its corner positions as they were when the file was read, and
 // `indices` becomes the fallback order again. Where the triangles themselves changed (simplify, a
 // moved vertex, quantised positions) the orders are dropped with a warning (and the whole
-// extension when no primitive keeps valid orders): never written stale.
+// extension when no primitive keeps valid orders): never written stale. A file whose extension
+// does not check out (the rules of animorder's runtime and `animorder check`) is read without
+// it, with a warning: a pipeline never carries, nor rewrites `indices` from, orders that an
+// engine would refuse.
 import { Extension, ExtensionProperty, PropertyType, RefList } from '@gltf-transform/core';
+import { AnimorderRuntime } from '../runtime/animorder.js';
 
 export const NAME = 'ANIMORDER_animated_triangle_orders';
 const ORDERS_USAGE = 'ANIMORDER_ORDERS';
@@ -87,12 +91,14 @@ function key(a, b, c) {
   return c + ',' + a + ',' + b;
 }
 
-// The triangles of `indices` (a flat array of vertex ids) as position keys: per triangle the
-// three corner positions, rotated so that the smallest comes first (windings stay apart).
+// The triangles of `indices` (a flat array of vertex ids) as vertex keys: per triangle the three
+// corners' values of every attribute (position, normal, texture coordinates...: two triangles
+// that only share positions stay apart), rotated so that the smallest comes first (windings
+// stay apart).
 function positionKeys(primitive, indices, begin, end) {
-  const position = primitive.getAttribute('POSITION');
-  if (!position) return null;
-  const corner = (v) => { const e = position.getElement(v, []); return e.join(','); };
+  if (!primitive.getAttribute('POSITION')) return null;
+  const attributes = primitive.listSemantics().sort().map((semantic) => primitive.getAttribute(semantic));
+  const corner = (v) => attributes.map((a) => a.getElement(v, []).join(',')).join(';');
   const keys = [];
   for (let i = begin; i < end; i += 3) {
     const c = [corner(indices[i]), corner(indices[i + 1]), corner(indices[i + 2])];
@@ -111,6 +117,8 @@ function positionKeys(primitive, indices, begin, end) {
 export function rederive(primitive, orders, bufferCount) {
   const stored = orders.positionKeys;
   const indices = primitive.getIndices();
+  // Only triangles, with one order per buffer: anything else is dropped, never re-derived.
+  if (primitive.getMode() !== 4 || orders.getOrderCount() !== bufferCount) return null;
   if (!stored || !indices || stored.length !== bufferCount) return null;
   const current = indices.getArray(), n = indices.getCount();
   if (stored[0].length * 3 !== n) return null;
@@ -146,6 +154,9 @@ export function staleReason(primitive, orders, bufferCount, fallback) {
   if (orders.getOrderCount() !== bufferCount) return 'orderCount differs from bufferCount';
   const n = indices.getCount();
   if (accessor.getCount() !== n * bufferCount) return 'orders accessor has ' + accessor.getCount() + ' elements, not ' + n * bufferCount;
+  if (accessor.getType() !== 'SCALAR' || accessor.getNormalized() ||
+      (accessor.getComponentType() !== 5123 && accessor.getComponentType() !== 5125))
+    return 'orders accessor is not SCALAR unsigned short or int indices, not normalized';
   const base = indices.getArray(), all = accessor.getArray();
   const counts = new Map();
   for (let i = 0; i < n; i += 3) { const k = key(base[i], base[i + 1], base[i + 2]); counts.set(k, (counts.get(k) || 0) + 1); }
@@ -162,6 +173,42 @@ export function staleReason(primitive, orders, bufferCount, fallback) {
   return null;
 }
 
+// Why the root object and its clips do not check out, or null: the runtime's rules (bufferCount,
+// fallback, each clip's dimensions, sample rate, table and centres accessors and every cell),
+// on the accessors as glTF-Transform read them; sparse ones refused as the runtime does.
+function rootProblem(rootDef, json, context) {
+  try {
+    AnimorderRuntime.fromExtension(rootDef, (index) => {
+      const def = Number.isInteger(index) ? (json.accessors || [])[index] : undefined;
+      const accessor = def && context.accessors[index];
+      if (!accessor) throw new Error(`accessor ${index} does not exist`);
+      if (def.sparse) throw new Error(`accessor ${index} is sparse`);
+      return { array: accessor.getArray(), itemSize: accessor.getElementSize(), count: accessor.getCount(),
+        componentType: accessor.getComponentType(), normalized: accessor.getNormalized() };
+    });
+    return null;
+  } catch (error) {
+    return (error && error.message ? error.message : String(error)).replace(`${NAME}: `, '');
+  }
+}
+
+// Why a primitive's orders do not check out when read, or null: `animorder check`'s rules.
+function primitiveProblem(def, primDef, json, context, primitive, bufferCount) {
+  if (primDef.mode !== undefined && primDef.mode !== 4) return 'not a TRIANGLES primitive';
+  if (def.orderCount !== bufferCount) return `orderCount ${def.orderCount} != bufferCount ${bufferCount}`;
+  const accessorDef = Number.isInteger(def.orders) ? (json.accessors || [])[def.orders] : undefined;
+  const orders = accessorDef && context.accessors[def.orders];
+  const indices = primitive.getIndices(), position = primitive.getAttribute('POSITION');
+  if (!orders || !indices || !position) return 'no orders accessor, indices or positions';
+  const wide = orders.getComponentType() === 5125;
+  if (orders.getType() !== 'SCALAR' || orders.getNormalized() || accessorDef.sparse ||
+      (!wide && orders.getComponentType() !== 5123) || orders.getCount() !== def.orderCount * indices.getCount())
+    return `orders must be ${def.orderCount}×${indices.getCount()} unsigned short or int indices, not normalized or sparse`;
+  const vertices = wide ? position.getCount() : Math.min(position.getCount(), 65535);  // 65535: primitive restart
+  for (const v of orders.getArray()) if (v >= vertices) return `an order names vertex ${v} of ${position.getCount()}`;
+  return null;
+}
+
 export class AnimorderTriangleOrders extends Extension {
   static EXTENSION_NAME = NAME;
   extensionName = NAME;
@@ -174,7 +221,10 @@ export class AnimorderTriangleOrders extends Extension {
   read(context) {
     const json = context.jsonDoc.json;
     const rootDef = json.extensions && json.extensions[NAME];
-    if (rootDef) {
+    const logger = this.document.getLogger();
+    const refused = rootDef ? rootProblem(rootDef, json, context) : null;
+    if (refused) logger.warn(`${NAME}: the file's extension does not check out (${refused}); reading the file without it.`);
+    if (rootDef && !refused) {
       const root = this.createOrders()
         .setMethod(rootDef.method || '')
         .setBufferCount(rootDef.bufferCount)
@@ -193,9 +243,14 @@ export class AnimorderTriangleOrders extends Extension {
     (json.meshes || []).forEach((meshDef, m) => {
       (meshDef.primitives || []).forEach((primDef, p) => {
         const def = primDef.extensions && primDef.extensions[NAME];
-        if (!def) return;
-        const orders = this.createPrimitiveOrders().setOrders(context.accessors[def.orders]).setOrderCount(def.orderCount);
+        if (!def || !rootDef || refused) return;
         const primitive = context.meshes[m].listPrimitives()[p];
+        const problem = primitiveProblem(def, primDef, json, context, primitive, rootDef.bufferCount);
+        if (problem) {
+          logger.warn(`${NAME}: dropping the orders of mesh ${m} primitive ${p}: ${problem}.`);
+          return;
+        }
+        const orders = this.createPrimitiveOrders().setOrders(context.accessors[def.orders]).setOrderCount(def.orderCount);
         primitive.setExtension(NAME, orders);
         // Each order's triangles by corner positions, to re-derive the orders after a transform
         // that renumbers vertices or re-sequences triangles (not written to the file).
@@ -254,6 +309,24 @@ export class AnimorderTriangleOrders extends Extension {
       this.document.getRoot().setExtension(NAME, null);
       root.dispose();
     }
+    // Orders of a primitive that a transform removed or merged (join) go with it, said once.
+    const orphans = [...this.properties].filter((p) => p instanceof PrimitiveOrders && !p.isDisposed() &&
+      !p.listParents().some((parent) => parent.propertyType === PropertyType.PRIMITIVE));
+    if (orphans.length) logger.warn(`${NAME}: dropping the orders of ${orphans.length} primitive(s) that a transform removed or merged.`);
+    for (const orphan of orphans) {
+      const accessor = orphan.getOrders();
+      orphan.dispose();
+      if (accessor && accessor.listParents().every((p) => p.propertyType === PropertyType.ROOT)) accessor.dispose();
+    }
+    // The extension's accessors stay dense: a reader refuses a sparse one (sparse() makes a
+    // mostly-zero table sparse).
+    const ours = [];
+    for (const p of this.properties) {
+      if (p.isDisposed()) continue;
+      if (p instanceof PrimitiveOrders) ours.push(p.getOrders());
+      if (p instanceof OrdersClip) ours.push(p.getTable(), p.getCenters());
+    }
+    for (const accessor of ours) if (accessor) accessor.setSparse(false);
     context.accessorUsageGroupedByParent.add(ORDERS_USAGE);  // each primitive's orders in a view of their own
     for (const p of this.properties)
       if (p instanceof PrimitiveOrders && p.getOrders()) context.addAccessorToUsageGroup(p.getOrders(), ORDERS_USAGE);

@@ -5,7 +5,7 @@ import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import { fileURLToPath } from 'node:url';
 import { Logger, NodeIO } from '@gltf-transform/core';
-import { dedup, prune, resample } from '@gltf-transform/functions';
+import { dedup, prune, resample, sparse } from '@gltf-transform/functions';
 import { AnimorderTriangleOrders, NAME, staleReason } from '../index.js';
 
 const example = fileURLToPath(new URL('../../../docs/extension/example.gltf', import.meta.url));
@@ -121,4 +121,108 @@ test('without the extension registered, glTF-Transform drops it (why registering
   const { json } = await roundTrip(io, document);
   assert.equal(json.extensions?.[NAME], undefined);
   assert.equal(JSON.stringify(readFileSync(example, 'utf8')).includes(NAME), true);
+});
+
+// The example with its JSON changed by `mutate`, read with the warnings recorded from the start.
+async function loadMutated(mutate) {
+  const json = JSON.parse(readFileSync(example, 'utf8'));
+  mutate(json);
+  const logger = new Recorder();
+  const io = new NodeIO().setLogger(logger).registerExtensions([AnimorderTriangleOrders]);
+  const document = await io.readJSON({ json, resources: {} });
+  return { io, document, logger };
+}
+const ext = (json) => json.extensions[NAME];
+const primitiveExt = (json) => json.meshes[0].primitives[0].extensions[NAME];
+
+test('an extension that does not check out is read without it, never carried or used', async () => {
+  // Each as the runtime and `animorder check` refuse it. A fallback out of range had made the
+  // prewrite rewrite `indices` from it: an empty accessor for every loader.
+  const broken = {
+    'fallback 5': (j) => { ext(j).fallback = 5; },
+    'fallback missing': (j) => { delete ext(j).fallback; },
+    'fallback "0"': (j) => { ext(j).fallback = '0'; },
+    'clips 5': (j) => { ext(j).clips = 5; },
+    'clips [null]': (j) => { ext(j).clips = [null]; },
+    'table 99': (j) => { ext(j).clips[0].table = 99; },
+    'centers missing': (j) => { delete ext(j).clips[0].centers; },
+    'sampleRate -1': (j) => { ext(j).clips[0].sampleRate = -1; },
+    'thetaSteps "x"': (j) => { ext(j).clips[0].thetaSteps = 'x'; },
+    'bufferBase 7': (j) => { ext(j).clips[0].bufferBase = 7; },
+    'bufferCount "2"': (j) => { ext(j).bufferCount = '2'; primitiveExt(j).orderCount = '2'; },
+  };
+  for (const [name, mutate] of Object.entries(broken)) {
+    const { io, document, logger } = await loadMutated(mutate);
+    assert.equal(document.getRoot().getExtension(NAME), null, name);
+    const { json } = await roundTrip(io, document);
+    assert.equal(json.extensions?.[NAME], undefined, name);
+    assert.equal(json.meshes[0].primitives[0].extensions?.[NAME], undefined, name);
+    assert.deepEqual(Array.from(document.getRoot().listMeshes()[0].listPrimitives()[0].getIndices().getArray()),
+      [0, 1, 2, 0, 2, 3], name);  // the file's own indices
+    assert.match(logger.warnings.join('\n'), /does not check out/, name);
+  }
+});
+
+test('orders that do not fit their primitive are dropped when read, never re-derived', async () => {
+  const broken = {
+    'a strip': [(j) => { j.meshes[0].primitives[0].mode = 5; }, /not a TRIANGLES primitive/],
+    'VEC2 orders': [(j) => { Object.assign(j.accessors[2], { type: 'VEC2', count: 6 }); }, /orders must be 2×6/],
+    'normalized orders': [(j) => { j.accessors[2].normalized = true; }, /orders must be 2×6/],
+    'orders naming vertex 4': [(j) => { j.accessors[0].count = 3; j.bufferViews[0].byteLength = 36; }, /vertex 3 of 3/],
+    'orderCount 3': [(j) => { primitiveExt(j).orderCount = 3; }, /orderCount 3 != bufferCount 2/],
+  };
+  for (const [name, [mutate, why]] of Object.entries(broken)) {
+    const { io, document, logger } = await loadMutated(mutate);
+    const { json } = await roundTrip(io, document);
+    assert.equal(json.meshes[0].primitives[0].extensions?.[NAME], undefined, name);
+    assert.equal(json.extensions?.[NAME], undefined, name);  // no primitive left with orders
+    assert.match(logger.warnings.join('\n'), why, name);
+    assert.doesNotMatch(logger.warnings.join('\n'), /re-derived/, name);
+  }
+});
+
+test('sparse() leaves the extension accessors dense (readers refuse sparse ones)', async () => {
+  const { io, document } = await loadMutated((j) => {});
+  await document.transform(sparse({ ratio: 1 }));  // sparse wherever zeros could be left out
+  const { glb, json } = await roundTrip(io, document);
+  const accessors = [ext(json).clips[0].table, ext(json).clips[0].centers, primitiveExt(json).orders];
+  for (const a of accessors) assert.equal(json.accessors[a].sparse, undefined);
+  const back = await io.readBinary(glb);
+  assert.deepEqual(Array.from(back.getRoot().getExtension(NAME).listClips()[0].getTable().getArray()), [0, 1, 1, 0]);
+});
+
+test('re-deriving tells apart triangles that share corner positions but not other attributes', async () => {
+  const { io, document, logger } = await load();
+  const primitive = document.getRoot().listMeshes()[0].listPrimitives()[0];
+  const buffer = document.getRoot().listBuffers()[0];
+  // Two triangles on the same three positions, told apart by their texture coordinates; order 1
+  // draws the second first.
+  primitive.getAttribute('POSITION').setArray(new Float32Array([0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 0, 0, 1, 0, 0, 1, 1, 0]));
+  primitive.setAttribute('TEXCOORD_0', document.createAccessor().setType('VEC2').setBuffer(buffer)
+    .setArray(new Float32Array([0, 0, 1, 0, 1, 1, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5])));
+  primitive.getIndices().setArray(new Uint16Array([0, 1, 2, 3, 4, 5]));
+  primitive.getExtension(NAME).getOrders().setArray(new Uint16Array([0, 1, 2, 3, 4, 5, 3, 4, 5, 0, 1, 2]));
+  const first = await io.readBinary((await roundTrip(io, document)).glb);
+  // Re-sequenced, as reorder does: order 0 must stay (0 1 2, 3 4 5), not swap the look-alikes.
+  first.setLogger(logger);
+  first.getRoot().listMeshes()[0].listPrimitives()[0].getIndices().setArray(new Uint16Array([3, 4, 5, 0, 1, 2]));
+  const back = (await io.readBinary((await roundTrip(io, first)).glb)).getRoot().listMeshes()[0].listPrimitives()[0];
+  assert.deepEqual(Array.from(back.getExtension(NAME).getOrders().getArray()), [0, 1, 2, 3, 4, 5, 3, 4, 5, 0, 1, 2]);
+  assert.deepEqual(Array.from(back.getIndices().getArray()), [0, 1, 2, 3, 4, 5]);
+  assert.match(logger.warnings.join('\n'), /re-derived/);
+});
+
+test('join() drops the orders of the primitives it merges, with a warning', async () => {
+  // A second, still node drawing a mesh of two primitives with orders: join() merges them.
+  const { io, document, logger } = await loadMutated((j) => {
+    j.meshes.push(structuredClone(j.meshes[0]));
+    j.meshes[1].primitives.push(structuredClone(j.meshes[1].primitives[0]));
+    j.nodes.push({ mesh: 1 });
+    j.scenes[0].nodes.push(1);
+  });
+  const { join } = await import('@gltf-transform/functions');
+  await document.transform(join());
+  const { json } = await roundTrip(io, document);
+  assert.match(logger.warnings.join('\n'), /dropping the orders of 2 primitive\(s\) that a transform removed or merged/);
+  assert.ok(primitiveExt(json), 'the animated node keeps its orders');
 });

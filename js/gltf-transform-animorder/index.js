@@ -5,7 +5,7 @@
 // properties, so prune, dedup, resample and friends track them like any other accessor. Before
 // writing, every primitive's orders are checked against its current triangles. Where a transform
 // renumbered vertices or re-sequenced triangles (weld, reorder) the orders are re-derived: each
-// triangle is found again by its corner positions as they were when the file was read, and
+// triangle is found again by its corners' attributes as they were when the file was read, and
 // `indices` becomes the fallback order again. Where the triangles themselves changed (simplify, a
 // moved vertex, quantised positions) the orders are dropped with a warning (and the whole
 // extension when no primitive keeps valid orders): never written stale. A file whose extension
@@ -91,11 +91,11 @@ function key(a, b, c) {
   return c + ',' + a + ',' + b;
 }
 
-// The triangles of `indices` (a flat array of vertex ids) as vertex keys: per triangle the three
+// The triangles of `indices` (a flat array of vertex ids) as keys: per triangle the three
 // corners' values of every attribute (position, normal, texture coordinates...: two triangles
 // that only share positions stay apart), rotated so that the smallest comes first (windings
 // stay apart).
-function positionKeys(primitive, indices, begin, end) {
+function cornerKeys(primitive, indices, begin, end) {
   if (!primitive.getAttribute('POSITION')) return null;
   const attributes = primitive.listSemantics().sort().map((semantic) => primitive.getAttribute(semantic));
   const corner = (v) => attributes.map((a) => a.getElement(v, []).join(',')).join(';');
@@ -111,18 +111,18 @@ function positionKeys(primitive, indices, begin, end) {
 /**
  * The orders re-derived for a primitive whose vertex ids or triangle sequence a transform
  * changed (weld that merged identical vertices, reorder): each stored triangle, known by its
- * corner positions when the file was read, found among the current triangles. Returns the new
+ * corners' attributes when the file was read, found among the current triangles. Returns the new
  * K × n index array, or null when the triangles themselves changed (simplify, a moved vertex).
  */
 export function rederive(primitive, orders, bufferCount) {
-  const stored = orders.positionKeys;
+  const stored = orders.cornerKeys;
   const indices = primitive.getIndices();
   // Only triangles, with one order per buffer: anything else is dropped, never re-derived.
   if (primitive.getMode() !== 4 || orders.getOrderCount() !== bufferCount) return null;
   if (!stored || !indices || stored.length !== bufferCount) return null;
   const current = indices.getArray(), n = indices.getCount();
   if (stored[0].length * 3 !== n) return null;
-  const keys = positionKeys(primitive, current, 0, n);
+  const keys = cornerKeys(primitive, current, 0, n);
   if (!keys) return null;
   const out = new Uint32Array(bufferCount * n);
   for (let b = 0; b < bufferCount; ++b) {
@@ -252,13 +252,13 @@ export class AnimorderTriangleOrders extends Extension {
         }
         const orders = this.createPrimitiveOrders().setOrders(context.accessors[def.orders]).setOrderCount(def.orderCount);
         primitive.setExtension(NAME, orders);
-        // Each order's triangles by corner positions, to re-derive the orders after a transform
-        // that renumbers vertices or re-sequences triangles (not written to the file).
+        // Each order's triangles by their corners' attributes, to re-derive the orders after a
+        // transform that renumbers vertices or re-sequences triangles (not written to the file).
         const all = orders.getOrders() && orders.getOrders().getArray();
         const n = primitive.getIndices() ? primitive.getIndices().getCount() : 0;
         if (all && n > 0 && all.length === n * def.orderCount) {
-          orders.positionKeys = [];
-          for (let b = 0; b < def.orderCount; ++b) orders.positionKeys.push(positionKeys(primitive, all, b * n, (b + 1) * n));
+          orders.cornerKeys = [];
+          for (let b = 0; b < def.orderCount; ++b) orders.cornerKeys.push(cornerKeys(primitive, all, b * n, (b + 1) * n));
         }
       });
     });

@@ -13,7 +13,7 @@
 // it, with a warning: a pipeline never carries, nor rewrites `indices` from, orders that an
 // engine would refuse.
 import { Extension, ExtensionProperty, PropertyType, RefList } from '@gltf-transform/core';
-import { AnimorderRuntime } from '../runtime/animorder.js';
+import { AnimorderRuntime, ordersProblem } from '../runtime/animorder.js';
 
 export const NAME = 'ANIMORDER_animated_triangle_orders';
 const ORDERS_USAGE = 'ANIMORDER_ORDERS';
@@ -192,7 +192,8 @@ function rootProblem(rootDef, json, context) {
   }
 }
 
-// Why a primitive's orders do not check out when read, or null: `animorder check`'s rules.
+// Why a primitive's orders do not check out when read, or null: `animorder check`'s rules (the
+// runtime's ordersProblem for the accessor and its values).
 function primitiveProblem(def, primDef, json, context, primitive, bufferCount) {
   if (primDef.mode !== undefined && primDef.mode !== 4) return 'not a TRIANGLES primitive';
   if (def.orderCount !== bufferCount) return `orderCount ${def.orderCount} != bufferCount ${bufferCount}`;
@@ -200,13 +201,10 @@ function primitiveProblem(def, primDef, json, context, primitive, bufferCount) {
   const orders = accessorDef && context.accessors[def.orders];
   const indices = primitive.getIndices(), position = primitive.getAttribute('POSITION');
   if (!orders || !indices || !position) return 'no orders accessor, indices or positions';
-  const wide = orders.getComponentType() === 5125;
-  if (orders.getType() !== 'SCALAR' || orders.getNormalized() || accessorDef.sparse ||
-      (!wide && orders.getComponentType() !== 5123) || orders.getCount() !== def.orderCount * indices.getCount())
-    return `orders must be ${def.orderCount}×${indices.getCount()} unsigned short or int indices, not normalized or sparse`;
-  const vertices = wide ? position.getCount() : Math.min(position.getCount(), 65535);  // 65535: primitive restart
-  for (const v of orders.getArray()) if (v >= vertices) return `an order names vertex ${v} of ${position.getCount()}`;
-  return null;
+  const values = orders.getArray();
+  const shape = { itemSize: orders.getElementSize(), componentType: orders.getComponentType(), count: orders.getCount(),
+    normalized: orders.getNormalized(), sparse: Boolean(accessorDef.sparse) };
+  return ordersProblem(shape, (e) => values[e], def.orderCount, indices.getCount(), position.getCount());
 }
 
 export class AnimorderTriangleOrders extends Extension {

@@ -204,11 +204,28 @@ function asAnimorderError(make) {
     }
 }
 
+// Why a primitive's orders accessor does not fit it, or null: `animorder check`'s rules, shared by
+// this runtime, the three.js plugin and the glTF-Transform extension. `orders` is { itemSize,
+// componentType, count, normalized, sparse } and valueAt(e) its e-th value: orderCount × the
+// indices' count unsigned shorts or ints, not normalized or sparse, each a vertex of the
+// primitive (an unsigned short never 65535, WebGL 2's primitive restart).
+export function ordersProblem(orders, valueAt, orderCount, indexCount, vertexCount) {
+    const wide = orders.componentType === 5125;
+    if (orders.itemSize !== 1 || (!wide && orders.componentType !== 5123) || orders.count !== orderCount * indexCount ||
+        orders.normalized || orders.sparse)
+        return `orders must be ${orderCount}×${indexCount} unsigned short or int indices, not normalized or sparse`;
+    const limit = wide ? vertexCount : Math.min(vertexCount, 65535);
+    for (let e = 0; e < orders.count; ++e) {
+        const v = valueAt(e);
+        if (v >= limit) return `an order names vertex ${v} of ${vertexCount}${v === 65535 ? ' (primitive restart)' : ''}`;
+    }
+    return null;
+}
+
 // What the extension asks of each primitive that carries orders (the checks of `animorder check`
-// an engine needs before binding them): triangles with indices, orderCount = bufferCount, an
-// orders accessor of orderCount × the indices' count unsigned shorts or ints, not normalized,
-// inside its buffer view and buffer (`reader`), each naming one of the primitive's vertices (an
-// unsigned short never 65535, WebGL 2's primitive restart).
+// an engine needs before binding them): triangles with indices and positions, orderCount =
+// bufferCount, an orders accessor inside its buffer view and buffer (`reader`) that fits
+// (ordersProblem).
 function checkPrimitives(json, bufferCount, reader) {
     const accessors = json.accessors || [];
     (json.meshes || []).forEach((mesh, m) => (mesh && mesh.primitives || []).forEach((primitive, p) => {
@@ -219,19 +236,14 @@ function checkPrimitives(json, bufferCount, reader) {
         const indices = accessors[primitive.indices];
         if (!Number.isInteger(primitive.indices) || !indices || !isCount(indices.count)) fail(`${where}: orders on a primitive without indices`);
         if (ext.orderCount !== bufferCount) fail(`${where}: orderCount ${ext.orderCount} != bufferCount ${bufferCount}`);
-        const orders = Number.isInteger(ext.orders) ? accessors[ext.orders] : undefined;
-        if (!orders || orders.type !== 'SCALAR' || (orders.componentType !== 5123 && orders.componentType !== 5125) ||
-            orders.count !== ext.orderCount * indices.count || orders.bufferView === undefined || orders.sparse)
-            fail(`${where}: orders must be ${ext.orderCount}×${indices.count} unsigned short or int indices in a buffer view`);
-        if (orders.normalized) fail(`${where}: orders must not be normalized`);
         const position = primitive.attributes ? accessors[primitive.attributes.POSITION] : undefined;
         if (!position || !isCount(position.count)) fail(`${where}: orders on a primitive without positions`);
-        const at = reader.locate(ext.orders);
-        const wide = orders.componentType === 5125, vertices = wide ? position.count : Math.min(position.count, 65535);
-        for (let e = 0; e < at.count; ++e) {
-            const v = wide ? at.data.getUint32(at.start + e * at.stride, true) : at.data.getUint16(at.start + e * at.stride, true);
-            if (v >= vertices) fail(`${where}: an order names vertex ${v} of ${position.count}${v === 65535 ? ' (primitive restart)' : ''}`);
-        }
+        const at = reader.locate(ext.orders);  // sparse or view-less accessors refused there
+        const wide = at.accessor.componentType === 5125;
+        const valueAt = (e) => wide ? at.data.getUint32(at.start + e * at.stride, true) : at.data.getUint16(at.start + e * at.stride, true);
+        const problem = ordersProblem({ itemSize: at.itemSize, componentType: at.accessor.componentType, count: at.count,
+            normalized: at.accessor.normalized === true, sparse: false }, valueAt, ext.orderCount, indices.count, position.count);
+        if (problem) fail(`${where}: ${problem}`);
     }));
 }
 

@@ -12,7 +12,7 @@
 //   const orders = gltf.userData.animorder;              // AnimorderCharacter, or null
 //   ... each frame: mixer.update(dt); orders?.update(camera, mixer); renderer.render(scene, camera);
 import { BufferAttribute, BufferGeometry, Vector3 } from 'three';
-import { AccessorReader, AnimorderError, AnimorderRuntime, EXTENSION_NAME } from '../runtime/animorder.js';
+import { AccessorReader, AnimorderError, AnimorderRuntime, EXTENSION_NAME, ordersProblem } from '../runtime/animorder.js';
 
 export { AnimorderRuntime, EXTENSION_NAME };
 
@@ -94,14 +94,8 @@ export class AnimorderGLTFPlugin {
                 if (!geometry.index) throw new AnimorderError(`${at} has no indices`);
                 n = geometry.index.count;
                 const orders = await this.accessor(ext.orders);
-                if (orders.itemSize !== 1 || orders.count !== ext.orderCount * n || orders.normalized ||
-                    (orders.componentType !== 5123 && orders.componentType !== 5125))
-                    throw new AnimorderError(`${at}: orders must be ${ext.orderCount}×${n} unsigned indices, not normalized`);
-                // Every value a vertex; an unsigned short never 65535 (WebGL 2's primitive restart).
-                const vertices = geometry.attributes.position.count;
-                const limit = orders.componentType === 5123 ? Math.min(vertices, 65535) : vertices;
-                for (let k = 0; k < orders.array.length; ++k)
-                    if (orders.array[k] >= limit) throw new AnimorderError(`${at}: an order names vertex ${orders.array[k]} of ${vertices}`);
+                const problem = ordersProblem(orders, (e) => orders.array[e], ext.orderCount, n, geometry.attributes.position.count);
+                if (problem) throw new AnimorderError(`${at}: ${problem}`);
                 toIndex.push({ geometry, array: orders.array });
                 done.set(geometry, { n, orders: ext.orders });
             }

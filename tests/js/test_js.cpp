@@ -32,6 +32,13 @@ protected:
     JsTest() : ScratchFolderTest("animorder-js") {}
     test::Outcome run(const std::string& command) { return test::run_captured(command, dir_); }
 
+    // Runs a node script of the repository that checks on its own and expects its closing line.
+    void expect_script_passes(const std::string& script, const std::string& closing_line) {
+        const test::Outcome o = run("node " + sh(source_dir + "/" + script));
+        EXPECT_EQ(o.exit_code, 0) << o.out << o.err;
+        EXPECT_NE(o.out.find(closing_line), std::string::npos) << o.out << o.err;
+    }
+
     // The bundled character as a glTF (its clips as morph-weight animations), optimised with small
     // clustering settings (k = 3, 42 views at 64²: seconds, not the 25 s of the defaults).
     void optimise_character() {
@@ -136,9 +143,7 @@ TEST_F(JsTest, ViewServesOnlyTheViewer) {
 TEST_F(JsTest, RuntimeHandWorkedOnTheSpecExample) {
     std::string why;
     ANIMORDER_REQUIRE_OR_SKIP("node", have_node(why), why);
-    const test::Outcome o = run("node " + sh(source_dir + "/js/test/hand-worked.mjs"));
-    EXPECT_EQ(o.exit_code, 0) << o.out << o.err;
-    EXPECT_NE(o.out.find("hand-worked: all checks passed"), std::string::npos) << o.out << o.err;
+    expect_script_passes("js/test/hand-worked.mjs", "hand-worked: all checks passed");
 }
 
 // The three.js plugin in node with three.js's GLTFLoader on the extension's example, broken as a
@@ -155,9 +160,7 @@ bool have_three(std::string& why) {
 TEST_F(JsTest, ThreePluginRefusesWhatTheRuntimeRefuses) {
     std::string why;
     ANIMORDER_REQUIRE_OR_SKIP("node", have_three(why), why);
-    const test::Outcome o = run("node " + sh(source_dir + "/js/test/three-plugin.mjs"));
-    EXPECT_EQ(o.exit_code, 0) << o.out << o.err;
-    EXPECT_NE(o.out.find("three plugin: all checks passed"), std::string::npos) << o.out << o.err;
+    expect_script_passes("js/test/three-plugin.mjs", "three plugin: all checks passed");
 }
 
 }  // namespace

@@ -76,6 +76,14 @@ struct AnimatedMesh {
 // keyframes, a keyframe array of the wrong size, or a non-finite position.
 void validate_animated_mesh(const AnimatedMesh& mesh);
 
+// validate_animated_mesh for code that reads the positions of `keyframes` only (cluster_nodes of
+// one clip's keyframes): the same checks, the positions of those keyframes alone, and each
+// keyframe must exist. A character's clips are then scanned once between them, not once each.
+void validate_animated_mesh(const AnimatedMesh& mesh, const std::vector<uint32_t>& keyframes);
+
+// validate_animated_mesh without the positions, for code that reads none (Tipsify's patches).
+void validate_mesh_topology(const AnimatedMesh& mesh);
+
 // Per triangle of mesh.indices: 1 where its primitive is double-sided (drawn without culling).
 // Empty when no primitive is, so that callers pass nullptr and keep the culling-only path.
 std::vector<uint8_t> double_sided_triangles(const AnimatedMesh& mesh);

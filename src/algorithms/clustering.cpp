@@ -603,8 +603,8 @@ std::vector<uint32_t> integrated_distance_order(const float* centroids, size_t k
 
 ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patches, const Framing& framing,
                                const std::vector<uint32_t>& keyframes, const ClusteringSettings& settings) {
-    validate_animated_mesh(mesh);
     validate_settings(keyframes, settings);
+    validate_animated_mesh(mesh, keyframes);  // the positions of these keyframes: all that it reads
 
     // Preprocessing (lines 2–8): nodes = keyframes × icosphere viewpoints, each keyframe framed
     // on its own centre, eyes at 3R.

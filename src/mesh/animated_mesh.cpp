@@ -52,7 +52,7 @@ bool has_blended_primitives(const AnimatedMesh& mesh) {
     return false;
 }
 
-void validate_animated_mesh(const AnimatedMesh& mesh) {
+void validate_mesh_topology(const AnimatedMesh& mesh) {
     if (mesh.indices.size() % 3 != 0)
         throw InvalidInput("index count " + std::to_string(mesh.indices.size()) + " is not a multiple of 3");
     size_t next = 0;
@@ -80,10 +80,15 @@ void validate_animated_mesh(const AnimatedMesh& mesh) {
             throw InvalidInput("clip '" + c.name + "' spans keyframes " + std::to_string(c.first_keyframe) + ".." +
                                std::to_string(c.first_keyframe + c.keyframe_count) + ", the mesh has " +
                                std::to_string(keyframes));
-    // Blocks of positions tested without a branch (a float is not finite when its exponent bits
-    // are all ones: a loop the compiler vectorises); a block with one is searched for the first.
-    const float* positions = mesh.keyframe_positions.data();
-    const size_t count = mesh.keyframe_positions.size();
+}
+
+namespace {
+
+// Throws for the first position of `count` floats from keyframe `keyframe` on that is not finite.
+// Blocks of positions are tested without a branch (a float is not finite when its exponent bits
+// are all ones: a loop the compiler vectorises); a block with one is searched for the first.
+void validate_positions(const AnimatedMesh& mesh, size_t keyframe, size_t count) {
+    const float* positions = mesh.keyframe_positions.data() + keyframe * 3 * mesh.vertex_count;
     constexpr size_t kBlock = 4096;
     for (size_t first = 0; first < count; first += kBlock) {
         const size_t end = std::min(count, first + kBlock);
@@ -96,8 +101,26 @@ void validate_animated_mesh(const AnimatedMesh& mesh) {
         if (!not_finite) continue;
         for (size_t i = first; i < end; ++i)
             if (!std::isfinite(positions[i]))
-                throw InvalidInput("keyframe " + std::to_string(i / (3 * mesh.vertex_count)) + ": position of vertex " +
-                                   std::to_string(i / 3 % mesh.vertex_count) + " is not finite");
+                throw InvalidInput("keyframe " + std::to_string(keyframe + i / (3 * mesh.vertex_count)) +
+                                   ": position of vertex " + std::to_string(i / 3 % mesh.vertex_count) +
+                                   " is not finite");
+    }
+}
+
+}  // namespace
+
+void validate_animated_mesh(const AnimatedMesh& mesh) {
+    validate_mesh_topology(mesh);
+    validate_positions(mesh, 0, mesh.keyframe_positions.size());
+}
+
+void validate_animated_mesh(const AnimatedMesh& mesh, const std::vector<uint32_t>& keyframes) {
+    validate_mesh_topology(mesh);
+    for (const uint32_t k : keyframes) {
+        if (k >= mesh.keyframe_count())
+            throw InvalidInput("keyframe " + std::to_string(k) + " does not exist (the mesh has " +
+                               std::to_string(mesh.keyframe_count()) + ")");
+        validate_positions(mesh, k, 3 * mesh.vertex_count);
     }
 }
 

@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 #include <vector>
 
 using namespace animorder;
@@ -255,6 +256,34 @@ TEST(Clustering, RejectsAbsurdSettings) {
     EXPECT_THROW(cluster_nodes(m, patches, framing_of(m), {0}, s), InvalidInput);
     s = small_settings();
     EXPECT_THROW(cluster_nodes(m, patches, framing_of(m), {}, s), InvalidInput);
+}
+
+// cluster_nodes reads the positions of its keyframes only, and build_mesh_patches none (each
+// checks what it reads, so a character's clips are not each scanned whole): a position that is
+// not finite elsewhere changes nothing; in a listed keyframe it is refused by name.
+TEST(Clustering, ReadsAndChecksTheListedKeyframesOnly) {
+    const AnimatedMesh& m = character();
+    const std::vector<uint32_t> keyframes = walk_keyframes(10);
+    const uint32_t unlisted = keyframes[0] + 1;
+    AnimatedMesh damaged = m;
+    damaged.keyframe_positions[size_t(unlisted) * 3 * m.vertex_count + 4] = NAN;  // vertex 1
+    const MeshPatches patches = build_mesh_patches(m, 0.85);
+    const MeshPatches damaged_patches = build_mesh_patches(damaged, 0.85);
+    EXPECT_EQ(damaged_patches.cache_order, patches.cache_order);
+    EXPECT_EQ(damaged_patches.patch_starts, patches.patch_starts);
+    const Framing framing = framing_of(m);
+    const ClusteringSettings s = small_settings();
+    const ClusteringResult clean = cluster_nodes(m, patches, framing, keyframes, s);
+    const ClusteringResult r = cluster_nodes(damaged, patches, framing, keyframes, s);
+    EXPECT_EQ(r.assignment, clean.assignment);
+    EXPECT_EQ(r.patch_orders, clean.patch_orders);
+    try {
+        cluster_nodes(damaged, patches, framing, {keyframes[0], unlisted}, s);
+        FAIL() << "accepted keyframe " << unlisted;
+    } catch (const InvalidInput& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  "keyframe " + std::to_string(unlisted) + ": position of vertex 1 is not finite");
+    }
 }
 
 TEST(SelectionTable, ReturnsTheNodesClusterAtEveryClusteringViewpoint) {

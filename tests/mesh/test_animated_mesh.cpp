@@ -80,6 +80,34 @@ TEST(AnimatedMesh, NamesTheFirstPositionThatIsNotFinite) {
     EXPECT_NO_THROW(validate_animated_mesh(extreme));
 }
 
+// The partial checks: of listed keyframes only (cluster_nodes of one clip), of the topology only
+// (build_mesh_patches); each still refuses what it reads.
+TEST(AnimatedMesh, PartialChecksReadWhatTheirCallersRead) {
+    AnimatedMesh m = good();
+    m.keyframe_positions.resize(3 * 4 * 3, 0.25f);
+    m.keyframe_positions[2 * 12 + 7] = NAN;  // keyframe 2, vertex 2
+    EXPECT_NO_THROW(validate_animated_mesh(m, {0, 1}));
+    EXPECT_NO_THROW(validate_mesh_topology(m));
+    for (const std::vector<uint32_t>& listed : {std::vector<uint32_t>{2}, std::vector<uint32_t>{1, 2}}) {
+        try {
+            validate_animated_mesh(m, listed);
+            FAIL() << "accepted keyframe 2";
+        } catch (const InvalidInput& e) {
+            EXPECT_STREQ(e.what(), "keyframe 2: position of vertex 2 is not finite");
+        }
+    }
+    try {
+        validate_animated_mesh(m, {3});
+        FAIL() << "accepted keyframe 3";
+    } catch (const InvalidInput& e) {
+        EXPECT_STREQ(e.what(), "keyframe 3 does not exist (the mesh has 3)");
+    }
+    m.keyframe_positions[2 * 12 + 7] = 0.25f;
+    m.indices[5] = 9;
+    EXPECT_THROW(validate_animated_mesh(m, {0}), InvalidInput);
+    EXPECT_THROW(validate_mesh_topology(m), InvalidInput);
+}
+
 // Clips that share a name (Mixamo names every animation "mixamo.com") are all kept when that name
 // is asked, in the mesh's order, each with its own keyframes (the last of them alone was kept).
 TEST(AnimatedMesh, SelectingANameSeveralClipsShareKeepsThemAll) {

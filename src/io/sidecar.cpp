@@ -35,6 +35,10 @@ std::string serialize_sidecar(const AnimatedMesh& mesh, const MethodBuffers& buf
     const size_t buffers_end =
         header + clip_record * mesh.clips.size() + buffers.orders.size() * mesh.indices.size() * 4;
     std::string out;
+    size_t tables_bytes = 0;
+    for (size_t c = 0; c < mesh.clips.size(); ++c)
+        tables_bytes += buffers.tables[c].cells.size() + size_t(mesh.clips[c].keyframe_count) * 12;
+    out.reserve(buffers_end + tables_bytes);  // one allocation: the buffers are most of the file
     out.append("AOR1", 4);
     put_u32(out, 1);
     put_u32(out, uint32_t(buffers.orders.size()));
@@ -58,7 +62,11 @@ std::string serialize_sidecar(const AnimatedMesh& mesh, const MethodBuffers& buf
     for (const auto& order : buffers.orders) {
         apply_triangle_order(indices.data(), mesh.indices.data(), order.data(), mesh.triangle_count());
         to_file_winding(mesh, indices.data());  // a mirrored primitive's triangles as the input file has them
-        for (uint32_t i : indices) put_u32(out, i);
+        const size_t at = out.size();
+        out.resize(at + 4 * indices.size());
+        char* bytes = &out[at];
+        for (size_t i = 0; i < indices.size(); ++i)  // put_u32's bytes, stored in place (no growth check)
+            for (int b = 0; b < 4; ++b) bytes[4 * i + size_t(b)] = char((indices[i] >> (8 * b)) & 0xff);
     }
     for (size_t c = 0; c < mesh.clips.size(); ++c) {
         out.append(reinterpret_cast<const char*>(buffers.tables[c].cells.data()), buffers.tables[c].cells.size());

@@ -5,6 +5,8 @@
 #include "animorder/load.h"
 #include "animorder/regular_file.h"
 
+#include "gltf_prune.h"
+
 #include <tiny_gltf.h>
 #include <nlohmann/json.hpp>
 
@@ -269,12 +271,52 @@ inline tinygltf::Model read_model(const std::string& path) {
     return model;
 }
 
+// An input object's `extras` (verbatim: tinygltf's values drop a null, shifting an array's
+// elements) and each of its `extensions` the output lacks (tinygltf 2.7 writes neither for skins,
+// channel targets, accessors, buffer views, buffers, samplers), put back on the output object it
+// became, then the same for the objects nested under the same keys (a material's texture infos,
+// a mesh's primitives, an animation's channels). The orders extension is never put back: the
+// writer names the orders it wrote, and left out the stale ones on purpose (gltf_prune.h).
+inline bool restore_extras_and_extensions(const nlohmann::ordered_json& in, nlohmann::ordered_json& out) {
+    if (!in.is_object() || !out.is_object()) return false;
+    bool changed = false;
+    if (in.contains("extras") && (!out.contains("extras") || out["extras"] != in["extras"])) {
+        out["extras"] = in["extras"];
+        changed = true;
+    }
+    if (in.contains("extensions") && in["extensions"].is_object())
+        for (const auto& [name, value] : in["extensions"].items()) {
+            if (name == "ANIMORDER_animated_triangle_orders") continue;
+            if (out.contains("extensions") && !out["extensions"].is_object()) break;
+            if (out.contains("extensions") && out["extensions"].contains(name)) continue;
+            out["extensions"][name] = value;
+            changed = true;
+        }
+    for (const auto& [key, value] : in.items()) {
+        if (key == "extras" || key == "extensions" || !out.contains(key)) continue;
+        nlohmann::ordered_json& nested = out[key];
+        if (value.is_object()) {
+            changed = restore_extras_and_extensions(value, nested) || changed;
+        } else if (value.is_array() && nested.is_array() && nested.size() == value.size()) {
+            for (size_t i = 0; i < value.size(); ++i)
+                changed = restore_extras_and_extensions(value[i], nested[i]) || changed;
+        }
+    }
+    return changed;
+}
+
 // What tinygltf 2.7 changes between reading and writing a file, put back from the input's JSON:
 // - the placeholder node of each animation channel whose target had none (json_with_placeholder_
 //   nodes), taken out again;
-// - a perspective camera's absent zfar (an infinite projection), written as 0, which glTF forbids.
+// - a perspective camera's absent zfar (an infinite projection), written as 0, which glTF forbids;
+// - an image given as a data: URI, whose bytes tinygltf decodes and then writes as no image at
+//   all (no URI, buffer view -1): the URI, as the input has it;
+// - extras and extensions tinygltf leaves out (restore_extras_and_extensions): on every object of
+//   the top-level arrays, accessors, views and buffers followed through `renumbering` (the writer
+//   left some out and moved others: gltf_prune.h), the others by their unchanged index.
 // Returns whether `output` changed.
-inline bool restore_what_tinygltf_drops(const nlohmann::ordered_json& input, nlohmann::ordered_json& output) {
+inline bool restore_what_tinygltf_drops(const nlohmann::ordered_json& input, nlohmann::ordered_json& output,
+                                        const Renumbering& renumbering = {}) {
     bool changed = false;
     const auto array = [](const nlohmann::ordered_json& j, const char* key) {
         return j.is_object() && j.contains(key) && j[key].is_array();
@@ -304,12 +346,45 @@ inline bool restore_what_tinygltf_drops(const nlohmann::ordered_json& input, nlo
                 changed = true;
             }
         }
+    if (array(input, "images") && array(output, "images"))
+        for (size_t i = 0; i < input["images"].size() && i < output["images"].size(); ++i) {
+            const nlohmann::ordered_json& in = input["images"][i];
+            nlohmann::ordered_json& out = output["images"][i];
+            if (!in.is_object() || !out.is_object() || !in.contains("uri") || !in["uri"].is_string() ||
+                in["uri"].get<std::string>().rfind("data:", 0) != 0 || (out.contains("uri") && out["uri"] != ""))
+                continue;
+            out["uri"] = in["uri"];
+            for (const char* key : {"bufferView", "mimeType"})  // as the input has them (a data: URI needs neither)
+                if (in.contains(key))
+                    out[key] = in[key];
+                else
+                    out.erase(key);
+            changed = true;
+        }
+    for (const auto& [key, list] : input.items()) {
+        if (!list.is_array() || !array(output, key.c_str())) continue;
+        const std::vector<int>* moved = key == "accessors"     ? &renumbering.accessors
+                                        : key == "bufferViews" ? &renumbering.views
+                                        : key == "buffers"     ? &renumbering.buffers
+                                                               : nullptr;
+        nlohmann::ordered_json& written = output[key];
+        for (size_t i = 0; i < list.size(); ++i) {
+            const int to = moved && !moved->empty() ? (i < moved->size() ? (*moved)[i] : -1) : int(i);
+            if (to >= 0 && size_t(to) < written.size())
+                changed = restore_extras_and_extensions(list[i], written[size_t(to)]) || changed;
+        }
+    }
+    if (input.contains("extras") && (!output.contains("extras") || output["extras"] != input["extras"])) {
+        output["extras"] = input["extras"];
+        changed = true;
+    }
     return changed;
 }
 
 // `written` (tinygltf's output: GLB bytes when `binary`, else JSON text) with
 // restore_what_tinygltf_drops applied against the input file's JSON.
-inline std::string restore_from_input(const std::string& input_path, std::string written, bool binary) {
+inline std::string restore_from_input(const std::string& input_path, std::string written, bool binary,
+                                      const Renumbering& renumbering = {}) {
     const std::string input_text = gltf_json_text(input_path);
     const nlohmann::ordered_json input = nlohmann::ordered_json::parse(input_text, nullptr, false);
     if (input.is_discarded()) return written;
@@ -322,7 +397,7 @@ inline std::string restore_from_input(const std::string& input_path, std::string
         json_text = written.substr(20, json_length);
     }
     nlohmann::ordered_json output = nlohmann::ordered_json::parse(json_text, nullptr, false);
-    if (output.is_discarded() || !restore_what_tinygltf_drops(input, output)) return written;
+    if (output.is_discarded() || !restore_what_tinygltf_drops(input, output, renumbering)) return written;
     if (!binary) return output.dump(2);
     const std::string glb = glb_with_json(written, output.dump());
     return glb.empty() ? written : glb;
@@ -330,10 +405,10 @@ inline std::string restore_from_input(const std::string& input_path, std::string
 
 // The model read from input_path as a file at output_path: buffers embedded (every buffer's URI
 // cleared), relative image URIs re-pointed from output_path's folder, images never re-encoded,
-// and what tinygltf drops put back (restore_from_input). GLB bytes when `binary`, else glTF JSON
-// text.
+// and what tinygltf drops put back (restore_from_input, through the writer's `renumbering`). GLB
+// bytes when `binary`, else glTF JSON text.
 inline std::string write_model(tinygltf::Model& model, const std::string& input_path, const std::string& output_path,
-                               bool binary) {
+                               bool binary, const Renumbering& renumbering = {}) {
     for (tinygltf::Buffer& b : model.buffers) b.uri.clear();
     namespace fs = std::filesystem;
     const fs::path from = fs::absolute(fs::path(input_path)).parent_path();
@@ -352,7 +427,7 @@ inline std::string write_model(tinygltf::Model& model, const std::string& input_
     std::ostringstream out;
     if (!writer.WriteGltfSceneToStream(&model, out, !binary, binary))
         throw LoadError(input_path + ": writing the glTF output failed");
-    return restore_from_input(input_path, out.str(), binary);
+    return restore_from_input(input_path, out.str(), binary, renumbering);
 }
 
 }  // namespace animorder::io

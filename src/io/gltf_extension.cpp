@@ -493,8 +493,9 @@ std::string gltf_with_extension_orders(const std::string& input_path, const std:
     model.extensionsRequired.erase(
         std::remove(model.extensionsRequired.begin(), model.extensionsRequired.end(), kOrdersExtensionName),
         model.extensionsRequired.end());
-    io::finish_replacing(model, replaced, input_path, note);  // the processed file's indices, earlier orders
-    return io::write_model(model, input_path, output_path, binary);
+    const io::Renumbering renumbering =  // the processed file's indices, earlier orders
+        io::finish_replacing(model, replaced, input_path, note);
+    return io::write_model(model, input_path, output_path, binary, renumbering);
 }
 
 }  // namespace animorder

@@ -278,16 +278,19 @@ std::vector<int> begin_replacing(tinygltf::Model& model, const std::vector<std::
     return replaced;
 }
 
-void finish_replacing(tinygltf::Model& model, const std::vector<int>& replaced, const std::string& path,
-                      std::string* note) {
+Renumbering finish_replacing(tinygltf::Model& model, const std::vector<int>& replaced, const std::string& path,
+                             std::string* note) {
     std::string unknown;
-    if (drop_replaced_accessors(model, replaced, &unknown) || !note) return;
+    Renumbering renumbering;
+    if (drop_replaced_accessors(model, replaced, &unknown, &renumbering) || !note) return renumbering;
     *note = path + " uses extension " + unknown +
             ", whose references to accessors animorder does not know: the indices and orders the new orders replace "
             "stay in the output, unused (renumbering could break what the extension names)";
+    return renumbering;
 }
 
-bool drop_replaced_accessors(tinygltf::Model& model, const std::vector<int>& replaced, std::string* unknown) {
+bool drop_replaced_accessors(tinygltf::Model& model, const std::vector<int>& replaced, std::string* unknown,
+                             Renumbering* renumbering) {
     // Accessors: those replaced that nothing names any more.
     std::vector<int> uses(model.accessors.size(), 0);
     for_each_accessor_reference(model, [&](int& a) {
@@ -341,6 +344,7 @@ bool drop_replaced_accessors(tinygltf::Model& model, const std::vector<int>& rep
     const std::vector<int> buffer_to = remove_marked(model.buffers, drop_buffer);
     for (tinygltf::BufferView& v : model.bufferViews)
         if (v.buffer >= 0 && size_t(v.buffer) < buffer_to.size()) v.buffer = buffer_to[size_t(v.buffer)];
+    if (renumbering) *renumbering = {accessor_to, view_to, buffer_to};
     return true;
 }
 

@@ -12,6 +12,13 @@
 
 namespace animorder::io {
 
+// Where the accessors, buffer views and buffers of the model a writer read ended up in the model
+// it wrote: old index -> new index, -1 for one left out; an empty list when none moved (so that
+// restore_from_input, gltf_buffer.h, can put back on each what tinygltf does not write).
+struct Renumbering {
+    std::vector<int> accessors, views, buffers;
+};
+
 // The accessors a writer is about to stop referring to: each primitive's `indices` in `primitives`
 // (mesh, primitive) and every accessor the ANIMORDER_animated_triangle_orders extension names in
 // `model` (its primitives' orders, its clips' tables and centres). Read before the writer replaces
@@ -32,15 +39,17 @@ std::vector<int> accessors_to_replace(const tinygltf::Model& model, const std::v
 // as it is: renumbering could break what such an extension points at. Returns false then, and
 // `unknown` (when given) gets the first such extension's name; true when it pruned or had
 // nothing to prune.
-bool drop_replaced_accessors(tinygltf::Model& model, const std::vector<int>& replaced, std::string* unknown = nullptr);
+// `renumbering` (when given) gets where each accessor, view and buffer went.
+bool drop_replaced_accessors(tinygltf::Model& model, const std::vector<int>& replaced, std::string* unknown = nullptr,
+                             Renumbering* renumbering = nullptr);
 
 // The two ends of a writer's work on the model read from `path`. begin_replacing, before it
 // writes: accessors_to_replace for the primitives it rewrites, and every primitive's orders
 // extension object erased (the writer names its own; stale ones on a primitive it does not
 // rewrite would contradict them). finish_replacing, after: drop_replaced_accessors, and when that
-// left the model as it was, `note` (when given) says why.
+// left the model as it was, `note` (when given) says why. Returns the renumbering.
 std::vector<int> begin_replacing(tinygltf::Model& model, const std::vector<std::pair<int, int>>& primitives);
-void finish_replacing(tinygltf::Model& model, const std::vector<int>& replaced, const std::string& path,
-                      std::string* note);
+Renumbering finish_replacing(tinygltf::Model& model, const std::vector<int>& replaced, const std::string& path,
+                             std::string* note);
 
 }  // namespace animorder::io

@@ -169,10 +169,11 @@ std::string gltf_with_orders(const std::string& input_path, const std::string& o
     root["clips"] = tinygltf::Value(clips);
     model.extensions[kOrdersExtension] = tinygltf::Value(root);
     add_extension_used(model, kOrdersExtension);
-    io::finish_replacing(model, replaced, input_path, note);  // no growth run after run
+    // What the new orders replace leaves the file: no growth run after run.
+    const io::Renumbering renumbering = io::finish_replacing(model, replaced, input_path, note);
     // Buffers embedded (the output stands alone); image files stay where they are, a relative URI
     // re-expressed from the output's folder (gltf_buffer.h).
-    return io::write_model(model, input_path, output_path, binary);
+    return io::write_model(model, input_path, output_path, binary, renumbering);
 }
 
 }  // namespace animorder

@@ -473,3 +473,76 @@ TEST_F(GltfWriter, OrdersOnAPrimitiveNoNodeDrawsLeaveWithTheRest) {
     EXPECT_EQ(undrawn["name"], "animorder fallback order");
     EXPECT_EQ(undrawn["count"], first.mesh.indices.size());
 }
+
+// What tinygltf 2.7 reads but does not write is put back from the input (gltf_buffer.h): an image
+// given as a data: URI (its bytes were lost: an invalid image, a file three.js refused), and
+// extras (nulls in them too) and extensions on skins, samplers, channel targets, accessors, buffer
+// views and buffers. Accessors and views are followed to where the writer moved them: the drawn
+// indices' accessor and view leave the file, and a new accessor takes the freed place.
+TEST_F(GltfWriter, WhatTinygltfLeavesOutIsPutBack) {
+    Sheet sheet = morph_sheet();
+    nlohmann::json doc = nlohmann::json::parse(sheet.g.text());
+    const std::string png = "data:image/png;base64," + test::base64(std::string("\x89PNG\r\n\x1a\n", 8));
+    const nlohmann::json xmp = {{"KHR_xmp_json_ld", {{"packet", 0}}}};
+    doc["extensionsUsed"] = {"KHR_xmp_json_ld"};
+    doc["extensions"]["KHR_xmp_json_ld"] = {{"packets", {{{"dc:creator", {"animorder test"}}}}}};
+    doc["images"] = {{{"uri", png}}};
+    doc["samplers"] = {{{"magFilter", 9729}, {"extras", {{"list", {1, nullptr, 2}}}}, {"extensions", xmp}}};
+    doc["textures"] = {{{"source", 0}, {"sampler", 0}}};
+    for (size_t a = 0; a < doc["accessors"].size(); ++a) {
+        doc["accessors"][a]["extras"] = {{"accessor", a}, {"unset", nullptr}};
+        doc["accessors"][a]["extensions"] = xmp;
+    }
+    for (size_t v = 0; v < doc["bufferViews"].size(); ++v) doc["bufferViews"][v]["extras"] = {{"view", v}};
+    doc["buffers"][0]["extras"] = {{"buffer", 0}};
+    doc["animations"][0]["channels"][0]["target"]["extras"] = {{"target", {nullptr}}};
+    doc["animations"][0]["samplers"][0]["extras"] = {{"sampler", 0}};
+    doc["extras"] = {{"root", {nullptr, 1}}};
+    const fs::path input = dir_ / "extras.gltf";
+    std::ofstream(input) << doc.dump();
+    const size_t index_accessor = 1, index_view = doc["accessors"][index_accessor]["bufferView"].get<size_t>();
+
+    for (const char* name : {"extras-out.gltf", "extras-out.glb"}) {
+        SCOPED_TRACE(name);
+        const Written w = optimise_and_write(input.string(), dir_ / name);
+        const nlohmann::json out =
+            w.path.extension() == ".glb" ? read_glb(w.path).doc : nlohmann::json::parse(test::slurp(w.path));
+        EXPECT_EQ(out["images"][0], doc["images"][0]);  // the URI, no bufferView -1
+        EXPECT_EQ(out["samplers"][0]["extras"], doc["samplers"][0]["extras"]);
+        EXPECT_EQ(out["samplers"][0]["extensions"], xmp);
+        EXPECT_EQ(out["buffers"][0]["extras"], doc["buffers"][0]["extras"]);
+        EXPECT_EQ(out["animations"][0]["channels"][0]["target"]["extras"],
+                  doc["animations"][0]["channels"][0]["target"]["extras"]);
+        EXPECT_EQ(out["animations"][0]["samplers"][0]["extras"], doc["animations"][0]["samplers"][0]["extras"]);
+        EXPECT_EQ(out["extras"], doc["extras"]);
+        // Each input accessor but the drawn indices' is found once, by its extras, with its own
+        // type, count and extension; the writer's new ones have none.
+        std::set<size_t> accessors, views;
+        for (const auto& a : out["accessors"]) {
+            if (!a.contains("extras")) {
+                EXPECT_FALSE(a.contains("extensions")) << a;
+                continue;
+            }
+            const size_t from = a["extras"]["accessor"].get<size_t>();
+            EXPECT_TRUE(accessors.insert(from).second) << from;
+            EXPECT_EQ(a["extras"], doc["accessors"][from]["extras"]);
+            EXPECT_EQ(a["extensions"], xmp);
+            for (const char* key : {"type", "count", "componentType"}) EXPECT_EQ(a[key], doc["accessors"][from][key]);
+        }
+        for (size_t a = 0; a < doc["accessors"].size(); ++a)
+            EXPECT_EQ(accessors.count(a), a == index_accessor ? 0u : 1u);
+        for (const auto& v : out["bufferViews"]) {
+            if (v.contains("extras")) {
+                EXPECT_TRUE(views.insert(v["extras"]["view"].get<size_t>()).second);
+            }
+        }
+        for (size_t v = 0; v < doc["bufferViews"].size(); ++v) EXPECT_EQ(views.count(v), v == index_view ? 0u : 1u);
+        EXPECT_TRUE(check_orders_extension(w.path.string()).errors.empty());
+        std::string report, input_report, why;
+        ANIMORDER_REQUIRE_OR_SKIP("validator", test::validator_available(why), why);
+        test::validate_gltf(w.path, report, dir_);
+        test::validate_gltf(input, input_report, dir_);
+        EXPECT_EQ(nlohmann::json::parse(report)["errors"], nlohmann::json::parse(input_report)["errors"])
+            << report << input_report;
+    }
+}

@@ -501,6 +501,37 @@ PrimitiveData parse_primitive(const Scene& s, size_t n, size_t p, AnimatedMesh& 
     return d;
 }
 
+// Whether a node of the tree under `root` draws a mesh (a cycle or a bad index ends the search).
+bool draws_a_mesh(const tinygltf::Model& model, int root) {
+    std::vector<int> stack = {root};
+    for (size_t visited = 0; !stack.empty() && visited <= model.nodes.size(); ++visited) {
+        const int n = stack.back();
+        stack.pop_back();
+        if (n < 0 || size_t(n) >= model.nodes.size()) continue;
+        if (model.nodes[size_t(n)].mesh >= 0) return true;
+        stack.insert(stack.end(), model.nodes[size_t(n)].children.begin(), model.nodes[size_t(n)].children.end());
+    }
+    return false;
+}
+
+// The scene parse_node_hierarchy read, for an error: which one and why that one, and another
+// scene that draws a mesh when there is one.
+std::string scene_named(const Scene& s) {
+    const tinygltf::Model& model = s.model;
+    if (model.scenes.empty()) return "the file's nodes (it has no scene)";
+    const size_t used = model.defaultScene >= 0 ? size_t(model.defaultScene) : 0;
+    if (used >= model.scenes.size()) return "the file's nodes";
+    std::string named = "scene " + std::to_string(used) +
+                        (model.defaultScene >= 0 ? " (the file's default `scene`)"
+                                                 : " (the file names no default `scene`: the first, as viewers show)");
+    for (size_t other = 0; other < model.scenes.size(); ++other)
+        if (other != used && std::any_of(model.scenes[other].nodes.begin(), model.scenes[other].nodes.end(),
+                                         [&](int root) { return draws_a_mesh(model, root); }))
+            return named + "; scene " + std::to_string(other) + " draws meshes: make it the file's `scene` to " +
+                   "optimise it";
+    return named;
+}
+
 // Every triangle primitive of the mesh nodes, in scene order (node, then primitive): at least one.
 // Points and lines are left out: they draw as the file has them, and writers leave them alone.
 void parse_primitives(Scene& s, AnimatedMesh& mesh) {
@@ -522,9 +553,8 @@ void parse_primitives(Scene& s, AnimatedMesh& mesh) {
         }
     }
     if (s.prims.empty())
-        s.reader.fail(points_or_lines
-                          ? "no triangle mesh in the scene (points and lines cannot be reordered for overdraw)"
-                          : "no triangle mesh in the scene");
+        s.reader.fail("no triangle mesh in " + scene_named(s) +
+                      (points_or_lines ? " (points and lines cannot be reordered for overdraw)" : ""));
 }
 
 // Every node's pose without animation: matrix or T, R, S, and morph weights (the node's, else

@@ -238,9 +238,23 @@ TEST_F(GltfLoader, BrokenFilesGiveOneLineErrorsNamingTheFile) {
         expect_error("nan.gltf", g.text(), "NaN or infinite");
     }
     {
+        // The character in scene 1, a marker alone in scene 0 and no default `scene`: the error
+        // says which scene was read, why, and which one draws meshes.
+        Gltf g = skinned_bar();
+        g.doc["nodes"].push_back({{"name", "marker"}});
+        g.doc["scenes"] = json::array({json{{"nodes", {g.doc["nodes"].size() - 1}}}, g.doc["scenes"][0]});
+        g.doc.erase("scene");
+        expect_error("second-scene.gltf", g.text(),
+                     "no triangle mesh in scene 0 (the file names no default `scene`: the first, as viewers show); "
+                     "scene 1 draws meshes: make it the file's `scene` to optimise it");
+        g.doc["scene"] = 1;
+        EXPECT_NO_THROW(load_gltf(write("scene-1.gltf", g.text())));
+    }
+    {
         Gltf g = skinned_bar();
         g.doc["meshes"][0]["primitives"][0]["mode"] = 1;  // LINES, and nothing else
-        expect_error("lines.gltf", g.text(), "no triangle mesh in the scene (points and lines");
+        expect_error("lines.gltf", g.text(),
+                     "no triangle mesh in scene 0 (the file's default `scene`) (points and lines");
         // Next to triangles, a lines primitive is left out (it was refused, and the file with it).
         g.doc["meshes"][0]["primitives"].push_back(g.doc["meshes"][0]["primitives"][0]);
         g.doc["meshes"][0]["primitives"][1].erase("mode");

@@ -246,6 +246,20 @@ TEST_F(GltfPipelines, CheckAndReapplyRefuseBadInputInOneLine) {
     EXPECT_EQ(o.exit_code, 1);
     EXPECT_NE(o.err.find("nothing written"), std::string::npos) << o.err;
     EXPECT_FALSE(fs::exists(path("out.glb")));
+    // The same quad posed 0.6% larger, as a resampled or quantised animation leaves a mesh: its
+    // corners move 0.3% to 0.6% of the diagonal, the default tolerance (0.1%) finds none of its
+    // triangles, and the error says which tolerance finds them all.
+    json moved = json::parse(test::slurp(example));
+    moved["nodes"][0]["scale"] = {1.006, 1.006, 1.006};
+    std::ofstream(path("moved.gltf")) << moved.dump();
+    o = run(exe() + " reapply -q " + q(example) + " " + q(path("moved.gltf")) + " -o " + q(path("out.glb")));
+    EXPECT_EQ(o.exit_code, 1);
+    EXPECT_NE(o.err.find("only 0 of 2 optimised triangles found within --tolerance 0.001"), std::string::npos) << o.err;
+    EXPECT_NE(o.err.find("all are found at --tolerance 0.01 (the posed corners moved"), std::string::npos) << o.err;
+    EXPECT_FALSE(fs::exists(path("out.glb")));
+    o = run(exe() + " reapply -q --tolerance 0.01 " + q(example) + " " + q(path("moved.gltf")) + " -o " +
+            q(path("out.glb")));
+    EXPECT_EQ(o.exit_code, 0) << o.err;
 }
 
 // A pipeline may drop, reorder or rename animations: reapply finds each clip's animation by name in

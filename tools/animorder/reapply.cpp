@@ -25,6 +25,13 @@
 namespace animorder::tool {
 namespace {
 
+// A tolerance as the option takes it (%g: 0.001, 0.01).
+std::string shown(double value) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", value);
+    return text;
+}
+
 // Per triangle of the listed primitives of `mesh` (or all when `only` is empty), its three
 // corners, each with xyz at every keyframe in `keyframes`.
 std::vector<float> corners(const AnimatedMesh& mesh, const std::vector<size_t>& triangles,
@@ -155,10 +162,23 @@ int run_reapply(const ReapplyOptions& options) {
         const uint32_t* corner = &a.indices[3 * t];
         dropped += b_of_a[t] < 0 && (corner[0] == corner[1] || corner[1] == corner[2] || corner[0] == corner[2]);
     }
-    if (m.matched + dropped != a_triangles.size())
+    if (m.matched + dropped != a_triangles.size()) {
+        // A mesh left as it was whose animation a pipeline resampled or quantised (gltfpack's
+        // defaults) poses its corners a little apart: say which tolerance would match them all.
+        std::string wider;
+        for (const double factor : {10.0, 100.0}) {
+            const TriangleMatch trial = match_triangles(corners(a, a_triangles, ka), corners(b, b_triangles, kb),
+                                                        3 * ka.size(), float(options.tolerance * factor) * diagonal);
+            if (trial.matched + dropped != a_triangles.size()) continue;
+            wider = "; all are found at --tolerance " + shown(options.tolerance * factor) +
+                    " (the posed corners moved: was the animation resampled or quantised?)";
+            break;
+        }
         throw std::runtime_error(options.processed + ": only " + std::to_string(m.matched) + " of " +
-                                 std::to_string(a_triangles.size() - dropped) +
-                                 " optimised triangles found (simplified or changed mesh?); nothing written");
+                                 std::to_string(a_triangles.size() - dropped) + " optimised triangles found within " +
+                                 "--tolerance " + shown(options.tolerance) + " (simplified or changed mesh?)" + wider +
+                                 "; nothing written");
+    }
 
     std::vector<PrimitiveOrders> out;
     std::map<std::pair<int, int>, size_t> seen;

@@ -40,6 +40,10 @@ struct LoadOptions {
     // importer opened or looked for as it read (an OBJ's .mtl, found or not), each once, in the
     // order first met.
     std::vector<std::string>* files_read = nullptr;
+    // Processor time a third-party parser (assimp) may spend on one file: this many seconds, plus
+    // as many again per MiB of the file; a file that makes it loop is then stopped with a
+    // LoadError, not waited on for ever (isolated_import.h).
+    double parse_seconds = 20;
 };
 
 // By extension: .gltf/.glb → load_gltf (gltf_loader.h), .md2 → load_md2, .iqm → load_iqm (no

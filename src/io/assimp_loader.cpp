@@ -145,19 +145,26 @@ private:
 };
 
 const aiScene* import(Assimp::Importer& importer, const std::string& path, std::vector<std::string>& opened,
-                      uint64_t budget) {
+                      const LoadOptions& options) {
+    const uint64_t budget = options.file_budget();
     if (!std::filesystem::exists(path)) throw LoadError(path + ": cannot open file");
-    if (const RegularFile file(path); file.ok() && file.size() > budget)
+    const RegularFile file(path);
+    if (file.ok() && file.size() > budget)
         throw LoadError(path + ": is larger than the loading budget of " + std::to_string(budget) +
                         " bytes (raise it with --max-memory)");
     importer.SetIOHandler(new RegularFilesOnly(opened, budget));  // the importer owns it
     importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+    io::begin_parsing(file.ok() ? file.size() : 0, options);  // a file assimp loops on is stopped
     const aiScene* scene =
         importer.ReadFile(path, aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_JoinIdenticalVertices |
                                     aiProcess_ValidateDataStructure);
+    io::end_parsing();
     if (!scene || !scene->mRootNode) {
         std::string why = importer.GetErrorString();
         std::replace(why.begin(), why.end(), '\n', ' ');
+        if (why.find("No meshes remaining") != std::string::npos)  // SortByPType left out every point and line
+            throw LoadError(path +
+                            ": no triangle mesh in the file (points and lines cannot be reordered for overdraw)");
         throw LoadError(path + ": not readable by assimp: " + why);
     }
     return scene;
@@ -203,6 +210,33 @@ void refuse_truncated_md5mesh(const std::string& path) {
                         " meshes, it holds " + std::to_string(blocks));
 }
 
+// assimp reads a cut ASCII .stl without a word too, keeping the facets before the cut: a text STL
+// (it starts with "solid" and its size is not a binary STL's 84 + 50 · its facet count) ends with
+// an "endsolid" line.
+void refuse_truncated_ascii_stl(const std::string& path) {
+    std::string extension = std::filesystem::path(path).extension().string();
+    for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (extension != ".stl") return;
+    std::ifstream in(path, std::ios::binary | std::ios::ate);
+    const std::streamoff size = in.tellg();
+    char head[84] = {};
+    in.seekg(0);
+    if (size < 5 || !in.read(head, std::min<std::streamoff>(size, 84)) || std::strncmp(head, "solid", 5) != 0) return;
+    uint32_t facets = 0;
+    std::memcpy(&facets, head + 80, 4);
+    if (size >= 84 && uint64_t(size) == 84 + 50 * uint64_t(facets)) return;  // binary, its header saying "solid"
+    const std::streamoff tail = std::min<std::streamoff>(size, 4096);
+    std::string end(size_t(tail), '\0');
+    in.seekg(size - tail);
+    in.read(end.data(), tail);
+    const size_t last = end.find_last_not_of(" \t\r\n");
+    const size_t line = last == std::string::npos ? 0 : end.find_last_of('\n', last);
+    const std::string closing = end.substr(line == std::string::npos ? 0 : line + 1);
+    if (closing.find_first_not_of(" \t") == std::string::npos ||
+        closing.compare(closing.find_first_not_of(" \t"), 8, "endsolid") != 0)
+        throw LoadError(path + ": cut short or damaged: a text STL ends with an 'endsolid' line, this one does not");
+}
+
 // For a file with bones and no geometry (an .md5anim, a .bvh), assimp's SkeletonMeshBuilder adds a
 // mesh of its own that draws the bones, with a material it names "SkeletonMaterial": not the
 // character.
@@ -220,8 +254,9 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
     const io::ReadingFile& reading = child.reading;
     reading(0);
     Assimp::Importer importer;
-    const aiScene* scene = import(importer, path, child.opened, options.file_budget());
+    const aiScene* scene = import(importer, path, child.opened, options);
     refuse_truncated_md5mesh(path);
+    refuse_truncated_ascii_stl(path);
     Flat flat;
     flatten(scene->mRootNode, flat);
 
@@ -338,7 +373,7 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
         const std::string& file = clip_files[i];
         reading(i + 1);
         clip_importers.push_back(std::make_unique<Assimp::Importer>());
-        const aiScene* clip_scene = import(*clip_importers.back(), file, child.opened, options.file_budget());
+        const aiScene* clip_scene = import(*clip_importers.back(), file, child.opened, options);
         if (clip_scene->mNumAnimations == 0) throw LoadError(file + ": has no animation");
         for (unsigned a = 0; a < clip_scene->mNumAnimations; ++a) {
             const aiAnimation* anim = clip_scene->mAnimations[a];

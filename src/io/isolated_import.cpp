@@ -11,6 +11,8 @@
 #include "animorder/load.h"
 
 #include <sys/mman.h>
+#include <sys/prctl.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -18,8 +20,10 @@
 #include <algorithm>
 #include <cerrno>
 #include <climits>
+#include <cmath>
 #include <csignal>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <new>
 
@@ -29,6 +33,11 @@ namespace {
 constexpr char kMagic[8] = {'A', 'O', 'C', 'H', 'I', 'L', 'D', '1'};
 constexpr char kEnd[8] = {'A', 'O', 'C', 'H', 'I', 'L', 'D', '.'};
 constexpr int kCannotWriteBack = 97;  // the child's exit code when the memfd write fails
+
+// The page the parent and the child share: [0] the file the child reads (ChildContext::reading),
+// [1] the processor time in ms its current parse may take (begin_parsing; 0 between parses).
+// Set in the child only: begin_parsing and end_parsing do nothing elsewhere.
+volatile uint64_t* child_page = nullptr;
 
 struct Fd {
     int fd = -1;
@@ -170,8 +179,16 @@ void write_error(Writer& w, const std::string& message) {
     w.flush();
 }
 
-[[noreturn]] void run_child(int data_fd, int log_fd, volatile uint64_t* reading_index, const std::string& path,
+[[noreturn]] void run_child(pid_t parent, int data_fd, int log_fd, volatile uint64_t* page, const std::string& path,
                             const std::function<AnimatedMesh(const ChildContext&)>& load) {
+    // Killed with the parent (a parent killed before this line is gone already: its child then
+    // belongs to another process); no core file from a parser that crashes or runs out of time.
+    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (::getppid() != parent) ::_exit(kCannotWriteBack);
+    const rlimit no_core{0, 0};
+    ::setrlimit(RLIMIT_CORE, &no_core);
+    child_page = page;
+    volatile uint64_t* reading_index = page;
     // Nothing the child (assimp, a sanitizer) prints reaches the user; the parent reads the log.
     ::dup2(log_fd, STDOUT_FILENO);
     ::dup2(log_fd, STDERR_FILENO);
@@ -350,6 +367,29 @@ std::string last_words(int log_fd) {
 
 }  // namespace
 
+void begin_parsing(uint64_t bytes, const LoadOptions& options) {
+    const double seconds = options.parse_seconds * (1.0 + double(bytes) / double(1 << 20));
+    if (!child_page || !(seconds > 0)) return;
+    rusage usage{};
+    rlimit limit{};
+    if (::getrusage(RUSAGE_SELF, &usage) != 0 || ::getrlimit(RLIMIT_CPU, &limit) != 0) return;
+    const double used = double(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+                        1e-6 * double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+    const double until = std::ceil(used + seconds);  // the limit is whole seconds of the process's time
+    if (limit.rlim_max != RLIM_INFINITY && until >= double(limit.rlim_max)) return;
+    limit.rlim_cur = until < 1e12 ? rlim_t(until) : RLIM_INFINITY;
+    child_page[1] = uint64_t(seconds * 1000.0);
+    ::setrlimit(RLIMIT_CPU, &limit);
+}
+
+void end_parsing() {
+    rlimit limit{};
+    if (!child_page || ::getrlimit(RLIMIT_CPU, &limit) != 0) return;
+    limit.rlim_cur = limit.rlim_max;
+    ::setrlimit(RLIMIT_CPU, &limit);
+    child_page[1] = 0;
+}
+
 AnimatedMesh load_isolated(const std::vector<std::string>& files, const LoadOptions& options,
                            const std::function<AnimatedMesh(const ChildContext& child)>& load) {
     if (files.empty()) throw LoadError("(no file): nothing to read");
@@ -358,15 +398,17 @@ AnimatedMesh load_isolated(const std::vector<std::string>& files, const LoadOpti
     const Fd log(::memfd_create("animorder-child-log", MFD_CLOEXEC));
     if (data.fd < 0 || log.fd < 0)
         throw LoadError(path + ": cannot create the isolated reader's buffer: " + errno_text());
-    const Mapping shared(::mmap(nullptr, sizeof(uint64_t), PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0),
-                         sizeof(uint64_t));
+    const Mapping shared(
+        ::mmap(nullptr, 2 * sizeof(uint64_t), PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0),
+        2 * sizeof(uint64_t));
     if (shared.data == MAP_FAILED) throw LoadError(path + ": cannot map the isolated reader's page: " + errno_text());
-    volatile uint64_t* reading_index = static_cast<volatile uint64_t*>(shared.data);
-    *reading_index = 0;
+    volatile uint64_t* page = static_cast<volatile uint64_t*>(shared.data);
+    page[0] = page[1] = 0;
 
+    const pid_t parent = ::getpid();
     const pid_t child = ::fork();
     if (child < 0) throw LoadError(path + ": cannot start the isolated reader: " + errno_text());
-    if (child == 0) run_child(data.fd, log.fd, reading_index, path, load);
+    if (child == 0) run_child(parent, data.fd, log.fd, page, path, load);
 
     int status = 0;
     pid_t waited;
@@ -374,8 +416,14 @@ AnimatedMesh load_isolated(const std::vector<std::string>& files, const LoadOpti
     while (waited < 0 && errno == EINTR);
     if (waited < 0) throw LoadError(path + ": lost the isolated reader: " + errno_text());
 
-    const uint64_t index = *reading_index;
+    const uint64_t index = page[0], parse_ms = page[1];
     const std::string& blamed = index < files.size() ? files[size_t(index)] : path;
+    if (WIFSIGNALED(status) && parse_ms > 0 && (WTERMSIG(status) == SIGXCPU || WTERMSIG(status) == SIGKILL)) {
+        char seconds[32];
+        std::snprintf(seconds, sizeof seconds, "%.0f", double(parse_ms) / 1000.0);
+        throw LoadError(blamed + ": assimp did not finish reading it in " + seconds +
+                        " s of processor time (a damaged file it loops on?)");
+    }
     if (WIFSIGNALED(status) ||
         (WIFEXITED(status) && WEXITSTATUS(status) != 0 && WEXITSTATUS(status) != kCannotWriteBack)) {
         std::string why = WIFSIGNALED(status)

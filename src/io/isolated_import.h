@@ -22,6 +22,13 @@ struct ChildContext {
     std::vector<std::string>& opened;
 };
 
+// Called in the child around each third-party parse of a file of `bytes` bytes: from
+// begin_parsing to end_parsing the child may use options.parse_seconds · (1 + MiB) more seconds
+// of processor time, after which the kernel stops it (SIGXCPU) and load_isolated reports a file
+// the parser could not finish.
+void begin_parsing(uint64_t bytes, const LoadOptions& options);
+void end_parsing();
+
 // Runs load(reading) in a forked child and returns the AnimatedMesh it produced. files[0] is
 // the character (the file errors are about when nothing better is known), the rest are the
 // clip files the loader reads. The child passes the mesh back through an in-memory file
@@ -32,7 +39,10 @@ struct ChildContext {
 //  - the child killed by a signal: "FILE: assimp crashed reading it (signal 11: SIGSEGV)",
 //    followed by the last meaningful line the child wrote to stderr, if any;
 //  - the child exiting non-zero (AddressSanitizer does this after a report): "FILE: assimp
-//    crashed reading it (exit code N)" and the same stderr line.
+//    crashed reading it (exit code N)" and the same stderr line;
+//  - the child over its processor time for a parse (begin_parsing): "FILE: assimp did not finish
+//    reading it in N s of processor time (...)".
+// The child dies with the parent (a killed animorder leaves no reader running) and dumps no core.
 // The child's stdout and stderr are captured, never shown. The files the child opened or looked
 // for are added to options.files_read (when set) if not there already.
 AnimatedMesh load_isolated(const std::vector<std::string>& files, const LoadOptions& options,

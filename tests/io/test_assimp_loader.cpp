@@ -11,7 +11,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -283,6 +285,45 @@ TEST_F(AssimpHostile, ACutMd5MeshIsRefused) {
     EXPECT_NE(load_error(write("two.md5mesh", two)).find("its header says 2 meshes, it holds 1"), std::string::npos);
     const std::string cut = whole.substr(0, whole.rfind("\tweight 2"));
     EXPECT_NE(load_error(write("cut.md5mesh", cut)).find("mesh 1 says 3 weights, it holds 2"), std::string::npos);
+}
+
+// A PLY whose header never ends: assimp 5.2 reads it for ever. The isolated reader is stopped
+// after its processor time (LoadOptions::parse_seconds, 1 s here) and the file named.
+TEST_F(AssimpHostile, AFileAssimpLoopsOnIsStoppedInItsTime) {
+    LoadOptions options;
+    options.parse_seconds = 1;
+    const std::string ply = write("cut-header.ply", "ply\nformat ascii 1.0\ncomment Created ");
+    const auto start = std::chrono::steady_clock::now();
+    const std::string what = load_error(ply, {}, options);
+    EXPECT_EQ(what, ply + ": assimp did not finish reading it in 1 s of processor time (a damaged file it loops on?)");
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 30.0);
+}
+
+// A cut text STL: assimp 5.2 keeps the facets before the cut without a word (Bob's STL cut in
+// half gave 512 of 1,027 triangles); a text STL ends with "endsolid". A binary STL whose header
+// starts with "solid" is no text STL.
+TEST_F(AssimpHostile, ACutTextStlIsRefused) {
+    const std::string facet =
+        "facet normal 0 0 1\n outer loop\n  vertex 0 0 0\n  vertex 1 0 0\n  vertex 0 1 0\n "
+        "endloop\nendfacet\n";
+    const std::string whole = "solid tri\n" + facet + facet + "endsolid tri\n";
+    EXPECT_EQ(load_character(write("whole.stl", whole)).triangle_count(), 2u);
+    const std::string cut = whole.substr(0, whole.rfind("endloop"));
+    EXPECT_NE(load_error(write("cut.stl", cut)).find("cut short or damaged: a text STL ends with an 'endsolid' line"),
+              std::string::npos);
+    std::string binary(84 + 50, '\0');  // one facet, its header starting "solid"
+    binary.replace(0, 5, "solid");
+    binary[80] = 1;
+    const float corners[12] = {0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0};
+    std::memcpy(&binary[84], corners, sizeof corners);
+    EXPECT_EQ(load_character(write("binary.stl", binary)).triangle_count(), 1u);
+}
+
+// A file of points and lines only: what the loader says of glTF, not assimp's "No meshes remaining".
+TEST_F(AssimpHostile, PointsAndLinesOnlyAreNamed) {
+    const std::string obj = write("lines.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\np 3\n");
+    EXPECT_EQ(load_error(obj),
+              obj + ": no triangle mesh in the file (points and lines cannot be reordered for overdraw)");
 }
 
 TEST_F(AssimpHostile, ACrashInAClipFileNamesTheClipFile) {

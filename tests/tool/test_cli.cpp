@@ -598,6 +598,18 @@ std::string entries_of(const fs::path& folder) {
 // writing it fails with "No space left on device". `exec` keeps the shell's PID ($$), so the link
 // carries the tool's PID. Afterwards the folder must be empty: no temporary (the link is it), no
 // output. Were the temporary named otherwise, the write would succeed and the link stay: a failure too.
+// animorder killed while assimp reads a file (here one it loops on) leaves no reader running:
+// the isolated reader dies with it.
+TEST_F(Cli, AKilledRunLeavesNoReaderBehind) {
+    const fs::path ply = path("never-ending-header.ply");
+    std::ofstream(ply) << "ply\nformat ascii 1.0\ncomment Created ";
+    // A script, so that no shell's command line names the file: pgrep finds animorder processes only.
+    std::ofstream(path("kill.sh")) << std::string(ANIMORDER_EXE) << " inspect '" << ply.string()
+                                   << "' & sleep 1; kill -9 $!; sleep 1; pgrep -f never-ending-header | wc -l\n";
+    const test::Outcome o = test::run_captured("sh '" + path("kill.sh").string() + "'", dir_);
+    EXPECT_EQ(o.out, "0\n") << o.err;
+}
+
 TEST_F(Cli, FailedWriteLeavesNoFileBehind) {
     ASSERT_TRUE(fs::exists("/dev/full"));
     const fs::path out = path("out");

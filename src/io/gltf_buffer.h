@@ -158,8 +158,20 @@ inline void refuse_undecodable_geometry(const std::vector<std::string>& required
 // extension the file requires when there is one (tinygltf then fails on its compressed bytes, or
 // reads them as plain ones), else tinygltf's own message.
 inline void finish_load(bool ok, std::string error, const tinygltf::Model& model, const std::string& path) {
-    if (ok) return refuse_undecodable_geometry(model.extensionsRequired, path);
+    // glTF 1.0 (scenes named by strings, techniques...) reads as an empty 2.0 file: say what it is.
+    const auto refuse_version = [&path](const std::string& version) {
+        if (version.rfind("1.", 0) == 0 || version == "1")
+            throw LoadError(path + ": is glTF " + version +
+                            "; animorder reads glTF 2.0 (gltf-pipeline -i FILE -o NEW.gltf upgrades it)");
+    };
+    if (ok) {
+        refuse_version(model.asset.version);
+        return refuse_undecodable_geometry(model.extensionsRequired, path);
+    }
     const nlohmann::json doc = nlohmann::json::parse(gltf_json_text(path), nullptr, false);
+    if (doc.is_object() && doc.contains("asset") && doc["asset"].is_object() && doc["asset"].contains("version") &&
+        doc["asset"]["version"].is_string())
+        refuse_version(doc["asset"]["version"].get<std::string>());
     if (doc.is_object() && doc.contains("extensionsRequired") && doc["extensionsRequired"].is_array()) {
         std::vector<std::string> required;
         for (const nlohmann::json& e : doc["extensionsRequired"])

@@ -238,6 +238,13 @@ TEST_F(GltfLoader, BrokenFilesGiveOneLineErrorsNamingTheFile) {
         expect_error("nan.gltf", g.text(), "NaN or infinite");
     }
     {
+        // glTF 1.0 (assimp's "gltf" exporter writes it) is named, not read as an empty 2.0 file.
+        Gltf g = skinned_bar();
+        g.doc["asset"]["version"] = "1.0";
+        g.doc["scene"] = "defaultScene";
+        expect_error("one.gltf", g.text(), "is glTF 1.0; animorder reads glTF 2.0 (gltf-pipeline");
+    }
+    {
         // The character in scene 1, a marker alone in scene 0 and no default `scene`: the error
         // says which scene was read, why, and which one draws meshes.
         Gltf g = skinned_bar();

@@ -3,7 +3,9 @@
 // Format (id Software's md2.h): a 68-byte header ("IDP2", version 8, counts and offsets), then
 // triangles as 3 vertex + 3 texture-coordinate indices, and frames as scale, translate, a
 // 16-character name and per vertex 3 bytes (position = byte · scale + translate) plus a normal
-// index. Frames whose names differ only in trailing digits ("run1" … "run6") form one clip.
+// index. Frames whose names differ only in trailing digits ("run1" … "run6") form one clip, split
+// where the number starts again or a Quake II variant begins ("pain101" … "pain104", "pain201"
+// …: clips pain1 and pain2).
 // MD2 has no timing; the Quake II convention plays 10 frames per second, so a clip of n frames
 // lasts (n − 1)/10 s and is resampled at the sample rate by linear interpolation between frames.
 // Triangles index the file's own vertex array (texture coordinates are separate in MD2), so
@@ -34,6 +36,20 @@ int32_t i32(const std::vector<unsigned char>& d, size_t at) {
     int32_t v;
     std::memcpy(&v, d.data() + at, 4);
     return v;
+}
+
+// Whether frame number `next` (its name's trailing digits) continues `previous` in one clip: it
+// does unless it starts again (not larger), or it is frame 01 of the next variant: Quake II
+// numbers the frames of an action's variants "pain101" … "pain104", "pain201" …, each variant a
+// clip (while "run099", "run100" continue). A gap ("run2", "run4") continues; so do names
+// without digits.
+bool follows(const std::string& previous, const std::string& next) {
+    if (previous.empty() || next.empty() || previous.size() > 9 || next.size() > 9) return true;
+    if (std::stol(next) <= std::stol(previous)) return false;
+    const bool next_variant = next.size() >= 3 && next.size() == previous.size() &&
+                              next.compare(0, next.size() - 2, previous, 0, previous.size() - 2) != 0 &&
+                              next.compare(next.size() - 2, 2, "01") == 0;
+    return !next_variant;
 }
 
 }  // namespace
@@ -83,7 +99,8 @@ AnimatedMesh load_md2(const std::string& path, const LoadOptions& options) {
 
     // Frame positions and names.
     std::vector<std::vector<float>> frame_positions(size_t(frames), std::vector<float>(size_t(vertices) * 3));
-    std::vector<std::string> group(static_cast<size_t>(frames));
+    // Per frame, its name without the trailing digits (the clip it belongs to) and those digits.
+    std::vector<std::string> group(static_cast<size_t>(frames)), number(static_cast<size_t>(frames));
     for (int32_t f = 0; f < frames; ++f) {
         const unsigned char* p = d.data() + ofs_frames + size_t(f) * size_t(frame_size);
         float scale[3], translate[3];
@@ -93,7 +110,10 @@ AnimatedMesh load_md2(const std::string& path, const LoadOptions& options) {
             if (!std::isfinite(scale[c]) || !std::isfinite(translate[c]))
                 throw fail("frame " + std::to_string(f) + " has a NaN or infinite scale or translation");
         std::string name(reinterpret_cast<const char*>(p + 24), strnlen(reinterpret_cast<const char*>(p + 24), 16));
-        while (!name.empty() && std::isdigit(static_cast<unsigned char>(name.back()))) name.pop_back();
+        size_t digits = name.size();
+        while (digits > 0 && std::isdigit(static_cast<unsigned char>(name[digits - 1]))) --digits;
+        number[size_t(f)] = name.substr(digits);
+        name.resize(digits);
         group[size_t(f)] = name.empty() ? "frames" : name;
         for (int32_t v = 0; v < vertices; ++v)
             for (int c = 0; c < 3; ++c)
@@ -108,7 +128,9 @@ AnimatedMesh load_md2(const std::string& path, const LoadOptions& options) {
     size_t total_keyframes = 0;
     for (int32_t begin = 0; begin < frames;) {
         int32_t end = begin + 1;
-        while (end < frames && group[size_t(end)] == group[size_t(begin)]) ++end;
+        while (end < frames && group[size_t(end)] == group[size_t(begin)] &&
+               follows(number[size_t(end) - 1], number[size_t(end)]))
+            ++end;
         Clip clip;
         clip.name = group[size_t(begin)];
         clip.duration_s = double(end - begin - 1) / kMd2FramesPerSecond;
@@ -119,6 +141,16 @@ AnimatedMesh load_md2(const std::string& path, const LoadOptions& options) {
         mesh.clips.push_back(clip);
         runs.emplace_back(begin, end);
         begin = end;
+    }
+    // A name that several clips share because follows() split its frames (Quake II's variants)
+    // takes the variant's digits: pain1, pain2, pain3.
+    std::vector<size_t> sharing(runs.size(), 0);
+    for (size_t c = 0; c < runs.size(); ++c)
+        for (const Clip& other : mesh.clips) sharing[c] += other.name == mesh.clips[c].name;
+    for (size_t c = 0; c < runs.size(); ++c) {
+        const std::string& digits = number[size_t(runs[c].first)];
+        if (sharing[c] > 1 && digits.size() >= 3 && digits.size() <= 9)
+            mesh.clips[c].name += digits.substr(0, digits.size() - 2);
     }
     io::check_keyframe_budget(path, total_keyframes, size_t(vertices), options);
     mesh.keyframe_positions.reserve(total_keyframes * size_t(vertices) * 3);

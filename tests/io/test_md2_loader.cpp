@@ -15,6 +15,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <string>
 #include <vector>
 
 using namespace animorder;
@@ -34,9 +35,11 @@ enum : size_t {
     kOfsEnd = 64
 };
 
-// Three vertices, one triangle (0, 1, 2), two frames "wave1" and "wave2": frame f has scale
-// (1, 1, 1), translate (0, 0, 10·f) and vertex bytes v0 = (0, 0, 0), v1 = (4, 0, 0), v2 = (0, 8 + 2·f, 0).
-test::ByteImage tiny_md2() {
+// Three vertices, one triangle (0, 1, 2), one frame per name (two, "wave1" and "wave2", by
+// default): frame f has scale (1, 1, 1), translate (0, 0, 10·f) and vertex bytes v0 = (0, 0, 0),
+// v1 = (4, 0, 0), v2 = (0, 8 + 2·f, 0).
+test::ByteImage tiny_md2(const std::vector<std::string>& names = {"wave1", "wave2"}) {
+    const int32_t frames = int32_t(names.size());
     test::ByteImage m;
     m.put_text(0, "IDP2", 4);
     m.put<int32_t>(4, 8);
@@ -45,23 +48,23 @@ test::ByteImage tiny_md2() {
     m.put<int32_t>(kVertices, vertices);
     m.put<int32_t>(kTexCoords, 0);
     m.put<int32_t>(kTriangles, 1);
-    m.put<int32_t>(kFrames, 2);
+    m.put<int32_t>(kFrames, frames);
     m.put<int32_t>(kOfsTris, 68);
     m.put<int32_t>(kOfsFrames, 68 + 12);
     const uint16_t tri[6] = {0, 1, 2, 0, 0, 0};
     for (size_t i = 0; i < 6; ++i) m.put<uint16_t>(68 + 2 * i, tri[i]);
-    for (int f = 0; f < 2; ++f) {
+    for (int f = 0; f < frames; ++f) {
         const size_t at = 80 + size_t(f) * size_t(frame_size);
         for (int c = 0; c < 3; ++c) m.put<float>(at + 4 * size_t(c), 1.0f);
         m.put<float>(at + 12, 0.0f);
         m.put<float>(at + 16, 0.0f);
         m.put<float>(at + 20, 10.0f * float(f));
-        m.put_text(at + 24, f == 0 ? "wave1" : "wave2", 16);
+        m.put_text(at + 24, names[size_t(f)].c_str(), 16);
         const unsigned char v[3][3] = {{0, 0, 0}, {4, 0, 0}, {0, static_cast<unsigned char>(8 + 2 * f), 0}};
         for (size_t i = 0; i < 3; ++i)
             for (size_t c = 0; c < 3; ++c) m.put<unsigned char>(at + 40 + 4 * i + c, v[i][c]);
     }
-    m.bytes.resize(80 + 2 * size_t(frame_size));  // the last normal index byte
+    m.bytes.resize(80 + size_t(frames) * size_t(frame_size));  // the last normal index byte
     m.put<int32_t>(kOfsEnd, int32_t(m.bytes.size()));
     return m;
 }
@@ -88,6 +91,22 @@ TEST_F(Md2Loader, TinyModelResamplesAsWorkedOutByHand) {
         EXPECT_NEAR(p[5], 10.0 * double(k) / 3, 1e-5);
         EXPECT_NEAR(p[7], 8 + 2.0 * double(k) / 3, 1e-5) << k;
     }
+}
+
+// Quake II's action variants (faerie.md2's pain101 … pain304) are clips of their own, named by
+// variant; numbers that start again start a clip; a three-digit count past 99 does not.
+TEST_F(Md2Loader, VariantsAndRestartsAreClipsOfTheirOwn) {
+    const AnimatedMesh m = load_md2(write("variants.md2", tiny_md2({"pain101", "pain102", "pain201", "pain202",
+                                                                    "run099", "run100", "jump1", "jump1", "pain301"})));
+    ASSERT_EQ(m.clips.size(), 6u);
+    const char* names[] = {"pain1", "pain2", "run", "jump", "jump", "pain3"};
+    for (size_t c = 0; c < 6; ++c) EXPECT_EQ(m.clips[c].name, names[c]) << c;
+    EXPECT_EQ(m.clips[0].keyframe_count, 4u);  // two frames each: 0.1 s at 30/s, both ends
+    EXPECT_EQ(m.clips[2].keyframe_count, 4u);
+    EXPECT_EQ(m.clips[3].keyframe_count, 1u);  // one frame
+    // pain2 starts at frame 2 (translate z = 20), not between pain1's last frame and it.
+    EXPECT_NEAR(m.keyframe(m.clips[1].first_keyframe)[5], 20.0, 1e-5);
+    EXPECT_NEAR(m.keyframe(m.clips[0].first_keyframe + 3)[5], 10.0, 1e-5);
 }
 
 TEST_F(Md2Loader, HostileHeadersGiveOneLineErrors) {

@@ -210,9 +210,10 @@ void refuse_truncated_md5mesh(const std::string& path) {
                         " meshes, it holds " + std::to_string(blocks));
 }
 
-// assimp reads a cut ASCII .stl without a word too, keeping the facets before the cut: a text STL
+// assimp reads a cut text .stl without a word too, keeping the facets before the cut: a text STL
 // (it starts with "solid" and its size is not a binary STL's 84 + 50 · its facet count) ends with
-// an "endsolid" line.
+// "endsolid" and a name, then nothing but blanks (some exporters add a NUL or a ^Z). Lines may end
+// in CR, LF or both, or the whole file be one line: assimp reads it word by word.
 void refuse_truncated_ascii_stl(const std::string& path) {
     std::string extension = std::filesystem::path(path).extension().string();
     for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
@@ -229,12 +230,14 @@ void refuse_truncated_ascii_stl(const std::string& path) {
     std::string end(size_t(tail), '\0');
     in.seekg(size - tail);
     in.read(end.data(), tail);
-    const size_t last = end.find_last_not_of(" \t\r\n");
-    const size_t line = last == std::string::npos ? 0 : end.find_last_of('\n', last);
-    const std::string closing = end.substr(line == std::string::npos ? 0 : line + 1);
-    if (closing.find_first_not_of(" \t") == std::string::npos ||
-        closing.compare(closing.find_first_not_of(" \t"), 8, "endsolid") != 0)
-        throw LoadError(path + ": cut short or damaged: a text STL ends with an 'endsolid' line, this one does not");
+    const size_t at = end.rfind("endsolid");
+    bool ends = at != std::string::npos;
+    if (ends) {
+        const size_t name_end = end.find_first_of("\r\n", at);  // the name runs to the end of its line
+        ends = name_end == std::string::npos ||
+               end.find_first_not_of(std::string(" \t\r\n\v\f\x1a\0", 8), name_end) == std::string::npos;
+    }
+    if (!ends) throw LoadError(path + ": cut short or damaged: a text STL ends with 'endsolid', this one does not");
 }
 
 // For a file with bones and no geometry (an .md5anim, a .bvh), assimp's SkeletonMeshBuilder adds a

@@ -187,6 +187,13 @@ void write_error(Writer& w, const std::string& message) {
     if (::getppid() != parent) ::_exit(kCannotWriteBack);
     const rlimit no_core{0, 0};
     ::setrlimit(RLIMIT_CORE, &no_core);
+    // begin_parsing's limit stops the child by SIGXCPU's default action, whatever the parent
+    // ignored or blocked (both are inherited).
+    ::signal(SIGXCPU, SIG_DFL);
+    sigset_t xcpu;
+    ::sigemptyset(&xcpu);
+    ::sigaddset(&xcpu, SIGXCPU);
+    ::sigprocmask(SIG_UNBLOCK, &xcpu, nullptr);
     child_page = page;
     volatile uint64_t* reading_index = page;
     // Nothing the child (assimp, a sanitizer) prints reaches the user; the parent reads the log.

@@ -32,6 +32,7 @@
 #include "animorder/regular_file.h"
 #include "checked_size.h"
 #include "isolated_import.h"
+#include "lower_extension.h"
 
 #include <assimp/DefaultIOSystem.h>
 #include <assimp/GltfMaterial.h>
@@ -174,8 +175,7 @@ const aiScene* import(Assimp::Importer& importer, const std::string& path, std::
 // numMeshes against the mesh blocks the text holds, and each block's numverts, numtris and
 // numweights against its vert, tri and weight lines (outside comments), say so.
 void refuse_truncated_md5mesh(const std::string& path) {
-    std::string extension = std::filesystem::path(path).extension().string();
-    for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
+    const std::string extension = io::lower_extension(path);
     if (extension != ".md5mesh") return;
     std::ifstream in(path, std::ios::binary);
     long declared = -1, blocks = 0;
@@ -215,8 +215,7 @@ void refuse_truncated_md5mesh(const std::string& path) {
 // "endsolid" and a name, then nothing but blanks (some exporters add a NUL or a ^Z). Lines may end
 // in CR, LF or both, or the whole file be one line: assimp reads it word by word.
 void refuse_truncated_ascii_stl(const std::string& path) {
-    std::string extension = std::filesystem::path(path).extension().string();
-    for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
+    const std::string extension = io::lower_extension(path);
     if (extension != ".stl") return;
     std::ifstream in(path, std::ios::binary | std::ios::ate);
     const std::streamoff size = in.tellg();
@@ -496,8 +495,7 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
     // a clip file, differs there (Bob's 'lamp' by 8.8%).
     auto check_clip_skeleton = [&](const ClipSource& source) {
         if (!source.scene || !(size > 0) || !std::isfinite(size)) return;
-        std::string extension = std::filesystem::path(source.file).extension().string();
-        for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
+        const std::string extension = io::lower_extension(source.file);
         if (extension == ".md5anim") return;
         double worst = 0;
         const aiNode* worst_node = nullptr;

@@ -283,6 +283,14 @@ inline tinygltf::Model read_model(const std::string& path) {
     return model;
 }
 
+// An input object's `extras` on the output object, verbatim (tinygltf's values drop a null,
+// shifting an array's elements); whether that changed it.
+inline bool restore_extras(const nlohmann::ordered_json& in, nlohmann::ordered_json& out) {
+    if (!in.contains("extras") || (out.contains("extras") && out["extras"] == in["extras"])) return false;
+    out["extras"] = in["extras"];
+    return true;
+}
+
 // An input object's `extras` (verbatim: tinygltf's values drop a null, shifting an array's
 // elements) and each of its `extensions` the output lacks (tinygltf 2.7 writes neither for skins,
 // channel targets, accessors, buffer views, buffers, samplers), put back on the output object it
@@ -291,11 +299,7 @@ inline tinygltf::Model read_model(const std::string& path) {
 // writer names the orders it wrote, and left out the stale ones on purpose (gltf_prune.h).
 inline bool restore_extras_and_extensions(const nlohmann::ordered_json& in, nlohmann::ordered_json& out) {
     if (!in.is_object() || !out.is_object()) return false;
-    bool changed = false;
-    if (in.contains("extras") && (!out.contains("extras") || out["extras"] != in["extras"])) {
-        out["extras"] = in["extras"];
-        changed = true;
-    }
+    bool changed = restore_extras(in, out);
     if (in.contains("extensions") && in["extensions"].is_object())
         for (const auto& [name, value] : in["extensions"].items()) {
             if (name == "ANIMORDER_animated_triangle_orders") continue;
@@ -386,10 +390,7 @@ inline bool restore_what_tinygltf_drops(const nlohmann::ordered_json& input, nlo
                 changed = restore_extras_and_extensions(list[i], written[size_t(to)]) || changed;
         }
     }
-    if (input.contains("extras") && (!output.contains("extras") || output["extras"] != input["extras"])) {
-        output["extras"] = input["extras"];
-        changed = true;
-    }
+    if (input.is_object() && output.is_object()) changed = restore_extras(input, output) || changed;
     return changed;
 }
 

@@ -11,6 +11,7 @@
 #include "animorder/regular_file.h"
 
 #include "gltf_buffer.h"
+#include "lower_extension.h"
 
 #include <tiny_gltf.h>
 #include <nlohmann/json.hpp>
@@ -25,12 +26,7 @@
 namespace animorder {
 namespace {
 
-std::string lower_extension(const std::string& path) {
-    std::string extension = std::filesystem::path(path).extension().string();
-    std::transform(extension.begin(), extension.end(), extension.begin(),
-                   [](unsigned char ch) { return char(std::tolower(ch)); });
-    return extension;
-}
+using io::lower_extension;
 
 // A clip folder stands for its regular files but hidden ones (.DS_Store), in name order.
 // Filesystem errors (a link loop, a folder that cannot be listed) are LoadErrors naming the path.

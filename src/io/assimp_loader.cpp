@@ -6,6 +6,11 @@
 // node hierarchy with keyed position/rotation/scaling (linear, rotations slerped), bones as
 // joint = node global transform · offset matrix (assimp's inverse bind), linear blend skinning
 // with weights normalised, every clip sampled at a fixed rate from its first to its last tick.
+// Morph targets (assimp's anim meshes, whole replacement positions) move a mesh by the weights
+// its clip keys for them (a morph channel named after the mesh's node or the mesh, linear between
+// keys): position = base + Σ weight · (target − base), before skinning, as glTF defines it. Only
+// keyed weights count: importers fill an anim mesh's own weight inconsistently (assimp's FBX
+// reader gives every single-shape channel 1), so an unkeyed target is left at 0.
 // Triangulated on import (polygons become triangle fans); points and lines are dropped by
 // assimp's primitive sorting and reported if nothing triangular is left.
 //
@@ -90,6 +95,20 @@ aiMatrix4x4 interpolate(const aiNodeAnim* channel, double tick, const aiMatrix4x
         r.Normalize();
     }
     return aiMatrix4x4(s, r, t);
+}
+
+// A morph channel's weights at `tick` (linear between its keys, held before the first and after the
+// last), added into `weights` (one entry per anim mesh of the mesh; a key's values index them).
+void add_morph_weights(const aiMeshMorphAnim* channel, double tick, std::vector<double>& weights) {
+    if (!channel->mNumKeys || !channel->mKeys) return;
+    unsigned i = 0;
+    while (i + 1 < channel->mNumKeys && channel->mKeys[i + 1].mTime <= tick) ++i;
+    const aiMeshMorphKey& a = channel->mKeys[i];
+    const aiMeshMorphKey& b = channel->mKeys[std::min(i + 1, channel->mNumKeys - 1)];
+    const double t = b.mTime > a.mTime ? std::clamp((tick - a.mTime) / (b.mTime - a.mTime), 0.0, 1.0) : 0.0;
+    for (const auto& [key, share] : {std::pair{&a, 1.0 - t}, std::pair{&b, t}})
+        for (unsigned j = 0; j < key->mNumValuesAndWeights; ++j)
+            if (key->mValues[j] < weights.size()) weights[key->mValues[j]] += share * key->mWeights[j];
 }
 
 struct Flat {
@@ -271,7 +290,8 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
         std::vector<float> weights;
         std::vector<size_t> bone_node;  // per bone: its node
         std::vector<aiMatrix4x4> offset;
-        std::vector<unsigned> unweighted;  // of a skinned mesh: the vertices no bone weighs (rigid with its node)
+        std::vector<unsigned> unweighted;        // of a skinned mesh: the vertices no bone weighs (rigid with its node)
+        std::vector<const aiAnimMesh*> targets;  // its morph targets (anim meshes with positions)
     };
     constexpr size_t kInfluences = 8;
     AnimatedMesh mesh;
@@ -286,7 +306,7 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
                 stand_in = true;
                 continue;
             }
-            Part part{m, n, mesh.vertex_count, {}, {}, {}, {}, {}};
+            Part part{m, n, mesh.vertex_count, {}, {}, {}, {}, {}, {}};
             Primitive prim;
             prim.name = m->mName.length ? m->mName.C_Str() : "mesh" + std::to_string(parts.size());
             prim.first_index = mesh.indices.size();
@@ -341,6 +361,14 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
                     if (!(*std::max_element(ws, ws + kInfluences) > 0.0f)) part.unweighted.push_back(v);
                 }
             }
+            for (unsigned t = 0; t < m->mNumAnimMeshes && m->mAnimMeshes; ++t) {
+                const aiAnimMesh* target = m->mAnimMeshes[t];
+                if (target && target->mVertices && target->mNumVertices != m->mNumVertices)
+                    throw LoadError(path + ": morph target " + std::to_string(t) + " of mesh '" + prim.name + "' has " +
+                                    std::to_string(target->mNumVertices) + " vertices, the mesh " +
+                                    std::to_string(m->mNumVertices));
+                part.targets.push_back(target && target->mVertices ? target : nullptr);
+            }
             mesh.vertex_count += m->mNumVertices;
             mesh.primitives.push_back(prim);
             parts.push_back(std::move(part));
@@ -350,6 +378,18 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
                         ": no mesh in the file, only a skeleton and its animation (an .md5anim, a .bvh): give "
                         "the character's mesh file as the input and this one as --clip");
     if (parts.empty()) throw LoadError(path + ": no triangle mesh in the file");
+    for (const Part& part : parts) mesh.morph_target_count = std::max(mesh.morph_target_count, part.targets.size());
+    // Whether a morph channel drives a part's targets: it names the part's node or mesh (before a
+    // "*N" some importers add, one channel per target).
+    auto drives = [&](const aiMeshMorphAnim* channel, const Part& part) {
+        if (part.targets.empty() || !channel) return false;
+        std::string name = channel->mName.C_Str();
+        name = name.substr(0, name.find('*'));
+        return name == flat.nodes[part.node]->mName.C_Str() || name == part.mesh->mName.C_Str();
+    };
+    auto drives_any = [&](const aiMeshMorphAnim* channel) {
+        return std::any_of(parts.begin(), parts.end(), [&](const Part& part) { return drives(channel, part); });
+    };
     {  // the skeleton's joints: every node some mesh's bone names, once (meshes share them)
         std::vector<size_t> bones;
         for (const Part& part : parts) bones.insert(bones.end(), part.bone_node.begin(), part.bone_node.end());
@@ -382,6 +422,8 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
             size_t matched = 0;
             for (unsigned c = 0; c < anim->mNumChannels; ++c)
                 matched += flat.by_name.count(anim->mChannels[c]->mNodeName.C_Str());
+            for (unsigned c = 0; c < anim->mNumMorphMeshChannels; ++c)
+                matched += drives_any(anim->mMorphMeshChannels[c]);
             if (matched == 0)
                 throw LoadError(file + ": none of its " + std::to_string(anim->mNumChannels) +
                                 " animated joints is a joint of " + path);
@@ -410,7 +452,33 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
     // keyframe and whether it did not in some (0, flattened, says neither): as in the glTF loader,
     // a mirrored mesh's file winding is clockwise-front (engines flip their culling for it).
     std::vector<uint8_t> mirrored_in_some(parts.size(), 0), upright_in_some(parts.size(), 0);
-    auto add_keyframe = [&](const aiAnimation* anim, double tick) {
+    // Per part, the morph channels of `anim` that drive it, their keys checked.
+    auto morph_channels = [&](const aiAnimation* anim) {
+        std::vector<std::vector<const aiMeshMorphAnim*>> of(parts.size());
+        for (unsigned c = 0; anim && c < anim->mNumMorphMeshChannels; ++c)
+            for (size_t i = 0; i < parts.size(); ++i) {
+                const aiMeshMorphAnim* channel = anim->mMorphMeshChannels[c];
+                if (!drives(channel, parts[i])) continue;
+                for (unsigned k = 0; k < channel->mNumKeys && channel->mKeys; ++k) {
+                    const aiMeshMorphKey& key = channel->mKeys[k];
+                    if (key.mNumValuesAndWeights && (!key.mValues || !key.mWeights))
+                        throw LoadError(path + ": morph channel '" + channel->mName.C_Str() +
+                                        "' has a key without values");
+                    for (unsigned j = 0; j < key.mNumValuesAndWeights; ++j)
+                        if (key.mValues[j] >= parts[i].targets.size() || !std::isfinite(key.mWeights[j]))
+                            throw LoadError(path + ": morph channel '" + channel->mName.C_Str() + "' keys " +
+                                            (std::isfinite(key.mWeights[j])
+                                                 ? "target " + std::to_string(key.mValues[j])
+                                                 : std::string("a weight that is not finite")) +
+                                            ", but mesh '" + parts[i].mesh->mName.C_Str() + "' has " +
+                                            std::to_string(parts[i].targets.size()) + " morph targets");
+                }
+                of[i].push_back(channel);
+            }
+        return of;
+    };
+    using MorphChannels = std::vector<std::vector<const aiMeshMorphAnim*>>;  // morph_channels(anim)
+    auto add_keyframe = [&](const aiAnimation* anim, const MorphChannels& morphs, double tick) {
         const std::vector<aiMatrix4x4> global = globals(anim, tick);
         for (size_t i = 0; i < parts.size(); ++i) {
             const ai_real det = global[parts[i].node].Determinant();  // an affine transform's: its 3 × 3 block's
@@ -420,12 +488,24 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
         const size_t first = mesh.keyframe_positions.size();
         mesh.keyframe_positions.resize(first + mesh.vertex_count * 3);
         float* out = mesh.keyframe_positions.data() + first;
-        for (const Part& part : parts) {
+        for (size_t i = 0; i < parts.size(); ++i) {
+            const Part& part = parts[i];
             const aiMesh* m = part.mesh;
             std::vector<float> bind(size_t(m->mNumVertices) * 3);
-            for (unsigned v = 0; v < m->mNumVertices; ++v)
-                bind[3 * v] = m->mVertices[v].x, bind[3 * v + 1] = m->mVertices[v].y,
-                         bind[3 * v + 2] = m->mVertices[v].z;
+            std::vector<double> weights(part.targets.size(), 0.0);
+            for (const aiMeshMorphAnim* channel : morphs[i]) add_morph_weights(channel, tick, weights);
+            for (unsigned v = 0; v < m->mNumVertices; ++v) {
+                const aiVector3D& base = m->mVertices[v];
+                double p[3] = {base.x, base.y, base.z};
+                for (size_t t = 0; t < weights.size(); ++t)
+                    if (weights[t] != 0.0 && part.targets[t]) {
+                        const aiVector3D& target = part.targets[t]->mVertices[v];
+                        p[0] += weights[t] * (double(target.x) - base.x);
+                        p[1] += weights[t] * (double(target.y) - base.y);
+                        p[2] += weights[t] * (double(target.z) - base.z);
+                    }
+                for (int k = 0; k < 3; ++k) bind[3 * v + size_t(k)] = float(p[k]);
+            }
             if (!part.bone_node.empty()) {
                 std::vector<Mat4> joints(part.bone_node.size());
                 for (size_t b = 0; b < joints.size(); ++b) {
@@ -446,14 +526,14 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
                 // A vertex no bone weighs (FBX and .X allow it) stays with its mesh's node, as at
                 // the bind pose, rather than at its mesh-space coordinates.
                 for (const unsigned v : part.unweighted) {
-                    const aiVector3D p = global[part.node] * m->mVertices[v];
+                    const aiVector3D p = global[part.node] * aiVector3D(bind[3 * v], bind[3 * v + 1], bind[3 * v + 2]);
                     float* o = out + 3 * (part.vertex_base + v);
                     o[0] = p.x, o[1] = p.y, o[2] = p.z;
                 }
             } else {
                 const aiMatrix4x4& g = global[part.node];
                 for (unsigned v = 0; v < m->mNumVertices; ++v) {
-                    const aiVector3D p = g * m->mVertices[v];
+                    const aiVector3D p = g * aiVector3D(bind[3 * v], bind[3 * v + 1], bind[3 * v + 2]);
                     float* o = out + 3 * (part.vertex_base + v);
                     o[0] = p.x, o[1] = p.y, o[2] = p.z;
                 }
@@ -551,6 +631,12 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
             for (unsigned k = 0; k < ch->mNumScalingKeys; ++k)
                 first = std::min(first, ch->mScalingKeys[k].mTime), last = std::max(last, ch->mScalingKeys[k].mTime);
         }
+        for (unsigned c = 0; c < anim->mNumMorphMeshChannels; ++c) {
+            const aiMeshMorphAnim* ch = anim->mMorphMeshChannels[c];
+            if (!drives_any(ch) || !ch->mKeys) continue;
+            for (unsigned k = 0; k < ch->mNumKeys; ++k)
+                first = std::min(first, ch->mKeys[k].mTime), last = std::max(last, ch->mKeys[k].mTime);
+        }
         if (!(first <= last)) throw LoadError(path + ": clip '" + source.name + "' animates nothing");
         const double keyframes = std::round((last - first) / ticks_per_second * options.sample_rate) + 1;
         if (!(keyframes <= 100000)) throw LoadError(path + ": clip '" + source.name + "' is absurdly long");
@@ -564,7 +650,7 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
         if (!source.file.empty()) check_clip_skeleton(source);
 
     if (sources.empty()) {
-        add_keyframe(nullptr, 0);
+        add_keyframe(nullptr, morph_channels(nullptr), 0);
         mesh.clips.push_back({"static", 0.0, options.sample_rate, 0, 1});
     }
     for (size_t s = 0; s < sources.size(); ++s) {
@@ -575,8 +661,9 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
         clip.sample_rate = options.sample_rate;
         clip.first_keyframe = mesh.keyframe_count();
         clip.keyframe_count = at.keyframes;
+        const MorphChannels morphs = morph_channels(sources[s].animation);
         for (size_t f = 0; f < clip.keyframe_count; ++f)
-            add_keyframe(sources[s].animation,
+            add_keyframe(sources[s].animation, morphs,
                          std::min(at.first + double(f) / options.sample_rate * at.ticks_per_second, at.last));
         mesh.clips.push_back(clip);
     }

@@ -190,15 +190,28 @@ void read_clip(const tinygltf::Model& model, const tinygltf::Value& value, size_
     std::memcpy(clip.centers.data(), bytes.data(), bytes.size());
     for (float f : clip.centers)
         if (!std::isfinite(f)) return p.add(where + ".centers holds a value that is not finite");
-    // The table covers the animation's time range: keyframe f at startTime + f / sampleRate.
+    // The table covers the animation's time range: keyframe f at startTime + f / sampleRate. The
+    // key times as the loader and the engines read them, the data (an accessor's declared min and
+    // max may disagree with it; they stand in only for keys this check cannot read: sparse ones).
     if (clip.animation >= 0) {
         const tinygltf::Animation& anim = model.animations[size_t(clip.animation)];
         double t0 = INFINITY, t1 = -INFINITY;
         for (const tinygltf::AnimationSampler& s : anim.samplers) {
             if (s.input < 0 || size_t(s.input) >= model.accessors.size()) continue;
             const tinygltf::Accessor& in = model.accessors[size_t(s.input)];
-            if (in.minValues.size() == 1 && in.maxValues.size() == 1)
+            std::vector<unsigned char> keys;
+            int key_type = 0;
+            if (accessor_bytes(model, s.input, TINYGLTF_TYPE_SCALAR, {TINYGLTF_COMPONENT_TYPE_FLOAT}, "", keys,
+                               key_type)
+                    .empty()) {
+                for (size_t k = 0; k + 4 <= keys.size(); k += 4) {
+                    float t;
+                    std::memcpy(&t, keys.data() + k, 4);
+                    t0 = std::min(t0, double(t)), t1 = std::max(t1, double(t));
+                }
+            } else if (in.minValues.size() == 1 && in.maxValues.size() == 1) {
                 t0 = std::min(t0, in.minValues[0]), t1 = std::max(t1, in.maxValues[0]);
+            }
         }
         if (t0 <= t1) {
             const double step = 1.0 / clip.sample_rate;

@@ -77,7 +77,17 @@ public:
         // The count is the file's: checked against the buffer view (and the budget) first.
         size_t stride = element;
         const unsigned char* base = nullptr;
-        if (a.bufferView >= 0) base = view_bytes(a.bufferView, a.byteOffset, a.count, element, true, index, stride);
+        if (a.bufferView >= 0) {
+            base = view_bytes(a.bufferView, a.byteOffset, a.count, element, true, index, stride);
+            // glTF 2.0 §3.6.2.4: an accessor's start in its buffer and its stride are multiples of its
+            // component size (engines make typed arrays over the bytes: three.js throws otherwise).
+            const size_t start = model_.bufferViews[size_t(a.bufferView)].byteOffset + a.byteOffset;
+            if (start % size_t(size) != 0 || stride % size_t(size) != 0)
+                fail(name +
+                     (start % size_t(size) ? " starts at byte " + std::to_string(start) + " of its buffer"
+                                           : " has a stride of " + std::to_string(stride) + " bytes") +
+                     ", not a multiple of its " + std::to_string(size) + "-byte components (glTF requires it)");
+        }
         size_t values = 0;
         if (!io::checked_mul(a.count, size_t(components), values) || values > max_bytes_ / sizeof(double))
             fail(name + " has " + std::to_string(a.count) + " elements, more than the loading budget of " +
@@ -357,8 +367,13 @@ void parse_node_hierarchy(Scene& s) {
     s.parent.assign(model.nodes.size(), -1);
     for (size_t n = 0; n < model.nodes.size(); ++n)
         for (int c : model.nodes[n].children) {
-            if (c < 0 || size_t(c) >= model.nodes.size() || s.parent[size_t(c)] >= 0)
-                s.reader.fail("node hierarchy is not a tree");
+            if (c < 0 || size_t(c) >= model.nodes.size())
+                s.reader.fail("node " + std::to_string(n) + " names child " + std::to_string(c) +
+                              ", but the file has " + std::to_string(model.nodes.size()) + " nodes");
+            if (s.parent[size_t(c)] >= 0 || size_t(c) == n)
+                s.reader.fail("node hierarchy is not a tree: node " + std::to_string(c) + " is a child of node " +
+                              std::to_string(s.parent[size_t(c)] >= 0 ? size_t(s.parent[size_t(c)]) : n) +
+                              (size_t(c) == n ? " (itself)" : " and of node " + std::to_string(n)));
             s.parent[size_t(c)] = int(n);
         }
     std::vector<int> roots;
@@ -382,10 +397,54 @@ void parse_node_hierarchy(Scene& s) {
     }
 }
 
+// The name of a component type for an error message.
+std::string component_name(int type) {
+    switch (type) {
+        case TINYGLTF_COMPONENT_TYPE_BYTE: return "bytes";
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return "unsigned bytes";
+        case TINYGLTF_COMPONENT_TYPE_SHORT: return "shorts";
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return "unsigned shorts";
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: return "unsigned ints";
+        case TINYGLTF_COMPONENT_TYPE_FLOAT: return "floats";
+        default: return "component type " + std::to_string(type);
+    }
+}
+
+// LoadError unless accessor `index` holds one of the component types glTF allows `what`
+// (`normalized` among them: the integer types that must be normalized; others may be either): read
+// as another type, its bytes would be taken for other numbers (a float's bytes as shorts).
+void require_format(const Scene& s, int index, const std::string& what, std::initializer_list<int> allowed,
+                    std::initializer_list<int> normalized, const std::string& note = "") {
+    if (index < 0 || size_t(index) >= s.model.accessors.size()) return;  // read() says so
+    const tinygltf::Accessor& a = s.model.accessors[size_t(index)];
+    const bool listed = std::find(allowed.begin(), allowed.end(), a.componentType) != allowed.end();
+    const bool must_normalize = std::find(normalized.begin(), normalized.end(), a.componentType) != normalized.end();
+    if (listed && (!must_normalize || a.normalized)) return;
+    s.reader.fail(what + " (accessor " + std::to_string(index) + ") are " +
+                  (a.normalized               ? "normalized "
+                   : must_normalize && listed ? "unnormalized "
+                                              : "") +
+                  component_name(a.componentType) + ", which glTF does not allow there" + note);
+}
+
+// POSITION (a primitive's or a morph target's) is floats, or with KHR_mesh_quantization
+// (extensionsUsed) bytes or shorts, signed or not, normalized or not.
+void require_position_format(const Scene& s, int index, const std::string& what) {
+    const auto& used = s.model.extensionsUsed;
+    if (std::find(used.begin(), used.end(), "KHR_mesh_quantization") == used.end())
+        return require_format(s, index, what, {TINYGLTF_COMPONENT_TYPE_FLOAT}, {},
+                              " (integer positions need KHR_mesh_quantization, which the file does not use)");
+    require_format(s, index, what,
+                   {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+                    TINYGLTF_COMPONENT_TYPE_SHORT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
+                   {});
+}
+
 // POSITION of each morph target of a primitive (zero deltas for a target without one).
 void parse_morph_targets(const Scene& s, const tinygltf::Primitive& prim, const std::string& where, PrimitiveData& d) {
     for (const auto& target : prim.targets) {
         const auto t = target.find("POSITION");
+        if (t != target.end()) require_position_format(s, t->second, where + ": a morph target's POSITION");
         d.targets.push_back(t == target.end() ? std::vector<double>(d.positions.size(), 0.0)
                                               : s.reader.read(t->second, 3));
         if (d.targets.back().size() != d.positions.size()) s.reader.fail(where + ": a morph target has the wrong size");
@@ -415,6 +474,10 @@ void parse_skin_weights(const Scene& s, const tinygltf::Primitive& prim, size_t 
         const auto w = prim.attributes.find("WEIGHTS_" + std::to_string(set));
         if (j == prim.attributes.end() || w == prim.attributes.end()) break;
         require_unsigned_integers(s, j->second, where + ": JOINTS_" + std::to_string(set));
+        require_format(s, w->second, where + ": WEIGHTS_" + std::to_string(set),
+                       {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+                        TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
+                       {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT});
         const std::vector<double> jv = s.reader.read(j->second, 4), wv = s.reader.read(w->second, 4);
         if (jv.size() != 4 * d.vertex_count || wv.size() != 4 * d.vertex_count)
             s.reader.fail(where + ": joints or weights do not match the vertex count");
@@ -450,9 +513,11 @@ PrimitiveData parse_primitive(const Scene& s, size_t n, size_t p, AnimatedMesh& 
     const tinygltf::Node& node = s.model.nodes[n];
     const tinygltf::Mesh& m = s.model.meshes[size_t(node.mesh)];
     const tinygltf::Primitive& prim = m.primitives[p];
-    const std::string where = "mesh '" + m.name + "' primitive " + std::to_string(p);
+    const std::string where = (m.name.empty() ? "mesh " + std::to_string(node.mesh) : "mesh '" + m.name + "'") +
+                              " primitive " + std::to_string(p);
     const auto position = prim.attributes.find("POSITION");
     if (position == prim.attributes.end()) s.reader.fail(where + " has no POSITION");
+    require_position_format(s, position->second, where + ": POSITION");
     PrimitiveData d;
     d.node = n;
     d.positions = s.reader.read(position->second, 3);
@@ -618,6 +683,7 @@ Channel parse_channel(const Scene& s, const tinygltf::Animation& anim, const tin
     if (c.interpolation != "LINEAR" && c.interpolation != "STEP" && c.interpolation != "CUBICSPLINE")
         s.reader.fail("clip '" + name + "' has a sampler of interpolation '" + c.interpolation +
                       "' (glTF has LINEAR, STEP and CUBICSPLINE)");
+    require_format(s, sampler.input, "clip '" + name + "': key times", {TINYGLTF_COMPONENT_TYPE_FLOAT}, {});
     c.times = s.reader.read(sampler.input, 1);
     if (c.times.empty()) s.reader.fail("clip '" + name + "' has a channel without keys");
     if (!std::is_sorted(c.times.begin(), c.times.end()))
@@ -626,6 +692,9 @@ Channel parse_channel(const Scene& s, const tinygltf::Animation& anim, const tin
     if (!c.geometry) return c;  // another path (KHR_animation_pointer's): its times only, the clip's length
     c.values = s.reader.read(sampler.output);
     const size_t components = channel_components(s, c.node, c.path);
+    if (c.path == "weights" && components == 0)
+        s.reader.fail("clip '" + name + "' animates the morph weights of node " + std::to_string(c.node) +
+                      ", which draws no morph targets");
     const size_t per_key = (c.interpolation == "CUBICSPLINE" ? 3 : 1) * components;
     if (components == 0 || c.values.size() != per_key * c.times.size())
         s.reader.fail("clip '" + name + "' channel for node " + std::to_string(c.node) + " (" + c.path +
@@ -660,18 +729,24 @@ tinygltf::AnimationChannel pointed_channel(const Scene& s, const tinygltf::Anima
 }
 
 // Every animation as a clip of channels, from its first to its last key time, with its keyframe
-// count at the sample rate (no more than kMaxClipKeyframes); channels of missing nodes are skipped.
+// count at the sample rate (no more than kMaxClipKeyframes); a channel naming a missing node is refused.
 std::vector<ClipChannels> parse_animations(const Scene& s, const std::string& path, const LoadOptions& options) {
     std::vector<ClipChannels> clips;
     for (size_t a = 0; a < s.model.animations.size(); ++a) {
         const tinygltf::Animation& anim = s.model.animations[a];
         ClipChannels c;
         c.clip.name = anim.name.empty() ? "animation" + std::to_string(a) : anim.name;
-        for (const tinygltf::AnimationChannel& ch : anim.channels)
-            if (ch.target_node >= 0 && size_t(ch.target_node) < s.model.nodes.size())
-                c.channels.push_back(parse_channel(s, anim, ch, c.clip.name));
-            else if (ch.target_node == io::kPlaceholderNode)  // no node in the file
+        for (size_t i = 0; i < anim.channels.size(); ++i) {
+            const tinygltf::AnimationChannel& ch = anim.channels[i];
+            if (ch.target_node == io::kPlaceholderNode)  // no node in the file
                 c.channels.push_back(parse_channel(s, anim, pointed_channel(s, ch), c.clip.name));
+            else if (ch.target_node >= 0 && size_t(ch.target_node) < s.model.nodes.size())
+                c.channels.push_back(parse_channel(s, anim, ch, c.clip.name));
+            else  // engines fail on it (three.js throws reading the missing node)
+                s.reader.fail("clip '" + c.clip.name + "' channel " + std::to_string(i) + " targets node " +
+                              std::to_string(ch.target_node) + ", but the file has " +
+                              std::to_string(s.model.nodes.size()) + " nodes");
+        }
         if (c.channels.empty()) s.reader.fail("clip '" + c.clip.name + "' animates nothing");
         c.t0 = INFINITY, c.t1 = -INFINITY;
         for (const Channel& ch : c.channels)

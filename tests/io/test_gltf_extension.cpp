@@ -204,6 +204,24 @@ TEST_F(GltfExtension, EveryCorruptionIsReportedOnOneLine) {
     }
 }
 
+// A clip's time range is the key times' data, as the loader (which wrote startTime) and the engines
+// read them: an input accessor's declared min and max may disagree with it (a validator error that
+// engines never see). Before, check took min and refused optimize's own output of such a file.
+TEST_F(GltfExtension, KeyTimesAreTheDataNotTheDeclaredBounds) {
+    const std::string stale = variant([](json& g) {
+        g["accessors"][5]["min"] = json::array({0.25});  // the key is at 0
+        g["accessors"][5]["max"] = json::array({0.25});
+    });
+    const OrdersExtensionCheck r = check_orders_extension(stale);
+    EXPECT_TRUE(r.errors.empty()) << r.errors.front();
+    const std::string shifted = variant([](json& g) { g["extensions"][kExt]["clips"][0]["startTime"] = 0.25; });
+    const OrdersExtensionCheck wrong = check_orders_extension(shifted);
+    ASSERT_EQ(wrong.errors.size(), 1u);
+    EXPECT_NE(wrong.errors[0].find("startTime 0.250000 is not animation 0's first key time 0.000000"),
+              std::string::npos)
+        << wrong.errors[0];
+}
+
 TEST_F(GltfExtension, WritingIntoAnotherFileReadsBackTheSame) {
     const std::string input = variant([](json& g) {
         g.erase("extensions");

@@ -316,6 +316,81 @@ TEST_F(GltfLoader, BrokenFilesGiveOneLineErrorsNamingTheFile) {
     }
 }
 
+// What the validator calls errors and engines misread or fail on, found by a sweep of the Khronos
+// validator's cases: data of a type glTF does not allow there (read anyway, a float's bytes became
+// shorts, unnormalized byte weights of 0..255 scaled the skin), an accessor off its component
+// alignment (read as garbage floats; three.js throws), a channel or a child naming a missing node
+// (the channel was skipped and written back: three.js throws on the output), and weights animated
+// on a node without morph targets. Each is refused in one line naming what is wrong; the allowed
+// variants (normalized byte weights, integer positions under KHR_mesh_quantization) load.
+TEST_F(GltfLoader, DataEnginesMisreadIsRefusedByName) {
+    auto expect_error = [&](const std::string& name, Gltf g, const std::string& message) {
+        const std::string path = write(name, g.text());
+        test::expect_one_line_load_error(path, message, [&] { load_gltf(path); });
+    };
+    const AnimatedMesh reference = load_gltf(write("bar.gltf", skinned_bar().text()));
+    {
+        Gltf g = skinned_bar();
+        g.doc["animations"][0]["channels"][0]["target"]["node"] = 99;
+        expect_error("channel.gltf", g, "clip 'bend' channel 0 targets node 99, but the file has 3 nodes");
+    }
+    {
+        Gltf g = skinned_bar();
+        g.doc["animations"][0]["samplers"][0]["input"] = g.u16({0, 1}, "SCALAR", 1);
+        expect_error("times.gltf", g, "clip 'bend': key times (accessor 7) are unsigned shorts");
+    }
+    {
+        // Byte weights must be normalized (0..255 as 0..1); normalized they give the float weights' skin.
+        Gltf g = skinned_bar();
+        const std::vector<uint8_t> bytes = {255, 0, 0, 0, 255, 0, 0, 0, 255, 0, 0, 0, 255, 0, 0, 0};
+        const int w = g.add(bytes.data(), bytes.size(), 4, "VEC4", 5121);
+        g.doc["meshes"][0]["primitives"][0]["attributes"]["WEIGHTS_0"] = w;
+        expect_error("weights.gltf", g, "WEIGHTS_0 (accessor 7) are unnormalized unsigned bytes");
+        g.doc["accessors"][size_t(w)]["normalized"] = true;
+        const AnimatedMesh m = load_gltf(write("weights-normalized.gltf", g.text()));
+        EXPECT_EQ(m.keyframe_positions, reference.keyframe_positions);
+    }
+    {
+        // Integer positions need KHR_mesh_quantization; with it, the same bar.
+        Gltf g = skinned_bar();
+        g.doc["meshes"][0]["primitives"][0]["attributes"]["POSITION"] =
+            g.u16({0, 0, 0, 1, 0, 0, 1, 2, 0, 0, 2, 0}, "VEC3", 3);
+        expect_error("quantised.gltf", g,
+                     "POSITION (accessor 7) are unsigned shorts, which glTF does not allow there "
+                     "(integer positions need KHR_mesh_quantization");
+        g.doc["extensionsUsed"] = {"KHR_mesh_quantization"};
+        const AnimatedMesh m = load_gltf(write("quantised-declared.gltf", g.text()));
+        EXPECT_EQ(m.keyframe_positions, reference.keyframe_positions);
+    }
+    {
+        Gltf g = skinned_bar();
+        g.doc["accessors"][0]["byteOffset"] = 2;
+        g.doc["accessors"][0]["count"] = 3;
+        expect_error("unaligned.gltf", g, "accessor 0 starts at byte 2 of its buffer, not a multiple of its 4-byte");
+    }
+    {
+        Gltf g = skinned_bar();
+        g.doc["nodes"][0]["children"] = {1, 99};
+        expect_error("child.gltf", g, "node 0 names child 99, but the file has 3 nodes");
+        g.doc["nodes"][0]["children"] = {1};
+        g.doc["nodes"][2]["children"] = {1};
+        expect_error("parents.gltf", g, "node hierarchy is not a tree: node 1 is a child of node 0 and of node 2");
+    }
+    {
+        Gltf g = skinned_bar();
+        g.doc["meshes"][0].erase("name");
+        g.doc["animations"][0]["channels"][0]["target"] = {{"node", 2}, {"path", "weights"}};
+        expect_error("weights-unmorphed.gltf", g,
+                     "clip 'bend' animates the morph weights of node 2, which draws no "
+                     "morph targets");
+        g = skinned_bar();
+        g.doc["meshes"][0].erase("name");
+        g.doc["meshes"][0]["primitives"][0]["attributes"]["POSITION"] =
+            g.u16({0, 0, 0, 1, 0, 0, 1, 2, 0, 0, 2, 0}, "VEC3", 3);
+        expect_error("unnamed.gltf", g, ": mesh 0 primitive 0: POSITION (accessor 7)");
+    }
+}
+
 // Regressions from hostile files: sizes, counts and offsets that wrapped or were used before they
 // were checked (heap overflows, a SEGV, out-of-bounds reads, 32 GB allocations).
 TEST_F(GltfLoader, HostileAccessorsGiveOneLineErrors) {

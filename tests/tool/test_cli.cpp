@@ -318,6 +318,22 @@ TEST_F(Cli, ZeroAreaMeshIsAnError) {
     EXPECT_NE(o.err.find("zero area"), std::string::npos) << o.err;
 }
 
+// An error the algorithms find in the character (here: a corner at 3e38, too far for float clip
+// coordinates) names the input file, as the loaders' errors do.
+TEST_F(Cli, AnAlgorithmsErrorNamesTheInput) {
+    test::Gltf g;
+    const int p = g.floats({0, 0, 0, 3e38f, 0, 0, 0, 1, 0}, "VEC3", 3), i = g.u16({0, 1, 2}, "SCALAR", 1);
+    g.doc["meshes"] = nlohmann::json::array(
+        {{{"primitives", nlohmann::json::array({{{"attributes", {{"POSITION", p}}}, {"indices", i}}})}}});
+    g.doc["nodes"] = nlohmann::json::array({{{"mesh", 0}}});
+    g.doc["scenes"] = nlohmann::json::array({{{"nodes", {0}}}});
+    std::ofstream(path("far.gltf")) << g.text();
+    const test::Outcome o = run("optimize -q " + path("far.gltf").string());
+    EXPECT_EQ(o.exit_code, 1);
+    EXPECT_EQ(o.err.rfind("animorder: error: " + path("far.gltf").string() + ": the model's extent", 0), 0u) << o.err;
+    EXPECT_EQ(std::count(o.err.begin(), o.err.end(), '\n'), 1) << o.err;
+}
+
 // A mesh two nodes draw (Blender's linked duplicates: a pair of eyes, one of them mirrored) has one
 // index buffer per file primitive: run_method gives both instances the first one's order, and the
 // glTF output writes it once (it was refused, after all the work); `check` passes it and its

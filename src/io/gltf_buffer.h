@@ -5,6 +5,7 @@
 #include "animorder/load.h"
 #include "animorder/regular_file.h"
 
+#include "gltf_diagnose.h"
 #include "gltf_prune.h"
 
 #include <tiny_gltf.h>
@@ -73,15 +74,18 @@ inline tinygltf::FsCallbacks regular_file_callbacks(const uint64_t* limit) {
             const_cast<uint64_t*>(limit)};
 }
 
-// The first four bytes of a regular file ("glTF" for a GLB); LoadError naming the path when it is
-// missing, not a regular file, or shorter.
+// The first four bytes of a regular file ("glTF" for a GLB; fewer when it is shorter, as a
+// 2-byte "[]" is, which the JSON reader then names); LoadError naming the path when it is missing,
+// not a regular file, or empty.
 inline std::string magic_of(const std::string& path) {
     RegularFile file(path);
     if (!file.ok())
         throw LoadError(
             path + (std::string(file.why()) == "missing" ? ": cannot open file" : std::string(": is ") + file.why()));
     std::string magic(4, '\0');
-    if (file.read(magic.data(), 4) != 4) throw LoadError(path + ": file is empty or truncated");
+    const size_t got = file.read(magic.data(), 4);
+    if (got == 0) throw LoadError(path + ": file is empty or truncated");
+    magic.resize(got);
     return magic;
 }
 
@@ -178,6 +182,7 @@ inline void finish_load(bool ok, std::string error, const tinygltf::Model& model
             if (e.is_string()) required.push_back(e.get<std::string>());
         refuse_undecodable_geometry(required, path);
     }
+    error = why_unreadable(path, error);  // gltf_diagnose.h: its GLB structure or JSON looked at again
     for (char& c : error)
         if (c == '\n' || c == '\r') c = ' ';
     // tinygltf quotes what it could not read, a whole data: URI included: the start of it says enough.

@@ -105,6 +105,24 @@ assert.match((await load((json) => { json.extensions[EXT].clips[0].sampleRate = 
     assert.deepEqual([...meshesOf(refused.gltf)[0].geometry.index.array], indices);
 }
 
+// EXT_mesh_gpu_instancing: GLTFLoader draws the node as an InstancedMesh (mapped to the node
+// only); it draws the orders like any mesh of the primitive, with per-instance attributes too
+// (a geometry of its own that shares the file's index).
+for (const attributes of [{ TRANSLATION: 6 }, { TRANSLATION: 6, _ID: 6 }]) {
+    const { gltf, character, error } = await load((json) => {
+        json.extensionsUsed.push('EXT_mesh_gpu_instancing');
+        json.nodes[0].extensions = { EXT_mesh_gpu_instancing: { attributes } };
+    });
+    assert.ok(character, error);
+    const instanced = meshesOf(gltf).filter((m) => m.isInstancedMesh);
+    assert.equal(instanced.length, 1);
+    assert.equal(character.meshes.length, 1);
+    assert.equal(character.meshes[0].mesh, instanced[0]);
+    assert.equal(instanced[0].geometry.index.count, 12);
+    character.setBuffer(1);
+    assert.deepEqual([instanced[0].geometry.drawRange.start, instanced[0].geometry.drawRange.count], [6, 6]);
+}
+
 // addOrderFrom (the viewer's --original): another file's order naming a vertex the primitive does
 // not have is refused, not wrapped into the index buffer.
 {

@@ -73,9 +73,23 @@ export class AnimorderGLTFPlugin {
         const plain = [];       // meshes whose primitive has no orders: they keep the file's indices
         const objects = [];
         for (const scene of gltf.scenes || [gltf.scene]) scene.traverse((o) => { if (o.isMesh) objects.push(o); });
+        // GLTFLoader's EXT_mesh_gpu_instancing makes an InstancedMesh of the node's mesh, mapped to the
+        // node only: its primitive is the one of the node's mesh (as GLTFLoader made it, cached)
+        // whose geometry it shares (or whose index, when per-instance attributes gave it a geometry
+        // of its own).
+        const instanced = async (mesh, where) => {
+            const node = where && where.nodes !== undefined && json.nodes && json.nodes[where.nodes];
+            if (!node || node.mesh === undefined) return where;
+            const made = await this.parser.getDependency('mesh', node.mesh);
+            const parts = made.isGroup ? made.children : [made];
+            const p = parts.findIndex((o) => o.geometry === mesh.geometry ||
+                (o.geometry.index !== null && o.geometry.index === mesh.geometry.index));
+            return p >= 0 ? { meshes: node.mesh, primitives: p } : where;
+        };
         let primitiveOrder = 0;
         for (const mesh of objects) {
-            const where = this.parser.associations.get(mesh);
+            let where = this.parser.associations.get(mesh);
+            if (mesh.isInstancedMesh && (!where || where.primitives === undefined)) where = await instanced(mesh, where);
             if (!where || where.meshes === undefined || where.primitives === undefined) continue;
             const primitive = json.meshes[where.meshes].primitives[where.primitives];
             const ext = primitive.extensions && primitive.extensions[EXTENSION_NAME];

@@ -115,35 +115,15 @@ inline std::string gltf_json_text(const std::string& path) {
     return file.read(text.data() + got, text.size() - got) == text.size() - got ? text : std::string();
 }
 
-// The deepest nesting of arrays and objects a glTF's JSON may have. tinygltf converts extension
-// and extras values recursively, and some tens of thousands of levels (a 1 MB file) overflow the
-// stack; real files nest a few levels.
-inline constexpr size_t kMaxJsonDepth = 512;
-
-// LoadError when the glTF's JSON nests arrays and objects deeper than kMaxJsonDepth (brackets
-// inside strings do not count); called before tinygltf reads the file. A file whose JSON cannot be
+// LoadError when the glTF's JSON nests arrays and objects deeper than kMaxJsonDepth
+// (gltf_diagnose.h; brackets inside strings do not count): tinygltf converts extension and extras
+// values recursively, and some tens of thousands of levels (a 1 MB file) overflow the stack; real
+// files nest a few levels. Called before tinygltf reads the file. A file whose JSON cannot be
 // found is left to the loader to report.
 inline void check_json_depth(const std::string& path) {
-    const std::string text = gltf_json_text(path);
-    size_t depth = 0;
-    bool in_string = false;
-    for (size_t i = 0; i < text.size(); ++i) {
-        const char c = text[i];
-        if (in_string) {
-            if (c == '\\')
-                ++i;
-            else if (c == '"')
-                in_string = false;
-        } else if (c == '"') {
-            in_string = true;
-        } else if (c == '[' || c == '{') {
-            if (++depth > kMaxJsonDepth)
-                throw LoadError(path + ": its JSON nests arrays and objects more than " +
-                                std::to_string(kMaxJsonDepth) + " levels deep");
-        } else if ((c == ']' || c == '}') && depth > 0) {
-            --depth;
-        }
-    }
+    if (nests_too_deep(gltf_json_text(path)))
+        throw LoadError(path + ": its JSON nests arrays and objects more than " + std::to_string(kMaxJsonDepth) +
+                        " levels deep");
 }
 
 // LoadError when the file requires an extension that changes how its geometry is stored and

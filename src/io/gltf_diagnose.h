@@ -23,10 +23,36 @@
 
 namespace animorder::io {
 
+// The deepest nesting of arrays and objects a glTF's JSON may have (check_json_depth in
+// gltf_buffer.h refuses deeper files before tinygltf reads them).
+inline constexpr size_t kMaxJsonDepth = 512;
+
+// Whether `text` nests arrays and objects deeper than kMaxJsonDepth (brackets inside strings do
+// not count).
+inline bool nests_too_deep(const std::string& text) {
+    size_t depth = 0;
+    bool in_string = false;
+    for (size_t i = 0; i < text.size(); ++i) {
+        const char c = text[i];
+        if (in_string) {
+            if (c == '\\')
+                ++i;
+            else if (c == '"')
+                in_string = false;
+        } else if (c == '"') {
+            in_string = true;
+        } else if (c == '[' || c == '{') {
+            if (++depth > kMaxJsonDepth) return true;
+        } else if ((c == ']' || c == '}') && depth > 0) {
+            --depth;
+        }
+    }
+    return false;
+}
+
 namespace diagnose_detail {
 
 inline constexpr uint64_t kMaxDiagnosedJson = uint64_t(1) << 30;  // as gltf_json_text reads
-inline constexpr size_t kMaxDiagnosedDepth = 512;                 // as check_json_depth allows
 inline constexpr uint32_t kChunkJson = 0x4E4F534A, kChunkBin = 0x004E4942;
 
 inline std::string hex32(uint32_t v) {
@@ -65,29 +91,6 @@ inline bool skip(RegularFile& file, uint64_t count) {
         count -= step;
     }
     return true;
-}
-
-// Whether the JSON text nests arrays and objects deeper than the loader allows (then it is never
-// parsed here: check_json_depth refuses it before tinygltf anyway).
-inline bool too_deep(const std::string& text) {
-    size_t depth = 0;
-    bool in_string = false;
-    for (size_t i = 0; i < text.size(); ++i) {
-        const char c = text[i];
-        if (in_string) {
-            if (c == '\\')
-                ++i;
-            else if (c == '"')
-                in_string = false;
-        } else if (c == '"') {
-            in_string = true;
-        } else if (c == '[' || c == '{') {
-            if (++depth > kMaxDiagnosedDepth) return true;
-        } else if ((c == ']' || c == '}') && depth > 0) {
-            --depth;
-        }
-    }
-    return false;
 }
 
 inline std::string trimmed(const std::string& s) {
@@ -315,7 +318,7 @@ inline std::string without_exception_id(std::string what) {
 
 // What is wrong in the glTF JSON `text` ("" when none of these checks finds it).
 inline std::string json_problem(const std::string& text, const std::string& error, bool glb, const GlbWalk* walk) {
-    if (too_deep(text)) return {};
+    if (nests_too_deep(text)) return {};  // check_json_depth refuses it before tinygltf anyway
     nlohmann::json doc;
     const std::string where = glb ? "its JSON chunk" : "its JSON";
     try {

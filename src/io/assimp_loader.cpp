@@ -8,7 +8,8 @@
 // with weights normalised, every clip sampled at a fixed rate from its first to its last tick.
 // Morph targets (assimp's anim meshes, whole replacement positions) move a mesh by the weights
 // its clip keys for them (a morph channel named after the mesh's node or the mesh, linear between
-// keys): position = base + Σ weight · (target − base), before skinning, as glTF defines it. Only
+// keys): position = base + Σ weight · (target − base), before skinning, as glTF defines it (for
+// Collada's RELATIVE morphs, whose targets are offsets, base + Σ weight · target). Only
 // keyed weights count: importers fill an anim mesh's own weight inconsistently (assimp's FBX
 // reader gives every single-shape channel 1), so an unkeyed target is left at 0.
 // Triangulated on import (polygons become triangle fans); points and lines are dropped by
@@ -464,14 +465,17 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
                     if (key.mNumValuesAndWeights && (!key.mValues || !key.mWeights))
                         throw LoadError(path + ": morph channel '" + channel->mName.C_Str() +
                                         "' has a key without values");
-                    for (unsigned j = 0; j < key.mNumValuesAndWeights; ++j)
-                        if (key.mValues[j] >= parts[i].targets.size() || !std::isfinite(key.mWeights[j]))
-                            throw LoadError(path + ": morph channel '" + channel->mName.C_Str() + "' keys " +
-                                            (std::isfinite(key.mWeights[j])
-                                                 ? "target " + std::to_string(key.mValues[j])
-                                                 : std::string("a weight that is not finite")) +
+                    const std::string channel_name = path + ": morph channel '" + channel->mName.C_Str() + "'";
+                    if (!std::isfinite(key.mTime)) throw LoadError(channel_name + " has a key time that is not finite");
+                    for (unsigned j = 0; j < key.mNumValuesAndWeights; ++j) {
+                        if (!(std::fabs(key.mWeights[j]) <= 1e6))
+                            throw LoadError(channel_name + " keys a weight of " + std::to_string(key.mWeights[j]) +
+                                            ", absurd for a morph target");
+                        if (key.mValues[j] >= parts[i].targets.size())
+                            throw LoadError(channel_name + " keys target " + std::to_string(key.mValues[j]) +
                                             ", but mesh '" + parts[i].mesh->mName.C_Str() + "' has " +
                                             std::to_string(parts[i].targets.size()) + " morph targets");
+                    }
                 }
                 of[i].push_back(channel);
             }
@@ -494,15 +498,18 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
             std::vector<float> bind(size_t(m->mNumVertices) * 3);
             std::vector<double> weights(part.targets.size(), 0.0);
             for (const aiMeshMorphAnim* channel : morphs[i]) add_morph_weights(channel, tick, weights);
+            // Targets are whole positions (FBX, glTF: assimp adds the file's offsets to the base),
+            // except for Collada's RELATIVE morphs, whose targets are the offsets themselves.
+            const double relative = m->mMethod == aiMorphingMethod_MORPH_RELATIVE ? 0.0 : 1.0;
             for (unsigned v = 0; v < m->mNumVertices; ++v) {
                 const aiVector3D& base = m->mVertices[v];
                 double p[3] = {base.x, base.y, base.z};
                 for (size_t t = 0; t < weights.size(); ++t)
                     if (weights[t] != 0.0 && part.targets[t]) {
                         const aiVector3D& target = part.targets[t]->mVertices[v];
-                        p[0] += weights[t] * (double(target.x) - base.x);
-                        p[1] += weights[t] * (double(target.y) - base.y);
-                        p[2] += weights[t] * (double(target.z) - base.z);
+                        p[0] += weights[t] * (double(target.x) - relative * base.x);
+                        p[1] += weights[t] * (double(target.y) - relative * base.y);
+                        p[2] += weights[t] * (double(target.z) - relative * base.z);
                     }
                 for (int k = 0; k < 3; ++k) bind[3 * v + size_t(k)] = float(p[k]);
             }

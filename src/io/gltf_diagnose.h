@@ -122,10 +122,14 @@ inline GlbWalk walk_glb(RegularFile& file, uint64_t size, bool glb_error) {
         return walk;
     }
     const uint32_t version = le32(header + 4), length = le32(header + 8);
+    std::string soft;  // the first problem tinygltf lets pass (it reads no version and no chunk past 1)
     if (version != 2) {
-        walk.problem = "its GLB header says version " + std::to_string(version) +
-                       (version == 1 ? " (a glTF 1.0 binary)" : "") + "; a glTF 2.0 GLB is version 2";
-        return walk;
+        soft = "its GLB header says version " + std::to_string(version) + (version == 1 ? " (a glTF 1.0 binary)" : "") +
+               "; a glTF 2.0 GLB is version 2";
+        if (glb_error) {  // a glTF 1.0 binary's header and chunks differ: that is why
+            walk.problem = soft;
+            return walk;
+        }
     }
     if (length < 12) {
         walk.problem = "its GLB header says " + std::to_string(length) + " bytes, less than the 12 of the header";
@@ -140,8 +144,15 @@ inline GlbWalk walk_glb(RegularFile& file, uint64_t size, bool glb_error) {
         "its GLB header says " + std::to_string(length) + " bytes, the file has " + std::to_string(size);
     // Past the length the header says: that length is wrong (the file goes on), or the file ends.
     const auto past = [&](const std::string& what) { return end < size ? mismatch : what + " the end of the file"; };
-    std::string soft;  // the first problem tinygltf lets pass
-    if (end < size) soft = mismatch;
+    if (end < size && soft.empty()) soft = mismatch;
+    // A problem of chunk i: chunks 0 and 1 are tinygltf's to read, so their problems are why it
+    // failed; past them, only when tinygltf failed on the structure (else its own reason stands).
+    const auto found = [&](size_t i, const std::string& what) {
+        if (i <= 1)
+            walk.problem = what;
+        else if (soft.empty())
+            soft = what;
+    };
     uint64_t at = 12;
     size_t bin_chunk = 0;  // the index of the first BIN chunk; 0: none
     uint32_t chunk1_type = 0;
@@ -152,15 +163,15 @@ inline GlbWalk walk_glb(RegularFile& file, uint64_t size, bool glb_error) {
         }
         unsigned char chunk[8];
         if (end - at < 8 || !read_exactly(file, chunk, 8)) {
-            walk.problem = past("chunk " + std::to_string(i) + "'s 8-byte header runs past");
-            return walk;
+            found(i, past("chunk " + std::to_string(i) + "'s 8-byte header runs past"));
+            break;
         }
         const uint32_t chunk_length = le32(chunk), type = le32(chunk + 4);
         at += 8;
         if (uint64_t(chunk_length) > end - at) {
-            walk.problem = past(chunk_label(i, type) + " runs past") + ": it says " + std::to_string(chunk_length) +
-                           " bytes, " + std::to_string(end - at) + " follow its header";
-            return walk;
+            found(i, past(chunk_label(i, type) + " runs past") + ": it says " + std::to_string(chunk_length) +
+                         " bytes, " + std::to_string(end - at) + " follow its header");
+            break;
         }
         if (i == 0 && type != kChunkJson) {
             walk.problem = "chunk 0 is " + chunk_kind(type) + "; a GLB starts with its JSON chunk";
@@ -171,17 +182,17 @@ inline GlbWalk walk_glb(RegularFile& file, uint64_t size, bool glb_error) {
             return walk;
         }
         if (i > 0 && type == kChunkJson) {
-            walk.problem = "two JSON chunks (0 and " + std::to_string(i) + "); a GLB has one";
-            return walk;
+            found(i, "two JSON chunks (0 and " + std::to_string(i) + "); a GLB has one");
+            break;
         }
         if (type == kChunkBin && bin_chunk > 0) {
-            walk.problem = "two BIN chunks (" + std::to_string(bin_chunk) + " and " + std::to_string(i) +
-                           "); a GLB has at most one";
-            return walk;
+            found(i, "two BIN chunks (" + std::to_string(bin_chunk) + " and " + std::to_string(i) +
+                         "); a GLB has at most one");
+            break;
         }
         if (type == kChunkBin && i > 1) {
-            walk.problem = "chunk " + std::to_string(i) + " is BIN; a GLB's BIN chunk can only be its second, chunk 1";
-            return walk;
+            found(i, "chunk " + std::to_string(i) + " is BIN; a GLB's BIN chunk can only be its second, chunk 1");
+            break;
         }
         if (chunk_length % 4 != 0) {
             const std::string unaligned =
@@ -204,14 +215,14 @@ inline GlbWalk walk_glb(RegularFile& file, uint64_t size, bool glb_error) {
         }
         at += chunk_length;
     }
-    if (!walk.problem.empty()) return walk;
+    if (!walk.problem.empty() || !glb_error) return walk;  // else tinygltf's reason is about the JSON
     // The structure holds; what tinygltf (which reads chunk 0 and chunk 1 only) cannot take.
     if (chunk1_type != 0 && chunk1_type != kChunkBin)
         walk.problem = "chunk 1 is of unknown type " + hex32(chunk1_type) +
                        "; glTF says to skip such chunks, but tinygltf (the reader used) cannot";
     else if (walk.has_bin && walk.bin_length == 0)
         walk.problem = "its BIN chunk is empty, which tinygltf (the reader used) refuses; leave the chunk out";
-    else if (glb_error)
+    else
         walk.problem = soft;
     return walk;
 }

@@ -370,10 +370,11 @@ void parse_node_hierarchy(Scene& s) {
             if (c < 0 || size_t(c) >= model.nodes.size())
                 s.reader.fail("node " + std::to_string(n) + " names child " + std::to_string(c) +
                               ", but the file has " + std::to_string(model.nodes.size()) + " nodes");
-            if (s.parent[size_t(c)] >= 0 || size_t(c) == n)
+            if (size_t(c) == n)
+                s.reader.fail("node hierarchy is not a tree: node " + std::to_string(n) + " names itself as its child");
+            if (s.parent[size_t(c)] >= 0)
                 s.reader.fail("node hierarchy is not a tree: node " + std::to_string(c) + " is a child of node " +
-                              std::to_string(s.parent[size_t(c)] >= 0 ? size_t(s.parent[size_t(c)]) : n) +
-                              (size_t(c) == n ? " (itself)" : " and of node " + std::to_string(n)));
+                              std::to_string(s.parent[size_t(c)]) + " and of node " + std::to_string(n));
             s.parent[size_t(c)] = int(n);
         }
     std::vector<int> roots;

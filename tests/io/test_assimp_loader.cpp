@@ -6,6 +6,8 @@
 #include "animorder/load.h"
 
 #include "support/files.h"
+#include "support/gltf_builder.h"
+#include "support/load_error.h"
 #include "support/meshes.h"
 #include "support/require.h"
 
@@ -21,6 +23,7 @@
 #include <iterator>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 using namespace animorder;
 namespace fs = std::filesystem;
@@ -515,6 +518,47 @@ TEST(AssimpCharacters, GltfReadByAssimpMatchesTheGltfLoader) {
                 }
         EXPECT_GT(size, 0.0);
         EXPECT_LE(worst, 1e-5 * size) << "largest difference " << worst << " in a character of size " << size;
+    }
+}
+
+// The same on a file of one triangle (no data needed): a morph target moving vertex 2 by (0, 0, 2),
+// its weight keyed 0 → 1 over 2 s under a node moved by (0, 0, 5); and morph weights assimp passes
+// on unchecked, refused by name: one that is not finite, one absurd.
+TEST_F(AssimpHostile, AMorphTargetThroughAssimpMovesAsTheGltfLoaderSays) {
+    const auto morphing = [](float weight, float time) {
+        test::Gltf g;
+        using nlohmann::json;
+        const int p = g.floats({0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3", 3), i = g.u16({0, 1, 2}, "SCALAR", 1);
+        const int target = g.floats({0, 0, 0, 0, 0, 0, 0, 0, 2}, "VEC3", 3);
+        const int t = g.floats({0, time}, "SCALAR", 1), w = g.floats({0, weight}, "SCALAR", 1);
+        json primitive = {
+            {"attributes", {{"POSITION", p}}}, {"indices", i}, {"targets", json::array({json{{"POSITION", target}}})}};
+        g.doc["meshes"] = json::array({json{{"primitives", json::array({primitive})}, {"weights", {0.0}}}});
+        g.doc["nodes"] = json::array({json{{"name", "blob"}, {"mesh", 0}, {"translation", {0, 0, 5}}}});
+        g.doc["scenes"] = json::array({json{{"nodes", json::array({0})}}});
+        json sampler = {{"input", t}, {"output", w}};
+        json channel = {{"sampler", 0}, {"target", {{"node", 0}, {"path", "weights"}}}};
+        g.doc["animations"] = json::array(
+            {json{{"name", "swell"}, {"samplers", json::array({sampler})}, {"channels", json::array({channel})}}});
+        return g.text();
+    };
+    const std::string file = write("swell.gltf", morphing(1, 2));
+    const AnimatedMesh gltf = load_character(file), assimp = load_assimp(file);
+    ASSERT_EQ(assimp.keyframe_count(), 61u);
+    ASSERT_EQ(gltf.keyframe_count(), 61u);
+    for (size_t k = 0; k < 61; ++k)
+        for (size_t i = 0; i < 3; ++i)
+            for (size_t d = 0; d < 3; ++d)
+                EXPECT_NEAR(assimp.keyframe(k)[3 * assimp.indices[i] + d], gltf.keyframe(k)[3 * gltf.indices[i] + d],
+                            1e-6);
+    EXPECT_FLOAT_EQ(assimp.keyframe(30)[3 * assimp.indices[2] + 2], 6.0f);  // weight 0.5: 5 + 1
+    for (const auto& [weight, time, message] :
+         {std::tuple{NAN, 2.0f, "morph channel 'blob' keys a weight of nan"},
+          std::tuple{1e30f, 2.0f,
+                     "morph channel 'blob' keys a weight of 1000000015047466219876688855040.000000, "
+                     "absurd for a morph target"}}) {
+        const std::string bad = write("bad.gltf", morphing(weight, time));
+        test::expect_one_line_load_error(bad, message, [&] { load_assimp(bad); });
     }
 }
 

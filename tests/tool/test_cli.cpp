@@ -319,7 +319,7 @@ TEST_F(Cli, ZeroAreaMeshIsAnError) {
 }
 
 // An error the algorithms find in the character (here: a corner at 3e38, too far for float clip
-// coordinates) names the input file, as the loaders' errors do.
+// coordinates) names the input file, as the loaders' errors do; an option's error does not.
 TEST_F(Cli, AnAlgorithmsErrorNamesTheInput) {
     test::Gltf g;
     const int p = g.floats({0, 0, 0, 3e38f, 0, 0, 0, 1, 0}, "VEC3", 3), i = g.u16({0, 1, 2}, "SCALAR", 1);
@@ -332,6 +332,10 @@ TEST_F(Cli, AnAlgorithmsErrorNamesTheInput) {
     EXPECT_EQ(o.exit_code, 1);
     EXPECT_EQ(o.err.rfind("animorder: error: " + path("far.gltf").string() + ": the model's extent", 0), 0u) << o.err;
     EXPECT_EQ(std::count(o.err.begin(), o.err.end(), '\n'), 1) << o.err;
+    // An option's error is the option's, not the file's.
+    const test::Outcome bad = run("optimize -q " + path("far.gltf").string() + " --method bogus");
+    EXPECT_EQ(bad.exit_code, 1);
+    EXPECT_EQ(bad.err.rfind("animorder: error: unknown method 'bogus'", 0), 0u) << bad.err;
 }
 
 // A mesh two nodes draw (Blender's linked duplicates: a pair of eyes, one of them mirrored) has one

@@ -215,7 +215,7 @@ int run_evaluate(const EvaluateOptions& options) {
         if (method_uses_clusters(n) && ks.size() > 1) label += " k=" + std::to_string(m.clustering.clusters);
         if (method_uses_clusters(n) && views.size() > 1) label += " views=" + std::to_string(m.clustering.views);
         note(options.common, "running " + label);
-        rows.push_back({run_method(mesh, n, m), m});
+        rows.push_back({about_input(options.common, [&, n = n, m = m] { return run_method(mesh, n, m); }), m});
     }
     const double methods_s = seconds_since(start);
 
@@ -230,7 +230,8 @@ int run_evaluate(const EvaluateOptions& options) {
     for (const Row& r : rows) buffers.push_back(r.result.buffers);
     for (MethodBuffers& m : stored) buffers.push_back(std::move(m));
     const Clock::time_point eval_start = Clock::now();
-    const std::vector<OrderEvaluation> results = evaluate_methods(mesh, buffers, eval);
+    const std::vector<OrderEvaluation> results =
+        about_input(options.common, [&] { return evaluate_methods(mesh, buffers, eval); });
     const double eval_s = seconds_since(eval_start);
     const size_t nodes = mesh.keyframe_count() * eval.views;
 

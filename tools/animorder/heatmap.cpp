@@ -31,7 +31,7 @@ int draw_blend_heatmap(const HeatmapOptions& options, const AnimatedMesh& mesh, 
                   double(options.view[2]) * options.view[2]);
     const float direction[3] = {float(options.view[0] / length), float(options.view[1] / length),
                                 float(options.view[2] / length)};
-    const Framing framing = frame_animated_mesh(mesh);
+    const Framing framing = about_input(options.common, [&] { return frame_animated_mesh(mesh); });
     std::vector<float> clip(mesh.vertex_count * 4);
     transform_to_clip(clip.data(), mesh.keyframe(options.keyframe), mesh.vertex_count,
                       &framing.centres[3 * options.keyframe], node_view_projection(direction, framing.radius));
@@ -85,10 +85,11 @@ int run_heatmap(const HeatmapOptions& options) {
     StaticMethodSettings settings;
     settings.lambda = options.lambda;
     settings.cache_size = options.common.cache_size;
-    const StaticMethodResult result = run_static_method(mesh, method, settings);
+    const StaticMethodResult result =
+        about_input(options.common, [&] { return run_static_method(mesh, method, settings); });
 
     if (options.blend) return draw_blend_heatmap(options, mesh, method, result.order);
-    const Framing framing = frame_animated_mesh(mesh);
+    const Framing framing = about_input(options.common, [&] { return frame_animated_mesh(mesh); });
     const float direction[3] = {float(options.view[0] / length), float(options.view[1] / length),
                                 float(options.view[2] / length)};
     std::vector<float> clip(mesh.vertex_count * 4);

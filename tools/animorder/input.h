@@ -5,9 +5,11 @@
 #include "commands.h"
 
 #include "animorder/animated_mesh.h"
+#include "animorder/invalid_input.h"
 
 #include <cstddef>
 #include <functional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -46,6 +48,19 @@ AnimatedMesh load_animated_input(const CommonOptions& common, std::string& input
 // triangle of zero area at its first keyframe).
 AnimatedMesh load_drawable_input(const CommonOptions& common, std::string& input_name,
                                  std::vector<std::string>* files_read = nullptr);
+
+// `work` on the character loaded from common.input: an InvalidInput it throws (an algorithm's word
+// on the character: a corner too far for float clip coordinates, say) names the file, as the
+// loaders' errors do. The options were checked before loading, so such an error is about the file.
+template <typename Work>
+auto about_input(const CommonOptions& common, Work&& work) -> decltype(work()) {
+    try {
+        return work();
+    } catch (const InvalidInput& e) {
+        if (common.input.empty()) throw;
+        throw std::runtime_error(common.input + ": " + e.what());
+    }
+}
 
 // The library's settings for one method from the options (names of the k-means variants
 // parsed, --cache-size, log and progress lines on stderr labelled with the method's name).

@@ -2,8 +2,6 @@
 // every failure into one line on stderr and a non-zero exit code (never a crash).
 #include "commands.h"
 
-#include "animorder/invalid_input.h"
-
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -341,16 +339,6 @@ int main(int argc, char** argv) {
         if (*view_cmd) return run_view(view);
         if (*check_cmd) return run_check(check);
         if (*reapply_cmd) return run_reapply(reapply);
-    } catch (const animorder::InvalidInput& e) {  // the algorithms' word on the character (a loader's names its file)
-        const animorder::tool::CommonOptions* common = *inspect_cmd     ? &inspect.common
-                                                       : *optimize_cmd  ? &optimize.common
-                                                       : *evaluate_cmd  ? &evaluate.common
-                                                       : *heatmap_cmd   ? &heatmap.common
-                                                       : *subdivide_cmd ? &subdivide.common
-                                                                        : nullptr;
-        const std::string file = common && !common->input.empty() ? common->input + ": " : "";
-        std::fprintf(stderr, "animorder: error: %s%s\n", file.c_str(), one_line(e.what()).c_str());
-        return 1;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "animorder: error: %s\n", one_line(e.what()).c_str());
         return 1;

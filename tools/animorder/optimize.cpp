@@ -120,7 +120,7 @@ OptimizeProduct produce_optimize(const OptimizeOptions& options, const OptimizeP
                              std::to_string(mesh.vertex_count) + " vertices, " + std::to_string(mesh.keyframe_count()) +
                              " keyframes");
 
-    product.run = run_method(mesh, method, settings);
+    product.run = about_input(options.common, [&] { return run_method(mesh, method, settings); });
     const MethodResult& run = product.run;
     product.before = analyze_mesh_vertex_cache(mesh, mesh.indices, settings.cache_size);
     const VertexCacheStats& before = product.before;

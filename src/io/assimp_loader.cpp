@@ -68,31 +68,38 @@
 namespace animorder {
 namespace {
 
+// The last of `count` keys (sorted by time) at or before `tick` (the first when none is).
+template <typename Key>
+unsigned key_index(const Key* keys, unsigned count, double tick) {
+    unsigned i = 0;
+    while (i + 1 < count && keys[i + 1].mTime <= tick) ++i;
+    return i;
+}
+
+// How far `tick` lies from key time t0 to t1 (0 to 1, held outside; 0 when they are equal).
+double blend(double t0, double t1, double tick) {
+    return t1 > t0 ? std::clamp((tick - t0) / (t1 - t0), 0.0, 1.0) : 0.0;
+}
+
 aiMatrix4x4 interpolate(const aiNodeAnim* channel, double tick, const aiMatrix4x4& rest) {
     aiVector3D t, s;
     aiQuaternion r;
     rest.Decompose(s, r, t);
-    auto key_index = [tick](const auto* keys, unsigned count) {
-        unsigned i = 0;
-        while (i + 1 < count && keys[i + 1].mTime <= tick) ++i;
-        return i;
-    };
-    auto blend = [tick](double t0, double t1) { return t1 > t0 ? std::clamp((tick - t0) / (t1 - t0), 0.0, 1.0) : 0.0; };
     // Position and scaling keys interpolate alike; rotations slerp.
     auto vector_at = [&](const aiVectorKey* keys, unsigned count, aiVector3D& out) {
         if (!count) return;
-        const unsigned i = key_index(keys, count);
+        const unsigned i = key_index(keys, count, tick);
         const aiVectorKey& a = keys[i];
         const aiVectorKey& b = keys[std::min(i + 1, count - 1)];
-        out = a.mValue + (b.mValue - a.mValue) * float(blend(a.mTime, b.mTime));
+        out = a.mValue + (b.mValue - a.mValue) * float(blend(a.mTime, b.mTime, tick));
     };
     vector_at(channel->mPositionKeys, channel->mNumPositionKeys, t);
     vector_at(channel->mScalingKeys, channel->mNumScalingKeys, s);
     if (channel->mNumRotationKeys) {
-        const unsigned i = key_index(channel->mRotationKeys, channel->mNumRotationKeys);
+        const unsigned i = key_index(channel->mRotationKeys, channel->mNumRotationKeys, tick);
         const aiQuatKey& a = channel->mRotationKeys[i];
         const aiQuatKey& b = channel->mRotationKeys[std::min(i + 1, channel->mNumRotationKeys - 1)];
-        aiQuaternion::Interpolate(r, a.mValue, b.mValue, float(blend(a.mTime, b.mTime)));
+        aiQuaternion::Interpolate(r, a.mValue, b.mValue, float(blend(a.mTime, b.mTime, tick)));
         r.Normalize();
     }
     return aiMatrix4x4(s, r, t);
@@ -102,11 +109,10 @@ aiMatrix4x4 interpolate(const aiNodeAnim* channel, double tick, const aiMatrix4x
 // last), added into `weights` (one entry per anim mesh of the mesh; a key's values index them).
 void add_morph_weights(const aiMeshMorphAnim* channel, double tick, std::vector<double>& weights) {
     if (!channel->mNumKeys || !channel->mKeys) return;
-    unsigned i = 0;
-    while (i + 1 < channel->mNumKeys && channel->mKeys[i + 1].mTime <= tick) ++i;
+    const unsigned i = key_index(channel->mKeys, channel->mNumKeys, tick);
     const aiMeshMorphKey& a = channel->mKeys[i];
     const aiMeshMorphKey& b = channel->mKeys[std::min(i + 1, channel->mNumKeys - 1)];
-    const double t = b.mTime > a.mTime ? std::clamp((tick - a.mTime) / (b.mTime - a.mTime), 0.0, 1.0) : 0.0;
+    const double t = blend(a.mTime, b.mTime, tick);
     for (const auto& [key, share] : {std::pair{&a, 1.0 - t}, std::pair{&b, t}})
         for (unsigned j = 0; j < key->mNumValuesAndWeights; ++j)
             if (key->mValues[j] < weights.size()) weights[key->mValues[j]] += share * key->mWeights[j];
@@ -454,18 +460,18 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
     // a mirrored mesh's file winding is clockwise-front (engines flip their culling for it).
     std::vector<uint8_t> mirrored_in_some(parts.size(), 0), upright_in_some(parts.size(), 0);
     // Per part, the morph channels of `anim` that drive it, their keys checked.
+    using MorphChannels = std::vector<std::vector<const aiMeshMorphAnim*>>;
     auto morph_channels = [&](const aiAnimation* anim) {
-        std::vector<std::vector<const aiMeshMorphAnim*>> of(parts.size());
+        MorphChannels of(parts.size());
         for (unsigned c = 0; anim && c < anim->mNumMorphMeshChannels; ++c)
             for (size_t i = 0; i < parts.size(); ++i) {
                 const aiMeshMorphAnim* channel = anim->mMorphMeshChannels[c];
                 if (!drives(channel, parts[i])) continue;
                 for (unsigned k = 0; k < channel->mNumKeys && channel->mKeys; ++k) {
                     const aiMeshMorphKey& key = channel->mKeys[k];
-                    if (key.mNumValuesAndWeights && (!key.mValues || !key.mWeights))
-                        throw LoadError(path + ": morph channel '" + channel->mName.C_Str() +
-                                        "' has a key without values");
                     const std::string channel_name = path + ": morph channel '" + channel->mName.C_Str() + "'";
+                    if (key.mNumValuesAndWeights && (!key.mValues || !key.mWeights))
+                        throw LoadError(channel_name + " has a key without values");
                     if (!std::isfinite(key.mTime)) throw LoadError(channel_name + " has a key time that is not finite");
                     for (unsigned j = 0; j < key.mNumValuesAndWeights; ++j) {
                         if (!(std::fabs(key.mWeights[j]) <= 1e6))
@@ -481,7 +487,6 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
             }
         return of;
     };
-    using MorphChannels = std::vector<std::vector<const aiMeshMorphAnim*>>;  // morph_channels(anim)
     auto add_keyframe = [&](const aiAnimation* anim, const MorphChannels& morphs, double tick) {
         const std::vector<aiMatrix4x4> global = globals(anim, tick);
         for (size_t i = 0; i < parts.size(); ++i) {

@@ -11,6 +11,8 @@
 
 #include "animorder/regular_file.h"
 
+#include "lower_extension.h"
+
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -372,13 +374,6 @@ inline std::string json_problem(const std::string& text, const std::string& erro
     return {};
 }
 
-inline bool ends_with_glb(const std::string& path) {
-    if (path.size() < 4) return false;
-    std::string tail = path.substr(path.size() - 4);
-    for (char& c : tail) c = char(std::tolower(uint8_t(c)));
-    return tail == ".glb";
-}
-
 }  // namespace diagnose_detail
 
 // Why the glTF at `path` is unreadable, tinygltf's load having failed with `tinygltf_error`: the
@@ -417,7 +412,7 @@ inline std::string why_unreadable(const std::string& path, const std::string& ti
     if (size > got && !read_exactly(file, text.data() + got, text.size() - got)) return told({});
     const std::string found = json_problem(text, tinygltf_error, false, nullptr);
     // A .glb that is no GLB: say so rather than how its bytes fail as JSON.
-    if (ends_with_glb(path) && (found.rfind("its JSON does not parse", 0) == 0 || size < 4))
+    if (lower_extension(path) == ".glb" && (found.rfind("its JSON does not parse", 0) == 0 || size < 4))
         return "not a GLB: it does not start with 'glTF'";
     return told(found);
 }

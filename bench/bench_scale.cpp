@@ -9,7 +9,8 @@
 //       each case as an `optimize` command line, run by this build's animorder and by EXE, another
 //       build's (scripts/build-baseline.sh builds the one the figures came from), one after
 //       the other, N rounds (the first order reversed each round, the fastest run of each kept):
-//       wall times, peak memory, the speed-up and whether the two wrote the same buffers
+//       wall times, peak memory, the speed-up and whether the two wrote the same buffers; with N > 1
+//       also each round's pair and its ratio, and those ratios' median and range
 //
 // Cases and their goals:
 //   ganfaul-joint   Ganfaul, joint over all 12 clips          <= 120 s, <= 3 GB
@@ -33,6 +34,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -233,6 +235,7 @@ int compare_with_baseline(const Case& c, const std::string& baseline, unsigned r
         std::string buffers;
     };
     Build builds[2] = {{"this build", ANIMORDER_EXE, {}, {}}, {"baseline", baseline, {}, {}}};
+    std::vector<double> walls[2];  // per build, round by round
     int failed = 0;
     for (unsigned round = 0; round < rounds && !failed; ++round)
         for (int i = 0; i < 2 && !failed; ++i) {
@@ -249,6 +252,7 @@ int compare_with_baseline(const Case& c, const std::string& baseline, unsigned r
                 break;
             }
             if (round == 0 || run.wall_s < b.run.wall_s) b.run = run;
+            walls[&b - builds].push_back(run.wall_s);
             b.buffers = file_bytes(out.string() + ".animorder.bin");
         }
     for (const Build& b : builds)
@@ -262,6 +266,21 @@ int compare_with_baseline(const Case& c, const std::string& baseline, unsigned r
                     builds[0].buffers.empty() || builds[1].buffers.empty() ? "not found (no .animorder.bin)"
                     : builds[0].buffers == builds[1].buffers               ? "identical"
                                                                            : "differ");
+    if (!failed && rounds > 1) {
+        // Each round's pair ran back to back: its ratio shows how far the machine's load moved
+        // the figures; the fastest runs above are each build's least disturbed one.
+        std::vector<double> ratios;
+        for (unsigned round = 0; round < rounds; ++round) {
+            ratios.push_back(walls[1][round] / walls[0][round]);
+            std::printf("%-17s round %u: this build %.2f s, baseline %.2f s: %.2fx\n", c.name, round + 1,
+                        walls[0][round], walls[1][round], ratios.back());
+        }
+        std::sort(ratios.begin(), ratios.end());
+        const size_t n = ratios.size();
+        const double median = n % 2 ? ratios[n / 2] : (ratios[n / 2 - 1] + ratios[n / 2]) / 2.0;
+        std::printf("%-17s per-round speed-ups: median %.2fx, %.2fx to %.2fx over %u rounds\n", c.name, median,
+                    ratios.front(), ratios.back(), rounds);
+    }
     std::fflush(stdout);
     return failed ? 1 : 0;
 }

@@ -238,7 +238,7 @@ fi
 # on any processor, where the goals' seconds belong to the machine that filed the issue.
 if [ -x "$BIN/bench/bench_scale" ] && selected bench-baseline.txt && [ ! -s "$OUT/bench-baseline.txt" ]; then
   BASELINE_ANIMORDER=$(bash scripts/build-baseline.sh | tail -n 1)
-  step_stdout bench-baseline.txt "$BIN/bench/bench_scale" --baseline "$BASELINE_ANIMORDER" --rounds 2 xbot-single xbot-single-sided clip60-single
+  step_stdout bench-baseline.txt "$BIN/bench/bench_scale" --baseline "$BASELINE_ANIMORDER" --rounds 5 xbot-single xbot-single-sided clip60-single
 fi
 mkdir -p "$OUT/out"
 step optimize-ganfaul-idle.json $A optimize --method single "$GANFAUL" --clip Idle -q \

@@ -6,8 +6,11 @@
 #include "support/files.h"
 #include "support/require.h"
 
+#include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace fs = std::filesystem;
 namespace test = animorder::test;
@@ -48,6 +51,44 @@ TEST_F(BenchScale, ABuildAgainstItselfWritesTheSameBuffers) {
     EXPECT_NE(o.out.find("xbot-single-sided speed-up "), std::string::npos) << o.out;
     EXPECT_NE(o.out.find("(the goal asks 2.75x: 33 s -> 12.0 s)"), std::string::npos) << o.out;
     EXPECT_TRUE(fs::is_empty(path("tmp"))) << "bench_scale left its scratch folders behind";
+}
+
+TEST_F(BenchScale, EachRoundsRatioAndTheirMedianAreThePrintedTimes) {
+    // Three rounds: each round's line gives its two wall times and their ratio; the summary's
+    // median and range are recomputed here from the rounds' printed times, and the fastest-run
+    // lines from the same times.
+    ANIMORDER_REQUIRE_OR_SKIP("data", fs::exists(kData / "mixamo-ganfaul" / "Ganfaul.gltf"),
+                              (kData / "mixamo-ganfaul" / "Ganfaul.gltf").string() + " is absent");
+    const test::Outcome o = run(std::string("--quick --baseline ") + ANIMORDER_EXE + " --rounds 3 clip60-single");
+    ASSERT_EQ(o.exit_code, 0) << o.out << o.err;
+    std::vector<double> mine, theirs, ratios;
+    for (unsigned round = 1; round <= 3; ++round) {
+        const std::string head = "clip60-single     round " + std::to_string(round) + ": this build ";
+        const size_t at = o.out.find(head);
+        ASSERT_NE(at, std::string::npos) << o.out;
+        double a = 0, b = 0, r = 0;
+        ASSERT_EQ(std::sscanf(o.out.c_str() + at + head.size(), "%lf s, baseline %lf s: %lfx", &a, &b, &r), 3) << o.out;
+        mine.push_back(a);
+        theirs.push_back(b);
+        ratios.push_back(r);
+        EXPECT_NEAR(r, b / a, 0.006 + (b / a) * (0.0051 / a + 0.0051 / b)) << o.out;  // times printed to 0.01 s
+    }
+    EXPECT_EQ(o.out.find("round 4:"), std::string::npos) << o.out;
+    std::sort(ratios.begin(), ratios.end());
+    char expected[160];
+    std::snprintf(expected, sizeof expected, "per-round speed-ups: median %.2fx, %.2fx to %.2fx over 3 rounds",
+                  ratios[1], ratios[0], ratios[2]);
+    EXPECT_NE(o.out.find(expected), std::string::npos) << expected << "\n" << o.out;
+    char fastest[64];
+    std::snprintf(fastest, sizeof fastest, "this build  wall %.1f s", *std::min_element(mine.begin(), mine.end()));
+    EXPECT_NE(o.out.find(fastest), std::string::npos) << fastest << "\n" << o.out;
+    std::snprintf(fastest, sizeof fastest, "baseline    wall %.1f s", *std::min_element(theirs.begin(), theirs.end()));
+    EXPECT_NE(o.out.find(fastest), std::string::npos) << fastest << "\n" << o.out;
+    // One round: no per-round lines (its ratio is the speed-up line's).
+    const test::Outcome one = run(std::string("--quick --baseline ") + ANIMORDER_EXE + " clip60-single");
+    ASSERT_EQ(one.exit_code, 0) << one.out << one.err;
+    EXPECT_EQ(one.out.find("round 1:"), std::string::npos) << one.out;
+    EXPECT_EQ(one.out.find("per-round"), std::string::npos) << one.out;
 }
 
 TEST_F(BenchScale, TheSingleSidedCopyLoadsAsTheSameCharacter) {

@@ -4,6 +4,7 @@
 // as an input is ever replaced, and no two outputs of a run may be the same file.
 #pragma once
 
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -51,6 +52,11 @@ public:
 
     void add(const std::string& path, const std::string& data);
     void commit();
+    // Called by each later add() with its path and bytes once they are written (batch records
+    // the outputs' digests in the item report that commits with them).
+    void observe(std::function<void(const std::string& path, const std::string& data)> observer) {
+        observer_ = std::move(observer);
+    }
 
 private:
     struct Pending {
@@ -59,6 +65,7 @@ private:
     };
     std::vector<Pending> pending_;
     bool committed_ = false;
+    std::function<void(const std::string&, const std::string&)> observer_;
 };
 
 // One file written atomically: an OutputSet of one.

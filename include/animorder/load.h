@@ -46,6 +46,10 @@ struct LoadOptions {
     double parse_seconds = 20;
 };
 
+// A file name's extension in lower case (".glb" for "Hero.GLB"): what load_character dispatches on,
+// so that a caller deciding by extension (glTF output or not, a manifest's format) agrees with it.
+std::string file_extension(const std::string& path);
+
 // By extension: .gltf/.glb → load_gltf (gltf_loader.h), .md2 → load_md2, .iqm → load_iqm (no
 // clip files), anything else → load_assimp. A folder in
 // clip_files stands for the files in it, in name order. Throws LoadError when a file it would

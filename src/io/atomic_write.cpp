@@ -236,6 +236,7 @@ void OutputSet::add(const std::string& path, const std::string& data) {
     const bool flushed = std::fflush(file) == 0 && ::fsync(::fileno(file)) == 0;
     const bool closed = std::fclose(file) == 0;
     if (!written || !flushed || !closed) throw OutputError(path + ": write failed: " + std::strerror(errno));
+    if (observer_) observer_(path, data);
 }
 
 void OutputSet::commit() {

@@ -127,6 +127,8 @@ void add_files_read(std::vector<std::string>& files_read, const std::vector<std:
         if (listed.insert(file).second) files_read.push_back(file);
 }
 
+std::string file_extension(const std::string& path) { return lower_extension(path); }
+
 std::vector<std::string> files_load_reads(const std::string& path, const std::vector<std::string>& clip_files) {
     std::vector<std::string> files = {path};
     const std::string extension = lower_extension(path);

@@ -546,6 +546,16 @@ TEST_F(Batch, AnotherBuildOfTheToolRedoesTheItems) {
     EXPECT_EQ(rebuilt.exit_code, 0) << rebuilt.err;
     EXPECT_NE(rebuilt.out.find("1 done, 0 up to date"), std::string::npos) << rebuilt.out;
     EXPECT_NE(run_shell(other + args).out.find("0 done, 1 up to date"), std::string::npos);
+    // A merge by a build other than the one that ran the items finds no current result, and says why.
+    EXPECT_EQ(run("batch -q --eval-views 0 --merge " + manifest()).exit_code, 4);
+    const nlohmann::json s = nlohmann::json::parse(test::slurp(path("m.summary.json")));
+    EXPECT_EQ(s["items"][0]["status"], "missing");
+    EXPECT_NE(s["items"][0]["error"].get<std::string>().find("another animorder build"), std::string::npos)
+        << s["items"][0];
+    EXPECT_EQ(run_shell(other + " batch -q --eval-views 1 --merge " + manifest()).exit_code, 4);
+    EXPECT_NE(nlohmann::json::parse(test::slurp(path("m.summary.json")))["items"][0]["error"].get<std::string>().find(
+                  "--eval-views"),
+              std::string::npos);
 }
 
 // What a killed run left of an item (its temporaries) is removed on the next run even when the
@@ -607,7 +617,12 @@ TEST_F(Batch, ManifestMistakesAreRefusedBeforeAnyWork) {
         // a NUL, which would cut the path short (another file read, or an output nobody named)
         {"m.json", R"({"items": [{"method": "original", "input": "in.glb\u0000.x", "output": "out/a"}]})"},
         {"m.json", R"({"items": [{"method": "original", "output": "out/a\u0000b"}]})"},
-        {"m.csv", std::string("method,output\noriginal,out/a\0b\n", 31)}};
+        {"m.csv", std::string("method,output\noriginal,out/a\0b\n", 31)},
+        // threads are the batch's: an item's own --threads would be ignored
+        {"m.json", R"({"items": [{"method": "original", "options": "--threads 1", "output": "out/a"}]})"},
+        // a spreadsheet's "Unicode text" (UTF-16), an empty file
+        {"m.csv", std::string("\xFF\xFEm\0e\0t\0h\0o\0d\0", 14)},
+        {"m.csv", ""}};
     for (const auto& [name, text] : bad) {
         write(name, text);
         const test::Outcome o = run("batch -q --eval-views 0 " + path(name).string());
@@ -616,6 +631,18 @@ TEST_F(Batch, ManifestMistakesAreRefusedBeforeAnyWork) {
         EXPECT_TRUE(outputs().empty()) << text;
         fs::remove(path(name));
     }
+    // What the errors name: the field at fault, the CSV line, the encoding.
+    const std::vector<std::pair<std::string, std::string>> named = {
+        {"method,output\noriginal,out/a\noriginal,\n", "m.csv: line 3 has no \"output\""},
+        {"method,output\noriginal,out/\xff\n", "line 2: the output is not valid UTF-8"},
+        {std::string("\xFF\xFEm\0e\0", 6), "m.csv: is UTF-16 text"},
+        {"", "m.csv: line 1: no header line"}};
+    for (const auto& [text, expected] : named) {
+        write("m.csv", text);
+        const test::Outcome o = run("batch -q --eval-views 0 " + path("m.csv").string());
+        EXPECT_NE(o.err.find(expected), std::string::npos) << o.err;
+    }
+    fs::remove(path("m.csv"));
     write("m.json", R"({"items": [{"method": "original", "output": "out/a"}]})");
     for (const char* options : {"--summary out/", "--shard env/0", "--summary /dev/null/x"}) {
         const test::Outcome o = run("batch -q --eval-views 0 " + std::string(options) + " " + manifest());
@@ -623,10 +650,13 @@ TEST_F(Batch, ManifestMistakesAreRefusedBeforeAnyWork) {
         EXPECT_EQ(test::line_count(o.err), 1u) << options << "\n" << o.err;
     }
     EXPECT_TRUE(outputs().empty());
-    write("m.csv", "\xEF\xBB\xBFmethod , output\n original , \"out/a\" \n");
-    const test::Outcome bom = run("batch -q --eval-views 0 " + path("m.csv").string());
+    // A byte order mark, spaces around fields, CRLF line ends, rows of empty fields (",,", as
+    // spreadsheets export them) and an upper-case extension are fine.
+    write("M.CSV", "\xEF\xBB\xBFmethod , output\r\n original , \"out/a\" \r\n,\r\n , \r\n");
+    const test::Outcome bom = run("batch -q --eval-views 0 " + path("M.CSV").string());
     EXPECT_EQ(bom.exit_code, 0) << bom.err;
     EXPECT_TRUE(fs::exists(path("out/a.animorder.bin")));
+    EXPECT_EQ(nlohmann::json::parse(test::slurp(path("M.summary.json")))["items"].size(), 1u);
 }
 
 // A report whose figures were edited into something else is not a result: the merge lists the
@@ -683,4 +713,89 @@ TEST_F(Batch, TheReadmesKubernetesCommandCompletesAShardWithAFailedItem) {
     // An error before any work (here a manifest that is not JSON) still fails the pod.
     write("m.json", "not json");
     EXPECT_EQ(run_shell("JOB_COMPLETION_INDEX=0 sh -c '" + command + "'").exit_code, 1);
+}
+
+// An output emptied or changed after its run is not up to date: the item is redone (only the
+// presence of the files was checked before), and the redone file is the first run's again.
+TEST_F(Batch, ADamagedOutputIsRedoneNotTakenAsUpToDate) {
+    write("m.json",
+          R"({"items": [{"name": "walk", "clips": ["walk"], "options": ")" + kFast + R"(", "output": "out/walk"},
+                        {"name": "orig", "method": "original", "output": "out/orig"}]})");
+    const std::string args = "batch -q --eval-views 0 --no-timings " + manifest();
+    ASSERT_EQ(run(args).exit_code, 0);
+    const std::string bin = test::slurp(path("out/walk.animorder.bin")),
+                      json = test::slurp(path("out/orig.animorder.json"));
+    write("out/walk.animorder.bin", "");
+    std::string changed = json;
+    changed[changed.size() / 2] ^= 1;  // the same size, one bit off
+    write("out/orig.animorder.json", changed);
+    const test::Outcome again = run(args);
+    EXPECT_EQ(again.exit_code, 0) << again.err;
+    EXPECT_NE(again.out.find("2 done, 0 up to date"), std::string::npos) << again.out;
+    EXPECT_EQ(test::slurp(path("out/walk.animorder.bin")), bin);
+    EXPECT_EQ(test::slurp(path("out/orig.animorder.json")), json);
+    EXPECT_NE(run(args).out.find("0 done, 2 up to date"), std::string::npos);
+}
+
+// An item that fails in this run is "failed" in this run's summary, even when an earlier result of
+// it still matches the stamp the run began with (--force redid it; an input was edited while it
+// ran). Its earlier files are left as they were; once the input is as before, the item is up to
+// date again and its error file goes.
+TEST_F(Batch, AnItemThatFailsNowIsFailedInTheSummaryAndItsErrorGoesOnceUpToDate) {
+    ASSERT_EQ(run("subdivide -q --levels 0 --clip walk -o " + path("in.glb").string()).exit_code, 0);
+    const std::string input = test::slurp(path("in.glb"));
+    write("m.json", R"({"items": [{"name": "slow", "input": "in.glb",
+                  "options": "-k 3 --views 42 --resolution 64 --max-iterations 3", "output": "out/slow"}]})");
+    ASSERT_EQ(run("batch -q --eval-views 0 " + manifest()).exit_code, 0);
+    const std::string bin = test::slurp(path("out/slow.animorder.bin"));
+
+    // --force, and the input edited once the item runs (after its stamp: the "running" line).
+    const pid_t child = fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+        const std::string log = path("forced.txt").string();
+        if (!std::freopen(log.c_str(), "w", stdout) || dup2(fileno(stdout), 2) < 0) _exit(126);
+        execl(ANIMORDER_EXE, ANIMORDER_EXE, "batch", "--force", "--eval-views", "0", manifest().c_str(),
+              static_cast<char*>(nullptr));
+        _exit(127);
+    }
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    while (test::slurp(path("forced.txt")).find("slow: running") == std::string::npos &&
+           std::chrono::steady_clock::now() < deadline)
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    kill(child, SIGSTOP);
+    std::ofstream(path("in.glb"), std::ios::binary | std::ios::app) << '\0';
+    kill(child, SIGCONT);
+    int status = 0;
+    waitpid(child, &status, 0);
+    const std::string log = test::slurp(path("forced.txt"));
+    ASSERT_TRUE(WIFEXITED(status)) << log;
+    EXPECT_EQ(WEXITSTATUS(status), 3) << log;
+    const nlohmann::json s = nlohmann::json::parse(test::slurp(path("m.summary.json")));
+    EXPECT_EQ(s["ok"], 0) << s;
+    EXPECT_EQ(s["failed"], 1) << s;
+    EXPECT_EQ(s["items"][0]["status"], "failed");
+    EXPECT_FALSE(s["items"][0]["error"].get<std::string>().empty());
+    EXPECT_EQ(test::slurp(path("out/slow.animorder.bin")), bin) << "the earlier result was replaced";
+    EXPECT_TRUE(fs::exists(path("out/slow.animorder.error.json")));
+
+    write("in.glb", input);
+    const test::Outcome again = run("batch -q --eval-views 0 " + manifest());
+    EXPECT_EQ(again.exit_code, 0) << again.err;
+    EXPECT_NE(again.out.find("0 done, 1 up to date"), std::string::npos) << again.out;
+    EXPECT_FALSE(fs::exists(path("out/slow.animorder.error.json"))) << "a stale failure marker stayed";
+}
+
+// The merge's exit code when items failed and others have no result yet: 5, so that a farm's
+// pipeline learns of both (the counts are in the summary).
+TEST_F(Batch, AMergeWithFailedAndMissingItemsExitsFive) {
+    write("broken.gltf", "{\"asset\": {\"version\": \"2.0\"}, \"meshes\": 7}");
+    write("m.json", R"({"items": [{"input": "broken.gltf", "method": "original", "output": "out/broken"},
+                                  {"method": "original", "output": "out/never"}]})");
+    EXPECT_EQ(run("batch -q --eval-views 0 --shard 0/2 " + manifest()).exit_code, 3);
+    EXPECT_EQ(run("batch -q --eval-views 0 --merge " + manifest()).exit_code, 5);
+    const nlohmann::json s = nlohmann::json::parse(test::slurp(path("m.summary.json")));
+    EXPECT_EQ(s["failed"], 1);
+    EXPECT_EQ(s["missing"], 1);
+    EXPECT_NE(s["items"][1]["error"].get<std::string>().find("no result yet"), std::string::npos) << s["items"][1];
 }

@@ -530,6 +530,15 @@ TEST_F(Cli, BadInputAndOptionsGiveOneLineErrors) {
         {"inspect --clip run", "no clip named 'run' (clips: walk, wave)"},
         {"optimize --method static-nehab06 --nehab-views 13", "icosphere"},
         {"optimize --method static-nehab06 --nehab-clusters 99999999", "nehab-clusters"},
+        // An empty path (an unset shell variable) is refused, not read as the option left out:
+        // no output written, or the bundled character loaded, without a word.
+        {"optimize ''", "input: must not be empty"},
+        {"optimize -o ''", "--output: must not be empty"},
+        {"optimize -r ''", "--report: must not be empty"},
+        {"evaluate --csv ''", "--csv: must not be empty"},
+        {"heatmap -o ''", "--output: must not be empty"},
+        {"inspect --clip ''", "--clip: must not be empty"},
+        {"batch ''", "manifest: must not be empty"},
     };
     for (const Case& c : cases) {
         const test::Outcome o = run(c.args + " --quiet");  // errors print even when quiet
@@ -806,4 +815,19 @@ TEST_F(CliOutputs, EvaluateStoredRefusesAFileWithoutOrdersBeforeTheMethods) {
     EXPECT_EQ(o.exit_code, 1) << o.err;
     EXPECT_NE(o.err.find("ANIMORDER_animated_triangle_orders"), std::string::npos) << o.err;
     EXPECT_EQ(o.err.find("running"), std::string::npos) << "a method ran first: " << o.err;
+}
+
+// File name extensions in any case, as the loaders read them: a .GLB input takes glTF output, and
+// an OUT.GLB output writes the glTF (it wrote only the sidecar, without a word).
+TEST_F(CliOutputs, ExtensionsAreReadInAnyCase) {
+    fs::copy_file(path("in.glb"), path("IN.GLB"));
+    const test::Outcome o =
+        run("optimize -q --method original " + path("IN.GLB").string() + " -o " + path("OUT.GLB").string());
+    ASSERT_EQ(o.exit_code, 0) << o.err;
+    EXPECT_EQ(test::slurp(path("OUT.GLB")).substr(0, 4), "glTF");
+    EXPECT_TRUE(fs::exists(path("OUT.animorder.bin")));
+    const test::Outcome s =
+        run("subdivide -q --levels 0 " + path("IN.GLB").string() + " -o " + path("S.GLTF").string());
+    ASSERT_EQ(s.exit_code, 0) << s.err;
+    EXPECT_EQ(test::slurp(path("S.GLTF")).substr(0, 1), "{");
 }

@@ -20,6 +20,7 @@
 
 #include "animorder/atomic_write.h"
 #include "animorder/evaluation.h"
+#include "animorder/load.h"
 #include "animorder/regular_file.h"
 
 #include <nettle/sha2.h>
@@ -50,8 +51,9 @@ using json = nlohmann::ordered_json;
 using Clock = std::chrono::steady_clock;
 
 // Exit codes beyond 0 (all done) and 1 (an error before any work).
-constexpr int kExitItemsFailed = 3;   // at least one item failed (each has its error line)
-constexpr int kExitItemsMissing = 4;  // merge: some items have no up-to-date result yet
+constexpr int kExitItemsFailed = 3;       // at least one item failed (each has its error line)
+constexpr int kExitItemsMissing = 4;      // merge: some items have no up-to-date result yet
+constexpr int kExitFailedAndMissing = 5;  // merge: both (a farm learns of unfinished shards either way)
 
 // ---------------------------------------------------------------------------------------------
 // The manifest
@@ -68,6 +70,7 @@ struct ManifestItem {
     std::string input_as_written, output_as_written;
     std::vector<std::string> clips_as_written;
     bool input_given = false;  // an "input" key or column: then it may not be blank
+    size_t line = 0;           // a CSV manifest's line, which its errors name (0: a JSON item)
 };
 
 // Items' relative paths are relative to the manifest's folder, so a manifest moves with its data.
@@ -269,6 +272,9 @@ void trim(std::string& text) {
 std::vector<ManifestItem> parse_csv_manifest(const std::string& text, const std::string& path) {
     size_t pos = text.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;
     std::vector<std::string> header = csv_record(text, pos, path + ": line 1");
+    if (header.size() == 1 && split_words(header[0]).empty())
+        throw std::runtime_error(path +
+                                 ": line 1: no header line (columns: name, input, clips, method, options, output)");
     for (size_t i = 0; i < header.size(); ++i) {
         std::string& h = header[i];
         trim(h);
@@ -282,11 +288,14 @@ std::vector<ManifestItem> parse_csv_manifest(const std::string& text, const std:
     for (size_t line = 2; pos < text.size(); ++line) {
         const std::string where = path + ": line " + std::to_string(line);
         const std::vector<std::string> fields = csv_record(text, pos, where);
-        if (fields.size() == 1 && split_words(fields[0]).empty()) continue;  // blank line
+        // A blank line, or a row of empty fields (",,": spreadsheets export them), is no item.
+        if (std::all_of(fields.begin(), fields.end(), [](const std::string& f) { return split_words(f).empty(); }))
+            continue;
         if (fields.size() != header.size())
             throw std::runtime_error(where + ": " + std::to_string(fields.size()) + " fields, the header has " +
                                      std::to_string(header.size()));
         ManifestItem item;
+        item.line = line;
         for (size_t f = 0; f < header.size(); ++f) {
             std::string v = fields[f];
             trim(v);
@@ -315,7 +324,13 @@ std::vector<ManifestItem> parse_csv_manifest(const std::string& text, const std:
 
 std::vector<ManifestItem> read_manifest(const std::string& path) {
     const std::string text = read_text(path, "a manifest");
-    const std::string ext = fs::path(path).extension().string();
+    // Text saved as UTF-16 ("Unicode text" in spreadsheets) is named as such, not parsed into
+    // columns of stray bytes.
+    if (text.rfind("\xFF\xFE", 0) == 0 || text.rfind("\xFE\xFF", 0) == 0)
+        throw std::runtime_error(path + ": is UTF-16 text; save the manifest as UTF-8");
+    if (text.find('\0') != std::string::npos)
+        throw std::runtime_error(path + ": holds NUL bytes (UTF-16 text?); a manifest is UTF-8 text");
+    const std::string ext = file_extension(path);
     std::vector<ManifestItem> items;
     if (ext == ".csv")
         items = parse_csv_manifest(text, path);
@@ -328,14 +343,15 @@ std::vector<ManifestItem> read_manifest(const std::string& path) {
     const fs::path base = fs::path(path).parent_path();
     for (size_t i = 0; i < items.size(); ++i) {
         ManifestItem& item = items[i];
-        const std::string where = path + ": item " + std::to_string(i + 1);
+        const std::string where =
+            path + (item.line ? ": line " + std::to_string(item.line) : ": item " + std::to_string(i + 1));
         if (item.output.empty()) throw std::runtime_error(where + " has no \"output\"");
         if (item.input_given && item.input.find_first_not_of(" \t") == std::string::npos)
             throw std::runtime_error(where + ": the input is empty (leave \"input\" out for the bundled character)");
+        require_utf8(item.output, where + ": the output");  // before the name, which defaults to it
         if (item.name.empty()) item.name = item.output;
         require_utf8(item.name, where + ": the name");
         require_utf8(item.input, where + ": the input");
-        require_utf8(item.output, where + ": the output");
         for (const std::string& c : item.clips) require_utf8(c, where + ": a clip");
         for (const std::string& o : item.options) require_utf8(o, where + ": an option");
         item.input_as_written = item.input;
@@ -365,7 +381,7 @@ struct PlannedItem {
 };
 
 std::string stem_of(const std::string& output) {
-    const std::string ext = fs::path(output).extension().string();
+    const std::string ext = file_extension(output);
     return ext == ".glb" || ext == ".gltf" ? output.substr(0, output.size() - ext.size()) : output;
 }
 
@@ -393,6 +409,9 @@ PlannedItem plan_item(const ManifestItem& item, size_t index, const BatchOptions
         if (o == "--clip" || o.rfind("--clip=", 0) == 0)
             throw std::runtime_error(label + ": option " + o +
                                      ": use the item's \"clips\" (resolved against the manifest's folder)");
+        if (o == "--threads" || o.rfind("--threads=", 0) == 0)
+            throw std::runtime_error(label + ": option " + o +
+                                     ": threads are the batch's (animorder batch --threads N)");
         args.push_back(o);
     }
     try {
@@ -434,6 +453,12 @@ public:
             sha256_update(&ctx_, got, block.data());
         add("bytes:" + std::to_string(total));
     }
+    // What add_file adds for a file of this name holding `data`, from the bytes in memory.
+    void add_data(const fs::path& path, const std::string& data) {
+        add("file:" + path.filename().string());
+        sha256_update(&ctx_, data.size(), reinterpret_cast<const uint8_t*>(data.data()));
+        add("bytes:" + std::to_string(data.size()));
+    }
     std::string hex() {
         uint8_t digest[SHA256_DIGEST_SIZE];
         sha256_digest(&ctx_, sizeof digest, digest);
@@ -451,9 +476,9 @@ private:
 // the tool (version and executable), the settings, the manifest's spellings of its paths, and the bytes of every
 // file it reads as far as known before loading (OptimizePlan::inputs: the character, a glTF's
 // external buffers and images, clip files, the files of clip folders).
-std::string item_stamp(const PlannedItem& p, const BatchOptions& batch) {
-    // The tool: its version and the bytes of its executable, since a rebuild that changes the
-    // outputs may keep the version string.
+// The tool: its version and the bytes of its executable, since a rebuild that changes the outputs
+// may keep the version string.
+const std::string& tool_digest() {
     static const std::string tool = [] {
         Sha256 hash;
         hash.add(ANIMORDER_VERSION);
@@ -465,9 +490,13 @@ std::string item_stamp(const PlannedItem& p, const BatchOptions& batch) {
             hash.add_file(executable);
         return hash.hex();
     }();
+    return tool;
+}
+
+std::string item_stamp(const PlannedItem& p, const BatchOptions& batch) {
     Sha256 hash;
     hash.add("animorder batch stamp 3");
-    hash.add(tool);
+    hash.add(tool_digest());
     hash.add(optimize_settings_json(p.options, p.plan, false).dump());
     hash.add("max_memory:" + std::to_string(p.options.common.max_memory));
     hash.add("input:" + p.item.input_as_written);
@@ -590,6 +619,16 @@ json current_report(const PlannedItem& p, const std::string& stamp) {
     for (const std::string& out : p.plan.outputs)
         if (!fs::is_regular_file(out, error)) return json();
     const json& batch = report["batch"];
+    // Every output but the report as it was written (a truncated or emptied one is not up to date).
+    const auto outputs = batch.find("outputs");
+    if (outputs == batch.end() || !outputs->is_array()) return json();
+    for (const std::string& out : p.plan.outputs) {
+        if (out == p.report) continue;
+        const std::string name = fs::path(out).filename().string();
+        const auto entry =
+            std::find_if(outputs->begin(), outputs->end(), [&](const json& e) { return string_at(e, "file") == name; });
+        if (entry == outputs->end() || string_at(*entry, "sha256") != file_digest(out)) return json();
+    }
     const auto side = batch.find("side_files");
     if (side != batch.end()) {
         if (!side->is_array()) return json();
@@ -674,6 +713,13 @@ void run_item(const PlannedItem& p, const std::string& stamp, const BatchOptions
     files_of_item.push_back(p.error);
     remove_stale_temporaries(files_of_item);
     OutputSet files;
+    json written = json::array();  // each output but the report: its name and digest
+    files.observe([&](const std::string& path, const std::string& data) {
+        if (path == p.report) return;
+        Sha256 hash;
+        hash.add_data(path, data);
+        written.push_back({{"file", fs::path(path).filename().string()}, {"sha256", hash.hex()}});
+    });
     json side;  // digests as loaded: an edit while the method runs makes the item stale
     OptimizeProduct product = produce_optimize(p.options, p.plan, files, [&](const std::vector<std::string>& read) {
         for (const std::string& file : read) {
@@ -729,6 +775,8 @@ void run_item(const PlannedItem& p, const std::string& stamp, const BatchOptions
                        {"eval_resolution", batch.eval_resolution},
                        {"index_bytes_added", uint64_t(buffers > 0 ? buffers - 1 : 0) * mesh.indices.size() * 4},
                        {"side_files", side},
+                       {"outputs", written},
+                       {"tool", tool_digest()},
                        {"time_s", std::chrono::duration<double>(Clock::now() - start).count()}};
     if (batch.no_timings) drop_timings(report);
     // An input edited while the item ran (between its stamp and its load): the outputs may come
@@ -744,12 +792,30 @@ void run_item(const PlannedItem& p, const std::string& stamp, const BatchOptions
 // ---------------------------------------------------------------------------------------------
 // The summary, merged from the items' files in manifest order
 
-json summary_row(const PlannedItem& p, const std::string& stamp) {
+// Why an item has no up-to-date result, as far as its files tell: none yet, or a report that no
+// longer matches (written by another animorder build, with other --eval-* options, or before its
+// inputs or options changed).
+std::string why_missing(const PlannedItem& p, const BatchOptions& batch) {
+    const json report = read_json_file(p.report);
+    if (!report.is_object() || !report.contains("batch")) return "no result yet (not run, or its run did not finish)";
+    const json& b = report["batch"];
+    if (b.contains("tool") && b["tool"] != tool_digest())
+        return "its result was written by another animorder build (run the merge with the build that ran the items)";
+    if (b.value("eval_views", json()) != json(batch.eval_views) ||
+        b.value("eval_resolution", json()) != json(batch.eval_resolution))
+        return "its result was evaluated with other --eval-views/--eval-resolution (give the merge the same)";
+    return "its result is out of date: its inputs, options, outputs or --no-timings changed since it ran";
+}
+
+// `failed_now`: the error of this run's attempt, when the item failed in it (its earlier report,
+// still matching, does not make it ok).
+json summary_row(const PlannedItem& p, const std::string& stamp, const BatchOptions& batch,
+                 const std::string& failed_now) {
     json row = {{"name", p.item.name},
                 {"input", p.item.input_as_written.empty() ? "(bundled)" : p.item.input_as_written},
                 {"output", p.item.output_as_written},
                 {"method", method_name(p.plan.method)}};
-    const json report = current_report(p, stamp);
+    const json report = failed_now.empty() ? current_report(p, stamp) : json();
     if (report.is_object()) {
         const json& b = report["batch"];
         for (const char* key : {"triangles", "clips", "buffers", "acmr_before", "acmr_after", "ovr_before", "ovr_after",
@@ -760,13 +826,12 @@ json summary_row(const PlannedItem& p, const std::string& stamp) {
         return row;
     }
     const json failure = read_json_file(p.error);
-    const bool failed = string_at(failure, "stamp") == stamp;
+    const bool failed = !failed_now.empty() || string_at(failure, "stamp") == stamp;
     for (const char* key : {"triangles", "clips", "buffers", "acmr_before", "acmr_after", "ovr_before", "ovr_after",
                             "index_bytes_added", "time_s"})
         row[key] = nullptr;
     row["status"] = failed ? "failed" : "missing";
-    row["error"] =
-        failed ? string_at(failure, "error") : "no up-to-date result (not run yet, or its inputs or options changed)";
+    row["error"] = !failed_now.empty() ? failed_now : failed ? string_at(failure, "error") : why_missing(p, batch);
     return row;
 }
 
@@ -805,15 +870,17 @@ std::string summary_markdown(const json& summary) {
     return md;
 }
 
-// Builds and writes the summary; returns the exit code it implies.
+// Builds and writes the summary; returns the exit code it implies. failed_now: per item, the
+// error of this run's attempt when it failed (empty otherwise).
 int write_summary(const std::vector<PlannedItem>& items, const std::vector<std::string>& stamps,
-                  const std::string& stem, const std::string& manifest, const BatchOptions& batch) {
+                  const std::vector<std::string>& failed_now, const std::string& stem, const std::string& manifest,
+                  const BatchOptions& batch) {
     json summary = {
         {"tool", "animorder"}, {"version", ANIMORDER_VERSION}, {"manifest", fs::path(manifest).filename().string()}};
     json rows = json::array();
     size_t ok = 0, failed = 0, missing = 0;
     for (size_t i = 0; i < items.size(); ++i) {
-        rows.push_back(summary_row(items[i], stamps[i]));
+        rows.push_back(summary_row(items[i], stamps[i], batch, failed_now[i]));
         const std::string status = rows.back()["status"].get<std::string>();
         (status == "ok" ? ok : status == "failed" ? failed : missing) += 1;
     }
@@ -829,7 +896,7 @@ int write_summary(const std::vector<PlannedItem>& items, const std::vector<std::
     if (!batch.quiet)
         std::fprintf(stderr, "animorder: batch: summary %s.json / .md: %zu ok, %zu failed, %zu missing\n", stem.c_str(),
                      ok, failed, missing);
-    return failed ? kExitItemsFailed : missing ? kExitItemsMissing : 0;
+    return failed && missing ? kExitFailedAndMissing : failed ? kExitItemsFailed : missing ? kExitItemsMissing : 0;
 }
 
 // --shard I/N or env/N → (I, N).
@@ -897,11 +964,11 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
 
     // A shard stamps its own items only, each when its turn comes (so that an input edited while
     // earlier items run is read as it is then); the merge stamps every item.
-    std::vector<std::string> stamps(items.size());
+    std::vector<std::string> stamps(items.size()), failed_now(items.size());
     const bool sharded = shard.second > 1 || !batch.shard.empty();
     if (batch.merge) {
         for (size_t i = 0; i < items.size(); ++i) stamps[i] = item_stamp(items[i], batch);
-        return write_summary(items, stamps, summary, batch.manifest, batch);
+        return write_summary(items, stamps, failed_now, summary, batch.manifest, batch);
     }
 
     size_t done = 0, skipped = 0, failed = 0, mine = 0;
@@ -919,6 +986,8 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
             std::vector<std::string> files_of_item = p.plan.outputs;
             files_of_item.push_back(p.error);
             remove_stale_temporaries(files_of_item);
+            std::error_code error;
+            fs::remove(p.error, error);  // an earlier failure of this item is over: its result is current
             note(p.options.common, label + ": up to date, skipped");
             continue;
         }
@@ -933,6 +1002,7 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
             for (char& c : message)
                 if (c == '\n' || c == '\r') c = ' ';
             std::fprintf(stderr, "animorder: %s: failed: %s\n", label.c_str(), message.c_str());
+            failed_now[i] = message;
             try {
                 write_file_atomically(
                     p.error,
@@ -947,8 +1017,7 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
                 sharded ? (" shard " + std::to_string(shard.first) + "/" + std::to_string(shard.second)).c_str() : "",
                 mine, done, skipped, failed);
     if (sharded) return failed ? kExitItemsFailed : 0;  // the summary is the merge step's
-    const int code = write_summary(items, stamps, summary, batch.manifest, batch);
-    return failed ? kExitItemsFailed : code;
+    return write_summary(items, stamps, failed_now, summary, batch.manifest, batch);
 }
 
 }  // namespace animorder::tool

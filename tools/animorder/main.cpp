@@ -28,12 +28,18 @@ const CLI::Validator kWholeNumber(
     },
     "UINT");
 
+// A path option given as "" (an unset shell variable, say): refused, where it would otherwise read as
+// the option left out (no output written, the bundled character loaded) without a word.
+const CLI::Validator kPath([](std::string& text) -> std::string { return text.empty() ? "must not be empty" : ""; },
+                           "PATH");
+
 void add_common(CLI::App& command, animorder::tool::CommonOptions& common) {
-    command.add_option("input", common.input, "Input mesh (default: the bundled procedural character)");
+    command.add_option("input", common.input, "Input mesh (default: the bundled procedural character)")->check(kPath);
     command.add_flag("-q,--quiet", common.quiet, "No progress or notes on stderr");
-    command.add_option(
-        "--clip", common.clips,
-        "A clip to keep (by name), or a clip file / folder of clip files to add (Mixamo style); repeatable");
+    command
+        .add_option("--clip", common.clips,
+                    "A clip to keep (by name), or a clip file / folder of clip files to add (Mixamo style); repeatable")
+        ->check(kPath);
     command.add_option("--cache-size", common.cache_size, "FIFO vertex cache entries for ACMR and Tipsify")
         ->check(CLI::Range(3u, 1024u));
     command
@@ -138,10 +144,12 @@ void add_optimize_options(CLI::App& command, animorder::tool::OptimizeOptions& o
     command.add_option("-m,--method", optimize.method, "One of: " + method_list(true))->capture_default_str();
     command.add_flag("--joint", optimize.joint, "One set of buffers for all clips (same as --method joint)");
     add_method_options(command, optimize.methods);
-    command.add_option("-o,--output", optimize.output,
-                       "Write OUT.animorder.bin (buffers + lookup tables) and OUT.animorder.json; "
-                       "OUT.glb or OUT.gltf (glTF input) also writes the glTF with the orders");
-    command.add_option("-r,--report", optimize.report_path, "Write the JSON report to this file");
+    command
+        .add_option("-o,--output", optimize.output,
+                    "Write OUT.animorder.bin (buffers + lookup tables) and OUT.animorder.json; "
+                    "OUT.glb or OUT.gltf (glTF input) also writes the glTF with the orders")
+        ->check(kPath);
+    command.add_option("-r,--report", optimize.report_path, "Write the JSON report to this file")->check(kPath);
 }
 
 // A batch item's optimize arguments → options, by the optimize subcommand's own parser.
@@ -205,8 +213,8 @@ int main(int argc, char** argv) {
     evaluate_cmd->add_option("--eval-seed", evaluate.evaluation.seed, "Seed of the evaluation viewpoints")
         ->capture_default_str()
         ->check(kWholeNumber);
-    evaluate_cmd->add_option("-r,--report", evaluate.report_path, "Write the JSON report to this file");
-    evaluate_cmd->add_option("--csv", evaluate.csv_path, "Write the table as CSV to this file");
+    evaluate_cmd->add_option("-r,--report", evaluate.report_path, "Write the JSON report to this file")->check(kPath);
+    evaluate_cmd->add_option("--csv", evaluate.csv_path, "Write the table as CSV to this file")->check(kPath);
     evaluate_cmd->add_flag(
         "--stored", evaluate.stored,
         "Also evaluate the orders stored in INPUT (ANIMORDER_animated_triangle_orders): row 'stored'");
@@ -231,7 +239,7 @@ int main(int argc, char** argv) {
     heatmap_cmd->add_option("--resolution", heatmap.resolution, "Image size in pixels")
         ->capture_default_str()
         ->check(CLI::Range(16u, 8192u));
-    heatmap_cmd->add_option("-o,--output", heatmap.output, "PNG file to write")->required();
+    heatmap_cmd->add_option("-o,--output", heatmap.output, "PNG file to write")->required()->check(kPath);
     heatmap_cmd->add_flag("--blend", heatmap.blend,
                           "Show the blended primitives' mis-sorted fragment pairs per pixel (drawn back to front: 0)");
 
@@ -245,21 +253,25 @@ int main(int argc, char** argv) {
         ->add_option("-o,--output", subdivide.output,
                      "OUT.glb or OUT.gltf; one morph target per keyframe, so the file is large "
                      "(vertices x keyframes x 12 bytes): keep fewer clips with --clip NAME")
-        ->required();
+        ->required()
+        ->check(kPath);
 
     BatchOptions batch;
     CLI::App* batch_cmd = app.add_subcommand(
         "batch", "Optimize every item of a manifest (JSON or CSV); up-to-date items skipped; shards; summary");
     batch_cmd->add_option("manifest", batch.manifest, "Manifest: JSON {\"items\": [...]} or CSV with a header line")
-        ->required();
+        ->required()
+        ->check(kPath);
     batch_cmd->add_flag("-q,--quiet", batch.quiet, "No progress or notes on stderr");
     batch_cmd->add_option("--shard", batch.shard,
                           "I/N: only items i with i % N == I (0-based); env/N: I from JOB_COMPLETION_INDEX or "
                           "SLURM_ARRAY_TASK_ID");
     batch_cmd->add_flag("--merge", batch.merge,
                         "Run nothing: build the summary from the items' reports (after the shards)");
-    batch_cmd->add_option("--summary", batch.summary,
-                          "Write SUMMARY.json and SUMMARY.md (default: the manifest's name + .summary)");
+    batch_cmd
+        ->add_option("--summary", batch.summary,
+                     "Write SUMMARY.json and SUMMARY.md (default: the manifest's name + .summary)")
+        ->check(kPath);
     batch_cmd->add_option("--eval-views", batch.eval_views, "OVR before/after: random views per keyframe (0: no OVR)")
         ->capture_default_str()
         ->check(CLI::Range(size_t(0), size_t(100000)));
@@ -276,10 +288,13 @@ int main(int argc, char** argv) {
     ViewOptions view;
     CLI::App* view_cmd = app.add_subcommand(
         "view", "Serve the viewer page and a glb on 127.0.0.1 (the bundled character, optimised, by default)");
-    view_cmd->add_option("input", view.common.input,
-                         "The optimised glb to show (default: the bundled character, optimised)");
+    view_cmd
+        ->add_option("input", view.common.input,
+                     "The optimised glb to show (default: the bundled character, optimised)")
+        ->check(kPath);
     view_cmd->add_flag("-q,--quiet", view.common.quiet, "No progress or notes on stderr");
-    view_cmd->add_option("--original", view.original, "The un-optimised file, to compare its order in the page");
+    view_cmd->add_option("--original", view.original, "The un-optimised file, to compare its order in the page")
+        ->check(kPath);
     view_cmd->add_option("--port", view.port, "Port on 127.0.0.1 (0: any free one)")
         ->capture_default_str()
         ->check(CLI::Range(0u, 65535u));
@@ -287,24 +302,30 @@ int main(int argc, char** argv) {
     view_cmd->add_option("--seconds", view.seconds, "Stop serving after this many seconds (0: until interrupted)")
         ->check(kWholeNumber)
         ->check(CLI::Range(0u, 100000000u));
-    view_cmd->add_option("--viewer-root", view.viewer_root,
-                         "The folder holding viewer/ and js/ (default: the source tree)");
+    view_cmd
+        ->add_option("--viewer-root", view.viewer_root, "The folder holding viewer/ and js/ (default: the source tree)")
+        ->check(kPath);
 
     CheckOptions check;
     CLI::App* check_cmd = app.add_subcommand(
         "check",
         "Check the ANIMORDER_animated_triangle_orders orders of a glTF file (JSON report; exit 1 when unusable)");
-    check_cmd->add_option("file", check.file, "glTF/GLB file")->required();
+    check_cmd->add_option("file", check.file, "glTF/GLB file")->required()->check(kPath);
     check_cmd->add_flag("-q,--quiet", check.quiet, "No error line on stderr (the JSON report still has it)");
 
     ReapplyOptions reapply;
     CLI::App* reapply_cmd = app.add_subcommand("reapply",
                                                "Map an optimised file's orders onto a processed copy of it (gltfpack, "
                                                "gltf-pipeline...) by matching triangles");
-    reapply_cmd->add_option("optimized", reapply.optimized, "The file animorder optimize wrote")->required();
-    reapply_cmd->add_option("processed", reapply.processed, "The same file after another tool")->required();
+    reapply_cmd->add_option("optimized", reapply.optimized, "The file animorder optimize wrote")
+        ->required()
+        ->check(kPath);
+    reapply_cmd->add_option("processed", reapply.processed, "The same file after another tool")
+        ->required()
+        ->check(kPath);
     reapply_cmd->add_option("-o,--output", reapply.output, "OUT.glb or OUT.gltf: PROCESSED with the orders")
-        ->required();
+        ->required()
+        ->check(kPath);
     reapply_cmd
         ->add_option("--tolerance", reapply.tolerance,
                      "Corner distance allowed, as a fraction of the bounding-box diagonal")

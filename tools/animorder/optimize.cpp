@@ -9,6 +9,7 @@
 
 #include "animorder/atomic_write.h"
 #include "animorder/gltf_writer.h"
+#include "animorder/load.h"
 #include "animorder/sidecar.h"
 
 #include <chrono>
@@ -27,9 +28,9 @@ void output_paths(const OptimizeOptions& options, OptimizePlan& paths) {
     if (options.output.empty()) return;
     check_output_stem(options.output);
     std::string stem = options.output;
-    const std::string extension = std::filesystem::path(options.output).extension().string();
+    const std::string extension = file_extension(options.output);
     if (extension == ".glb" || extension == ".gltf") {
-        const std::string in_ext = std::filesystem::path(options.common.input).extension().string();
+        const std::string in_ext = file_extension(options.common.input);
         if (in_ext != ".glb" && in_ext != ".gltf")
             throw std::runtime_error(options.output +
                                      ": glTF output needs a glTF input (the sidecar works for any input)");
@@ -127,7 +128,7 @@ OptimizeProduct produce_optimize(const OptimizeOptions& options, const OptimizeP
 
     nlohmann::ordered_json written = {{"gltf", nullptr}, {"sidecar", nullptr}, {"sidecar_json", nullptr}};
     if (!paths.gltf.empty()) {
-        const bool binary = std::filesystem::path(paths.gltf).extension() == ".glb";
+        const bool binary = file_extension(paths.gltf) == ".glb";
         std::string kept;
         files.add(paths.gltf, gltf_with_orders(options.common.input, paths.gltf, mesh, run.buffers, run.fallback,
                                                run.framing, method_name(method), binary, &kept));

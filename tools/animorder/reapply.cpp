@@ -51,7 +51,7 @@ std::vector<float> corners(const AnimatedMesh& mesh, const std::vector<size_t>& 
 }  // namespace
 
 int run_reapply(const ReapplyOptions& options) {
-    const std::string extension = std::filesystem::path(options.output).extension().string();
+    const std::string extension = file_extension(options.output);
     if (extension != ".glb" && extension != ".gltf")
         throw std::runtime_error(options.output + ": the output must be a .glb or .gltf file");
     // Every file the two loads read (a .gltf's buffers and images too) is an input.

@@ -6,6 +6,7 @@
 
 #include "animorder/atomic_write.h"
 #include "animorder/gltf_animated_writer.h"
+#include "animorder/load.h"
 #include "animorder/subdivide_animated_mesh.h"
 
 #include <chrono>
@@ -27,7 +28,7 @@ std::string megabytes(size_t bytes) {
 
 int run_subdivide(const SubdivideOptions& options) {
     const auto start = std::chrono::steady_clock::now();
-    const std::string extension = std::filesystem::path(options.output).extension().string();
+    const std::string extension = file_extension(options.output);
     if (extension != ".glb" && extension != ".gltf")
         throw std::runtime_error(options.output + ": the output must be a .glb or .gltf file");
     if (options.levels > kMaxSubdivisionLevels)

@@ -9,7 +9,11 @@
 #include "support/gltf_builder.h"
 #include "support/require.h"
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
+#include <unistd.h>
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -830,4 +834,60 @@ TEST_F(CliOutputs, ExtensionsAreReadInAnyCase) {
         run("subdivide -q --levels 0 " + path("IN.GLB").string() + " -o " + path("S.GLTF").string());
     ASSERT_EQ(s.exit_code, 0) << s.err;
     EXPECT_EQ(test::slurp(path("S.GLTF")).substr(0, 1), "{");
+}
+
+// `view`: a port that is taken is refused before any work (it was found only after optimising the
+// bundled character, whose scratch folder then stayed behind), and the scratch folders that
+// killed runs left are removed once their process is gone.
+class CliView : public Cli {
+protected:
+    void SetUp() override {
+        Cli::SetUp();
+        // A viewer root with the files view checks for: no browser or three.js needed here.
+        fs::create_directories(path("root/viewer/node_modules/three/build"));
+        std::ofstream(path("root/viewer/index.html")) << "<html></html>\n";
+        std::ofstream(path("root/viewer/node_modules/three/build/three.module.js")) << "\n";
+        fs::create_directories(path("tmp"));
+    }
+    std::string view(const std::string& args) {
+        return "env TMPDIR=" + path("tmp").string() + " " + std::string(ANIMORDER_EXE) +
+               " view --no-open --viewer-root " + path("root").string() + " " + args;
+    }
+};
+
+TEST_F(CliView, ATakenPortIsRefusedBeforeAnyWorkAndLeavesNothing) {
+    const int taken = ::socket(AF_INET, SOCK_STREAM, 0);
+    ASSERT_GE(taken, 0);
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    address.sin_port = 0;
+    socklen_t length = sizeof address;
+    ASSERT_EQ(::bind(taken, reinterpret_cast<sockaddr*>(&address), sizeof address), 0);
+    ASSERT_EQ(::listen(taken, 1), 0);
+    ASSERT_EQ(::getsockname(taken, reinterpret_cast<sockaddr*>(&address), &length), 0);
+    const std::string port = std::to_string(ntohs(address.sin_port));
+    const test::Outcome o = test::run_captured(view("--seconds 1 --port " + port), dir_);
+    ::close(taken);
+    EXPECT_EQ(o.exit_code, 1) << o.err;
+    EXPECT_NE(o.err.find("cannot listen on 127.0.0.1:" + port), std::string::npos) << o.err;
+    EXPECT_EQ(o.err.find("optimising"), std::string::npos) << "work came first: " << o.err;
+    EXPECT_TRUE(fs::is_empty(path("tmp"))) << entries_of(path("tmp"));
+}
+
+TEST_F(CliView, ScratchFoldersOfGoneProcessesAreRemoved) {
+    ASSERT_EQ(run("subdivide -q --levels 0 --clip walk -o " + path("in.glb").string()).exit_code, 0);
+    const pid_t gone = ::fork();
+    ASSERT_GE(gone, 0);
+    if (gone == 0) ::_exit(0);
+    ASSERT_EQ(::waitpid(gone, nullptr, 0), gone);
+    const fs::path dead = path("tmp/animorder-view-" + std::to_string(gone));
+    const fs::path alive = path("tmp/animorder-view-" + std::to_string(::getpid()));
+    fs::create_directories(dead);
+    std::ofstream(dead / "char.glb") << "left by a killed run";
+    fs::create_directories(alive);
+    const test::Outcome o = test::run_captured(view("-q --seconds 1 --port 0 " + path("in.glb").string()), dir_);
+    EXPECT_EQ(o.exit_code, 0) << o.err;
+    EXPECT_FALSE(fs::exists(dead)) << "a gone process's scratch folder stayed";
+    EXPECT_TRUE(fs::exists(alive)) << "a running process's scratch folder was removed";
 }

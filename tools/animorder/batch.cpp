@@ -655,17 +655,6 @@ void drop_timings(json& value) {
     }
 }
 
-// Whether process `pid` may still be running: it exists (or is not ours to judge) and is not a
-// zombie (killed, its parent not yet told: it writes nothing more).
-bool process_may_run(const std::string& pid) {
-    if (::kill(pid_t(std::stol(pid)), 0) != 0 && errno == ESRCH) return false;
-    std::ifstream stat("/proc/" + pid + "/stat");
-    std::string line;
-    if (!std::getline(stat, line)) return true;
-    const size_t name_end = line.rfind(')');  // "pid (name) state ...": the name may hold anything
-    return !(name_end != std::string::npos && name_end + 2 < line.size() && line[name_end + 2] == 'Z');
-}
-
 // What a run killed part-way leaves of an item (atomic_write.cpp's temporaries ".NAME.tmpPID" and
 // backups ".NAME.oldPID") is removed when the item is redone or found up to date, once that
 // process is gone.

@@ -66,6 +66,11 @@ auto about_input(const CommonOptions& common, Work&& work) -> decltype(work()) {
 // parsed, --cache-size, log and progress lines on stderr labelled with the method's name).
 MethodSettings method_settings(const MethodOptions& options, const CommonOptions& common, Method method);
 
+// Whether process `pid` (decimal digits) may still be running: it exists (or is not ours to judge)
+// and is not a zombie (killed, its parent not yet told: it writes nothing more). What a killed run
+// left (a temporary named by its process id) may be removed once it is not.
+bool process_may_run(const std::string& pid);
+
 // Numbers in labels and tables: the shortest form that reads back the same ("0.85", "3").
 std::string format_number(double value);
 

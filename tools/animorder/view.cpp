@@ -7,6 +7,7 @@
 // read with a 5 s timeout, files only below the viewer's folders (no "..", no "%", no links out),
 // nothing but loopback.
 #include "commands.h"
+#include "input.h"
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
@@ -14,6 +15,7 @@
 #include <sys/time.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -150,6 +152,33 @@ void make_bundled(const fs::path& dir, bool quiet) {
     if (run_optimize(o) != 0) throw std::runtime_error("could not optimise the bundled character");
 }
 
+// The scratch folders of earlier `view` runs whose process is gone (killed while optimising the
+// bundled character, before it could remove its folder): removed.
+void remove_stale_scratch_folders(const fs::path& temp) {
+    const std::string prefix = "animorder-view-";
+    std::error_code error;
+    for (auto it = fs::directory_iterator(temp, error); !error && it != fs::directory_iterator(); it.increment(error)) {
+        const std::string name = it->path().filename().string(),
+                          pid = name.substr(std::min(name.size(), prefix.size()));
+        if (name.rfind(prefix, 0) != 0 || pid.empty() || pid.size() > 9 ||
+            !std::all_of(pid.begin(), pid.end(), [](char c) { return c >= '0' && c <= '9'; }) || process_may_run(pid))
+            continue;
+        std::error_code ignored;
+        fs::remove_all(it->path(), ignored);
+    }
+}
+
+// The server's socket and the scratch folder, released on every way out (an error included).
+struct Resources {
+    int server = -1;
+    fs::path scratch;
+    ~Resources() {
+        if (server >= 0) ::close(server);
+        std::error_code ignored;
+        if (!scratch.empty()) fs::remove_all(scratch, ignored);
+    }
+};
+
 }  // namespace
 
 int run_view(const ViewOptions& options) {
@@ -160,9 +189,27 @@ int run_view(const ViewOptions& options) {
     if (!fs::is_regular_file(site.root / "viewer" / "node_modules" / "three" / "build" / "three.module.js"))
         throw std::runtime_error("three.js is not installed in " + (site.root / "viewer" / "node_modules").string() +
                                  " (run scripts/install-deps.sh)");
-    fs::path scratch;
+    // The port first: one that is taken is refused before any work.
+    Resources held;
+    held.server = ::socket(AF_INET, SOCK_STREAM, 0);
+    if (held.server < 0) throw std::runtime_error("cannot open a socket");
+    const int server = held.server;
+    const int yes = 1;
+    setsockopt(server, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);  // loopback only
+    address.sin_port = htons(options.port);
+    if (::bind(server, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0 || ::listen(server, 16) != 0)
+        throw std::runtime_error("cannot listen on 127.0.0.1:" + std::to_string(options.port) + " (try --port 0)");
+
+    std::error_code error;
+    const fs::path temp = fs::temp_directory_path(error);
+    if (!error) remove_stale_scratch_folders(temp);
+    fs::path& scratch = held.scratch;
     if (options.common.input.empty()) {
-        scratch = fs::temp_directory_path() / ("animorder-view-" + std::to_string(::getpid()));
+        if (error) throw std::runtime_error("no folder for temporary files: " + error.message());
+        scratch = temp / ("animorder-view-" + std::to_string(::getpid()));
         fs::create_directories(scratch);
         if (!options.common.quiet) std::fprintf(stderr, "view: optimising the bundled character (about 25 s)\n");
         make_bundled(scratch, options.common.quiet);
@@ -177,18 +224,6 @@ int run_view(const ViewOptions& options) {
         if (!fs::is_regular_file(site.original)) throw std::runtime_error("cannot read " + site.original.string());
     }
 
-    const int server = ::socket(AF_INET, SOCK_STREAM, 0);
-    if (server < 0) throw std::runtime_error("cannot open a socket");
-    const int yes = 1;
-    setsockopt(server, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
-    sockaddr_in address{};
-    address.sin_family = AF_INET;
-    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);  // loopback only
-    address.sin_port = htons(options.port);
-    if (::bind(server, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0 || ::listen(server, 16) != 0) {
-        ::close(server);
-        throw std::runtime_error("cannot listen on 127.0.0.1:" + std::to_string(options.port) + " (try --port 0)");
-    }
     socklen_t length = sizeof address;
     getsockname(server, reinterpret_cast<sockaddr*>(&address), &length);
     const std::string url = "http://127.0.0.1:" + std::to_string(ntohs(address.sin_port)) + "/";
@@ -214,9 +249,7 @@ int run_view(const ViewOptions& options) {
         serve_one(client, site, options.common.quiet);
         ::close(client);
     }
-    ::close(server);
-    if (!scratch.empty()) fs::remove_all(scratch);
-    return 0;
+    return 0;  // `held` closes the socket and removes the scratch folder
 }
 
 }  // namespace animorder::tool

@@ -68,6 +68,17 @@ private:
     std::function<void(const std::string&, const std::string&)> observer_;
 };
 
+// Whether process `pid` may still be running: it exists (or is not ours to judge) and is not a
+// zombie (killed, its parent not yet told: it writes nothing more).
+bool process_may_run(long pid);
+
+// What runs killed part-way left beside `target` (SIGKILL, or a signal during a commit): its
+// temporaries (".NAME.tmpPID") whose process is gone are removed, and so are such backups
+// (".NAME.oldPID") while the target exists (a backup whose target is missing may be the only copy
+// of the file it replaced: kept). A process id cannot tell a live process on another machine
+// sharing the folder.
+void remove_stale_temporaries(const std::string& target);
+
 // One file written atomically: an OutputSet of one.
 void write_file_atomically(const std::string& path, const std::string& data);
 

@@ -44,6 +44,43 @@ std::string temporary_name(const fs::path& target, const char* kind) {
     return (folder / ("." + target.filename().string() + "." + kind + std::to_string(::getpid()))).string();
 }
 
+}  // namespace
+
+bool process_may_run(long pid) {
+    if (pid <= 0) return true;
+    if (::kill(pid_t(pid), 0) != 0 && errno == ESRCH) return false;
+    std::FILE* stat = std::fopen(("/proc/" + std::to_string(pid) + "/stat").c_str(), "r");
+    if (!stat) return true;
+    char line[512];
+    const size_t n = std::fread(line, 1, sizeof line - 1, stat);
+    std::fclose(stat);
+    const std::string text(line, n);
+    const size_t name_end = text.rfind(')');  // "pid (name) state ...": the name may hold anything
+    return !(name_end != std::string::npos && name_end + 2 < text.size() && text[name_end + 2] == 'Z');
+}
+
+void remove_stale_temporaries(const std::string& target) {
+    const fs::path path(target);
+    const fs::path folder = path.has_parent_path() ? path.parent_path() : fs::path(".");
+    const std::string prefix = "." + path.filename().string() + ".";
+    std::error_code error;
+    for (auto it = fs::directory_iterator(folder, error); !error && it != fs::directory_iterator();
+         it.increment(error)) {
+        const std::string name = it->path().filename().string();
+        if (name.size() <= prefix.size() + 3 || name.compare(0, prefix.size(), prefix) != 0) continue;
+        const std::string kind = name.substr(prefix.size(), 3), pid = name.substr(prefix.size() + 3);
+        if ((kind != "tmp" && kind != "old") || pid.empty() || pid.size() > 9 ||
+            !std::all_of(pid.begin(), pid.end(), [](char c) { return c >= '0' && c <= '9'; }))
+            continue;
+        if (process_may_run(std::stol(pid))) continue;
+        std::error_code ignored;
+        if (kind == "old" && !fs::exists(path, ignored)) continue;
+        fs::remove(it->path(), ignored);
+    }
+}
+
+namespace {
+
 // The temporaries of the unfinished OutputSets, for the signal handler: a slot names one (and
 // the process that made it) while its file exists and is not being put in place. Each slot's name
 // is written into its own buffer, reused, while the slot names nothing.

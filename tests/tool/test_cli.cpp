@@ -891,3 +891,26 @@ TEST_F(CliView, ScratchFoldersOfGoneProcessesAreRemoved) {
     EXPECT_FALSE(fs::exists(dead)) << "a gone process's scratch folder stayed";
     EXPECT_TRUE(fs::exists(alive)) << "a running process's scratch folder was removed";
 }
+
+// What killed runs left beside an output (temporaries ".NAME.tmpPID", backups ".NAME.oldPID") is
+// removed by the next run that writes it, once that process is gone: a running process's stays,
+// and so does a backup whose target is missing (it may be the only copy of the file it replaced).
+TEST_F(CliOutputs, AKilledRunsTemporariesGoWithTheNextRun) {
+    const pid_t gone = ::fork();
+    ASSERT_GE(gone, 0);
+    if (gone == 0) ::_exit(0);
+    ASSERT_EQ(::waitpid(gone, nullptr, 0), gone);
+    const std::string dead = std::to_string(gone), alive = std::to_string(::getpid());
+    for (const std::string& name :
+         {".out.animorder.bin.tmp" + dead, ".out.animorder.json.tmp" + alive, ".s.glb.tmp" + dead, ".s.glb.old" + dead})
+        std::ofstream(path(name)) << "left by a killed run";
+    const std::string in = path("in.glb").string();
+    ASSERT_EQ(run("optimize -q --method original " + in + " -o " + path("out").string()).exit_code, 0);
+    EXPECT_FALSE(fs::exists(path(".out.animorder.bin.tmp" + dead)));
+    EXPECT_TRUE(fs::exists(path(".out.animorder.json.tmp" + alive))) << "a running process's temporary went";
+    ASSERT_EQ(run("subdivide -q --levels 0 " + in + " -o " + path("s.glb").string()).exit_code, 0);
+    EXPECT_FALSE(fs::exists(path(".s.glb.tmp" + dead)));
+    EXPECT_TRUE(fs::exists(path(".s.glb.old" + dead))) << "the backup went while its target was missing";
+    ASSERT_EQ(run("subdivide -q --levels 0 " + in + " -o " + path("s.glb").string()).exit_code, 0);
+    EXPECT_FALSE(fs::exists(path(".s.glb.old" + dead))) << "a backup of a replaced file stayed";
+}

@@ -655,28 +655,10 @@ void drop_timings(json& value) {
     }
 }
 
-// What a run killed part-way leaves of an item (atomic_write.cpp's temporaries ".NAME.tmpPID" and
-// backups ".NAME.oldPID") is removed when the item is redone or found up to date, once that
-// process is gone.
+// What a run killed part-way left of an item (atomic_write.h's remove_stale_temporaries), removed
+// when the item is redone or found up to date.
 void remove_stale_temporaries(const std::vector<std::string>& outputs) {
-    std::error_code error;
-    for (const std::string& out : outputs) {
-        const fs::path target(out);
-        const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
-        const std::string prefix = "." + target.filename().string() + ".";
-        for (auto it = fs::directory_iterator(folder, error); !error && it != fs::directory_iterator();
-             it.increment(error)) {
-            const std::string name = it->path().filename().string();
-            if (name.size() <= prefix.size() + 3 || name.compare(0, prefix.size(), prefix) != 0) continue;
-            const std::string kind = name.substr(prefix.size(), 3), pid = name.substr(prefix.size() + 3);
-            if ((kind != "tmp" && kind != "old") || pid.empty() || pid.size() > 9 ||
-                !std::all_of(pid.begin(), pid.end(), [](char c) { return std::isdigit(uint8_t(c)); }))
-                continue;
-            if (process_may_run(pid)) continue;
-            std::error_code ignored;
-            fs::remove(it->path(), ignored);
-        }
-    }
+    for (const std::string& out : outputs) animorder::remove_stale_temporaries(out);
 }
 
 json number_or_null(double v, bool have) { return have ? json(v) : json(nullptr); }

@@ -4,14 +4,10 @@
 #include "animorder/load.h"
 #include "animorder/procedural_character.h"
 
-#include <signal.h>
-
-#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 #include <stdexcept>
 
@@ -64,6 +60,7 @@ std::vector<std::string> input_folders(const CommonOptions& common) {
 
 void check_outputs_before_loading(const std::vector<std::string>& outputs, const CommonOptions& common) {
     check_output_paths(outputs, input_files(common), input_folders(common));
+    for (const std::string& output : outputs) remove_stale_temporaries(output);
 }
 
 AnimatedMesh load_animated_input(const CommonOptions& common, std::string& input_name,
@@ -126,15 +123,6 @@ MethodSettings method_settings(const MethodOptions& options, const CommonOptions
     settings.clustering.log = [common, name](const std::string& line) { note(common, name + ": " + line); };
     settings.clustering.progress = progress_printer(common, name + ": assigning nodes");
     return settings;
-}
-
-bool process_may_run(const std::string& pid) {
-    if (::kill(pid_t(std::stol(pid)), 0) != 0 && errno == ESRCH) return false;
-    std::ifstream stat("/proc/" + pid + "/stat");
-    std::string line;
-    if (!std::getline(stat, line)) return true;
-    const size_t name_end = line.rfind(')');  // "pid (name) state ...": the name may hold anything
-    return !(name_end != std::string::npos && name_end + 2 < line.size() && line[name_end + 2] == 'Z');
 }
 
 std::string format_number(double value) {

@@ -35,7 +35,8 @@ std::vector<std::string> input_folders(const CommonOptions& common);
 
 // check_output_paths of the outputs against input_files and input_folders: called before any
 // work, so that no output overwrites an input (a .gltf's .bin, a clip file) or lands in a clip
-// folder, whichever subcommand writes it.
+// folder, whichever subcommand writes it. Then what killed runs left beside the outputs is
+// removed (remove_stale_temporaries).
 void check_outputs_before_loading(const std::vector<std::string>& outputs, const CommonOptions& common);
 
 // The input named on the command line (or the bundled character, saying so). --clip values that
@@ -65,11 +66,6 @@ auto about_input(const CommonOptions& common, Work&& work) -> decltype(work()) {
 // The library's settings for one method from the options (names of the k-means variants
 // parsed, --cache-size, log and progress lines on stderr labelled with the method's name).
 MethodSettings method_settings(const MethodOptions& options, const CommonOptions& common, Method method);
-
-// Whether process `pid` (decimal digits) may still be running: it exists (or is not ours to judge)
-// and is not a zombie (killed, its parent not yet told: it writes nothing more). What a killed run
-// left (a temporary named by its process id) may be removed once it is not.
-bool process_may_run(const std::string& pid);
 
 // Numbers in labels and tables: the shortest form that reads back the same ("0.85", "3").
 std::string format_number(double value);

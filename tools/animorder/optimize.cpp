@@ -158,6 +158,7 @@ int run_optimize(const OptimizeOptions& options) {
     // Every output is checked now, not after minutes of work: folders exist, nothing is an input,
     // no file is named twice.
     check_output_paths(plan.outputs, plan.inputs, plan.input_folders);
+    for (const std::string& output : plan.outputs) remove_stale_temporaries(output);  // of killed runs
 
     OutputSet files;
     const OptimizeProduct product = produce_optimize(options, plan, files);

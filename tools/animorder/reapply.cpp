@@ -65,6 +65,7 @@ int run_reapply(const ReapplyOptions& options) {
         }
     }
     check_output_paths({options.output}, inputs);
+    remove_stale_temporaries(options.output);  // what killed runs left
     const OrdersExtensionCheck orders = read_orders_extension(options.optimized);
     LoadOptions load;
     load.max_keyframe_bytes = options.max_memory;

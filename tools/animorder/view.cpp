@@ -7,7 +7,8 @@
 // read with a 5 s timeout, files only below the viewer's folders (no "..", no "%", no links out),
 // nothing but loopback.
 #include "commands.h"
-#include "input.h"
+
+#include "animorder/atomic_write.h"
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
@@ -161,7 +162,8 @@ void remove_stale_scratch_folders(const fs::path& temp) {
         const std::string name = it->path().filename().string(),
                           pid = name.substr(std::min(name.size(), prefix.size()));
         if (name.rfind(prefix, 0) != 0 || pid.empty() || pid.size() > 9 ||
-            !std::all_of(pid.begin(), pid.end(), [](char c) { return c >= '0' && c <= '9'; }) || process_may_run(pid))
+            !std::all_of(pid.begin(), pid.end(), [](char c) { return c >= '0' && c <= '9'; }) ||
+            process_may_run(std::stol(pid)))
             continue;
         std::error_code ignored;
         fs::remove_all(it->path(), ignored);

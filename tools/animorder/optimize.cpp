@@ -117,9 +117,9 @@ OptimizeProduct produce_optimize(const OptimizeOptions& options, const OptimizeP
                                          std::to_string(kMaxPerKeyframeBuffers) +
                                          "; keep shorter clips (--clip), or write only the report (no -o)");
     const double load_s = seconds_since(start);
-    note(options.common, "loaded " + input_name + ": " + std::to_string(mesh.triangle_count()) + " triangles, " +
-                             std::to_string(mesh.vertex_count) + " vertices, " + std::to_string(mesh.keyframe_count()) +
-                             " keyframes");
+    note(options.common, std::string(method_name(method)) + ": " + std::to_string(mesh.triangle_count()) +
+                             " triangles, " + std::to_string(mesh.vertex_count) + " vertices, " +
+                             std::to_string(mesh.keyframe_count()) + " keyframes (" + input_name + ")");
 
     product.run = about_input(options.common, [&] { return run_method(mesh, method, settings); });
     const MethodResult& run = product.run;

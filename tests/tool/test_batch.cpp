@@ -622,7 +622,10 @@ TEST_F(Batch, ManifestMistakesAreRefusedBeforeAnyWork) {
         {"m.json", R"({"items": [{"method": "original", "options": "--threads 1", "output": "out/a"}]})"},
         // a spreadsheet's "Unicode text" (UTF-16), an empty file
         {"m.csv", std::string("\xFF\xFEm\0e\0t\0h\0o\0d\0", 14)},
-        {"m.csv", ""}};
+        {"m.csv", ""},
+        // an object's option keys are names without dashes; a manifest that is neither object nor list
+        {"m.json", R"({"items": [{"method": "original", "options": {"": "x"}, "output": "out/a"}]})"},
+        {"m.json", "5"}};
     for (const auto& [name, text] : bad) {
         write(name, text);
         const test::Outcome o = run("batch -q --eval-views 0 " + path(name).string());
@@ -644,7 +647,7 @@ TEST_F(Batch, ManifestMistakesAreRefusedBeforeAnyWork) {
     }
     fs::remove(path("m.csv"));
     write("m.json", R"({"items": [{"method": "original", "output": "out/a"}]})");
-    for (const char* options : {"--summary out/", "--shard env/0", "--summary /dev/null/x"}) {
+    for (const char* options : {"--summary out/", "--shard env/0", "--summary /dev/null/x", "--merge --force"}) {
         const test::Outcome o = run("batch -q --eval-views 0 " + std::string(options) + " " + manifest());
         EXPECT_EQ(o.exit_code, 1) << options;
         EXPECT_EQ(test::line_count(o.err), 1u) << options << "\n" << o.err;
@@ -798,4 +801,22 @@ TEST_F(Batch, AMergeWithFailedAndMissingItemsExitsFive) {
     EXPECT_EQ(s["failed"], 1);
     EXPECT_EQ(s["missing"], 1);
     EXPECT_NE(s["items"][1]["error"].get<std::string>().find("no result yet"), std::string::npos) << s["items"][1];
+}
+
+// The summary is the same bytes whichever folder the batch starts in, failed rows included (their
+// errors named the input as resolved from the current folder); --summary S.json names S.json and S.md.
+TEST_F(Batch, AFailedRowIsTheSameFromAnyFolderAndSummaryTakesItsJsonName) {
+    fs::create_directories(path("lib/out"));
+    write("lib/m.json", R"({"items": [{"input": "missing.glb", "method": "original", "output": "out/a"},
+                                      {"method": "original", "output": "out/b"}]})");
+    const std::string options = " -q --no-timings --eval-views 0 --threads 1 ";
+    EXPECT_EQ(run_from(path("lib"), "batch" + options + "m.json", dir_).exit_code, 3);
+    const std::string from_lib = test::slurp(path("lib/m.summary.json"));
+    EXPECT_NE(from_lib.find("missing.glb"), std::string::npos) << from_lib;
+    EXPECT_EQ(run_from(dir_, "batch" + options + "lib/m.json", dir_).exit_code, 3);
+    EXPECT_EQ(test::slurp(path("lib/m.summary.json")), from_lib);
+    EXPECT_EQ(run_from(dir_, "batch" + options + "--merge --summary lib/s.json lib/m.json", dir_).exit_code, 3);
+    EXPECT_EQ(test::slurp(path("lib/s.json")), from_lib);
+    EXPECT_TRUE(fs::exists(path("lib/s.md")));
+    EXPECT_FALSE(fs::exists(path("lib/s.json.json")));
 }

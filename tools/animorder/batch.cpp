@@ -133,6 +133,9 @@ std::vector<std::string> options_from_json(const json& value, const std::string&
     }
     if (value.is_object()) {
         for (auto it = value.begin(); it != value.end(); ++it) {
+            if (it.key().empty() || it.key()[0] == '-')
+                throw std::runtime_error(where + ": option name \"" + it.key() +
+                                         "\" (an object's keys are option names without dashes: {\"lambda\": 3})");
             const std::string flag = (it.key().size() == 1 ? "-" : "--") + it.key();
             if (it.value().is_boolean()) {
                 if (it.value().get<bool>()) out.push_back(flag);
@@ -182,7 +185,10 @@ std::vector<ManifestItem> parse_json_manifest(const std::string& text, const std
                 throw std::runtime_error(path + ": unknown key \"" + it.key() + "\" (a manifest holds only \"items\")");
         list = &doc["items"];
     }
-    if (!list->is_array()) throw std::runtime_error(path + ": \"items\" must be a list");
+    if (!list->is_array())
+        throw std::runtime_error(path + (doc.is_object()
+                                             ? ": \"items\" must be a list"
+                                             : ": a JSON manifest is {\"items\": [...]} or a list of items"));
     std::vector<ManifestItem> items;
     for (size_t i = 0; i < list->size(); ++i) {
         const json& e = (*list)[i];
@@ -870,6 +876,24 @@ int write_summary(const std::vector<PlannedItem>& items, const std::vector<std::
     return failed && missing ? kExitFailedAndMissing : failed ? kExitItemsFailed : missing ? kExitItemsMissing : 0;
 }
 
+// An item's error with its paths as the manifest writes them (the loaders name them as resolved
+// against the manifest's folder, or made absolute), so that the summary is the same bytes whatever
+// folder the batch starts in.
+std::string as_written(const ManifestItem& item, std::string message) {
+    std::vector<std::pair<std::string, std::string>> paths = {{item.input, item.input_as_written},
+                                                              {item.output, item.output_as_written}};
+    for (size_t c = 0; c < item.clips.size() && c < item.clips_as_written.size(); ++c)
+        paths.emplace_back(item.clips[c], item.clips_as_written[c]);
+    std::sort(paths.begin(), paths.end(), [](const auto& a, const auto& b) { return a.first.size() > b.first.size(); });
+    for (const auto& [resolved, written] : paths) {
+        if (resolved.empty() || resolved == written) continue;
+        for (size_t at = message.find(resolved); at != std::string::npos;
+             at = message.find(resolved, at + written.size()))
+            message.replace(at, resolved.size(), written);
+    }
+    return message;
+}
+
 // --shard I/N or env/N → (I, N).
 std::pair<size_t, size_t> parse_shard(const std::string& text) {
     const size_t slash = text.find('/');
@@ -911,12 +935,15 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
     if (!batch.shard.empty()) shard = parse_shard(batch.shard);
     if (batch.merge && !batch.shard.empty())
         throw std::runtime_error("--merge builds the summary of every shard: drop --shard");
+    if (batch.merge && batch.force) throw std::runtime_error("--merge runs no item: drop --force");
 
     // Every item planned and every output of every item checked before any work: folders exist
     // and are writable, no output is any item's input or the manifest, no file is named twice.
     std::vector<PlannedItem> items;
     for (size_t i = 0; i < manifest.size(); ++i) items.push_back(plan_item(manifest[i], i, batch, parse_item));
     std::string summary = batch.summary;
+    if (file_extension(summary) == ".json" || file_extension(summary) == ".md")  // --summary S.json: S
+        summary.erase(summary.size() - file_extension(summary).size());
     if (summary.empty()) {
         const fs::path m(batch.manifest);
         summary = (m.parent_path() / m.stem()).string() + ".summary";
@@ -969,7 +996,7 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
             note(p.options.common, label + ": done");
         } catch (const std::exception& e) {
             ++failed;
-            std::string message = e.what();
+            std::string message = as_written(p.item, e.what());
             for (char& c : message)
                 if (c == '\n' || c == '\r') c = ' ';
             std::fprintf(stderr, "animorder: %s: failed: %s\n", label.c_str(), message.c_str());

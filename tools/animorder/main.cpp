@@ -270,7 +270,8 @@ int main(int argc, char** argv) {
                         "Run nothing: build the summary from the items' reports (after the shards)");
     batch_cmd
         ->add_option("--summary", batch.summary,
-                     "Write SUMMARY.json and SUMMARY.md (default: the manifest's name + .summary)")
+                     "Write SUMMARY.json and SUMMARY.md (SUMMARY.json says the same; default: the manifest's name + "
+                     ".summary)")
         ->check(kPath);
     batch_cmd->add_option("--eval-views", batch.eval_views, "OVR before/after: random views per keyframe (0: no OVR)")
         ->capture_default_str()

@@ -50,6 +50,10 @@ struct LoadOptions {
 // so that a caller deciding by extension (glTF output or not, a manifest's format) agrees with it.
 std::string file_extension(const std::string& path);
 
+// Whether a file of this name carries its own clips (glTF, MD2, IQM), so that clip files do not
+// apply to it (load_character refuses them): a clip given for it is a clip name.
+bool carries_its_clips(const std::string& path);
+
 // By extension: .gltf/.glb → load_gltf (gltf_loader.h), .md2 → load_md2, .iqm → load_iqm (no
 // clip files), anything else → load_assimp. A folder in
 // clip_files stands for the files in it, in name order. Throws LoadError when a file it would

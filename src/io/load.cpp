@@ -129,6 +129,11 @@ void add_files_read(std::vector<std::string>& files_read, const std::vector<std:
 
 std::string file_extension(const std::string& path) { return lower_extension(path); }
 
+bool carries_its_clips(const std::string& path) {
+    const std::string extension = lower_extension(path);
+    return extension == ".gltf" || extension == ".glb" || extension == ".md2" || extension == ".iqm";
+}
+
 std::vector<std::string> files_load_reads(const std::string& path, const std::vector<std::string>& clip_files) {
     std::vector<std::string> files = {path};
     const std::string extension = lower_extension(path);
@@ -169,7 +174,7 @@ AnimatedMesh load_character(const std::string& path, const std::vector<std::stri
     if (options.files_read) add_files_read(*options.files_read, reads);
     const std::vector<std::string> files = expand_clip_files(clip_files);
     const std::string extension = lower_extension(path);
-    if (extension == ".gltf" || extension == ".glb" || extension == ".md2" || extension == ".iqm") {
+    if (carries_its_clips(path)) {
         if (!files.empty())
             throw LoadError(path + ": clip files apply to assimp formats (this file carries its clips)");
         if (extension == ".md2") return load_md2(path, options);

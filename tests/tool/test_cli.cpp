@@ -719,13 +719,15 @@ TEST_F(CliOutputs, TwoOutputsOnOneFileAreRefusedBeforeAnyWrite) {
 }
 
 // A clip folder is read whole: an output placed in it would be read as a clip by the next run.
+// (Clip folders are for characters that do not carry their clips: an OBJ here.)
 TEST_F(CliOutputs, AnOutputInAClipFolderIsRefused) {
     fs::create_directories(path("clips"));
     fs::copy_file(path("in.glb"), path("clips/walk.glb"));
-    expect_refused("optimize " + path("in.glb").string() + " --clip " + path("clips").string() + " -o " +
+    std::ofstream(path("in.obj")) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    expect_refused("optimize " + path("in.obj").string() + " --clip " + path("clips").string() + " -o " +
                        path("clips/out").string(),
                    "clip folder");
-    expect_refused("optimize " + path("in.glb").string() + " --clip " + path("clips").string() + " -r " +
+    expect_refused("optimize " + path("in.obj").string() + " --clip " + path("clips").string() + " -r " +
                        (dir_ / "clips" / "." / "r.json").string(),
                    "clip folder");
     EXPECT_EQ(entries_of(path("clips")), "walk.glb ") << "nothing written";
@@ -791,10 +793,11 @@ TEST_F(CliOutputs, NoCommandWritesOverAFileItsLoadReadsOrIntoAClipFolder) {
     }
     fs::create_directories(path("clips"));
     fs::copy_file(path("in.glb"), path("clips/walk.glb"));
+    std::ofstream(path("in.obj")) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";  // a character without clips
     const std::string clips = " --clip " + path("clips").string();
-    expect_refused("evaluate " + path("in.glb").string() + clips + small + " --csv " + path("clips/t.csv").string(),
+    expect_refused("evaluate " + path("in.obj").string() + clips + small + " --csv " + path("clips/t.csv").string(),
                    "clip folder");
-    expect_refused("subdivide --levels 1 " + path("in.glb").string() + clips + " -o " + path("clips/s.glb").string(),
+    expect_refused("subdivide --levels 1 " + path("in.obj").string() + clips + " -o " + path("clips/s.glb").string(),
                    "clip folder");
     EXPECT_EQ(entries_of(path("clips")), "walk.glb ") << "nothing written";
 }
@@ -913,4 +916,18 @@ TEST_F(CliOutputs, AKilledRunsTemporariesGoWithTheNextRun) {
     EXPECT_TRUE(fs::exists(path(".s.glb.old" + dead))) << "the backup went while its target was missing";
     ASSERT_EQ(run("subdivide -q --levels 0 " + in + " -o " + path("s.glb").string()).exit_code, 0);
     EXPECT_FALSE(fs::exists(path(".s.glb.old" + dead))) << "a backup of a replaced file stayed";
+}
+
+// A character that carries its clips (glTF here, and the bundled one) takes --clip values as clip
+// names, even when a file of that name is in the current folder (it was read as a clip file, and
+// refused: "clip files apply to assimp formats").
+TEST_F(CliOutputs, AClipNameIsANameWhateverTheCurrentFolderHolds) {
+    std::ofstream(path("walk")) << "a file named like the clip";
+    const test::Outcome gltf = test::run_captured(
+        "cd '" + dir_.string() + "' && " + std::string(ANIMORDER_EXE) + " inspect --json in.glb --clip walk", dir_);
+    ASSERT_EQ(gltf.exit_code, 0) << gltf.err;
+    EXPECT_EQ(nlohmann::json::parse(gltf.out)["clips"].size(), 1u) << gltf.out;
+    const test::Outcome bundled = test::run_captured(
+        "cd '" + dir_.string() + "' && " + std::string(ANIMORDER_EXE) + " inspect -q --clip walk", dir_);
+    EXPECT_EQ(bundled.exit_code, 0) << bundled.err;
 }

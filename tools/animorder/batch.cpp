@@ -368,6 +368,7 @@ std::vector<ManifestItem> read_manifest(const std::string& path) {
         // A clip file or folder beside the manifest (or absolute), made absolute: optimize then
         // takes an absolute clip as a file and any other as a clip name, whatever the current folder.
         for (std::string& c : item.clips) {
+            if (!item.input_given || carries_its_clips(item.input)) break;  // clip names only
             std::error_code error;
             const fs::path beside = fs::path(c).is_absolute() ? fs::path(c) : base / c;
             if (fs::exists(beside, error)) c = fs::absolute(beside, error).string();

@@ -33,6 +33,9 @@ std::function<void(size_t, size_t)> progress_printer(const CommonOptions& common
 }
 
 bool clip_is_file(const CommonOptions& common, const std::string& clip) {
+    // A character that carries its clips takes clip names only: a file of that name in the
+    // current folder does not make it a clip file.
+    if (common.input.empty() || carries_its_clips(common.input)) return false;
     return common.clip_files_absolute ? std::filesystem::path(clip).is_absolute() : std::filesystem::exists(clip);
 }
 

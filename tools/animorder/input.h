@@ -22,7 +22,8 @@ void note(const CommonOptions& common, const std::string& text);
 // A progress line on stderr that rewrites itself (at most two updates a second); none if --quiet.
 std::function<void(size_t, size_t)> progress_printer(const CommonOptions& common, const std::string& stage);
 
-// Whether a --clip value names a clip file or folder (else the name of a clip to keep).
+// Whether a --clip value names a clip file or folder (else the name of a clip to keep): never for a
+// character that carries its clips (glTF, MD2, IQM, the bundled one).
 bool clip_is_file(const CommonOptions& common, const std::string& clip);
 
 // Every file a run on these options reads, as far as known before loading (files_load_reads):
@@ -40,7 +41,7 @@ std::vector<std::string> input_folders(const CommonOptions& common);
 void check_outputs_before_loading(const std::vector<std::string>& outputs, const CommonOptions& common);
 
 // The input named on the command line (or the bundled character, saying so). --clip values that
-// exist on disk are clip files or folders (Mixamo style); the others name the clips to keep.
+// exist on disk are clip files or folders (Mixamo style) (clip_is_file); the others name the clips to keep.
 // files_read, when given, receives every file the load read (LoadOptions::files_read).
 AnimatedMesh load_animated_input(const CommonOptions& common, std::string& input_name,
                                  std::vector<std::string>* files_read = nullptr);

@@ -479,10 +479,6 @@ private:
     sha256_ctx ctx_;
 };
 
-// The stamp of an item: everything its outputs depend on (not --threads, which changes nothing):
-// the tool (version and executable), the settings, the manifest's spellings of its paths, and the bytes of every
-// file it reads as far as known before loading (OptimizePlan::inputs: the character, a glTF's
-// external buffers and images, clip files, the files of clip folders).
 // The tool: its version and the bytes of its executable, since a rebuild that changes the outputs
 // may keep the version string.
 const std::string& tool_digest() {
@@ -500,6 +496,10 @@ const std::string& tool_digest() {
     return tool;
 }
 
+// The stamp of an item: everything its outputs depend on (not --threads, which changes nothing):
+// the tool (version and executable), the settings, the manifest's spellings of its paths, and the bytes of every
+// file it reads as far as known before loading (OptimizePlan::inputs: the character, a glTF's
+// external buffers and images, clip files, the files of clip folders).
 std::string item_stamp(const PlannedItem& p, const BatchOptions& batch) {
     Sha256 hash;
     hash.add("animorder batch stamp 3");

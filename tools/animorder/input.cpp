@@ -61,9 +61,14 @@ std::vector<std::string> input_folders(const CommonOptions& common) {
     return folders;
 }
 
-void check_outputs_before_loading(const std::vector<std::string>& outputs, const CommonOptions& common) {
-    check_output_paths(outputs, input_files(common), input_folders(common));
+void check_outputs(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs,
+                   const std::vector<std::string>& input_folders) {
+    check_output_paths(outputs, inputs, input_folders);
     for (const std::string& output : outputs) remove_stale_temporaries(output);
+}
+
+void check_outputs_before_loading(const std::vector<std::string>& outputs, const CommonOptions& common) {
+    check_outputs(outputs, input_files(common), input_folders(common));
 }
 
 AnimatedMesh load_animated_input(const CommonOptions& common, std::string& input_name,

@@ -34,7 +34,12 @@ std::vector<std::string> input_files(const CommonOptions& common);
 // The --clip values that are folders: a run reads every file in them.
 std::vector<std::string> input_folders(const CommonOptions& common);
 
-// check_output_paths of the outputs against input_files and input_folders: called before any
+// check_output_paths, then what killed runs left beside the outputs removed
+// (remove_stale_temporaries): every command's check of its outputs before any work.
+void check_outputs(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs,
+                   const std::vector<std::string>& input_folders = {});
+
+// check_outputs of the outputs against input_files and input_folders: called before any
 // work, so that no output overwrites an input (a .gltf's .bin, a clip file) or lands in a clip
 // folder, whichever subcommand writes it. Then what killed runs left beside the outputs is
 // removed (remove_stale_temporaries).

@@ -157,8 +157,7 @@ int run_optimize(const OptimizeOptions& options) {
     const OptimizePlan plan = plan_optimize(options);
     // Every output is checked now, not after minutes of work: folders exist, nothing is an input,
     // no file is named twice.
-    check_output_paths(plan.outputs, plan.inputs, plan.input_folders);
-    for (const std::string& output : plan.outputs) remove_stale_temporaries(output);  // of killed runs
+    check_outputs(plan.outputs, plan.inputs, plan.input_folders);
 
     OutputSet files;
     const OptimizeProduct product = produce_optimize(options, plan, files);

@@ -7,6 +7,7 @@
 // differ). Refused, with nothing written, unless every triangle of every optimised primitive
 // matches one triangle of PROCESSED and every processed primitive is wholly matched or untouched.
 #include "commands.h"
+#include "input.h"
 
 #include "animorder/animated_mesh.h"
 #include "animorder/atomic_write.h"
@@ -64,8 +65,7 @@ int run_reapply(const ReapplyOptions& options) {
             inputs.push_back(*file);
         }
     }
-    check_output_paths({options.output}, inputs);
-    remove_stale_temporaries(options.output);  // what killed runs left
+    check_outputs({options.output}, inputs);
     const OrdersExtensionCheck orders = read_orders_extension(options.optimized);
     LoadOptions load;
     load.max_keyframe_bytes = options.max_memory;

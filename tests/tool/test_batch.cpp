@@ -820,3 +820,71 @@ TEST_F(Batch, AFailedRowIsTheSameFromAnyFolderAndSummaryTakesItsJsonName) {
     EXPECT_TRUE(fs::exists(path("lib/s.md")));
     EXPECT_FALSE(fs::exists(path("lib/s.json.json")));
 }
+
+// --dry-run writes nothing and says, per item of the shard, whether a run would redo it and which
+// part of its stamp or which output is why: each change below is made by hand, so the reasons
+// are known independently of batch.
+TEST_F(Batch, ADryRunSaysWhatWouldRunAndWhyAndWritesNothing) {
+    write("tri.bin", triangle_bytes(0));
+    write("tri.gltf", triangle_gltf("tri.bin"));
+    const auto manifest_with = [&](const std::string& k_of_b) {
+        write("m.json", R"({"items": [
+          {"name": "a", "clips": ["walk"], "options": "-k 2 --views 12 --resolution 32 --max-iterations 2", "output": "out/a"},
+          {"name": "b", "clips": ["wave"], "options": "-k )" +
+                            k_of_b + R"( --views 12 --resolution 32 --max-iterations 2", "output": "out/b"},
+          {"name": "tri", "input": "tri.gltf", "method": "original", "output": "out/tri"},
+          {"name": "c", "method": "original", "output": "out/c"}
+        ]})");
+    };
+    manifest_with("2");
+    const auto plan = [&](const std::string& options) {  // --eval-views 0 unless given
+        const std::string eval = options.find("--eval-views") == std::string::npos ? " --eval-views 0" : "";
+        const test::Outcome o = run("batch -q --dry-run" + eval + options + " " + manifest());
+        EXPECT_EQ(o.exit_code, 0) << o.err;
+        return nlohmann::json::parse(o.out);
+    };
+    const auto whys = [](const nlohmann::json& p) {
+        std::vector<std::string> out;
+        for (const auto& item : p["items"])
+            out.push_back(item["action"].get<std::string>() + ": " + item["why"].get<std::string>());
+        return out;
+    };
+    const std::string none = "run: no result yet (not run, or its run did not finish)";
+    nlohmann::json p = plan("");
+    EXPECT_EQ(whys(p), std::vector<std::string>(4, none));
+    EXPECT_EQ(p["run"], 4);
+    EXPECT_TRUE(outputs().empty());
+    EXPECT_FALSE(fs::exists(path("m.summary.json")));
+
+    ASSERT_EQ(run("batch -q --eval-views 0 " + manifest()).exit_code, 0);
+    const std::map<std::string, std::string> written = outputs();
+    EXPECT_EQ(whys(plan("")), std::vector<std::string>(4, "skip: up to date"));
+    EXPECT_EQ(whys(plan(" --force")), std::vector<std::string>(4, "run: --force"));
+    const nlohmann::json evaluated = plan(" --eval-views 1");
+    EXPECT_NE(evaluated["items"][0]["why"].get<std::string>().find("--eval-views"), std::string::npos);
+
+    manifest_with("3");
+    write("tri.bin", triangle_bytes(0.5f));
+    fs::remove(path("out/c.animorder.bin"));
+    p = plan("");
+    EXPECT_EQ(whys(p), (std::vector<std::string>{"skip: up to date", "run: its options changed since it ran",
+                                                 "run: its input ../tri.bin changed since it ran",
+                                                 "run: its output out/c.animorder.bin is missing"}));
+    EXPECT_EQ(p["run"], 3);
+    EXPECT_EQ(p["skip"], 1);
+    // A shard's plan lists its own items only.
+    p = plan(" --shard 1/2");
+    ASSERT_EQ(p["items"].size(), 2u);
+    EXPECT_EQ(p["items"][0]["name"], "b");
+    EXPECT_EQ(p["items"][1]["name"], "c");
+    EXPECT_EQ(p["shard"], nlohmann::json::array({1, 2}));
+    // Nothing was written or removed by any of the plans.
+    std::map<std::string, std::string> now = outputs();
+    EXPECT_EQ(now.size() + 1, written.size());
+    for (const auto& [name, bytes] : now) EXPECT_EQ(bytes, written.at(name)) << name;
+    // A failed item says so, with its error.
+    write("tri.gltf", "{");
+    EXPECT_EQ(run("batch -q --eval-views 0 " + manifest()).exit_code, 3);
+    EXPECT_NE(plan("")["items"][2]["why"].get<std::string>().find("it failed when it last ran: "), std::string::npos);
+    EXPECT_NE(run("batch -q --dry-run --merge " + manifest()).err.find("drop --dry-run"), std::string::npos);
+}

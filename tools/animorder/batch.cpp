@@ -7,7 +7,8 @@
 // as the manifest writes them and the bytes of every file it reads as known before loading, plus
 // the side files the importer opened (an OBJ's .mtl), each with its digest. An item whose report
 // carries the stamp it would have now, with its side files unchanged and every output present,
-// is up to date and skipped; so a run killed at any moment and started
+// is up to date and skipped (`--dry-run` says which items would run and why: the report keeps the
+// stamp's parts); so a run killed at any moment and started
 // again redoes only the items it had not finished, and a changed option or input re-runs only the
 // items it affects. A failing item leaves OUT.animorder.error.json (its stamp and the error) and
 // the batch goes on. `--shard I/N` runs items i with i % N == I (and reads their files only);
@@ -496,25 +497,6 @@ const std::string& tool_digest() {
     return tool;
 }
 
-// The stamp of an item: everything its outputs depend on (not --threads, which changes nothing):
-// the tool (version and executable), the settings, the manifest's spellings of its paths, and the bytes of every
-// file it reads as far as known before loading (OptimizePlan::inputs: the character, a glTF's
-// external buffers and images, clip files, the files of clip folders).
-std::string item_stamp(const PlannedItem& p, const BatchOptions& batch) {
-    Sha256 hash;
-    hash.add("animorder batch stamp 3");
-    hash.add(tool_digest());
-    hash.add(optimize_settings_json(p.options, p.plan, false).dump());
-    hash.add("max_memory:" + std::to_string(p.options.common.max_memory));
-    hash.add("input:" + p.item.input_as_written);
-    hash.add("output:" + p.item.output_as_written);
-    for (const std::string& c : p.item.clips_as_written) hash.add("clip:" + c);
-    hash.add("eval:" + std::to_string(batch.eval_views) + "/" + std::to_string(batch.eval_resolution) +
-             (batch.no_timings ? "/no-timings" : ""));
-    for (const std::string& file : p.plan.inputs) hash.add_file(file);
-    return hash.hex();
-}
-
 json read_json_file(const std::string& path) {
     std::error_code error;
     if (!fs::is_regular_file(path, error)) return json();
@@ -576,6 +558,71 @@ std::string side_file_path(const json& entry) {
     return out;
 }
 
+// A file's path from the item report's folder, as the report names the files the item read.
+std::string from_report_folder(const PlannedItem& p, const std::string& file) {
+    std::error_code error;
+    // Both absolute first: relative() leaves a relative path whose folders are all missing as
+    // it is, and the result was empty (the absolute path was kept, tying the report to a place).
+    fs::path from_report = fs::relative(fs::absolute(file, error), fs::absolute(folder_of(p.report), error), error);
+    if (error || from_report.empty()) from_report = fs::absolute(file, error);
+    return from_report.generic_string();
+}
+
+// The stamp of an item: everything its outputs depend on (not --threads, which changes nothing),
+// in parts, each a digest: the tool (version and executable), the settings, the manifest's
+// spellings of its paths, the batch's evaluation, and the bytes of every file it reads as far as
+// known before loading (OptimizePlan::inputs: the character, a glTF's external buffers and images,
+// clip files, the files of clip folders). The report keeps the parts too ("stamp_parts"), so that
+// an item that is not up to date can say which of them changed.
+struct StampParts {
+    std::string settings, paths, eval;
+    std::vector<std::pair<std::string, std::string>> inputs;  // (file as named, digest)
+};
+
+StampParts stamp_parts(const PlannedItem& p, const BatchOptions& batch) {
+    StampParts parts;
+    Sha256 settings;
+    settings.add(optimize_settings_json(p.options, p.plan, false).dump());
+    settings.add("max_memory:" + std::to_string(p.options.common.max_memory));
+    parts.settings = settings.hex();
+    Sha256 paths;
+    paths.add("input:" + p.item.input_as_written);
+    paths.add("output:" + p.item.output_as_written);
+    for (const std::string& c : p.item.clips_as_written) paths.add("clip:" + c);
+    parts.paths = paths.hex();
+    parts.eval = std::to_string(batch.eval_views) + "/" + std::to_string(batch.eval_resolution) +
+                 (batch.no_timings ? "/no-timings" : "");
+    for (const std::string& file : p.plan.inputs) {
+        Sha256 bytes;
+        bytes.add_file(file);
+        parts.inputs.emplace_back(from_report_folder(p, file), bytes.hex());
+    }
+    return parts;
+}
+
+std::string item_stamp(const StampParts& parts) {
+    Sha256 hash;
+    hash.add("animorder batch stamp 4");
+    hash.add(tool_digest());
+    hash.add(parts.settings);
+    hash.add(parts.paths);
+    hash.add("eval:" + parts.eval);
+    for (const auto& [file, digest] : parts.inputs) hash.add(digest);
+    return hash.hex();
+}
+
+std::string item_stamp(const PlannedItem& p, const BatchOptions& batch) { return item_stamp(stamp_parts(p, batch)); }
+
+json stamp_parts_json(const StampParts& parts) {
+    json inputs = json::array();
+    for (const auto& [file, digest] : parts.inputs) {
+        json entry = side_file_name(file);
+        entry["sha256"] = digest;
+        inputs.push_back(entry);
+    }
+    return {{"settings", parts.settings}, {"paths", parts.paths}, {"eval", parts.eval}, {"inputs", inputs}};
+}
+
 // The files loading read beyond the stamp's (an OBJ's .mtl: only the importer knows them, found
 // or not), each with its path from the report's folder and its digest taken as it was loaded,
 // for the report's "side_files".
@@ -586,12 +633,7 @@ json side_files(const PlannedItem& p, const std::vector<std::string>& files_read
     std::unordered_set<std::string> listed;
     for (const std::string& file : files_read) {
         if (known.count(file_identity(file))) continue;
-        std::error_code error;
-        // Both absolute first: relative() leaves a relative path whose folders are all missing as
-        // it is, and the result was empty (the absolute path was kept, tying the report to a place).
-        fs::path from_report = fs::relative(fs::absolute(file, error), fs::absolute(folder_of(p.report), error), error);
-        if (error || from_report.empty()) from_report = fs::absolute(file, error);
-        const std::string name = from_report.generic_string();
+        const std::string name = from_report_folder(p, file);
         if (!listed.insert(name).second) continue;
         json entry = side_file_name(name);
         // The digest of the path as kept (relative() normalises "dir/" to "dir"), as current_report
@@ -615,36 +657,95 @@ bool summary_fields_hold(const json& batch) {
     return true;
 }
 
-// The item's report when it is up to date: its stamp matches, the summary's figures are as
-// written, every output is there and every side file it lists still has its digest.
-json current_report(const PlannedItem& p, const std::string& stamp) {
+// Why an item's result is not up to date, as far as its files tell ("" when it is: its report
+// carries the stamp the item has now, the summary's figures as written, every output present as
+// it was written, and every side file it lists with its digest). `kind` tells the merge which
+// hint to add.
+struct Staleness {
+    enum Kind { kCurrent, kNoResult, kOtherBuild, kOtherEvaluation, kChanged } kind = kCurrent;
+    std::string why;
+};
+
+// An output's path as the manifest writes it (the item's output stem as written).
+std::string output_as_written(const PlannedItem& p, const std::string& out) {
+    const std::string stem = stem_of(p.item.output);
+    return out.rfind(stem, 0) == 0 ? stem_of(p.item.output_as_written) + out.substr(stem.size()) : out;
+}
+
+// Which part of the stamp changed since the report was written (its "stamp_parts").
+Staleness stamp_change(const PlannedItem& p, const json& then, const BatchOptions& batch) {
+    using S = Staleness;
+    if (string_at(then, "tool") != tool_digest())
+        return {S::kOtherBuild, "its result was written by another animorder build"};
+    const auto old = then.find("stamp_parts");
+    if (old == then.end() || !old->is_object())
+        return {S::kChanged, "its result is out of date: its inputs, options or paths changed since it ran"};
+    const StampParts now = stamp_parts(p, batch);
+    if (string_at(*old, "eval") != now.eval)
+        return {S::kOtherEvaluation, "its result was evaluated with other --eval-views/--eval-resolution/--no-timings"};
+    if (string_at(*old, "settings") != now.settings) return {S::kChanged, "its options changed since it ran"};
+    if (string_at(*old, "paths") != now.paths)
+        return {S::kChanged, "its input, output or clip paths in the manifest changed since it ran"};
+    std::vector<std::pair<std::string, std::string>> before;
+    if (old->contains("inputs") && (*old)["inputs"].is_array())
+        for (const json& entry : (*old)["inputs"])
+            before.emplace_back(side_file_path(entry), string_at(entry, "sha256"));
+    for (const auto& [file, digest] : now.inputs) {
+        const auto same_name =
+            std::find_if(before.begin(), before.end(), [&](const auto& b) { return b.first == file; });
+        if (same_name == before.end()) return {S::kChanged, "it now reads " + file + ", which it did not when it ran"};
+        if (same_name->second != digest) return {S::kChanged, "its input " + file + " changed since it ran"};
+    }
+    for (const auto& [file, digest] : before) {
+        const auto still =
+            std::find_if(now.inputs.begin(), now.inputs.end(), [&](const auto& n) { return n.first == file; });
+        if (still == now.inputs.end())
+            return {S::kChanged, "it no longer reads " + file + ", which it read when it ran"};
+    }
+    return {S::kChanged, "its result is out of date: its inputs, options or paths changed since it ran"};
+}
+
+Staleness staleness(const PlannedItem& p, const std::string& stamp, const BatchOptions& batch,
+                    json* report_out = nullptr) {
+    using S = Staleness;
     json report = read_json_file(p.report);
-    if (!report.is_object() || !report.contains("batch") || string_at(report["batch"], "stamp") != stamp ||
-        !summary_fields_hold(report["batch"]))
-        return json();
+    if (!report.is_object() || !report.contains("batch") || !report["batch"].is_object())
+        return {S::kNoResult, "no result yet (not run, or its run did not finish)"};
+    const json& b = report["batch"];
+    if (string_at(b, "stamp") != stamp) return stamp_change(p, b, batch);
+    if (!summary_fields_hold(b)) return {S::kChanged, "its report was edited: its figures are not as written"};
     std::error_code error;
     for (const std::string& out : p.plan.outputs)
-        if (!fs::is_regular_file(out, error)) return json();
-    const json& batch = report["batch"];
+        if (!fs::is_regular_file(out, error))
+            return {S::kChanged, "its output " + output_as_written(p, out) + " is missing"};
     // Every output but the report as it was written (a truncated or emptied one is not up to date).
-    const auto outputs = batch.find("outputs");
-    if (outputs == batch.end() || !outputs->is_array()) return json();
+    const auto outputs = b.find("outputs");
+    if (outputs == b.end() || !outputs->is_array()) return {S::kChanged, "its report was edited: it lists no outputs"};
     for (const std::string& out : p.plan.outputs) {
         if (out == p.report) continue;
         const std::string name = fs::path(out).filename().string();
         const auto entry =
             std::find_if(outputs->begin(), outputs->end(), [&](const json& e) { return string_at(e, "file") == name; });
-        if (entry == outputs->end() || string_at(*entry, "sha256") != file_digest(out)) return json();
+        if (entry == outputs->end() || string_at(*entry, "sha256") != file_digest(out))
+            return {S::kChanged, "its output " + output_as_written(p, out) + " changed since it was written"};
     }
-    const auto side = batch.find("side_files");
-    if (side != batch.end()) {
-        if (!side->is_array()) return json();
+    const auto side = b.find("side_files");
+    if (side != b.end()) {
+        if (!side->is_array()) return {S::kChanged, "its report was edited: its side files are not a list"};
         for (const json& entry : *side) {
             const std::string file = side_file_path(entry);
-            if (file.empty() || string_at(entry, "sha256") != file_digest(folder_of(p.report) / file)) return json();
+            if (file.empty() || string_at(entry, "sha256") != file_digest(folder_of(p.report) / file))
+                return {S::kChanged, "its input " + file + " changed since it ran"};
         }
     }
-    return report;
+    if (report_out) *report_out = std::move(report);
+    return {};
+}
+
+// The item's report when it is up to date, else null.
+json current_report(const PlannedItem& p, const std::string& stamp, const BatchOptions& batch) {
+    json report;
+    return staleness(p, stamp, batch, &report).kind == Staleness::kCurrent ? report : json();
 }
 
 // Wall times out (--no-timings): every key of seconds set to null, wherever it is, and the thread
@@ -684,8 +785,9 @@ std::string place_of(const std::string& path) {
 // importer's side files are known only then).
 using OutputsByPlace = std::unordered_map<std::string, std::string>;
 
-void run_item(const PlannedItem& p, const std::string& stamp, const BatchOptions& batch,
+void run_item(const PlannedItem& p, const StampParts& parts, const BatchOptions& batch,
               const OutputsByPlace& all_outputs) {
+    const std::string stamp = item_stamp(parts);
     const Clock::time_point start = Clock::now();
     std::vector<std::string> files_of_item = p.plan.outputs;
     files_of_item.push_back(p.error);
@@ -739,6 +841,7 @@ void run_item(const PlannedItem& p, const std::string& stamp, const BatchOptions
         if (path.is_string() && path.get<std::string>().rfind(stem, 0) == 0)
             path = stem_as_written + path.get<std::string>().substr(stem.size());
     report["batch"] = {{"stamp", stamp},
+                       {"stamp_parts", stamp_parts_json(parts)},
                        {"item", p.item.name},
                        {"status", "ok"},
                        {"triangles", mesh.triangle_count()},
@@ -770,19 +873,13 @@ void run_item(const PlannedItem& p, const std::string& stamp, const BatchOptions
 // ---------------------------------------------------------------------------------------------
 // The summary, merged from the items' files in manifest order
 
-// Why an item has no up-to-date result, as far as its files tell: none yet, or a report that no
-// longer matches (written by another animorder build, with other --eval-* options, or before its
-// inputs or options changed).
-std::string why_missing(const PlannedItem& p, const BatchOptions& batch) {
-    const json report = read_json_file(p.report);
-    if (!report.is_object() || !report.contains("batch")) return "no result yet (not run, or its run did not finish)";
-    const json& b = report["batch"];
-    if (b.contains("tool") && b["tool"] != tool_digest())
-        return "its result was written by another animorder build (run the merge with the build that ran the items)";
-    if (b.value("eval_views", json()) != json(batch.eval_views) ||
-        b.value("eval_resolution", json()) != json(batch.eval_resolution))
-        return "its result was evaluated with other --eval-views/--eval-resolution (give the merge the same)";
-    return "its result is out of date: its inputs, options, outputs or --no-timings changed since it ran";
+// Why an item has no up-to-date result, for the merge's summary (with what to do about it when
+// the merge itself is the cause).
+std::string why_missing(const PlannedItem& p, const std::string& stamp, const BatchOptions& batch) {
+    const Staleness s = staleness(p, stamp, batch);
+    if (s.kind == Staleness::kOtherBuild) return s.why + " (run the merge with the build that ran the items)";
+    if (s.kind == Staleness::kOtherEvaluation) return s.why + " (give the merge the same)";
+    return s.why;
 }
 
 // `failed_now`: the error of this run's attempt, when the item failed in it (its earlier report,
@@ -793,7 +890,7 @@ json summary_row(const PlannedItem& p, const std::string& stamp, const BatchOpti
                 {"input", p.item.input_as_written.empty() ? "(bundled)" : p.item.input_as_written},
                 {"output", p.item.output_as_written},
                 {"method", method_name(p.plan.method)}};
-    const json report = failed_now.empty() ? current_report(p, stamp) : json();
+    const json report = failed_now.empty() ? current_report(p, stamp, batch) : json();
     if (report.is_object()) {
         const json& b = report["batch"];
         for (const char* key : {"triangles", "clips", "buffers", "acmr_before", "acmr_after", "ovr_before", "ovr_after",
@@ -809,7 +906,9 @@ json summary_row(const PlannedItem& p, const std::string& stamp, const BatchOpti
                             "index_bytes_added", "time_s"})
         row[key] = nullptr;
     row["status"] = failed ? "failed" : "missing";
-    row["error"] = !failed_now.empty() ? failed_now : failed ? string_at(failure, "error") : why_missing(p, batch);
+    row["error"] = !failed_now.empty() ? failed_now
+                   : failed            ? string_at(failure, "error")
+                                       : why_missing(p, stamp, batch);
     return row;
 }
 
@@ -930,6 +1029,38 @@ std::pair<size_t, size_t> parse_shard(const std::string& text) {
 
 }  // namespace
 
+// --dry-run: which of the shard's items a run would redo, and why, as JSON on stdout; nothing is
+// written or removed.
+int print_plan(const std::vector<PlannedItem>& items, std::pair<size_t, size_t> shard, bool sharded,
+               const BatchOptions& batch) {
+    json rows = json::array();
+    size_t run = 0, skip = 0;
+    for (size_t i = 0; i < items.size(); ++i) {
+        if (i % shard.second != shard.first) continue;
+        const PlannedItem& p = items[i];
+        const std::string stamp = item_stamp(p, batch);
+        Staleness s = staleness(p, stamp, batch);
+        if (batch.force) s = {Staleness::kChanged, "--force"};
+        const json failure = read_json_file(p.error);
+        if (s.kind != Staleness::kCurrent && string_at(failure, "stamp") == stamp)
+            s.why = "it failed when it last ran: " + string_at(failure, "error");
+        const bool current = s.kind == Staleness::kCurrent;
+        (current ? skip : run) += 1;
+        rows.push_back({{"item", i + 1},
+                        {"name", p.item.name},
+                        {"output", p.item.output_as_written},
+                        {"action", current ? "skip" : "run"},
+                        {"why", current ? json("up to date") : json(s.why)}});
+    }
+    json plan = {{"manifest", fs::path(batch.manifest).filename().string()},
+                 {"shard", sharded ? json::array({shard.first, shard.second}) : json(nullptr)},
+                 {"run", run},
+                 {"skip", skip},
+                 {"items", rows}};
+    std::fputs(report_text(plan).c_str(), stdout);
+    return 0;
+}
+
 int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
     const std::vector<ManifestItem> manifest = read_manifest(batch.manifest);
     std::pair<size_t, size_t> shard = {0, 1};
@@ -937,6 +1068,7 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
     if (batch.merge && !batch.shard.empty())
         throw std::runtime_error("--merge builds the summary of every shard: drop --shard");
     if (batch.merge && batch.force) throw std::runtime_error("--merge runs no item: drop --force");
+    if (batch.merge && batch.dry_run) throw std::runtime_error("--merge runs no item: drop --dry-run");
 
     // Every item planned and every output of every item checked before any work: folders exist
     // and are writable, no output is any item's input or the manifest, no file is named twice.
@@ -970,6 +1102,8 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
         return write_summary(items, stamps, failed_now, summary, batch.manifest, batch);
     }
 
+    if (batch.dry_run) return print_plan(items, shard, sharded, batch);
+
     size_t done = 0, skipped = 0, failed = 0, mine = 0;
     for (size_t i = 0; i < items.size(); ++i) mine += i % shard.second == shard.first;
     size_t position = 0;
@@ -979,8 +1113,9 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
         std::string label = "batch [" + std::to_string(++position) + "/" + std::to_string(mine) + "] " + p.item.name;
         for (char& c : label)  // progress and failure lines stay one line each
             if (c == '\n' || c == '\r') c = ' ';
-        stamps[i] = item_stamp(p, batch);
-        if (!batch.force && current_report(p, stamps[i]).is_object()) {
+        const StampParts parts = stamp_parts(p, batch);
+        stamps[i] = item_stamp(parts);
+        if (!batch.force && current_report(p, stamps[i], batch).is_object()) {
             ++skipped;
             std::vector<std::string> files_of_item = p.plan.outputs;
             files_of_item.push_back(p.error);
@@ -992,7 +1127,7 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
         }
         note(p.options.common, label + ": running");
         try {
-            run_item(p, stamps[i], batch, outputs_by_place);
+            run_item(p, parts, batch, outputs_by_place);
             ++done;
             note(p.options.common, label + ": done");
         } catch (const std::exception& e) {

@@ -127,6 +127,7 @@ struct BatchOptions {
     unsigned eval_resolution = 256;
     bool no_timings = false;  // wall times left out: identical work gives byte-identical files
     bool force = false;       // redo items even when up to date
+    bool dry_run = false;     // write nothing: print which items would run and why (JSON on stdout)
     unsigned threads = 0;
 };
 using ItemParser = std::function<OptimizeOptions(const std::vector<std::string>& args)>;

@@ -282,6 +282,8 @@ int main(int argc, char** argv) {
     batch_cmd->add_flag("--no-timings", batch.no_timings,
                         "Leave wall times out of reports and summary (identical work: byte-identical files)");
     batch_cmd->add_flag("--force", batch.force, "Redo items whose outputs are up to date");
+    batch_cmd->add_flag("--dry-run", batch.dry_run,
+                        "Write nothing: print which of the shard's items would run and why (JSON on stdout)");
     batch_cmd->add_option("--threads", batch.threads, "Worker threads per item (0: all cores)")
         ->capture_default_str()
         ->check(CLI::Range(0u, 1024u));

@@ -87,6 +87,10 @@ public:
     size_t node_count() const { return node_count_; }
     size_t kept_count() const { return kept_.size(); }  // nodes [0, kept_count()) are kept
     size_t kept_bytes() const { return kept_bytes_; }
+    // The nodes rasterised to fill the cache (kept, and the first that did not fit) and their
+    // total KeptNode bytes: the sample nodes_within sizes later chunks by.
+    uint64_t sampled_nodes() const { return sampled_nodes_; }
+    uint64_t sampled_bytes() const { return sampled_bytes_; }
     const UnitPartition& partition() const { return partition_; }
 
     // visible[n] and passed[n · order_count + o] for every node and every order of the rank table
@@ -114,6 +118,12 @@ private:
     ScoreSettings settings_;
     std::vector<KeptNode> kept_;
     size_t kept_bytes_ = 0;
+    uint64_t sampled_nodes_ = 0, sampled_bytes_ = 0;
 };
+
+// How many nodes to rasterise together so that their KeptNodes take about `bytes`, at the mean
+// size of the sampled nodes (one more, to find where a budget ends), between `least` (one per
+// thread, say) and `most`; `least` when nothing is sampled yet.
+size_t nodes_within(uint64_t bytes, uint64_t sampled_bytes, uint64_t sampled_nodes, size_t least, size_t most);
 
 }  // namespace animorder

@@ -371,7 +371,11 @@ struct MeasuredGraphs {
 };
 
 // Nodes into (sign +1) or out of (−1) a cluster's graph: the kept ones as kept, the others
-// rasterised again, a chunk at a time.
+// rasterised again, a chunk of about kTransientFragmentBytes at a time (a few hundred nodes at
+// 256², a few dozen at 4096²: nodes beyond the budget never all come back at once). The counts
+// are sums, the same however the nodes are chunked.
+constexpr uint64_t kTransientFragmentBytes = uint64_t(64) << 20;
+
 void add_to_graph(const NodeCache& cache, const std::vector<uint32_t>& which, int sign, unsigned threads,
                   MeasuredPairCounts& graph) {
     std::vector<const KeptNode*> kept;
@@ -383,12 +387,18 @@ void add_to_graph(const NodeCache& cache, const std::vector<uint32_t>& which, in
             again.push_back(n);
     }
     graph.add(kept.data(), kept.size(), sign, threads);
-    const size_t chunk = 1024;
-    for (size_t begin = 0; begin < again.size(); begin += chunk) {
-        const size_t count = std::min(chunk, again.size() - begin);
+    uint64_t sampled_bytes = cache.sampled_bytes(), sampled_nodes = cache.sampled_nodes();
+    const size_t least = size_t(worker_threads(threads));
+    for (size_t begin = 0, count = 0; begin < again.size(); begin += count) {
+        count = std::min(again.size() - begin,
+                         nodes_within(kTransientFragmentBytes, sampled_bytes, sampled_nodes, least, 1024));
         const std::vector<KeptNode> nodes = cache.rasterize_again(again.data() + begin, count);
         std::vector<const KeptNode*> pointers;
-        for (const KeptNode& node : nodes) pointers.push_back(&node);
+        for (const KeptNode& node : nodes) {
+            pointers.push_back(&node);
+            sampled_bytes += node.bytes();
+            ++sampled_nodes;
+        }
         graph.add(pointers.data(), pointers.size(), sign, threads);
     }
 }

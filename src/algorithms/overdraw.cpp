@@ -70,8 +70,8 @@ struct NodeWorker {
                          settings.resolution, settings.triangle_modes);
         const FacingFilter::Candidates candidates = facing.candidates(node.direction);
         rasterizer.rasterize_validated(centred.vertices(node_view_projection(node.direction, framing.radius)),
-                                       vertex_count, indices, index_count, settings.resolution,
-                                       settings.triangle_modes, candidates.ids, candidates.count);
+                                       vertex_count, indices, index_count, settings.resolution, settings.triangle_modes,
+                                       candidates.ids, candidates.count);
     }
 };
 
@@ -229,29 +229,43 @@ NodeCache::NodeCache(const float* keyframe_positions, size_t vertex_count, const
     for (size_t n = 0; n < node_count; ++n)
         if (nodes[n].keyframe >= keyframes)
             throw InvalidInput("node " + std::to_string(n) + " names a missing keyframe");
-    // In chunks, so that memory never holds more than the budget and one chunk; which nodes are
-    // kept depends on their sizes in node order only, never on the schedule.
-    const size_t chunk = 2048;
+    // In chunks sized by the budget left, at the mean size of the nodes rasterised so far, so that
+    // memory holds about the budget (and never rasterises a node only to drop it once the budget
+    // is spent). Which nodes are kept, the longest run in node order whose total fits, depends on
+    // their sizes only, never on the chunks or the schedule.
+    const size_t least = size_t(worker_threads(settings.threads));
     std::vector<KeptNode> batch;
     bool full = false;
-    for (size_t begin = 0; begin < node_count && !full; begin += chunk) {
-        const size_t end = std::min(node_count, begin + chunk);
-        batch.assign(end - begin, KeptNode{});
-        for_nodes(end - begin, 1, [&](Worker& w, size_t i) {
+    size_t begin = 0;
+    while (begin < node_count && !full && kept_bytes_ < max_bytes) {
+        const size_t count = std::min(
+            node_count - begin, nodes_within(max_bytes - kept_bytes_, sampled_bytes_, sampled_nodes_, least, 2048));
+        batch.assign(count, KeptNode{});
+        for_nodes(count, 1, [&](Worker& w, size_t i) {
             rasterize_node(w, begin + i);
             const NodeRasterizer::FragmentLists l = w.node.rasterizer.fragment_lists();
             batch[i] = keep_fragments(l.visible, l.single, l.starts, l.pixels, l.fragments, partition_, w.scratch);
         });
         for (KeptNode& node : batch) {
-            if (kept_bytes_ + node.bytes() > max_bytes) {
+            sampled_bytes_ += node.bytes();
+            ++sampled_nodes_;
+            if (full || kept_bytes_ + node.bytes() > max_bytes) {
                 full = true;
-                break;
+                continue;
             }
             kept_bytes_ += node.bytes();
             kept_.push_back(std::move(node));
         }
-        if (settings.progress) settings.progress(full ? node_count : end, node_count);
+        begin += count;
+        if (settings.progress) settings.progress(full ? node_count : begin, node_count);
     }
+}
+
+size_t nodes_within(uint64_t bytes, uint64_t sampled_bytes, uint64_t sampled_nodes, size_t least, size_t most) {
+    least = std::max<size_t>(1, std::min(least, most));
+    if (sampled_nodes == 0) return least;
+    const uint64_t mean = std::max<uint64_t>(1, sampled_bytes / sampled_nodes);
+    return size_t(std::clamp<uint64_t>(bytes / mean + 1, least, most));
 }
 
 NodeCache::~NodeCache() = default;

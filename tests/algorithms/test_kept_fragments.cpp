@@ -140,8 +140,8 @@ TEST(KeptFragments, HandWorkedPixelsAreReducedAndShared) {
 TEST(KeptFragments, AUnitLeftTwiceAfterADropStaysAUnitList) {
     const UnitPartition p = runs({2, 1, 3});  // units 0 {0,1}, 1 {2}, 2 {3,4,5}
     Lists l;
-    l.pixel({4, 5, 3});  // 5 behind 4 (drawn after it): dropped; 3 drawn before 4: unit 2 twice
-    l.pixel({2, 4, 3});  // unit 1, then unit 2 twice (3 drawn first)
+    l.pixel({4, 5, 3});     // 5 behind 4 (drawn after it): dropped; 3 drawn before 4: unit 2 twice
+    l.pixel({2, 4, 3});     // unit 1, then unit 2 twice (3 drawn first)
     l.pixel({4, 5, 3, 2});  // the same as the first pixel, with unit 1 behind: the general path
     const KeptNode k = keep(l.node(0), p);
     EXPECT_EQ(k.triangle_lists, 0u);
@@ -387,6 +387,12 @@ void check_cache_budgets(const AnimatedMesh& mesh, const std::vector<uint32_t>& 
         } else {
             EXPECT_LT(cache.kept_count(), nodes.size()) << budget;
             EXPECT_LE(cache.kept_bytes(), budget);
+            // Nodes are rasterised to be kept only while the budget lasts: none for a budget of
+            // nothing; for half, the kept ones and the chunk that found the end, whose estimate
+            // comes from the nodes before it (here within half the budget again).
+            EXPECT_EQ(cache.sampled_nodes() == 0, budget == 0);
+            EXPECT_LT(cache.sampled_nodes(), nodes.size());
+            EXPECT_LE(cache.sampled_bytes(), budget + budget / 2);
         }
         std::vector<uint64_t> v(nodes.size()), p(nodes.size() * 5);
         cache.score(v.data(), p.data(), ranks.data(), 5);

@@ -13,7 +13,8 @@
 
 namespace animorder {
 
-AnimatedMesh subdivide_animated_mesh(const AnimatedMesh& mesh, unsigned levels) {
+AnimatedMesh subdivide_animated_mesh(const AnimatedMesh& mesh, unsigned levels,
+                                     const std::function<void(size_t, size_t)>& before_building) {
     validate_animated_mesh(mesh);
     if (levels > kMaxSubdivisionLevels)
         throw InvalidInput("subdivision levels is " + std::to_string(levels) + "; at most " +
@@ -41,6 +42,7 @@ AnimatedMesh subdivide_animated_mesh(const AnimatedMesh& mesh, unsigned levels) 
         out.primitives.push_back(q);  // generated vertices: source_mesh −1, no vertex range
     }
     const size_t keyframes = mesh.keyframe_count();
+    if (before_building) before_building(out.vertex_count, keyframes);
     out.keyframe_positions.resize(keyframes * out.vertex_count * 3);
     // Each keyframe is written by one task only: the same bytes whatever the thread count.
     tbb::parallel_for(size_t(0), keyframes,

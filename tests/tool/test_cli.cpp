@@ -501,6 +501,25 @@ TEST_F(Cli, TipsifyPerFrameNamesAClipTooLongForItsLookupTable) {
     EXPECT_EQ(nlohmann::json::parse(test::slurp(path("r.json")))["methods"][0]["buffers"], 301);
 }
 
+// subdivide's output is sized before its keyframes are built: one over --max-memory is refused
+// with nothing written (it used to be built whole first, 6 GB for Xbot at 3 levels). The
+// bundled character at one level is 24,381 vertices × 77 keyframes × 12 bytes = 22.5 MB of
+// morph targets (the counts from `inspect` of the written file below).
+TEST_F(Cli, SubdivideRefusesAnOutputOverTheLoadingBudgetBeforeBuildingIt) {
+    const test::Outcome refused = run("subdivide -q --levels 1 --max-memory 20000000 -o " + path("s.glb").string());
+    EXPECT_EQ(refused.exit_code, 1);
+    EXPECT_NE(refused.err.find("22.5 MB of morph targets"), std::string::npos) << refused.err;
+    EXPECT_NE(refused.err.find("--max-memory"), std::string::npos) << refused.err;
+    EXPECT_FALSE(fs::exists(path("s.glb")));
+    const test::Outcome written = run("subdivide -q --levels 1 --max-memory 23000000 -o " + path("s.glb").string());
+    ASSERT_EQ(written.exit_code, 0) << written.err;
+    const test::Outcome inspected = run("inspect --json " + path("s.glb").string());
+    ASSERT_EQ(inspected.exit_code, 0) << inspected.err;
+    const nlohmann::json j = nlohmann::json::parse(inspected.out);
+    EXPECT_EQ(j["vertices"], 24381);
+    EXPECT_EQ(j["keyframes"], 77);
+}
+
 TEST_F(Cli, LambdaChangesTheAcmrTheWayThePaperSays) {
     ASSERT_EQ(run("optimize -q --lambda 0 --report " + path("r0.json").string()).exit_code, 0);
     ASSERT_EQ(run("optimize -q --lambda 3 --report " + path("r3.json").string()).exit_code, 0);

@@ -40,14 +40,22 @@ int run_subdivide(const SubdivideOptions& options) {
     std::vector<std::string> files_read;
     const AnimatedMesh mesh = load_animated_input(options.common, input_name, &files_read);
     check_output_paths({options.output}, files_read);
-    AnimatedMesh result = subdivide_animated_mesh(mesh, options.levels);
+    // Every keyframe is a morph target of 12 bytes per vertex: say how big before building it,
+    // and refuse what neither the loading budget (--max-memory) nor a GLB can hold.
+    double estimate = 0;
+    AnimatedMesh result = subdivide_animated_mesh(mesh, options.levels, [&](size_t vertices, size_t keyframes) {
+        estimate = double(vertices) * double(keyframes) * 12.0;
+        const std::string size = "about " + megabytes(size_t(estimate)) + " of morph targets (" +
+                                 std::to_string(vertices) + " vertices, " + std::to_string(keyframes) + " keyframes)";
+        if (estimate > double(options.common.max_memory))
+            throw std::runtime_error("the output would hold " + size + ", more than the loading budget of " +
+                                     megabytes(options.common.max_memory) +
+                                     " (--max-memory); keep fewer clips with --clip NAME, or fewer --levels");
+        if (estimate > 4.0e9)
+            throw std::runtime_error("the output would hold " + size +
+                                     ", more than a GLB can; keep fewer clips with --clip NAME");
+    });
     if (!options.common.input.empty()) result.name = std::filesystem::path(options.common.input).stem().string();
-    // Every keyframe is a morph target of 12 bytes per vertex: say how big before building it.
-    const double estimate = double(result.vertex_count) * double(result.keyframe_count()) * 12.0;
-    if (estimate > 4.0e9)
-        throw std::runtime_error("the output would hold about " + megabytes(size_t(estimate)) + " of morph targets (" +
-                                 std::to_string(result.keyframe_count()) +
-                                 " keyframes), more than a GLB can; keep fewer clips with --clip NAME");
     note(options.common, "subdivided " + std::to_string(options.levels) + " level(s); writing " +
                              std::to_string(result.keyframe_count()) + " keyframes as morph targets (about " +
                              megabytes(size_t(estimate)) + (estimate > 5e8 ? "; --clip NAME keeps fewer" : "") + ")");

@@ -4,6 +4,7 @@
 // as an input is ever replaced, and no two outputs of a run may be the same file.
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <stdexcept>
 #include <string>
@@ -24,9 +25,11 @@ public:
 // resolving links) one of `inputs`, it does not lie in one of `input_folders` (folders every
 // file of which the run reads, such as a clip folder: a later run would read the output as an
 // input), and no two outputs are the same file. Call it before any long work, so a bad path fails
-// at once.
+// at once. Only the first `written_here` outputs are checked for writing: the others are those
+// other processes of the same job write (a farm's other shards), checked against the inputs and
+// against each other only.
 void check_output_paths(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs,
-                        const std::vector<std::string>& input_folders = {});
+                        const std::vector<std::string>& input_folders = {}, size_t written_here = SIZE_MAX);
 
 // A key equal for two paths exactly when they name the same file: its device and inode when it
 // exists, else its path with links and "." / ".." resolved.

@@ -224,7 +224,7 @@ void check_output_stem(const std::string& stem) {
 }
 
 void check_output_paths(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs,
-                        const std::vector<std::string>& input_folders) {
+                        const std::vector<std::string>& input_folders, size_t written_here) {
     // Each path resolved once (a library's batch checks thousands against thousands).
     std::unordered_set<std::string> input_files;
     for (const std::string& input : inputs)
@@ -234,7 +234,7 @@ void check_output_paths(const std::vector<std::string>& outputs, const std::vect
         if (!folder.empty()) folders.emplace(file_identity(folder), folder);
     std::unordered_map<std::string, size_t> output_files;
     for (size_t i = 0; i < outputs.size(); ++i) {
-        check_writable_target(outputs[i]);
+        if (i < written_here) check_writable_target(outputs[i]);
         const std::string identity = file_identity(outputs[i]);
         if (input_files.count(identity))
             throw OutputError(outputs[i] +

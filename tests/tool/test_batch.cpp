@@ -680,6 +680,42 @@ TEST_F(Batch, AReportEditedByHandIsStaleNotTrusted) {
     const test::Outcome again = run("batch -q --eval-views 0 " + manifest());
     EXPECT_EQ(again.exit_code, 0) << again.err;
     EXPECT_NE(again.out.find("1 done, 1 up to date"), std::string::npos) << again.out;
+    // A "batch" that is no object at all (the merge stopped on it with a JSON type error).
+    for (const char* edited : {R"({"batch": null})", R"({"batch": [1]})", R"({"batch": "x"})"}) {
+        write("out/a.animorder.report.json", edited);
+        const test::Outcome m = run("batch -q --eval-views 0 --merge " + manifest());
+        EXPECT_EQ(m.exit_code, 4) << edited << ": " << m.err;
+        EXPECT_EQ(nlohmann::json::parse(test::slurp(path("m.summary.json")))["items"][0]["status"], "missing");
+    }
+}
+
+// A shard checks for writing only the files it writes, and the merge only the summary: another
+// shard's output folder that is missing here (a farm's pods may mount only their own) stops
+// neither; the shard that writes there refuses at once. A failed item's row in a merge with other
+// --eval-* options than its run says that its last run failed, and why.
+TEST_F(Batch, AShardChecksOnlyWhatItWritesAndTheMergeOnlyTheSummary) {
+    write("m.json", R"({"items": [
+      {"method": "original", "output": "out/a"},
+      {"method": "original", "output": "elsewhere/b"},
+      {"input": "broken.obj", "method": "original", "output": "out/c"}
+    ]})");
+    write("broken.obj", "v 0 0 0\nf 1 2 3\n");
+    const test::Outcome mine = run("batch -q --eval-views 0 --shard 0/3 " + manifest());
+    EXPECT_EQ(mine.exit_code, 0) << mine.err;
+    EXPECT_TRUE(fs::exists(path("out/a.animorder.bin")));
+    const test::Outcome theirs = run("batch -q --eval-views 0 --shard 1/3 " + manifest());
+    EXPECT_EQ(theirs.exit_code, 1);
+    EXPECT_NE(theirs.err.find("elsewhere does not exist"), std::string::npos) << theirs.err;
+    EXPECT_EQ(run("batch -q --eval-views 0 --shard 2/3 " + manifest()).exit_code, 3);
+    fs::create_directories(path("summaries"));
+    const test::Outcome merged =
+        run("batch -q --eval-views 1 --merge --summary " + path("summaries/s").string() + " " + manifest());
+    EXPECT_EQ(merged.exit_code, 4) << merged.err;
+    const nlohmann::json s = nlohmann::json::parse(test::slurp(path("summaries/s.json")));
+    EXPECT_NE(s["items"][1]["error"].get<std::string>().find("no result yet"), std::string::npos) << s["items"][1];
+    EXPECT_NE(s["items"][2]["error"].get<std::string>().find("its last run failed"), std::string::npos)
+        << s["items"][2];
+    EXPECT_NE(s["items"][2]["error"].get<std::string>().find("broken.obj"), std::string::npos) << s["items"][2];
 }
 
 // The README's Kubernetes Indexed Job runs its container command once per index: a pod whose

@@ -55,6 +55,7 @@ using Clock = std::chrono::steady_clock;
 constexpr int kExitItemsFailed = 3;       // at least one item failed (each has its error line)
 constexpr int kExitItemsMissing = 4;      // merge: some items have no up-to-date result yet
 constexpr int kExitFailedAndMissing = 5;  // merge: both (a farm learns of unfinished shards either way)
+constexpr int kExitNoSummary = 6;         // the items ran (or were merged) but the summary could not be written
 
 // ---------------------------------------------------------------------------------------------
 // The manifest
@@ -877,6 +878,11 @@ void run_item(const PlannedItem& p, const StampParts& parts, const BatchOptions&
 // the merge itself is the cause).
 std::string why_missing(const PlannedItem& p, const std::string& stamp, const BatchOptions& batch) {
     const Staleness s = staleness(p, stamp, batch);
+    const std::string failed = string_at(read_json_file(p.error), "error");
+    if (s.kind == Staleness::kNoResult && !failed.empty())
+        return "its last run failed, with another build, other --eval-*/--no-timings options or other inputs or "
+               "options than this merge's: " +
+               failed;
     if (s.kind == Staleness::kOtherBuild) return s.why + " (run the merge with the build that ran the items)";
     if (s.kind == Staleness::kOtherEvaluation) return s.why + " (give the merge the same)";
     return s.why;
@@ -1029,6 +1035,18 @@ std::pair<size_t, size_t> parse_shard(const std::string& text) {
 
 }  // namespace
 
+// write_summary, whose failure (a full disk, say) comes after the items' work: its own exit code,
+// not 1 (an error before any work), so that a farm does not take it for a bad manifest.
+int summarise(const std::vector<PlannedItem>& items, const std::vector<std::string>& stamps,
+              const std::vector<std::string>& failed_now, const std::string& stem, const BatchOptions& batch) {
+    try {
+        return write_summary(items, stamps, failed_now, stem, batch.manifest, batch);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "animorder: batch: the items' files are written, but not the summary: %s\n", e.what());
+        return kExitNoSummary;
+    }
+}
+
 // --dry-run: which of the shard's items a run would redo, and why, as JSON on stdout; nothing is
 // written or removed.
 int print_plan(const std::vector<PlannedItem>& items, std::pair<size_t, size_t> shard, bool sharded,
@@ -1082,24 +1100,33 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
         summary = (m.parent_path() / m.stem()).string() + ".summary";
     }
     check_output_stem(summary);
-    std::vector<std::string> outputs = {summary + ".json", summary + ".md"}, inputs = {batch.manifest}, folders;
-    for (const PlannedItem& p : items) {
-        outputs.insert(outputs.end(), p.plan.outputs.begin(), p.plan.outputs.end());
-        outputs.push_back(p.error);
+    // Only what this process writes is checked for writing (a shard its own items' files, the
+    // merge the summary, a whole run everything); the files of the job's other processes are
+    // checked against every input and every other output only.
+    const bool sharded = shard.second > 1 || !batch.shard.empty();
+    std::vector<std::string> written, others, inputs = {batch.manifest}, folders;
+    std::vector<std::string>& summary_files = batch.merge || !sharded ? written : others;
+    summary_files.insert(summary_files.end(), {summary + ".json", summary + ".md"});
+    for (size_t i = 0; i < items.size(); ++i) {
+        const PlannedItem& p = items[i];
+        std::vector<std::string>& files = !batch.merge && i % shard.second == shard.first ? written : others;
+        files.insert(files.end(), p.plan.outputs.begin(), p.plan.outputs.end());
+        files.push_back(p.error);
         inputs.insert(inputs.end(), p.plan.inputs.begin(), p.plan.inputs.end());
         folders.insert(folders.end(), p.plan.input_folders.begin(), p.plan.input_folders.end());
     }
-    check_output_paths(outputs, inputs, folders);
+    std::vector<std::string> outputs = written;
+    outputs.insert(outputs.end(), others.begin(), others.end());
+    check_output_paths(outputs, inputs, folders, written.size());
     OutputsByPlace outputs_by_place;
     for (const std::string& output : outputs) outputs_by_place.emplace(place_of(output), output);
 
     // A shard stamps its own items only, each when its turn comes (so that an input edited while
     // earlier items run is read as it is then); the merge stamps every item.
     std::vector<std::string> stamps(items.size()), failed_now(items.size());
-    const bool sharded = shard.second > 1 || !batch.shard.empty();
     if (batch.merge) {
         for (size_t i = 0; i < items.size(); ++i) stamps[i] = item_stamp(items[i], batch);
-        return write_summary(items, stamps, failed_now, summary, batch.manifest, batch);
+        return summarise(items, stamps, failed_now, summary, batch);
     }
 
     if (batch.dry_run) return print_plan(items, shard, sharded, batch);
@@ -1151,7 +1178,7 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
                 sharded ? (" shard " + std::to_string(shard.first) + "/" + std::to_string(shard.second)).c_str() : "",
                 mine, done, skipped, failed);
     if (sharded) return failed ? kExitItemsFailed : 0;  // the summary is the merge step's
-    return write_summary(items, stamps, failed_now, summary, batch.manifest, batch);
+    return summarise(items, stamps, failed_now, summary, batch);
 }
 
 }  // namespace animorder::tool

@@ -82,6 +82,12 @@ bool process_may_run(long pid);
 // sharing the folder.
 void remove_stale_temporaries(const std::string& target);
 
+// SIGINT, SIGTERM and SIGHUP, where their action is the default one, remove this process's
+// temporaries and end it as killed (also as a container's PID 1, whose default actions do
+// nothing: it exits with 128 + the signal). The first temporary installs it; a program that may
+// run as PID 1 calls it at its start, so that the signals end it before it writes too.
+void install_signal_cleanup();
+
 // One file written atomically: an OutputSet of one.
 void write_file_atomically(const std::string& path, const std::string& data);
 

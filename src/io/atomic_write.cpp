@@ -93,18 +93,26 @@ TrackedTemporary tracked_temporaries[kTrackedTemporaries];
 
 // SIGINT, SIGTERM, SIGHUP: this process's temporaries removed (unlink is async-signal-safe; a
 // forked child, such as isolated_import's, removes only its own), then the signal's default
-// action, so the run still ends as killed.
+// action, so the run still ends as killed. A container's first process (PID 1) is not killed by
+// a default action: it then exits with the status a shell gives a killed process (128 + signal).
 void remove_temporaries_and_reraise(int sig) {
     const pid_t self = ::getpid();
     for (TrackedTemporary& slot : tracked_temporaries)
         if (slot.owner.load() == self)
             if (const char* name = slot.name.load()) ::unlink(name);
     ::signal(sig, SIG_DFL);
+    sigset_t just_this;  // blocked while its handler runs: unblocked, it acts before raise returns
+    sigemptyset(&just_this);
+    sigaddset(&just_this, sig);
+    ::sigprocmask(SIG_UNBLOCK, &just_this, nullptr);
     ::raise(sig);
+    ::_exit(128 + sig);
 }
 
-// Installed at the first temporary, for the signals whose action is the default one (one that is
-// ignored, as under nohup, or that the program handles itself is left as it is).
+}  // namespace
+
+// For the signals whose action is the default one (one that is ignored, as under nohup, or that
+// the program handles itself is left as it is); once.
 void install_signal_cleanup() {
     static std::once_flag once;
     std::call_once(once, [] {
@@ -120,6 +128,8 @@ void install_signal_cleanup() {
         }
     });
 }
+
+namespace {
 
 constexpr size_t kNoSlot = SIZE_MAX;
 

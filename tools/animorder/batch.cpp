@@ -1087,6 +1087,9 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
         throw std::runtime_error("--merge builds the summary of every shard: drop --shard");
     if (batch.merge && batch.force) throw std::runtime_error("--merge runs no item: drop --force");
     if (batch.merge && batch.dry_run) throw std::runtime_error("--merge runs no item: drop --dry-run");
+    if (batch.merge && batch.item_failures_ok)
+        throw std::runtime_error(
+            "--merge runs no item: drop --item-failures-ok (the merge's exit 3 lists the failures)");
 
     // Every item planned and every output of every item checked before any work: folders exist
     // and are writable, no output is any item's input or the manifest, no file is named twice.
@@ -1177,8 +1180,10 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
     std::printf("batch%s: %zu items: %zu done, %zu up to date, %zu failed\n",
                 sharded ? (" shard " + std::to_string(shard.first) + "/" + std::to_string(shard.second)).c_str() : "",
                 mine, done, skipped, failed);
-    if (sharded) return failed ? kExitItemsFailed : 0;  // the summary is the merge step's
-    return summarise(items, stamps, failed_now, summary, batch);
+    const bool failures_count = failed && !batch.item_failures_ok;
+    if (sharded) return failures_count ? kExitItemsFailed : 0;  // the summary is the merge step's
+    const int code = summarise(items, stamps, failed_now, summary, batch);
+    return code == kExitItemsFailed && !failures_count ? 0 : code;
 }
 
 }  // namespace animorder::tool

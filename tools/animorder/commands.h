@@ -125,9 +125,10 @@ struct BatchOptions {
     std::string summary;     // SUMMARY → SUMMARY.json and SUMMARY.md (default: beside the manifest)
     size_t eval_views = 10;  // OVR before/after per item: random views per keyframe (0: no OVR)
     unsigned eval_resolution = 256;
-    bool no_timings = false;  // wall times left out: identical work gives byte-identical files
-    bool force = false;       // redo items even when up to date
-    bool dry_run = false;     // write nothing: print which items would run and why (JSON on stdout)
+    bool no_timings = false;        // wall times left out: identical work gives byte-identical files
+    bool force = false;             // redo items even when up to date
+    bool item_failures_ok = false;  // exit 0 when items failed (not with --merge)
+    bool dry_run = false;           // write nothing: print which items would run and why (JSON on stdout)
     unsigned threads = 0;
 };
 using ItemParser = std::function<OptimizeOptions(const std::vector<std::string>& args)>;

@@ -2,6 +2,8 @@
 // every failure into one line on stderr and a non-zero exit code (never a crash).
 #include "commands.h"
 
+#include "animorder/atomic_write.h"
+
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -185,6 +187,9 @@ int main(int argc, char** argv) {
         "(Han & Sander 2017; Sander, Nehab & Barczak 2007)"};
     app.set_version_flag("--version", std::string("animorder ") + ANIMORDER_VERSION);
     app.require_subcommand(1);
+    // SIGTERM ends a run at any moment, also as a container's first process (PID 1), which the
+    // signal's default action would leave running until it is killed.
+    animorder::install_signal_cleanup();
 
     InspectOptions inspect;
     CLI::App* inspect_cmd =
@@ -282,6 +287,9 @@ int main(int argc, char** argv) {
     batch_cmd->add_flag("--no-timings", batch.no_timings,
                         "Leave wall times out of reports and summary (identical work: byte-identical files)");
     batch_cmd->add_flag("--force", batch.force, "Redo items whose outputs are up to date");
+    batch_cmd->add_flag("--item-failures-ok", batch.item_failures_ok,
+                        "Exit 0 when items failed (each recorded for the merge, which still exits 3): for farms "
+                        "whose retry would only fail the same items again");
     batch_cmd->add_flag("--dry-run", batch.dry_run,
                         "Write nothing: print which of the shard's items would run and why (JSON on stdout)");
     batch_cmd->add_option("--threads", batch.threads, "Worker threads per item (0: all cores)")

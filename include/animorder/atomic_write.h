@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <ctime>
 #include <functional>
 #include <stdexcept>
 #include <string>
@@ -79,8 +80,9 @@ bool process_may_run(long pid);
 // temporaries (".NAME.tmpPID") whose process is gone are removed, and so are such backups
 // (".NAME.oldPID") while the target exists (a backup whose target is missing may be the only copy
 // of the file it replaced: kept). A process id cannot tell a live process on another machine
-// sharing the folder.
-void remove_stale_temporaries(const std::string& target);
+// sharing the folder, nor one that took the id since: so a temporary whose inode has not changed
+// for an hour before `now` is removed whatever its process id (a temporary lives seconds).
+void remove_stale_temporaries(const std::string& target, std::time_t now = std::time(nullptr));
 
 // SIGINT, SIGTERM and SIGHUP, where their action is the default one, remove this process's
 // temporaries and end it as killed (also as a container's PID 1, whose default actions do

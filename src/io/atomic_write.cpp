@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
 #include <memory>
 #include <mutex>
@@ -44,6 +45,15 @@ std::string temporary_name(const fs::path& target, const char* kind) {
     return (folder / ("." + target.filename().string() + "." + kind + std::to_string(::getpid()))).string();
 }
 
+// A temporary lives from its first write to the commit (seconds; its backup only during the
+// commit), so one whose inode has not changed for an hour (ctime: writes and renames set it) is
+// left over, whatever its process id now names: another process that took the id, as a
+// container's PID 1 on a volume shared between machines does, or one on another machine.
+bool untouched_for_an_hour(const fs::path& path, std::time_t now) {
+    struct stat st {};
+    return ::stat(path.c_str(), &st) == 0 && now - st.st_ctime > 3600;
+}
+
 }  // namespace
 
 bool process_may_run(long pid) {
@@ -59,7 +69,7 @@ bool process_may_run(long pid) {
     return !(name_end != std::string::npos && name_end + 2 < text.size() && text[name_end + 2] == 'Z');
 }
 
-void remove_stale_temporaries(const std::string& target) {
+void remove_stale_temporaries(const std::string& target, std::time_t now) {
     const fs::path path(target);
     const fs::path folder = path.has_parent_path() ? path.parent_path() : fs::path(".");
     const std::string prefix = "." + path.filename().string() + ".";
@@ -72,7 +82,7 @@ void remove_stale_temporaries(const std::string& target) {
         if ((kind != "tmp" && kind != "old") || pid.empty() || pid.size() > 9 ||
             !std::all_of(pid.begin(), pid.end(), [](char c) { return c >= '0' && c <= '9'; }))
             continue;
-        if (process_may_run(std::stol(pid))) continue;
+        if (process_may_run(std::stol(pid)) && !untouched_for_an_hour(it->path(), now)) continue;
         std::error_code ignored;
         if (kind == "old" && !fs::exists(path, ignored)) continue;
         fs::remove(it->path(), ignored);

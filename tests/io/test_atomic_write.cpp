@@ -10,6 +10,7 @@
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -146,4 +147,32 @@ TEST_F(AtomicWrite, AnOutputThatIsNoRegularFileIsRefused) {
     EXPECT_TRUE(fs::is_fifo(path("fifo")));
     EXPECT_TRUE(fs::is_symlink(path("link.json")));
     EXPECT_TRUE(fs::is_character_file("/dev/null"));
+}
+
+// What killed runs left: a temporary of a process that is gone goes at once; one whose process id
+// names a live process (PID 1 always does: a container's killed first process, seen from a
+// volume another machine shares) stays while it may be written, and goes once its inode has not
+// changed for an hour (a temporary lives seconds). A backup whose target is missing stays.
+TEST_F(AtomicWrite, LeftOverTemporariesGoOnceTheirProcessIsGoneOrAnHourHasPassed) {
+    const std::string target = path("out.glb").string();
+    std::ofstream(target) << "result";
+    const pid_t gone = [] {
+        const pid_t child = ::fork();
+        if (child == 0) ::_exit(0);
+        ::waitpid(child, nullptr, 0);
+        return child;
+    }();
+    for (const std::string& name : {".out.glb.tmp" + std::to_string(gone), std::string(".out.glb.tmp1"),
+                                    std::string(".out.glb.old1"), std::string(".other.glb.old1")})
+        std::ofstream(path(name)) << "left";
+    animorder::remove_stale_temporaries(target);
+    EXPECT_FALSE(fs::exists(path(".out.glb.tmp" + std::to_string(gone))));
+    EXPECT_TRUE(fs::exists(path(".out.glb.tmp1")));  // PID 1 runs: it may be writing it now
+    EXPECT_TRUE(fs::exists(path(".out.glb.old1")));
+    const std::time_t later = std::time(nullptr) + 3601 + 5;
+    animorder::remove_stale_temporaries(path("other.glb").string(), later);  // its target is missing
+    EXPECT_TRUE(fs::exists(path(".other.glb.old1")));
+    animorder::remove_stale_temporaries(target, later);
+    EXPECT_FALSE(fs::exists(path(".out.glb.tmp1")));
+    EXPECT_FALSE(fs::exists(path(".out.glb.old1")));
 }

@@ -695,6 +695,66 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
     return mesh;
 }
 
+// load_assimp_here in the child, run from the character's folder on its bare file name. Importers
+// make the names of the side files they look for from the path they are given (assimp's MD5
+// reader tries "chars/chars/Bob.md5anim" for "chars/Bob.md5mesh", and names cut from the whole
+// path), so the files looked at (OptimizeProduct's files_read, the batch reports' side files)
+// would depend on how the path was spelled and on the current folder. The files looked at come
+// back named from the current folder again, clip files are made absolute first, and errors name
+// the files as the caller did.
+AnimatedMesh load_from_its_folder(const std::string& path, const std::vector<std::string>& clip_files,
+                                  const LoadOptions& options, const io::ChildContext& child) {
+    namespace fs = std::filesystem;
+    const fs::path folder = fs::path(path).parent_path();
+    std::error_code error;
+    if (folder.empty() || !fs::is_directory(folder, error)) return load_assimp_here(path, clip_files, options, child);
+    std::vector<std::pair<std::string, std::string>> as_given;  // (as the child names it, as the caller did)
+    std::vector<std::string> clips;
+    for (const std::string& c : clip_files) {
+        clips.push_back(fs::absolute(c, error).string());
+        if (error || clips.back().empty()) clips.back() = c;
+        if (clips.back() != c) as_given.emplace_back(clips.back(), c);
+    }
+    const std::string name = fs::path(path).filename().string();
+    if (::chdir(folder.c_str()) != 0)
+        return load_assimp_here(path, clip_files, options, child);  // the child's own folder
+    std::vector<std::string> looked_at;
+    const io::ChildContext here{child.reading, looked_at};
+    try {
+        AnimatedMesh mesh = load_assimp_here(name, clips, options, here);
+        for (const std::string& file : looked_at)
+            child.opened.push_back(fs::path(file).is_absolute() ? file : (folder / file).string());
+        return mesh;
+    } catch (const LoadError& e) {
+        // Each name as a whole word of the message (not inside a longer path), the longest first,
+        // in one pass (a name as given is never read again).
+        as_given.emplace_back(name, path);
+        std::sort(as_given.begin(), as_given.end(),
+                  [](const auto& a, const auto& b) { return a.first.size() > b.first.size(); });
+        const auto in_a_path = [](char c) {
+            return std::isalnum(uint8_t(c)) || c == '/' || c == '.' || c == '_' || c == '-';
+        };
+        const std::string said = e.what();
+        std::string message;
+        for (size_t at = 0; at < said.size();) {
+            bool replaced = false;
+            for (const auto& [shown, given] : as_given) {
+                const size_t end = at + shown.size();
+                if (said.compare(at, shown.size(), shown) != 0 || (at > 0 && in_a_path(said[at - 1]))) continue;
+                const bool sentence_end =
+                    end < said.size() && said[end] == '.' && (end + 1 == said.size() || said[end + 1] == ' ');
+                if (end < said.size() && in_a_path(said[end]) && !sentence_end) continue;
+                message += given;
+                at = end;
+                replaced = true;
+                break;
+            }
+            if (!replaced) message += said[at++];
+        }
+        throw LoadError(message);
+    }
+}
+
 }  // namespace
 
 AnimatedMesh load_assimp(const std::string& path, const std::vector<std::string>& clip_files,
@@ -705,7 +765,7 @@ AnimatedMesh load_assimp(const std::string& path, const std::vector<std::string>
     std::vector<std::string> files{path};
     files.insert(files.end(), clip_files.begin(), clip_files.end());
     return io::load_isolated(files, options, [&](const io::ChildContext& child) {
-        return load_assimp_here(path, clip_files, options, child);
+        return load_from_its_folder(path, clip_files, options, child);
     });
 }
 

@@ -51,7 +51,7 @@ std::string temporary_name(const fs::path& target, const char* kind) {
 // container's PID 1 on a volume shared between machines does, or one on another machine.
 bool untouched_for_an_hour(const fs::path& path, std::time_t now) {
     struct stat st {};
-    return ::stat(path.c_str(), &st) == 0 && now - st.st_ctime > 3600;
+    return ::lstat(path.c_str(), &st) == 0 && now - st.st_ctime > 3600;
 }
 
 }  // namespace

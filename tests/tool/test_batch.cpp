@@ -940,3 +940,29 @@ TEST_F(Batch, AsAContainersFirstProcessItEndsOnSigterm) {
     EXPECT_NE(o.out.find("rc=143"), std::string::npos) << o.out << test::slurp(path("err.txt"));
     EXPECT_FALSE(fs::exists(path("out/a.animorder.bin")));
 }
+
+// The files an importer looked for are listed in the report as found from the report's folder,
+// the same whatever folder the batch starts in: assimp's MD5 reader also looks for names made
+// from the input's path as spelled ("chars/chars/Bob.md5anim", cut-off names), which were
+// listed and differed with the spelling.
+TEST_F(Batch, AReportIsTheSameBytesFromAnyFolderWhenTheImporterProbes) {
+    const fs::path bob = test::shared_data_path("md5-bob");
+    ANIMORDER_REQUIRE_DATA(bob / "Bob.md5mesh");
+    fs::create_directories(path("chars/anims"));
+    fs::copy_file(bob / "Bob.md5mesh", path("chars/Bob.md5mesh"));
+    fs::copy_file(bob / "Bob.md5anim", path("chars/anims/Bob.md5anim"));
+    write("m.json", R"({"items": [{"input": "chars/Bob.md5mesh", "clips": ["chars/anims/"], "method": "original",
+                                   "output": "out/bob"}]})");
+    const std::string report = path("out/bob.animorder.report.json").string();
+    ASSERT_EQ(run_from(dir_, "batch -q --eval-views 0 --no-timings m.json", dir_).exit_code, 0);
+    const std::string first = test::slurp(report);
+    const nlohmann::json side = nlohmann::json::parse(first)["batch"]["side_files"];
+    ASSERT_EQ(side.size(), 1u) << side;  // the anim beside the mesh, looked for and missing
+    EXPECT_EQ(side[0]["file"], "../chars/Bob.md5anim");
+    for (const std::string& spelling : {manifest(), std::string("./m.json")}) {
+        const test::Outcome o = run_from(spelling == manifest() ? fs::path("/") : dir_,
+                                         "batch -q --eval-views 0 --no-timings --force '" + spelling + "'", dir_);
+        ASSERT_EQ(o.exit_code, 0) << o.err;
+        EXPECT_EQ(test::slurp(report), first) << spelling;
+    }
+}

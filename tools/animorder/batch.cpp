@@ -626,7 +626,11 @@ json stamp_parts_json(const StampParts& parts) {
 
 // The files loading read beyond the stamp's (an OBJ's .mtl: only the importer knows them, found
 // or not), each with its path from the report's folder and its digest taken as it was loaded,
-// for the report's "side_files".
+// for the report's "side_files". A missing file in a missing folder is left out: importers look
+// for names made from the input's path (assimp's MD5 reader tries "chars/chars/Bob.md5anim" and
+// names cut from the path; load_assimp runs it from the character's folder, so those no longer
+// depend on the spelling, but such guesses still name folders nobody made), and a file to
+// appear there would need its folder made first.
 json side_files(const PlannedItem& p, const std::vector<std::string>& files_read) {
     std::unordered_set<std::string> known;
     for (const std::string& input : p.plan.inputs) known.insert(file_identity(input));
@@ -634,6 +638,8 @@ json side_files(const PlannedItem& p, const std::vector<std::string>& files_read
     std::unordered_set<std::string> listed;
     for (const std::string& file : files_read) {
         if (known.count(file_identity(file))) continue;
+        std::error_code error;
+        if (!fs::exists(file, error) && !fs::is_directory(folder_of(file), error)) continue;
         const std::string name = from_report_folder(p, file);
         if (!listed.insert(name).second) continue;
         json entry = side_file_name(name);

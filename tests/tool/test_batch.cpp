@@ -966,3 +966,26 @@ TEST_F(Batch, AReportIsTheSameBytesFromAnyFolderWhenTheImporterProbes) {
         EXPECT_EQ(test::slurp(report), first) << spelling;
     }
 }
+
+// A CSV error names the line it is on, a quoted field over several lines counted (the record
+// count was named), also for an item's options; the Markdown summary escapes a name's
+// punctuation instead of changing it ("a|b" was shown as "a/b", a name's *stars* as emphasis).
+TEST_F(Batch, CsvErrorsNameTheirLineAndTheMarkdownSummaryEscapesNames) {
+    write("m.csv", "name,method,output\n\"multi\nline\",original,out/a\nb,original,out/\"b\n");
+    test::Outcome o = run("batch -q --eval-views 0 " + path("m.csv").string());
+    EXPECT_EQ(o.exit_code, 1);
+    EXPECT_NE(o.err.find("m.csv: line 4: field 3: a quote inside an unquoted field"), std::string::npos) << o.err;
+    write("m.csv", "name,method,options,output\n\"multi\nline\",original,,out/a\nb,original,--no-such-option,out/b\n");
+    o = run("batch -q --eval-views 0 " + path("m.csv").string());
+    EXPECT_EQ(o.exit_code, 1);
+    EXPECT_NE(o.err.find("line 4 (b): "), std::string::npos) << o.err;
+
+    write("m.json", R"({"items": [{"name": "a|b", "method": "original", "output": "out/a"},
+                                  {"name": "a/b", "method": "original", "output": "out/b"},
+                                  {"name": "*em* <i>x</i> `c`", "method": "original", "output": "out/c"}]})");
+    ASSERT_EQ(run("batch -q --eval-views 0 " + manifest()).exit_code, 0);
+    const std::string md = test::slurp(path("m.summary.md"));
+    EXPECT_NE(md.find("\n| a\\|b | original |"), std::string::npos) << md;
+    EXPECT_NE(md.find("\n| a/b | original |"), std::string::npos) << md;
+    EXPECT_NE(md.find("\n| \\*em\\* \\<i\\>x\\</i\\> \\`c\\` | original |"), std::string::npos) << md;
+}

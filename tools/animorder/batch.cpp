@@ -34,6 +34,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <numeric>
@@ -293,7 +294,11 @@ std::vector<ManifestItem> parse_csv_manifest(const std::string& text, const std:
             throw std::runtime_error(path + ": line 1: the column \"" + h + "\" appears twice");
     }
     std::vector<ManifestItem> items;
-    for (size_t line = 2; pos < text.size(); ++line) {
+    size_t line = 1, counted = 0;  // the line a record starts on: line ends before pos (a quoted field may hold some)
+    while (pos < text.size()) {
+        for (; counted < pos; ++counted)
+            line += text[counted] == '\n' ||
+                    (text[counted] == '\r' && (counted + 1 == text.size() || text[counted + 1] != '\n'));
         const std::string where = path + ": line " + std::to_string(line);
         const std::vector<std::string> fields = csv_record(text, pos, where);
         // A blank line, or a row of empty fields (",,": spreadsheets export them), is no item.
@@ -406,7 +411,8 @@ bool names_an_output(const std::string& o) {
 PlannedItem plan_item(const ManifestItem& item, size_t index, const BatchOptions& batch, const ItemParser& parse) {
     PlannedItem p;
     p.item = item;
-    const std::string label = "item " + std::to_string(index + 1) + " (" + item.name + ")";
+    const std::string label = (item.line ? "line " + std::to_string(item.line) : "item " + std::to_string(index + 1)) +
+                              " (" + item.name + ")";
     // The item's own fields first, its options last (so an option missing its value says so).
     std::vector<std::string> args = {"-o", item.output};
     if (!item.input.empty()) args.push_back(item.input);
@@ -931,10 +937,16 @@ std::string cell(const json& v, int digits) {
         std::snprintf(text, sizeof text, "%.*f", digits, v.get<double>());
         return text;
     }
-    if (v.is_string()) {
-        std::string s = v.get<std::string>();
-        for (char& c : s)
-            if (c == '|' || c == '\n' || c == '\r') c = c == '|' ? '/' : ' ';
+    if (v.is_string()) {  // as text: Markdown's punctuation escaped, a line end as a space
+        std::string s;
+        for (const char c : v.get<std::string>()) {
+            if (c == '\n' || c == '\r') {
+                s += ' ';
+                continue;
+            }
+            if (std::strchr("\\`*_[]<>|~", c) && c != '\0') s += '\\';
+            s += c;
+        }
         return s;
     }
     return v.dump();

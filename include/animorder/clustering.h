@@ -52,8 +52,10 @@ struct ClusteringSettings {
     // (kept_fragments.h), in node order while they fit in this many bytes; the nodes beyond are
     // rasterised again whenever they are scored (slower, same result).
     size_t max_cache_bytes = size_t(6) << 30;
-    std::function<void(const std::string&)> log;   // one line per event (re-seeding, …)
-    std::function<void(size_t, size_t)> progress;  // nodes scored, total, per iteration
+    std::function<void(const std::string&)> log;  // one line per event (re-seeding, …)
+    // Now and then: what the nodes go through ("rasterising nodes", "scoring the first orders",
+    // "assigning nodes, iteration 2"), nodes done, total; (total, total) ends each stage.
+    std::function<void(const std::string& stage, size_t done, size_t total)> progress;
 };
 
 struct ClusteringIteration {

@@ -32,6 +32,7 @@
 #include "worker_threads.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <memory>
 
 #include <tbb/blocked_range.h>
@@ -370,6 +371,12 @@ struct MeasuredGraphs {
     std::vector<std::vector<uint32_t>> start;  // per cluster: the buffer that order started from
 };
 
+std::string megabytes(uint64_t bytes) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.1f MB", double(bytes) / 1e6);
+    return text;
+}
+
 // Nodes into (sign +1) or out of (−1) a cluster's graph: the kept ones as kept, the others
 // rasterised again, a chunk of about kTransientFragmentBytes at a time (a few hundred nodes at
 // 256², a few dozen at 4096²: nodes beyond the budget never all come back at once). The counts
@@ -651,13 +658,18 @@ ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patc
         nodes.patch_visible = patch_visibility(mesh, patches, framing, keyframes, nodes.eyes);
     nodes.score.resolution = settings.resolution;
     nodes.score.threads = settings.threads;
-    nodes.score.progress = settings.progress;
+    std::string stage = "scoring the first orders";  // what nodes.score's progress reports
+    if (settings.progress)
+        nodes.score.progress = [&settings, &stage](size_t done, size_t total) {
+            settings.progress(stage, done, total);
+        };
     nodes.modes = opaque_pass_modes(mesh);
     nodes.score.triangle_modes = nodes.modes.empty() ? nullptr : nodes.modes.data();
 
     result.patch_orders = bootstrap_orders(nodes, settings);
 
     // Rasterise every node once; later iterations only replay the kept fragments in new orders.
+    stage = "rasterising nodes";
     const Clock::time_point raster_start = Clock::now();
     nodes.cache =
         std::make_unique<NodeCache>(mesh.keyframe_positions.data(), mesh.vertex_count, framing, mesh.indices.data(),
@@ -669,10 +681,10 @@ ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patc
     result.kept_nodes = nodes.cache->kept_count();
     result.kept_bytes = nodes.cache->kept_bytes();
     if (nodes.cache->kept_count() < nodes.count)
-        say(settings, "node fragments exceed the cache budget: " + std::to_string(nodes.cache->kept_count()) + " of " +
-                          std::to_string(nodes.count) + " nodes kept (" +
-                          std::to_string(nodes.cache->kept_bytes() >> 20) +
-                          " MiB), the others rasterised again when scored");
+        say(settings, "node fragments exceed the cache budget of " + megabytes(settings.max_cache_bytes) + ": " +
+                          std::to_string(nodes.cache->kept_count()) + " of " + std::to_string(nodes.count) +
+                          " nodes kept (" + megabytes(nodes.cache->kept_bytes()) +
+                          "), the others rasterised again when scored");
 
     NodeScores scores{std::vector<uint64_t>(nodes.count), std::vector<uint64_t>(nodes.count * nodes.k), {}};
     std::vector<double> node_ovr;
@@ -682,6 +694,7 @@ ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patc
     tbb::task_arena update_arena(worker_threads(settings.threads));
     for (size_t iteration = 0;; ++iteration) {
         ClusteringIteration log;
+        stage = "assigning nodes, iteration " + std::to_string(iteration + 1);
         const Clock::time_point assignment_start = Clock::now();
         assign_nodes(nodes, result.patch_orders, scores, result.assignment, node_ovr, log);
         log.seconds_assignment = seconds_since(assignment_start);

@@ -246,10 +246,23 @@ AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double
     } else {
         for (const Clip& c : mesh.clips) sets.push_back(clip_keyframes(c));
     }
-    for (const auto& keyframes : sets) {
+    for (size_t s = 0; s < sets.size(); ++s) {
+        const std::vector<uint32_t>& keyframes = sets[s];
         const Framing framing = frame_subset(result.framing, keyframes);
         result.run_radius.push_back(framing.radius);
-        result.runs.push_back(cluster_nodes(mesh, result.patches, framing, keyframes, settings));
+        // A run per clip names its clip in its log lines and progress.
+        ClusteringSettings run_settings = settings;
+        if (!joint && sets.size() > 1) {
+            const std::string clip = "clip '" + mesh.clips[s].name + "' (" + std::to_string(s + 1) + "/" +
+                                     std::to_string(sets.size()) + "): ";
+            if (settings.log)
+                run_settings.log = [&settings, clip](const std::string& line) { settings.log(clip + line); };
+            if (settings.progress)
+                run_settings.progress = [&settings, clip](const std::string& stage, size_t done, size_t total) {
+                    settings.progress(clip + stage, done, total);
+                };
+        }
+        result.runs.push_back(cluster_nodes(mesh, result.patches, framing, keyframes, run_settings));
         // Blended primitives: back to front for each cluster, in the measured blend order of its
         // nodes (blend_orders.h; the nodes' transparent pass rasterised once); with blend_clusters,
         // by their own k clusters of the same nodes, the buffers then being the (opaque, blend)

@@ -520,6 +520,31 @@ TEST_F(Cli, SubdivideRefusesAnOutputOverTheLoadingBudgetBeforeBuildingIt) {
     EXPECT_EQ(j["keyframes"], 77);
 }
 
+// Progress into a file (a farm's log): whole lines, no carriage returns, each stage named (it
+// said "assigning nodes" for everything) with its clip, and once per stage; --quiet: nothing.
+TEST_F(Cli, ProgressIntoAFileIsWholeLinesNamingTheStageAndClip) {
+    const std::string fast = "optimize -k 2 --views 12 --resolution 32 --max-iterations 2 -o ";
+    const auto expect_once = [](const std::string& err, const std::string& line) {
+        const size_t at = err.find(line);
+        EXPECT_NE(at, std::string::npos) << line << " in\n" << err;
+        EXPECT_EQ(err.find(line, at + 1), std::string::npos) << line << " twice in\n" << err;
+    };
+    const test::Outcome o = run(fast + path("o").string());
+    ASSERT_EQ(o.exit_code, 0) << o.err;
+    EXPECT_EQ(o.err.find('\r'), std::string::npos) << o.err;
+    expect_once(o.err, "animorder: single: clip 'walk' (1/2): rasterising nodes: 372/372 nodes, ");
+    expect_once(o.err, "animorder: single: clip 'walk' (1/2): assigning nodes, iteration 1: 372/372 nodes, ");
+    expect_once(o.err, "animorder: single: clip 'wave' (2/2): rasterising nodes: 552/552 nodes, ");
+    const test::Outcome lean = run(fast + path("l").string() + " --fragment-memory 0");
+    ASSERT_EQ(lean.exit_code, 0) << lean.err;
+    expect_once(lean.err,
+                "animorder: single: clip 'wave' (2/2): node fragments exceed the cache budget of 0.0 MB: 0 "
+                "of 552 nodes kept");
+    const test::Outcome quiet = run(fast + path("q").string() + " -q");
+    EXPECT_EQ(quiet.exit_code, 0);
+    EXPECT_EQ(quiet.err, "");
+}
+
 TEST_F(Cli, LambdaChangesTheAcmrTheWayThePaperSays) {
     ASSERT_EQ(run("optimize -q --lambda 0 --report " + path("r0.json").string()).exit_code, 0);
     ASSERT_EQ(run("optimize -q --lambda 3 --report " + path("r3.json").string()).exit_code, 0);

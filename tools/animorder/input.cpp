@@ -4,6 +4,7 @@
 #include "animorder/load.h"
 #include "animorder/procedural_character.h"
 
+#include <unistd.h>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -17,19 +18,43 @@ void note(const CommonOptions& common, const std::string& text) {
     if (!common.quiet) std::fprintf(stderr, "animorder: %s\n", text.c_str());
 }
 
-std::function<void(size_t, size_t)> progress_printer(const CommonOptions& common, const std::string& stage) {
+// Progress on stderr: on a terminal one line rewritten in place (\r), at most twice a second;
+// into a file or a pipe (a farm's log) whole lines only, at most every 10 s, and each stage's end.
+std::function<void(const std::string&, size_t, size_t)> staged_progress_printer(const CommonOptions& common,
+                                                                                const std::string& prefix) {
     if (common.quiet) return {};
     using Clock = std::chrono::steady_clock;
-    const Clock::time_point start = Clock::now();
-    auto last = std::make_shared<double>(-1.0);
-    return [stage, start, last](size_t done, size_t total) {
-        const double now = std::chrono::duration<double>(Clock::now() - start).count();
-        if (done != total && now - *last < 0.5) return;  // at most two updates a second
-        *last = now;
-        std::fprintf(stderr, "\ranimorder: %s: %zu/%zu nodes, %.1f s", stage.c_str(), done, total, now);
-        if (done == total) std::fputc('\n', stderr);
+    struct State {
+        Clock::time_point start = Clock::now();
+        double last = -1;
+        std::string stage;
+        bool open = false;   // a terminal line not yet ended
+        bool ended = false;  // the stage's end is shown (a stage may go over its nodes twice)
+    };
+    auto state = std::make_shared<State>();
+    const bool terminal = ::isatty(2) == 1;
+    return [prefix, state, terminal](const std::string& stage, size_t done, size_t total) {
+        State& s = *state;
+        const double now = std::chrono::duration<double>(Clock::now() - s.start).count();
+        if (stage != s.stage) {
+            if (s.open) std::fputc('\n', stderr);
+            s.stage = stage, s.open = false, s.last = -1, s.ended = false;
+        }
+        if (s.ended || (done != total && now - s.last < (terminal ? 0.5 : 10.0))) return;  // a stage's end once
+        s.ended = done == total;
+        s.last = now;
+        const std::string name = prefix + (stage.empty() ? "" : (prefix.empty() ? "" : ": ") + stage);
+        std::fprintf(stderr, "%sanimorder: %s: %zu/%zu nodes, %.1f s%s", terminal ? "\r" : "", name.c_str(), done,
+                     total, now, terminal && done != total ? "" : "\n");
+        s.open = terminal && done != total;
         std::fflush(stderr);
     };
+}
+
+std::function<void(size_t, size_t)> progress_printer(const CommonOptions& common, const std::string& stage) {
+    auto staged = staged_progress_printer(common, stage);
+    if (!staged) return {};
+    return [staged](size_t done, size_t total) { staged("", done, total); };
 }
 
 bool clip_is_file(const CommonOptions& common, const std::string& clip) {
@@ -129,7 +154,7 @@ MethodSettings method_settings(const MethodOptions& options, const CommonOptions
     settings.clustering.update = parse_update(options.update);
     const std::string name = method_name(method);
     settings.clustering.log = [common, name](const std::string& line) { note(common, name + ": " + line); };
-    settings.clustering.progress = progress_printer(common, name + ": assigning nodes");
+    settings.clustering.progress = staged_progress_printer(common, name);
     return settings;
 }
 

@@ -21,6 +21,9 @@ void note(const CommonOptions& common, const std::string& text);
 
 // A progress line on stderr that rewrites itself (at most two updates a second); none if --quiet.
 std::function<void(size_t, size_t)> progress_printer(const CommonOptions& common, const std::string& stage);
+// The same for work in stages (ClusteringSettings::progress): "PREFIX: STAGE: done/total nodes".
+std::function<void(const std::string&, size_t, size_t)> staged_progress_printer(const CommonOptions& common,
+                                                                                const std::string& prefix);
 
 // Whether a --clip value names a clip file or folder (else the name of a clip to keep): never for a
 // character that carries its clips (glTF, MD2, IQM, the bundled one).

@@ -535,8 +535,14 @@ TEST_F(Cli, ProgressIntoAFileIsWholeLinesNamingTheStageAndClip) {
     expect_once(o.err, "animorder: single: clip 'walk' (1/2): rasterising nodes: 372/372 nodes, ");
     expect_once(o.err, "animorder: single: clip 'walk' (1/2): assigning nodes, iteration 1: 372/372 nodes, ");
     expect_once(o.err, "animorder: single: clip 'wave' (2/2): rasterising nodes: 552/552 nodes, ");
-    const test::Outcome lean = run(fast + path("l").string() + " --fragment-memory 0");
+    const test::Outcome lean =
+        run(fast + path("l").string() + " --fragment-memory 0 --threads 1 -r " + path("l.json").string());
     ASSERT_EQ(lean.exit_code, 0) << lean.err;
+    // The report says how the run went: the budget, the threads used.
+    const nlohmann::json settings = nlohmann::json::parse(test::slurp(path("l.json")))["settings"];
+    EXPECT_EQ(settings["fragment_memory"], 0);
+    EXPECT_EQ(settings["threads"], 1);
+    EXPECT_GT(settings["max_memory"].get<uint64_t>(), 0u);
     expect_once(lean.err,
                 "animorder: single: clip 'wave' (2/2): node fragments exceed the cache budget of 0.0 MB: 0 "
                 "of 552 nodes kept");

@@ -12,10 +12,12 @@
 #include "animorder/load.h"
 #include "animorder/sidecar.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <stdexcept>
+#include <thread>
 
 namespace animorder::tool {
 namespace {
@@ -63,7 +65,12 @@ nlohmann::ordered_json optimize_settings_json(const OptimizeOptions& options, co
                                        {"nehab_all_keyframes", m.nehab_all_keyframes},
                                        {"blend_clusters", m.blend_clusters},
                                        {"planar_units", m.measured_planar_units}};
-    if (with_threads) settings["threads"] = m.clustering.threads;
+    if (with_threads) {  // how it ran, which changes no output: threads used, the memory budgets
+        const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+        settings["threads"] = m.clustering.threads ? std::min(m.clustering.threads, cores) : cores;
+        settings["fragment_memory"] = m.clustering.max_cache_bytes;
+        settings["max_memory"] = options.common.max_memory;
+    }
     return settings;
 }
 

@@ -31,8 +31,8 @@ struct OptimizePlan {
 // Validates the options (method, settings, output names) and names the outputs; touches no file.
 OptimizePlan plan_optimize(const OptimizeOptions& options);
 
-// The settings as the report writes them (without "threads" when with_threads is false: the
-// thread count never changes an output).
+// The settings as the report writes them: with_threads adds how the run went, which never
+// changes an output (the threads used, --fragment-memory and --max-memory).
 nlohmann::ordered_json optimize_settings_json(const OptimizeOptions& options, const OptimizePlan& plan,
                                               bool with_threads = true);
 

@@ -593,6 +593,11 @@ TEST_F(Cli, BadInputAndOptionsGiveOneLineErrors) {
         {"heatmap -o ''", "--output: must not be empty"},
         {"inspect --clip ''", "--clip: must not be empty"},
         {"batch ''", "manifest: must not be empty"},
+        // A count that is no number says so (it said "Value abc not in range 0 to 1024").
+        {"optimize --threads abc", "--threads: must be a whole number (digits only), not 'abc'"},
+        {"batch m.json --threads ''", "--threads: must be a whole number (digits only), not ''"},
+        {"optimize --max-memory -1", "--max-memory: must be a whole number (digits only), not '-1'"},
+        {"reapply a.glb b.glb -o c.glb --max-memory 0", "--max-memory: Value 0 not in range 1048576"},
     };
     for (const Case& c : cases) {
         const test::Outcome o = run(c.args + " --quiet");  // errors print even when quiet

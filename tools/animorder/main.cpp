@@ -20,7 +20,7 @@ namespace {
 const CLI::Validator kWholeNumber(
     [](std::string& text) -> std::string {
         if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos)
-            return "must be a whole number of at least 0, not '" + text + "'";
+            return "must be a whole number (digits only), not '" + text + "'";
         try {
             (void)std::stoull(text);
         } catch (const std::out_of_range&) {
@@ -129,6 +129,7 @@ void add_method_options(CLI::App& command, animorder::tool::MethodOptions& optio
         ->check(kWholeNumber);
     command.add_option("--threads", c.threads, "Worker threads (0: all cores)")
         ->capture_default_str()
+        ->check(kWholeNumber)
         ->check(CLI::Range(0u, 1024u));
 }
 
@@ -294,6 +295,7 @@ int main(int argc, char** argv) {
                         "Write nothing: print which of the shard's items would run and why (JSON on stdout)");
     batch_cmd->add_option("--threads", batch.threads, "Worker threads per item (0: all cores)")
         ->capture_default_str()
+        ->check(kWholeNumber)
         ->check(CLI::Range(0u, 1024u));
 
     ViewOptions view;
@@ -344,7 +346,8 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(0.0, 0.1));
     reapply_cmd->add_option("--max-memory", reapply.max_memory, "Loading budget in bytes for the sampled animation")
         ->capture_default_str()
-        ->check(kWholeNumber);
+        ->check(kWholeNumber)
+        ->check(CLI::Range(size_t(1) << 20, std::numeric_limits<size_t>::max()));
     reapply_cmd->add_flag("-q,--quiet", reapply.quiet, "No progress or notes on stderr");
 
     if (argc == 1) {  // no arguments: the basics, and where to look next (gltfpack style)

@@ -742,6 +742,9 @@ ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patc
             // Monotone rule's form of lines 18–19).
             result.converged = true;
             result.stop_reason = "converged";
+            say(settings, "converged: no buffer changed; keeping iteration " +
+                              std::to_string(result.best_iteration + 1) + " (mean OVR " +
+                              std::to_string(best.mean_ovr) + ")");
             finish(result, patches, best);
             break;
         }

@@ -142,6 +142,16 @@ protected:
             EXPECT_NEAR(stored_ovr(out), ovr, 1e-3);
         }
 
+        // The file's other extensions stay: the config's extension list replaces the CLI's own,
+        // and once held only ours, so quantize wrote KHR_mesh_quantization's accessors without
+        // the extension (invalid) and prune dropped every KHR_* one.
+        const fs::path quantized = path(name + "-gt-quantize.glb");
+        o = run(gt + " quantize " + q(optimised) + " " + q(quantized) + " --config " + q(kConfig));
+        ASSERT_EQ(o.exit_code, 0) << o.out << o.err;
+        EXPECT_NE(test::slurp(quantized).find("KHR_mesh_quantization"), std::string::npos);
+        expect_valid(quantized);
+        EXPECT_EQ(check(quantized), 0);
+
         // gltf-pipeline (dangling accessor references) and gltfpack (extension dropped, triangles
         // reordered, positions quantised): check rejects, reapply repairs.
         const fs::path pipeline = path(name + "-pipeline.glb"), pack = path(name + "-gltfpack.glb");

@@ -119,6 +119,31 @@ void remove_temporaries_and_reraise(int sig) {
     ::_exit(128 + sig);
 }
 
+// Commits under way in this process, and a signal that came meanwhile: a commit moves targets
+// aside and renames temporaries into place, and stopped half-way it would leave targets missing
+// or temporaries behind, so the signal waits until the commit has finished or rolled back (renames
+// only: at once).
+std::atomic<int> commits_running{0};
+std::atomic<int> deferred_signal{0};
+
+void on_signal(int sig) {
+    if (commits_running.load() > 0) {
+        deferred_signal.store(sig);
+        return;
+    }
+    remove_temporaries_and_reraise(sig);
+}
+
+// For the length of one commit: then a deferred signal acts (the temporaries not put in place are
+// still tracked, so it removes them).
+struct SignalsWaitForTheCommit {
+    SignalsWaitForTheCommit() { commits_running.fetch_add(1); }
+    ~SignalsWaitForTheCommit() {
+        if (commits_running.fetch_sub(1) == 1)
+            if (const int sig = deferred_signal.exchange(0)) remove_temporaries_and_reraise(sig);
+    }
+};
+
 }  // namespace
 
 // For the signals whose action is the default one (one that is ignored, as under nohup, or that
@@ -132,7 +157,7 @@ void install_signal_cleanup() {
                 previous.sa_handler != SIG_DFL)
                 continue;
             struct sigaction action {};
-            action.sa_handler = remove_temporaries_and_reraise;
+            action.sa_handler = on_signal;
             sigemptyset(&action.sa_mask);
             ::sigaction(sig, &action, nullptr);
         }
@@ -297,9 +322,9 @@ void OutputSet::add(const std::string& path, const std::string& data) {
 }
 
 void OutputSet::commit() {
-    // From here a signal leaves the temporaries (and backups) where they are: removing those not
-    // yet in place would leave their targets missing. batch sweeps what is left.
-    for (Pending& p : pending_) untrack_temporary(p.slot);
+    // A signal now waits for the end of the commit (or of its roll-back); each temporary is
+    // tracked until it is in place.
+    const SignalsWaitForTheCommit wait;
     // Existing targets move aside first, so a failure part-way can put every one of them back.
     std::vector<std::pair<std::string, std::string>> backups;  // target, backup
     size_t placed = 0;
@@ -323,6 +348,7 @@ void OutputSet::commit() {
     for (; placed < pending_.size(); ++placed) {
         fs::rename(pending_[placed].temp, pending_[placed].target, error);
         if (error) roll_back(pending_[placed].target + ": cannot replace: " + error.message());
+        untrack_temporary(pending_[placed].slot);
     }
     committed_ = true;
     for (const auto& backup : backups) std::remove(backup.second.c_str());

@@ -986,3 +986,23 @@ TEST_F(CliOutputs, AClipNameIsANameWhateverTheCurrentFolderHolds) {
         "cd '" + dir_.string() + "' && " + std::string(ANIMORDER_EXE) + " inspect -q --clip walk", dir_);
     EXPECT_EQ(bundled.exit_code, 0) << bundled.err;
 }
+
+// A signal while the outputs are being put in place waits for the end of that (renames only):
+// the run ends as killed with every output in place and no temporary left. It left the
+// temporaries behind (or, between moving a target aside and renaming its new file in, the target
+// missing). strace slows each rename down so that the signal lands during the commit.
+TEST_F(Cli, ASignalDuringTheCommitWaitsForItsEnd) {
+    if (test::run_captured("strace -o /dev/null true", dir_).exit_code != 0)
+        GTEST_SKIP() << "strace missing: the commit cannot be slowed down to signal it in the middle";
+    fs::create_directories(path("out"));
+    const std::string script = "cd '" + dir_.string() + "' || exit 1; " +
+                               "strace -f -o /dev/null -e inject=rename,renameat,renameat2:delay_enter=700000 " +
+                               std::string(ANIMORDER_EXE) + " optimize -q --views 12 --resolution 32 -k 2 -o out/o & " +
+                               "s=$!; for i in $(seq 600); do ls -A out | grep -q tmp && break; sleep 0.05; done; " +
+                               "sleep 0.3; kill -TERM $(pgrep -P $s); wait $s; echo rc=$?";
+    const test::Outcome o = test::run_captured(script, dir_);
+    EXPECT_NE(o.out.find("rc=143"), std::string::npos) << o.out << o.err;
+    std::string names;
+    for (const auto& e : fs::directory_iterator(path("out"))) names += e.path().filename().string() + " ";
+    EXPECT_TRUE(names == "o.animorder.bin o.animorder.json " || names == "o.animorder.json o.animorder.bin ") << names;
+}

@@ -713,7 +713,9 @@ TEST_F(Batch, AShardChecksOnlyWhatItWritesAndTheMergeOnlyTheSummary) {
     EXPECT_EQ(merged.exit_code, 4) << merged.err;
     const nlohmann::json s = nlohmann::json::parse(test::slurp(path("summaries/s.json")));
     EXPECT_NE(s["items"][1]["error"].get<std::string>().find("no result yet"), std::string::npos) << s["items"][1];
-    EXPECT_NE(s["items"][2]["error"].get<std::string>().find("its last run failed"), std::string::npos)
+    EXPECT_NE(s["items"][2]["error"].get<std::string>().find(
+                  "evaluated with other --eval-views/--eval-resolution/--no-timings; it failed when it last ran: "),
+              std::string::npos)
         << s["items"][2];
     EXPECT_NE(s["items"][2]["error"].get<std::string>().find("broken.obj"), std::string::npos) << s["items"][2];
 }
@@ -922,6 +924,10 @@ TEST_F(Batch, ADryRunSaysWhatWouldRunAndWhyAndWritesNothing) {
     write("tri.gltf", "{");
     EXPECT_EQ(run("batch -q --eval-views 0 " + manifest()).exit_code, 3);
     EXPECT_NE(plan("")["items"][2]["why"].get<std::string>().find("it failed when it last ran: "), std::string::npos);
+    // ... and, once something changed since, what changed and that it failed (it said "no result yet").
+    const std::string changed = plan(" --eval-views 1")["items"][2]["why"].get<std::string>();
+    EXPECT_NE(changed.find("--eval-views"), std::string::npos) << changed;
+    EXPECT_NE(changed.find("; it failed when it last ran: "), std::string::npos) << changed;
     EXPECT_NE(run("batch -q --dry-run --merge " + manifest()).err.find("drop --dry-run"), std::string::npos);
 }
 

@@ -718,8 +718,8 @@ Staleness stamp_change(const PlannedItem& p, const json& then, const BatchOption
     return {S::kChanged, "its result is out of date: its inputs, options or paths changed since it ran"};
 }
 
-Staleness staleness(const PlannedItem& p, const std::string& stamp, const BatchOptions& batch,
-                    json* report_out = nullptr) {
+Staleness staleness_of_report(const PlannedItem& p, const std::string& stamp, const BatchOptions& batch,
+                              json* report_out) {
     using S = Staleness;
     json report = read_json_file(p.report);
     if (!report.is_object() || !report.contains("batch") || !report["batch"].is_object())
@@ -753,6 +753,26 @@ Staleness staleness(const PlannedItem& p, const std::string& stamp, const BatchO
     }
     if (report_out) *report_out = std::move(report);
     return {};
+}
+
+// The same, and a failure the item's last run left (OUTPUT.animorder.error.json, with the stamp
+// and its parts of that run, the last attempt: a success removes it): named, with what changed
+// since.
+Staleness staleness(const PlannedItem& p, const std::string& stamp, const BatchOptions& batch,
+                    json* report_out = nullptr) {
+    Staleness s = staleness_of_report(p, stamp, batch, report_out);
+    if (s.kind == Staleness::kCurrent) return s;
+    const json failure = read_json_file(p.error);
+    const std::string error = string_at(failure, "error");
+    if (error.empty()) return s;
+    if (string_at(failure, "stamp") == stamp) return {Staleness::kChanged, "it failed when it last ran: " + error};
+    // The failure is the last attempt (a success removes it): what changed since, as far as known.
+    if (failure.contains("stamp_parts"))
+        s = stamp_change(p, failure, batch);
+    else if (s.kind == Staleness::kNoResult)
+        s = {Staleness::kChanged, "its inputs, options or build changed since"};
+    s.why += "; it failed when it last ran: " + error;
+    return s;
 }
 
 // The item's report when it is up to date, else null.
@@ -890,11 +910,6 @@ void run_item(const PlannedItem& p, const StampParts& parts, const BatchOptions&
 // the merge itself is the cause).
 std::string why_missing(const PlannedItem& p, const std::string& stamp, const BatchOptions& batch) {
     const Staleness s = staleness(p, stamp, batch);
-    const std::string failed = string_at(read_json_file(p.error), "error");
-    if (s.kind == Staleness::kNoResult && !failed.empty())
-        return "its last run failed, with another build, other --eval-*/--no-timings options or other inputs or "
-               "options than this merge's: " +
-               failed;
     if (s.kind == Staleness::kOtherBuild) return s.why + " (run the merge with the build that ran the items)";
     if (s.kind == Staleness::kOtherEvaluation) return s.why + " (give the merge the same)";
     return s.why;
@@ -1077,9 +1092,6 @@ int print_plan(const std::vector<PlannedItem>& items, std::pair<size_t, size_t> 
         const std::string stamp = item_stamp(p, batch);
         Staleness s = staleness(p, stamp, batch);
         if (batch.force) s = {Staleness::kChanged, "--force"};
-        const json failure = read_json_file(p.error);
-        if (s.kind != Staleness::kCurrent && string_at(failure, "stamp") == stamp)
-            s.why = "it failed when it last ran: " + string_at(failure, "error");
         const bool current = s.kind == Staleness::kCurrent;
         (current ? skip : run) += 1;
         rows.push_back({{"item", i + 1},
@@ -1186,10 +1198,12 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
             std::fprintf(stderr, "animorder: %s: failed: %s\n", label.c_str(), message.c_str());
             failed_now[i] = message;
             try {
-                write_file_atomically(
-                    p.error,
-                    report_text(
-                        json{{"stamp", stamps[i]}, {"item", p.item.name}, {"status", "failed"}, {"error", message}}));
+                write_file_atomically(p.error, report_text(json{{"stamp", stamps[i]},
+                                                                {"stamp_parts", stamp_parts_json(parts)},
+                                                                {"tool", tool_digest()},
+                                                                {"item", p.item.name},
+                                                                {"status", "failed"},
+                                                                {"error", message}}));
             } catch (const std::exception& again) {
                 std::fprintf(stderr, "animorder: %s: cannot record the failure: %s\n", label.c_str(), again.what());
             }

@@ -877,7 +877,8 @@ TEST_F(Batch, ADryRunSaysWhatWouldRunAndWhyAndWritesNothing) {
     manifest_with("2");
     const auto plan = [&](const std::string& options) {  // --eval-views 0 unless given
         const std::string eval = options.find("--eval-views") == std::string::npos ? " --eval-views 0" : "";
-        const test::Outcome o = run("batch -q --dry-run" + eval + options + " " + manifest());
+        const test::Outcome o =
+            run("batch -q --dry-run --summary " + path("sums/s").string() + eval + options + " " + manifest());
         EXPECT_EQ(o.exit_code, 0) << o.err;
         return nlohmann::json::parse(o.out);
     };
@@ -888,8 +889,13 @@ TEST_F(Batch, ADryRunSaysWhatWouldRunAndWhyAndWritesNothing) {
         return out;
     };
     const std::string none = "run: no result yet (not run, or its run did not finish)";
+    fs::create_directories(path("sums"));
+    const auto folder_time = fs::last_write_time(path("out")), summary_folder_time = fs::last_write_time(path("sums"));
     nlohmann::json p = plan("");
     EXPECT_EQ(whys(p), std::vector<std::string>(4, none));
+    // Not even a file created and removed (the checks of a run probe each folder that way).
+    EXPECT_EQ(fs::last_write_time(path("out")), folder_time);
+    EXPECT_EQ(fs::last_write_time(path("sums")), summary_folder_time);
     EXPECT_EQ(p["run"], 4);
     EXPECT_TRUE(outputs().empty());
     EXPECT_FALSE(fs::exists(path("m.summary.json")));

@@ -1150,7 +1150,8 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
     }
     std::vector<std::string> outputs = written;
     outputs.insert(outputs.end(), others.begin(), others.end());
-    check_output_paths(outputs, inputs, folders, written.size());
+    // A dry run writes nothing, not even the probes that check a folder takes a new file.
+    check_output_paths(outputs, inputs, folders, batch.dry_run ? 0 : written.size());
     OutputsByPlace outputs_by_place;
     for (const std::string& output : outputs) outputs_by_place.emplace(place_of(output), output);
 

@@ -717,6 +717,7 @@ ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patc
             break;
         }
 
+        stage = "updating orders, iteration " + std::to_string(iteration + 1);
         const Clock::time_point update_start = Clock::now();
         const std::vector<std::vector<uint32_t>> previous_orders = result.patch_orders;
         std::vector<size_t> members;

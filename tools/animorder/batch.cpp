@@ -685,6 +685,13 @@ std::string output_as_written(const PlannedItem& p, const std::string& out) {
     return out.rfind(stem, 0) == 0 ? stem_of(p.item.output_as_written) + out.substr(stem.size()) : out;
 }
 
+// A file named from the item report's folder (as reports keep them), as the manifest would write
+// it: from the manifest's folder.
+std::string as_manifest_writes(const PlannedItem& p, const std::string& from_report) {
+    const fs::path out(p.item.output_as_written);
+    return (out.parent_path() / from_report).lexically_normal().generic_string();
+}
+
 // Which part of the stamp changed since the report was written (its "stamp_parts").
 Staleness stamp_change(const PlannedItem& p, const json& then, const BatchOptions& batch) {
     using S = Staleness;
@@ -706,14 +713,16 @@ Staleness stamp_change(const PlannedItem& p, const json& then, const BatchOption
     for (const auto& [file, digest] : now.inputs) {
         const auto same_name =
             std::find_if(before.begin(), before.end(), [&](const auto& b) { return b.first == file; });
-        if (same_name == before.end()) return {S::kChanged, "it now reads " + file + ", which it did not when it ran"};
-        if (same_name->second != digest) return {S::kChanged, "its input " + file + " changed since it ran"};
+        if (same_name == before.end())
+            return {S::kChanged, "it now reads " + as_manifest_writes(p, file) + ", which it did not when it ran"};
+        if (same_name->second != digest)
+            return {S::kChanged, "its input " + as_manifest_writes(p, file) + " changed since it ran"};
     }
     for (const auto& [file, digest] : before) {
         const auto still =
             std::find_if(now.inputs.begin(), now.inputs.end(), [&](const auto& n) { return n.first == file; });
         if (still == now.inputs.end())
-            return {S::kChanged, "it no longer reads " + file + ", which it read when it ran"};
+            return {S::kChanged, "it no longer reads " + as_manifest_writes(p, file) + ", which it read when it ran"};
     }
     return {S::kChanged, "its result is out of date: its inputs, options or paths changed since it ran"};
 }
@@ -748,7 +757,7 @@ Staleness staleness_of_report(const PlannedItem& p, const std::string& stamp, co
         for (const json& entry : *side) {
             const std::string file = side_file_path(entry);
             if (file.empty() || string_at(entry, "sha256") != file_digest(folder_of(p.report) / file))
-                return {S::kChanged, "its input " + file + " changed since it ran"};
+                return {S::kChanged, "its input " + as_manifest_writes(p, file) + " changed since it ran"};
         }
     }
     if (report_out) *report_out = std::move(report);
@@ -859,6 +868,7 @@ void run_item(const PlannedItem& p, const StampParts& parts, const BatchOptions&
         evaluation.views = batch.eval_views;
         evaluation.resolution = batch.eval_resolution;
         evaluation.threads = batch.threads;
+        evaluation.progress = progress_printer(p.options.common, "evaluating OVR before and after");
         const std::vector<OrderEvaluation> ovr = evaluate_methods(mesh, {input_order, run.buffers}, evaluation);
         ovr_before = ovr[0].overall.ovr_mean;
         ovr_after = ovr[1].overall.ovr_mean;

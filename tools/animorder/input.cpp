@@ -39,6 +39,7 @@ std::function<void(const std::string&, size_t, size_t)> staged_progress_printer(
         if (stage != s.stage) {
             if (s.open) std::fputc('\n', stderr);
             s.stage = stage, s.open = false, s.last = -1, s.ended = false;
+            s.start = Clock::now();  // seconds within the stage
         }
         if (s.ended || (done != total && now - s.last < (terminal ? 0.5 : 10.0))) return;  // a stage's end once
         s.ended = done == total;

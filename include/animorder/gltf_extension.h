@@ -40,6 +40,12 @@ struct OrdersExtensionCheck {
     uint32_t buffer_count = 0, fallback = 0;
     std::vector<ExtensionClip> clips;
     std::vector<ExtensionPrimitive> primitives;
+    // Triangle primitives without orders (a tool dropped them, say): drawn in their file order.
+    struct Unordered {
+        int mesh = -1, primitive = -1;
+        size_t triangles = 0;
+    };
+    std::vector<Unordered> without_orders;
     std::vector<std::string> errors;
 };
 

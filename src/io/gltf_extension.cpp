@@ -361,8 +361,22 @@ OrdersExtensionCheck check_orders_extension(const std::string& path) {
             read_clip(model, clips->second.Get(int(c)), c, r.buffer_count, p, r.clips);
     for (size_t m = 0; m < model.meshes.size(); ++m)
         for (size_t pi = 0; pi < model.meshes[m].primitives.size(); ++pi) {
-            const auto e = model.meshes[m].primitives[pi].extensions.find(kOrdersExtensionName);
-            if (e == model.meshes[m].primitives[pi].extensions.end()) continue;
+            const tinygltf::Primitive& prim = model.meshes[m].primitives[pi];
+            const auto e = prim.extensions.find(kOrdersExtensionName);
+            if (e == prim.extensions.end()) {  // drawn in its file order: said, not an error
+                if (prim.mode == TINYGLTF_MODE_TRIANGLES || prim.mode == -1) {
+                    const bool indexed = prim.indices >= 0 && size_t(prim.indices) < model.accessors.size();
+                    const auto position = prim.attributes.find("POSITION");
+                    const int counted = indexed                             ? prim.indices
+                                        : position != prim.attributes.end() ? position->second
+                                                                            : -1;
+                    const size_t count = counted >= 0 && size_t(counted) < model.accessors.size()
+                                             ? model.accessors[size_t(counted)].count
+                                             : 0;
+                    r.without_orders.push_back({int(m), int(pi), count / 3});
+                }
+                continue;
+            }
             if (!e->second.IsObject()) {
                 p.add("meshes[" + std::to_string(m) + "].primitives[" + std::to_string(pi) +
                       "] extension is not an object");

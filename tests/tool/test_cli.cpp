@@ -598,6 +598,7 @@ TEST_F(Cli, BadInputAndOptionsGiveOneLineErrors) {
         {"batch m.json --threads ''", "--threads: must be a whole number (digits only), not ''"},
         {"optimize --max-memory -1", "--max-memory: must be a whole number (digits only), not '-1'"},
         {"reapply a.glb b.glb -o c.glb --max-memory 0", "--max-memory: Value 0 not in range 1048576"},
+        {"reapply a.glb b.glb -o c.glb --tolerance nan", "--tolerance: must be a number, not 'nan'"},
     };
     for (const Case& c : cases) {
         const test::Outcome o = run(c.args + " --quiet");  // errors print even when quiet

@@ -447,7 +447,14 @@ TEST_F(GltfPipelines, ReapplySaysWhichPrimitivesItLeftWithoutOrders) {
     const json out = json::parse(test::slurp(path("twice-out.gltf")));
     EXPECT_TRUE(out["meshes"][0]["primitives"][0].contains("extensions"));
     EXPECT_FALSE(out["meshes"][0]["primitives"][1].contains("extensions"));
-    EXPECT_EQ(run(exe() + " check " + q(path("twice-out.gltf"))).exit_code, 0);
+    // check says so too (it listed only the primitives with orders): usable, and which draw as stored.
+    const test::Outcome checked = run(exe() + " check " + q(path("twice-out.gltf")));
+    EXPECT_EQ(checked.exit_code, 0);
+    const json report = json::parse(checked.out);
+    ASSERT_EQ(report["primitives_without_orders"].size(), 1u) << report;
+    EXPECT_EQ(report["primitives_without_orders"][0]["primitive"], 1);
+    EXPECT_EQ(report["primitives_without_orders"][0]["triangles"], report["primitives"][0]["triangles"]);
+    EXPECT_NE(checked.err.find("1 triangle primitive(s)"), std::string::npos) << checked.err;
     o = run(exe() + " reapply -q " + q(example) + " " + q(path("twice.gltf")) + " -o " + q(path("quiet.gltf")));
     EXPECT_EQ(o.err, "");
     EXPECT_NE(o.out.find("1 without orders"), std::string::npos) << o.out;

@@ -58,8 +58,22 @@ int run_check(const CheckOptions& options) {
                                        {"indices_equal_fallback", p.indices_equal_fallback}});
         }
     }
+    if (r.present) {
+        j["primitives_without_orders"] = nlohmann::json::array();
+        for (const OrdersExtensionCheck::Unordered& u : r.without_orders)
+            j["primitives_without_orders"].push_back(
+                {{"mesh", u.mesh}, {"primitive", u.primitive}, {"triangles", u.triangles}});
+    }
     j["errors"] = r.errors;
     std::printf("%s\n", j.dump(2).c_str());
+    if (r.present && !r.without_orders.empty() && !options.quiet) {
+        size_t triangles = 0;
+        for (const OrdersExtensionCheck::Unordered& u : r.without_orders) triangles += u.triangles;
+        std::fprintf(stderr,
+                     "animorder: note: %s: %zu triangle primitive(s) (%zu triangles) carry no orders and draw in "
+                     "their file order (primitives_without_orders)\n",
+                     options.file.c_str(), r.without_orders.size(), triangles);
+    }
     if (r.errors.empty()) return 0;
     if (options.quiet) return 1;
     std::fprintf(

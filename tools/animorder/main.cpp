@@ -6,7 +6,9 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <limits>
 #include <stdexcept>
@@ -343,6 +345,12 @@ int main(int argc, char** argv) {
         ->add_option("--tolerance", reapply.tolerance,
                      "Corner distance allowed, as a fraction of the bounding-box diagonal")
         ->capture_default_str()
+        ->check(CLI::Validator(
+            [](std::string& text) {  // CLI::Range lets NaN through (every comparison with it is false)
+                const double v = std::strtod(text.c_str(), nullptr);
+                return std::isnan(v) ? std::string("must be a number, not '") + text + "'" : std::string();
+            },
+            "NUMBER"))
         ->check(CLI::Range(0.0, 0.1));
     reapply_cmd->add_option("--max-memory", reapply.max_memory, "Loading budget in bytes for the sampled animation")
         ->capture_default_str()

@@ -1007,3 +1007,34 @@ TEST_F(Cli, ASignalDuringTheCommitWaitsForItsEnd) {
     for (const auto& e : fs::directory_iterator(path("out"))) names += e.path().filename().string() + " ";
     EXPECT_TRUE(names == "o.animorder.bin o.animorder.json " || names == "o.animorder.json o.animorder.bin ") << names;
 }
+
+// check compares each clip's stored centres with the frame centres of the mesh as the file now
+// poses it: a parent node that moves the whole scene (glTF-Transform's `center` adds one) leaves
+// every order valid but every lookup's view direction wrong; check said ok.
+TEST_F(Cli, CheckRefusesCentresTheSceneMovedAwayFrom) {
+    const fs::path out = path("c.gltf"), moved = path("moved.gltf");
+    ASSERT_EQ(run("subdivide -q --levels 0 -o " + path("in.glb").string()).exit_code, 0);
+    ASSERT_EQ(run("optimize -q -k 2 --views 12 --resolution 32 --max-iterations 2 " + path("in.glb").string() + " -o " +
+                  out.string())
+                  .exit_code,
+              0);
+    test::Outcome o = run("check " + out.string());
+    ASSERT_EQ(o.exit_code, 0) << o.err;
+    nlohmann::json report = nlohmann::json::parse(o.out);
+    EXPECT_EQ(report["centers"]["checked"], true);
+    EXPECT_EQ(report["centers"]["keyframes"], 77);  // every keyframe of both clips
+    EXPECT_EQ(report["centers"]["largest_offset"], 0.0);
+
+    nlohmann::json g = nlohmann::json::parse(test::slurp(out));
+    const size_t scene = g.value("scene", 0);
+    g["nodes"].push_back(
+        {{"name", "pivot"}, {"translation", {0.0, -0.5, 0.25}}, {"children", g["scenes"][scene]["nodes"]}});
+    g["scenes"][scene]["nodes"] = {g["nodes"].size() - 1};
+    std::ofstream(moved) << g.dump();
+    o = run("check " + moved.string());
+    EXPECT_EQ(o.exit_code, 1);
+    report = nlohmann::json::parse(o.out);
+    EXPECT_EQ(report["ok"], false);
+    EXPECT_NEAR(report["centers"]["largest_offset"].get<double>(), std::hypot(0.5, 0.25), 1e-4);
+    EXPECT_NE(o.err.find("clip 'walk': its centers are"), std::string::npos) << o.err;
+}

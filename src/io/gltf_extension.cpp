@@ -151,7 +151,8 @@ void read_clip(const tinygltf::Model& model, const tinygltf::Value& value, size_
     // Positive as the runtimes keep it too (a float: 1e-300 is 0 there).
     if (!number(o, "sampleRate", clip.sample_rate) || !(clip.sample_rate > 0) || !(float(clip.sample_rate) > 0) ||
         !std::isfinite(float(clip.sample_rate)))
-        return p.add(where + ".sampleRate is missing or not a positive number");
+        return p.add(where + ".sampleRate is missing or not a positive number a 32-bit float holds (from about "
+                             "1.2e-38 to 3.4e38)");
     bool ok = bounded(o, "keyframes", 1, 100000, where, p, v);
     clip.keyframes = uint32_t(v);
     ok = bounded(o, "thetaSteps", 2, 100000, where, p, v) && ok;
@@ -347,7 +348,10 @@ OrdersExtensionCheck check_orders_extension(const std::string& path) {
         return r;
     }
     const Object& o = root->second.Get<Object>();
-    if (o.count("method") && o.at("method").IsString()) r.method = o.at("method").Get<std::string>();
+    if (o.count("method") && o.at("method").IsString())
+        r.method = o.at("method").Get<std::string>();
+    else if (o.count("method"))
+        p.add("root.method is not a string");
     int64_t v = 0;
     if (!bounded(o, "bufferCount", 1, 65536, "root", p, v)) return r;
     r.buffer_count = uint32_t(v);

@@ -154,7 +154,8 @@ TEST_F(GltfExtension, EveryCorruptionIsReportedOnOneLine) {
         {"negative byteOffset", [](json& g) { g["accessors"][2]["byteOffset"] = -4; }, buffer_bytes(),
          "accessors[2].byteOffset -4 is not a non-negative integer"},
         {"sampleRate 0 as a float", [&](json& g) { root(g)["clips"][0]["sampleRate"] = 1e-300; }, buffer_bytes(),
-         "sampleRate is missing or not a positive"},
+         "sampleRate is missing or not a positive number a 32-bit float holds"},
+        {"method not a string", [&](json& g) { root(g)["method"] = 5; }, buffer_bytes(), "root.method is not a string"},
         // A clip named after another animation: reapply put its table on that one.
         {"name of another animation", [&](json& g) { root(g)["clips"][0]["name"] = "walk"; }, buffer_bytes(),
          "clips[0].name 'walk' is not the name of animation 0 ('still')"},

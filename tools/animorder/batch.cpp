@@ -618,7 +618,17 @@ std::string item_stamp(const StampParts& parts) {
     return hash.hex();
 }
 
-std::string item_stamp(const PlannedItem& p, const BatchOptions& batch) { return item_stamp(stamp_parts(p, batch)); }
+// An item's stamp as taken now: its parts (which name what changed, when it did) and the digest.
+struct Stamp {
+    StampParts parts;
+    std::string digest;
+};
+
+Stamp stamp_of(const PlannedItem& p, const BatchOptions& batch) {
+    Stamp stamp{stamp_parts(p, batch), {}};
+    stamp.digest = item_stamp(stamp.parts);
+    return stamp;
+}
 
 json stamp_parts_json(const StampParts& parts) {
     json inputs = json::array();
@@ -693,14 +703,13 @@ std::string as_manifest_writes(const PlannedItem& p, const std::string& from_rep
 }
 
 // Which part of the stamp changed since the report was written (its "stamp_parts").
-Staleness stamp_change(const PlannedItem& p, const json& then, const BatchOptions& batch) {
+Staleness stamp_change(const PlannedItem& p, const json& then, const StampParts& now) {
     using S = Staleness;
     if (string_at(then, "tool") != tool_digest())
         return {S::kOtherBuild, "its result was written by another animorder build"};
     const auto old = then.find("stamp_parts");
     if (old == then.end() || !old->is_object())
         return {S::kChanged, "its result is out of date: its inputs, options or paths changed since it ran"};
-    const StampParts now = stamp_parts(p, batch);
     if (string_at(*old, "eval") != now.eval)
         return {S::kOtherEvaluation, "its result was evaluated with other --eval-views/--eval-resolution/--no-timings"};
     if (string_at(*old, "settings") != now.settings) return {S::kChanged, "its options changed since it ran"};
@@ -727,14 +736,13 @@ Staleness stamp_change(const PlannedItem& p, const json& then, const BatchOption
     return {S::kChanged, "its result is out of date: its inputs, options or paths changed since it ran"};
 }
 
-Staleness staleness_of_report(const PlannedItem& p, const std::string& stamp, const BatchOptions& batch,
-                              json* report_out) {
+Staleness staleness_of_report(const PlannedItem& p, const Stamp& stamp, json* report_out) {
     using S = Staleness;
     json report = read_json_file(p.report);
     if (!report.is_object() || !report.contains("batch") || !report["batch"].is_object())
         return {S::kNoResult, "no result yet (not run, or its run did not finish)"};
     const json& b = report["batch"];
-    if (string_at(b, "stamp") != stamp) return stamp_change(p, b, batch);
+    if (string_at(b, "stamp") != stamp.digest) return stamp_change(p, b, stamp.parts);
     if (!summary_fields_hold(b)) return {S::kChanged, "its report was edited: its figures are not as written"};
     std::error_code error;
     for (const std::string& out : p.plan.outputs)
@@ -767,17 +775,17 @@ Staleness staleness_of_report(const PlannedItem& p, const std::string& stamp, co
 // The same, and a failure the item's last run left (OUTPUT.animorder.error.json, with the stamp
 // and its parts of that run, the last attempt: a success removes it): named, with what changed
 // since.
-Staleness staleness(const PlannedItem& p, const std::string& stamp, const BatchOptions& batch,
-                    json* report_out = nullptr) {
-    Staleness s = staleness_of_report(p, stamp, batch, report_out);
+Staleness staleness(const PlannedItem& p, const Stamp& stamp, json* report_out = nullptr) {
+    Staleness s = staleness_of_report(p, stamp, report_out);
     if (s.kind == Staleness::kCurrent) return s;
     const json failure = read_json_file(p.error);
     const std::string error = string_at(failure, "error");
     if (error.empty()) return s;
-    if (string_at(failure, "stamp") == stamp) return {Staleness::kChanged, "it failed when it last ran: " + error};
+    if (string_at(failure, "stamp") == stamp.digest)
+        return {Staleness::kChanged, "it failed when it last ran: " + error};
     // The failure is the last attempt (a success removes it): what changed since, as far as known.
     if (failure.contains("stamp_parts"))
-        s = stamp_change(p, failure, batch);
+        s = stamp_change(p, failure, stamp.parts);
     else if (s.kind == Staleness::kNoResult)
         s = {Staleness::kChanged, "its inputs, options or build changed since"};
     s.why += "; it failed when it last ran: " + error;
@@ -785,9 +793,9 @@ Staleness staleness(const PlannedItem& p, const std::string& stamp, const BatchO
 }
 
 // The item's report when it is up to date, else null.
-json current_report(const PlannedItem& p, const std::string& stamp, const BatchOptions& batch) {
+json current_report(const PlannedItem& p, const Stamp& stamp) {
     json report;
-    return staleness(p, stamp, batch, &report).kind == Staleness::kCurrent ? report : json();
+    return staleness(p, stamp, &report).kind == Staleness::kCurrent ? report : json();
 }
 
 // Wall times out (--no-timings): every key of seconds set to null, wherever it is, and the thread
@@ -827,9 +835,7 @@ std::string place_of(const std::string& path) {
 // importer's side files are known only then).
 using OutputsByPlace = std::unordered_map<std::string, std::string>;
 
-void run_item(const PlannedItem& p, const StampParts& parts, const BatchOptions& batch,
-              const OutputsByPlace& all_outputs) {
-    const std::string stamp = item_stamp(parts);
+void run_item(const PlannedItem& p, const Stamp& stamp, const BatchOptions& batch, const OutputsByPlace& all_outputs) {
     const Clock::time_point start = Clock::now();
     std::vector<std::string> files_of_item = p.plan.outputs;
     files_of_item.push_back(p.error);
@@ -879,12 +885,10 @@ void run_item(const PlannedItem& p, const StampParts& parts, const BatchOptions&
     // Paths as the manifest writes them (relative to its folder), so that the report is the same
     // bytes whatever folder the batch starts in and however the manifest's path is spelled.
     if (p.item.input_given && report["input"] == p.options.common.input) report["input"] = p.item.input_as_written;
-    const std::string stem = stem_of(p.item.output), stem_as_written = stem_of(p.item.output_as_written);
     for (auto& [kind, path] : report["outputs"].items())  // OUT.glb, OUT.animorder.bin, ...: all from the stem
-        if (path.is_string() && path.get<std::string>().rfind(stem, 0) == 0)
-            path = stem_as_written + path.get<std::string>().substr(stem.size());
-    report["batch"] = {{"stamp", stamp},
-                       {"stamp_parts", stamp_parts_json(parts)},
+        if (path.is_string()) path = output_as_written(p, path.get<std::string>());
+    report["batch"] = {{"stamp", stamp.digest},
+                       {"stamp_parts", stamp_parts_json(stamp.parts)},
                        {"item", p.item.name},
                        {"status", "ok"},
                        {"triangles", mesh.triangle_count()},
@@ -905,7 +909,7 @@ void run_item(const PlannedItem& p, const StampParts& parts, const BatchOptions&
     if (batch.no_timings) drop_timings(report);
     // An input edited while the item ran (between its stamp and its load): the outputs may come
     // from other bytes than the stamp's, so none is kept and the next run redoes the item.
-    if (item_stamp(p, batch) != stamp)
+    if (stamp_of(p, batch).digest != stamp.digest)
         throw std::runtime_error("an input changed while the item ran; run the batch again to redo it");
     files.add(p.report, report_text(report));
     files.commit();
@@ -918,8 +922,8 @@ void run_item(const PlannedItem& p, const StampParts& parts, const BatchOptions&
 
 // Why an item has no up-to-date result, for the merge's summary (with what to do about it when
 // the merge itself is the cause).
-std::string why_missing(const PlannedItem& p, const std::string& stamp, const BatchOptions& batch) {
-    const Staleness s = staleness(p, stamp, batch);
+std::string why_missing(const PlannedItem& p, const Stamp& stamp) {
+    const Staleness s = staleness(p, stamp);
     if (s.kind == Staleness::kOtherBuild) return s.why + " (run the merge with the build that ran the items)";
     if (s.kind == Staleness::kOtherEvaluation) return s.why + " (give the merge the same)";
     return s.why;
@@ -927,13 +931,12 @@ std::string why_missing(const PlannedItem& p, const std::string& stamp, const Ba
 
 // `failed_now`: the error of this run's attempt, when the item failed in it (its earlier report,
 // still matching, does not make it ok).
-json summary_row(const PlannedItem& p, const std::string& stamp, const BatchOptions& batch,
-                 const std::string& failed_now) {
+json summary_row(const PlannedItem& p, const Stamp& stamp, const std::string& failed_now) {
     json row = {{"name", p.item.name},
                 {"input", p.item.input_as_written.empty() ? "(bundled)" : p.item.input_as_written},
                 {"output", p.item.output_as_written},
                 {"method", method_name(p.plan.method)}};
-    const json report = failed_now.empty() ? current_report(p, stamp, batch) : json();
+    const json report = failed_now.empty() ? current_report(p, stamp) : json();
     if (report.is_object()) {
         const json& b = report["batch"];
         for (const char* key : {"triangles", "clips", "buffers", "acmr_before", "acmr_after", "ovr_before", "ovr_after",
@@ -944,14 +947,12 @@ json summary_row(const PlannedItem& p, const std::string& stamp, const BatchOpti
         return row;
     }
     const json failure = read_json_file(p.error);
-    const bool failed = !failed_now.empty() || string_at(failure, "stamp") == stamp;
+    const bool failed = !failed_now.empty() || string_at(failure, "stamp") == stamp.digest;
     for (const char* key : {"triangles", "clips", "buffers", "acmr_before", "acmr_after", "ovr_before", "ovr_after",
                             "index_bytes_added", "time_s"})
         row[key] = nullptr;
     row["status"] = failed ? "failed" : "missing";
-    row["error"] = !failed_now.empty() ? failed_now
-                   : failed            ? string_at(failure, "error")
-                                       : why_missing(p, stamp, batch);
+    row["error"] = !failed_now.empty() ? failed_now : failed ? string_at(failure, "error") : why_missing(p, stamp);
     return row;
 }
 
@@ -998,7 +999,7 @@ std::string summary_markdown(const json& summary) {
 
 // Builds and writes the summary; returns the exit code it implies. failed_now: per item, the
 // error of this run's attempt when it failed (empty otherwise).
-int write_summary(const std::vector<PlannedItem>& items, const std::vector<std::string>& stamps,
+int write_summary(const std::vector<PlannedItem>& items, const std::vector<Stamp>& stamps,
                   const std::vector<std::string>& failed_now, const std::string& stem, const std::string& manifest,
                   const BatchOptions& batch) {
     json summary = {
@@ -1006,7 +1007,7 @@ int write_summary(const std::vector<PlannedItem>& items, const std::vector<std::
     json rows = json::array();
     size_t ok = 0, failed = 0, missing = 0;
     for (size_t i = 0; i < items.size(); ++i) {
-        rows.push_back(summary_row(items[i], stamps[i], batch, failed_now[i]));
+        rows.push_back(summary_row(items[i], stamps[i], failed_now[i]));
         const std::string status = rows.back()["status"].get<std::string>();
         (status == "ok" ? ok : status == "failed" ? failed : missing) += 1;
     }
@@ -1080,7 +1081,7 @@ std::pair<size_t, size_t> parse_shard(const std::string& text) {
 
 // write_summary, whose failure (a full disk, say) comes after the items' work: its own exit code,
 // not 1 (an error before any work), so that a farm does not take it for a bad manifest.
-int summarise(const std::vector<PlannedItem>& items, const std::vector<std::string>& stamps,
+int summarise(const std::vector<PlannedItem>& items, const std::vector<Stamp>& stamps,
               const std::vector<std::string>& failed_now, const std::string& stem, const BatchOptions& batch) {
     try {
         return write_summary(items, stamps, failed_now, stem, batch.manifest, batch);
@@ -1099,8 +1100,7 @@ int print_plan(const std::vector<PlannedItem>& items, std::pair<size_t, size_t> 
     for (size_t i = 0; i < items.size(); ++i) {
         if (i % shard.second != shard.first) continue;
         const PlannedItem& p = items[i];
-        const std::string stamp = item_stamp(p, batch);
-        Staleness s = staleness(p, stamp, batch);
+        Staleness s = staleness(p, stamp_of(p, batch));
         if (batch.force) s = {Staleness::kChanged, "--force"};
         const bool current = s.kind == Staleness::kCurrent;
         (current ? skip : run) += 1;
@@ -1167,9 +1167,10 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
 
     // A shard stamps its own items only, each when its turn comes (so that an input edited while
     // earlier items run is read as it is then); the merge stamps every item.
-    std::vector<std::string> stamps(items.size()), failed_now(items.size());
+    std::vector<Stamp> stamps(items.size());
+    std::vector<std::string> failed_now(items.size());
     if (batch.merge) {
-        for (size_t i = 0; i < items.size(); ++i) stamps[i] = item_stamp(items[i], batch);
+        for (size_t i = 0; i < items.size(); ++i) stamps[i] = stamp_of(items[i], batch);
         return summarise(items, stamps, failed_now, summary, batch);
     }
 
@@ -1184,9 +1185,8 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
         std::string label = "batch [" + std::to_string(++position) + "/" + std::to_string(mine) + "] " + p.item.name;
         for (char& c : label)  // progress and failure lines stay one line each
             if (c == '\n' || c == '\r') c = ' ';
-        const StampParts parts = stamp_parts(p, batch);
-        stamps[i] = item_stamp(parts);
-        if (!batch.force && current_report(p, stamps[i], batch).is_object()) {
+        stamps[i] = stamp_of(p, batch);
+        if (!batch.force && current_report(p, stamps[i]).is_object()) {
             ++skipped;
             std::vector<std::string> files_of_item = p.plan.outputs;
             files_of_item.push_back(p.error);
@@ -1198,7 +1198,7 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
         }
         note(p.options.common, label + ": running");
         try {
-            run_item(p, parts, batch, outputs_by_place);
+            run_item(p, stamps[i], batch, outputs_by_place);
             ++done;
             note(p.options.common, label + ": done");
         } catch (const std::exception& e) {
@@ -1209,8 +1209,8 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
             std::fprintf(stderr, "animorder: %s: failed: %s\n", label.c_str(), message.c_str());
             failed_now[i] = message;
             try {
-                write_file_atomically(p.error, report_text(json{{"stamp", stamps[i]},
-                                                                {"stamp_parts", stamp_parts_json(parts)},
+                write_file_atomically(p.error, report_text(json{{"stamp", stamps[i].digest},
+                                                                {"stamp_parts", stamp_parts_json(stamps[i].parts)},
                                                                 {"tool", tool_digest()},
                                                                 {"item", p.item.name},
                                                                 {"status", "failed"},

@@ -76,7 +76,8 @@ struct ClusteringResult {
     std::vector<uint32_t> assignment;
     std::vector<ClusteringIteration> iterations;
     bool converged = false;            // the last iteration reassigned no node
-    std::string stop_reason;           // "converged", "stalled" (patience ran out) or "iteration cap"
+    std::string stop_reason;           // "converged", "stalled" (patience ran out), "iteration cap", or
+                                       // "nothing drawn" (every keyframe a point: one buffer, no iteration)
     size_t best_iteration = 0;         // 0-based: the iteration whose buffers and assignment these are
     double seconds_rasterization = 0;  // rasterising every node once (kept for all iterations)
     size_t kept_nodes = 0;             // nodes whose fragments fit the cache budget (the first ones)

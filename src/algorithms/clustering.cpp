@@ -628,6 +628,20 @@ ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patc
     ClusteringResult result;
     result.keyframes = keyframes;
     result.directions = icosphere_directions(icosphere_subdivisions_for(settings.views));
+    // Keyframes that all shrink the mesh to a point (a clip that hides it by scale 0) draw nothing
+    // at any node: every order passes no fragment, so one buffer, the patches in their own order,
+    // serves every node (and no camera can be placed at 3R = 0).
+    if (!(framing.radius > 0)) {
+        BestState nothing_drawn{0.0,
+                                {std::vector<uint32_t>(patches.patch_count())},
+                                std::vector<uint32_t>(keyframes.size() * settings.views, 0)};
+        std::iota(nothing_drawn.patch_orders[0].begin(), nothing_drawn.patch_orders[0].end(), 0u);
+        result.converged = true;
+        result.stop_reason = "nothing drawn";
+        say(settings, "the mesh has no size at any of its keyframes: nothing is drawn, one buffer for every node");
+        finish(result, patches, nothing_drawn);
+        return result;
+    }
     Nodes nodes(mesh, patches, framing);
     nodes.k = settings.clusters;
     nodes.keyframes = keyframes.size();

@@ -152,6 +152,9 @@ Nodes make_nodes(const uint32_t* indices, size_t index_count, const float* keyfr
     const std::vector<float> directions = icosphere_directions(icosphere_subdivisions_for(views));
     nodes.framing = frame_subset(
         frame_keyframes(keyframe_positions, keyframe_count, vertex_count, indices, index_count), keyframes);
+    // Keyframes that shrink the mesh (or a primitive framed on its own) to a point draw nothing from
+    // any view: no node, no arc (and no camera at 3R = 0).
+    if (!(nodes.framing.radius > 0)) return nodes;
     for (uint32_t k : keyframes)
         for (size_t v = 0; v < directions.size() / 3; ++v) {
             OverdrawNode node;

@@ -32,6 +32,7 @@
 #include <cstring>
 #include <exception>
 #include <map>
+#include <set>
 
 namespace animorder {
 namespace {
@@ -560,7 +561,6 @@ PrimitiveData parse_primitive(const Scene& s, size_t n, size_t p, AnimatedMesh& 
     if (node.skin >= 0) {
         if (size_t(node.skin) >= s.model.skins.size()) s.reader.fail(where + ": the node names a missing skin");
         const size_t joint_count = s.model.skins[size_t(node.skin)].joints.size();
-        mesh.joint_count = std::max(mesh.joint_count, joint_count);
         parse_skin_weights(s, prim, joint_count, where, d);
     }
     mesh.vertex_count += d.vertex_count;
@@ -621,6 +621,15 @@ void parse_primitives(Scene& s, AnimatedMesh& mesh) {
     if (s.prims.empty())
         s.reader.fail("no triangle mesh in " + scene_named(s) +
                       (points_or_lines ? " (points and lines cannot be reordered for overdraw)" : ""));
+    // The joints: the nodes of the skins that the drawn primitives' nodes name, each node once
+    // (two skins of one skeleton share their nodes; two skeletons add up).
+    std::set<int> joints;
+    for (const PrimitiveData& d : s.prims) {
+        const tinygltf::Node& node = s.model.nodes[d.node];
+        if (node.skin >= 0)
+            for (const int j : s.model.skins[size_t(node.skin)].joints) joints.insert(j);
+    }
+    mesh.joint_count = joints.size();
 }
 
 // Every node's pose without animation: matrix or T, R, S, and morph weights (the node's, else

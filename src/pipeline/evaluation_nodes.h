@@ -115,6 +115,14 @@ void for_each_evaluation_node(const AnimatedMesh& mesh, const Framing& all, cons
         const Framing framing = frame_subset(all, keyframes);  // R of this animation
         const size_t node_count = keyframes.size() * settings.views;
         begin(c, keyframes, framing, node_count);
+        if (!(framing.radius > 0)) {
+            // Every keyframe of the clip shrinks the mesh to a point: nothing is drawn at any of
+            // its nodes (no pixel to count), and no camera can be placed at 3R = 0.
+            done_before += node_count;
+            if (settings.progress && total_nodes) settings.progress(done_before, total_nodes);
+            end(c, node_count);
+            continue;
+        }
         std::atomic<size_t> done{0};
         const size_t report_every = std::max<size_t>(1, total_nodes / 200);
         auto body = [&](const tbb::blocked_range<size_t>& range) {

@@ -266,14 +266,16 @@ AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double
         // Blended primitives: back to front for each cluster, in the measured blend order of its
         // nodes (blend_orders.h; the nodes' transparent pass rasterised once); with blend_clusters,
         // by their own k clusters of the same nodes, the buffers then being the (opaque, blend)
-        // cluster pairs the nodes take.
-        if (has_blended_primitives(mesh) && !blend_clusters) {
+        // cluster pairs the nodes take. A run that draws nothing (cluster_nodes' "nothing drawn")
+        // keeps its one buffer as it is.
+        const bool drawn = framing.radius > 0;
+        if (drawn && has_blended_primitives(mesh) && !blend_clusters) {
             blended_orders_from_clusters(mesh, result.framing, framing.radius, result.runs.back());
             ClusteringResult& run = result.runs.back();
             measured_blended_orders(mesh,
                                     blend_fragments_of_nodes(mesh, framing, run, settings.resolution, settings.threads),
                                     run.assignment, run.triangle_orders, settings.threads);
-        } else if (has_blended_primitives(mesh)) {
+        } else if (drawn && has_blended_primitives(mesh)) {
             const BlendClustering blend =
                 cluster_blend_nodes(mesh, framing, result.runs.back(), settings.resolution, settings.threads);
             combine_with_blend_clusters(mesh, blend, result.runs.back());

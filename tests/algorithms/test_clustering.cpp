@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -284,6 +285,28 @@ TEST(Clustering, ReadsAndChecksTheListedKeyframesOnly) {
         EXPECT_EQ(std::string(e.what()),
                   "keyframe " + std::to_string(unlisted) + ": position of vertex 1 is not finite");
     }
+}
+
+// Keyframes that all shrink the mesh to a point (a clip that hides it by scale 0) draw nothing at
+// any node and leave no camera to place (R = 0): one buffer, the patches in their own order (the
+// cache order), every node on it, no iteration. It threw "view radius must be positive".
+TEST(Clustering, KeyframesThatDrawNothingGetOneBufferInTheCacheOrder) {
+    AnimatedMesh m = character();
+    const std::vector<uint32_t> keyframes = walk_keyframes(10);
+    for (uint32_t k : keyframes)
+        for (size_t v = 0; v < m.vertex_count; ++v)
+            std::copy_n(std::vector<float>{0.5f, -1, 2}.data(), 3, m.keyframe(k) + 3 * v);
+    const MeshPatches patches = build_mesh_patches(m, 0.85);
+    const Framing framing = frame_subset(framing_of(m), keyframes);
+    ASSERT_EQ(framing.radius, 0.0f);
+    const ClusteringResult r = cluster_nodes(m, patches, framing, keyframes, small_settings());
+    ASSERT_EQ(r.triangle_orders.size(), 1u);
+    EXPECT_EQ(r.triangle_orders[0], patches.cache_order);
+    EXPECT_EQ(r.assignment, std::vector<uint32_t>(keyframes.size() * 42, 0));
+    EXPECT_EQ(r.stop_reason, "nothing drawn");
+    EXPECT_TRUE(r.converged);
+    EXPECT_TRUE(r.iterations.empty());
+    EXPECT_EQ(r.keyframes, keyframes);
 }
 
 TEST(SelectionTable, ReturnsTheNodesClusterAtEveryClusteringViewpoint) {

@@ -104,6 +104,26 @@ TEST_F(GltfLoader, SkinnedBarBendsAsWorkedOutByHand) {
     expect_position(m, 15, 2, 0, 1 + std::sqrt(2.0), 0);
 }
 
+// joint_count counts the joint nodes of the skins the drawn nodes use, each once: a second skin of
+// the same skeleton adds none, one of a second skeleton adds its own (it gave the largest skin's).
+TEST_F(GltfLoader, JointsAreTheDistinctJointNodesOfEverySkin) {
+    for (const bool second_skeleton : {false, true}) {
+        SCOPED_TRACE(second_skeleton ? "a second skeleton" : "a second skin of the same skeleton");
+        Gltf g = skinned_bar();
+        json& nodes = g.doc["nodes"];
+        nodes.push_back(json{{"name", "root2"}, {"children", {4}}});
+        nodes.push_back(json{{"name", "child2"}, {"translation", {0, 1, 0}}});
+        nodes.push_back(json{{"name", "skinned2"}, {"mesh", 0}, {"skin", 1}});
+        json skin = g.doc["skins"][0];
+        if (second_skeleton) skin["joints"] = {3, 4};
+        g.doc["skins"].push_back(skin);
+        g.doc["scenes"][0]["nodes"] = {0, 2, 3, 5};
+        const AnimatedMesh m = load_gltf(write("two-skins.gltf", g.text()));
+        EXPECT_EQ(m.triangle_count(), 4u);
+        EXPECT_EQ(m.joint_count, second_skeleton ? 4u : 2u);
+    }
+}
+
 TEST_F(GltfLoader, StepAndCubicSplineInterpolation) {
     const AnimatedMesh step = load_gltf(write("step.gltf", skinned_bar("STEP").text()));
     expect_position(step, 29, 2, 1, 2, 0);  // holds the first key until t = 1

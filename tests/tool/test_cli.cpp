@@ -322,6 +322,131 @@ TEST_F(Cli, ZeroAreaMeshIsAnError) {
     EXPECT_NE(o.err.find("zero area"), std::string::npos) << o.err;
 }
 
+// A tetrahedron whose node scale two clips animate, in an embedded-buffer glTF: "grow" from 0 to 1
+// (nothing drawn at its first keyframe) and "hidden" at 0 throughout (a clip that hides the mesh:
+// every keyframe a point), in the order given.
+std::string scaled_tetrahedron(bool hidden_first) {
+    test::Gltf g;
+    const int p = g.floats({0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1}, "VEC3", 3);
+    const int i = g.u16({0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3}, "SCALAR", 1);
+    const int times = g.floats({0.0f, 1.0f}, "SCALAR", 1);
+    g.doc["accessors"][size_t(times)]["min"] = {0.0};
+    g.doc["accessors"][size_t(times)]["max"] = {1.0};
+    const int grow = g.floats({0, 0, 0, 1, 1, 1}, "VEC3", 3), zero = g.floats({0, 0, 0, 0, 0, 0}, "VEC3", 3);
+    g.doc["meshes"] = {{{"primitives", {{{"attributes", {{"POSITION", p}}}, {"indices", i}}}}}};
+    g.doc["nodes"] = {{{"mesh", 0}}};
+    g.doc["scenes"] = {{{"nodes", {0}}}};
+    auto clip = [&](const char* name, int output) {
+        return nlohmann::json{{"name", name},
+                              {"samplers", {{{"input", times}, {"output", output}, {"interpolation", "LINEAR"}}}},
+                              {"channels", {{{"sampler", 0}, {"target", {{"node", 0}, {"path", "scale"}}}}}}};
+    };
+    g.doc["animations"] = hidden_first ? nlohmann::json{clip("hidden", zero), clip("grow", grow)}
+                                       : nlohmann::json{clip("grow", grow), clip("hidden", zero)};
+    return g.text();
+}
+
+// A mesh with no area at its first keyframe is drawn at the others: it was refused as "every
+// triangle has zero area", looking at keyframe 0 alone (the same file with its clips the other way
+// round passed). A clip that keeps the mesh a point draws nothing at any node: optimize gives it one
+// buffer ("nothing drawn", no iteration) and evaluate a dash for its OVR; both stopped with "view
+// radius must be positive and finite" (after the clips before it had run).
+TEST_F(Cli, AMeshFirstDrawnLaterIsOrderedAndAClipThatHidesItGetsOneBuffer) {
+    for (const bool hidden_first : {true, false}) {
+        SCOPED_TRACE(hidden_first ? "hidden clip first" : "hidden clip second");
+        const std::string file = path(hidden_first ? "hidden-first.gltf" : "hidden-second.gltf").string();
+        std::ofstream(file) << scaled_tetrahedron(hidden_first);
+        const test::Outcome inspect = run("inspect -q " + file);
+        EXPECT_EQ(inspect.exit_code, 0) << inspect.err;
+        const std::string out = path(hidden_first ? "first" : "second").string();
+        const test::Outcome o = run("optimize -q --views 42 " + file + " -o " + out + ".glb -r " + out + ".json");
+        ASSERT_EQ(o.exit_code, 0) << o.err;
+        const nlohmann::json report = nlohmann::json::parse(test::slurp(out + ".json"));
+        const nlohmann::json& runs = report["methods"][0]["runs"];
+        ASSERT_EQ(runs.size(), 2u);
+        for (const nlohmann::json& r : runs) {
+            EXPECT_EQ(r["nodes"], 31 * 42) << r;
+            if (r["clips"] == "hidden") {
+                EXPECT_EQ(r["stop"], "nothing drawn") << r;
+                EXPECT_EQ(r["view_radius"], 0.0) << r;
+                EXPECT_TRUE(r["iterations"].empty()) << r;
+            } else {
+                EXPECT_EQ(r["stop"], "converged") << r;
+                EXPECT_GT(r["view_radius"].get<double>(), 0.8) << r;  // sqrt(3)/2 at scale 1
+            }
+        }
+        const test::Outcome check = run("check -q " + out + ".glb");
+        EXPECT_EQ(check.exit_code, 0) << check.out << check.err;
+        for (const char* method : {"static-nehab06", "measured"}) {
+            const test::Outcome m = run("optimize -q --views 12 --method " + std::string(method) + " " + file);
+            EXPECT_EQ(m.exit_code, 0) << method << ": " << m.err;
+        }
+        const test::Outcome e =
+            run("evaluate -q --views 12 --eval-views 6 --methods "
+                "original,single,oracle --eval-resolution 256 " +
+                file + " -r " + out + "-eval.json");
+        ASSERT_EQ(e.exit_code, 0) << e.err;
+        const nlohmann::json eval = nlohmann::json::parse(test::slurp(out + "-eval.json"));
+        for (const nlohmann::json& m : eval["methods"]) {
+            ASSERT_EQ(m["per_clip"].size(), 2u);
+            for (const nlohmann::json& c : m["per_clip"]) {
+                if (c["clip"] == "hidden") {
+                    EXPECT_EQ(c["nodes"], 0) << c;
+                    EXPECT_TRUE(c["ovr_mean"].is_null()) << c;
+                } else {
+                    EXPECT_EQ(c["nodes"], 31 * 6 - 6) << c;  // every view but the first keyframe's
+                    EXPECT_GE(c["ovr_mean"].get<double>(), 1.0) << c;
+                }
+            }
+        }
+        EXPECT_NE(e.out.find(" — |"), std::string::npos) << e.out;
+    }
+    // A mesh without area at every keyframe is still refused.
+    std::ofstream(path("never.gltf")) << scaled_tetrahedron(true);
+    const test::Outcome never_drawn = run("inspect -q " + path("never.gltf").string() + " --clip hidden");
+    EXPECT_EQ(never_drawn.exit_code, 1);
+    EXPECT_NE(never_drawn.err.find("zero area at every keyframe"), std::string::npos) << never_drawn.err;
+}
+
+// A list option takes one value (comma-separated), --clip one a time and --view one x,y,z, so the
+// input may follow any of them: `inspect --clip walk FILE` took FILE as a second clip and
+// inspected the bundled character, `evaluate --views 12 FILE` called FILE a bad view count.
+TEST_F(Cli, TheInputMayFollowAListOrAClipOption) {
+    const std::string file = path("t.gltf").string();
+    std::ofstream(file) << scaled_tetrahedron(false);
+    const test::Outcome inspect = run("inspect --clip grow " + file + " --json");
+    ASSERT_EQ(inspect.exit_code, 0) << inspect.err;
+    const nlohmann::json j = nlohmann::json::parse(inspect.out);
+    EXPECT_EQ(j["triangles"], 4) << j;
+    ASSERT_EQ(j["clips"].size(), 1u) << j;
+    EXPECT_EQ(j["clips"][0]["name"], "grow");
+    const test::Outcome evaluate = run("evaluate -q --methods original,single --lambda 0.85,3 -k 2 --views 12 " + file +
+                                       " --eval-views 3 --eval-resolution 32 -r " + path("e.json").string());
+    ASSERT_EQ(evaluate.exit_code, 0) << evaluate.err;
+    EXPECT_EQ(nlohmann::json::parse(test::slurp(path("e.json")))["methods"].size(), 3u);  // original, single x 2
+    const test::Outcome heatmap = run("heatmap -q --frame 30 --view 1,1,1 " + file + " -o " + path("h.png").string());
+    EXPECT_EQ(heatmap.exit_code, 0) << heatmap.err;
+    EXPECT_TRUE(fs::exists(path("h.png")));
+}
+
+// inspect's text shows a name that holds a space or a control character as a JSON string, so a
+// tab or a line break in a clip's name no longer cuts its line in two (--json has the names as
+// they are).
+TEST_F(Cli, InspectShowsNamesWithLineBreaksOnTheirOwnLine) {
+    nlohmann::json gltf = nlohmann::json::parse(scaled_tetrahedron(false));
+    gltf["animations"][0]["name"] = "tab\there\nnewline";
+    gltf["animations"][1]["name"] = "plain";
+    std::ofstream(path("names.gltf")) << gltf.dump();
+    const test::Outcome text = run("inspect -q " + path("names.gltf").string());
+    ASSERT_EQ(text.exit_code, 0) << text.err;
+    EXPECT_NE(text.out.find("\n  clip \"tab\\there\\nnewline\" "), std::string::npos) << text.out;
+    EXPECT_NE(text.out.find("\n  clip plain "), std::string::npos) << text.out;
+    EXPECT_EQ(test::line_count(text.out), 6u) << text.out;  // name, counts, ACMR, one primitive, two clips
+    const test::Outcome json = run("inspect -q --json " + path("names.gltf").string());
+    ASSERT_EQ(json.exit_code, 0) << json.err;
+    EXPECT_EQ(nlohmann::json::parse(json.out)["clips"][0]["name"], "tab\there\nnewline");
+}
+
 // An error the algorithms find in the character (here: a corner at 3e38, too far for float clip
 // coordinates) names the input file, as the loaders' errors do; an option's error does not.
 TEST_F(Cli, AnAlgorithmsErrorNamesTheInput) {

@@ -255,6 +255,14 @@ int run_evaluate(const EvaluateOptions& options) {
     report["clips"] = json::array();
     for (const Clip& c : mesh.clips) report["clips"].push_back({{"name", c.name}, {"keyframes", c.keyframe_count}});
     report["methods"] = json::array();
+    // A clip whose nodes draw nothing (every keyframe a point: a clip that hides the mesh) has no
+    // overdraw ratio: null in the report, a dash in the table.
+    const auto ovr_json = [](const OverdrawSummary& s, double value) { return s.nodes ? json(value) : json(nullptr); };
+    const auto ovr_cell = [](const OverdrawSummary& s) {
+        char cell[32];
+        std::snprintf(cell, sizeof cell, s.nodes ? " %.3f |" : " — |", s.ovr_mean);
+        return std::string(cell);
+    };
     std::string table = "| method | lambda | k | views | buffers | ACMR | ATVR | OVR mean | OVR pooled | time s |";
     std::string rule = "|---|---|---|---|---|---|---|---|---|---|";
     for (const Clip& c : mesh.clips) {
@@ -276,8 +284,8 @@ int run_evaluate(const EvaluateOptions& options) {
         entry["per_clip"] = json::array();
         for (size_t c = 0; c < mesh.clips.size(); ++c)
             entry["per_clip"].push_back({{"clip", mesh.clips[c].name},
-                                         {"ovr_mean", r.per_clip[c].ovr_mean},
-                                         {"ovr_pooled", r.per_clip[c].ovr_pooled},
+                                         {"ovr_mean", ovr_json(r.per_clip[c], r.per_clip[c].ovr_mean)},
+                                         {"ovr_pooled", ovr_json(r.per_clip[c], r.per_clip[c].ovr_pooled)},
                                          {"nodes", r.per_clip[c].nodes},
                                          {"time_s", (run.method == Method::Single || run.method == Method::Measured) &&
                                                             c < run.run_seconds.size()
@@ -292,10 +300,7 @@ int run_evaluate(const EvaluateOptions& options) {
                       lambda.c_str(), k.c_str(), v.c_str(), count.c_str(), run.acmr_mean, run.atvr_mean,
                       r.overall.ovr_mean, r.overall.ovr_pooled, run.seconds);
         table += cells;
-        for (size_t c = 0; c < mesh.clips.size(); ++c) {
-            std::snprintf(cells, sizeof cells, " %.3f |", r.per_clip[c].ovr_mean);
-            table += cells;
-        }
+        for (size_t c = 0; c < mesh.clips.size(); ++c) table += ovr_cell(r.per_clip[c]);
         table += "\n";
         std::snprintf(cells, sizeof cells, "%s,%s,%s,%s,%zu,%.6f,%.6f,%.6f,%.6f,%.6f\n", name, lambda.c_str(),
                       k.c_str(), v.c_str(), per_node ? nodes : run.buffers.orders.size(), run.acmr_mean, run.atvr_mean,
@@ -315,11 +320,10 @@ int run_evaluate(const EvaluateOptions& options) {
                       {"ovr_pooled", r.overall.ovr_pooled},
                       {"per_clip", json::array()}};
         for (size_t c = 0; c < mesh.clips.size(); ++c) {
-            std::snprintf(cells, sizeof cells, " %.3f |", r.per_clip[c].ovr_mean);
-            table += cells;
+            table += ovr_cell(r.per_clip[c]);
             entry["per_clip"].push_back({{"clip", mesh.clips[c].name},
-                                         {"ovr_mean", r.per_clip[c].ovr_mean},
-                                         {"ovr_pooled", r.per_clip[c].ovr_pooled},
+                                         {"ovr_mean", ovr_json(r.per_clip[c], r.per_clip[c].ovr_mean)},
+                                         {"ovr_pooled", ovr_json(r.per_clip[c], r.per_clip[c].ovr_pooled)},
                                          {"nodes", r.per_clip[c].nodes}});
         }
         table += "\n";

@@ -127,16 +127,22 @@ AnimatedMesh load_drawable_input(const CommonOptions& common, std::string& input
                                  std::vector<std::string>* files_read) {
     AnimatedMesh mesh = load_animated_input(common, input_name, files_read);
     validate_animated_mesh(mesh);
-    // A mesh with no area at its first keyframe has nothing to draw, so nothing to reorder.
+    // A mesh with no area at any keyframe has nothing to draw, so nothing to reorder. One that has
+    // none at some keyframes only (a node or joint scaled from 0, a clip that hides the mesh) is
+    // drawn at the others; the search stops at the first triangle with area.
     double area = 0;
-    const float* p = mesh.keyframe_count() ? mesh.keyframe(0) : nullptr;
-    for (size_t t = 0; p && t < mesh.indices.size() && area == 0; t += 3) {
-        const float *a = p + 3 * mesh.indices[t], *b = p + 3 * mesh.indices[t + 1], *c = p + 3 * mesh.indices[t + 2];
-        const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-        area += std::fabs(u[1] * v[2] - u[2] * v[1]) + std::fabs(u[2] * v[0] - u[0] * v[2]) +
-                std::fabs(u[0] * v[1] - u[1] * v[0]);
+    for (size_t k = 0; k < mesh.keyframe_count() && area == 0; ++k) {
+        const float* p = mesh.keyframe(k);
+        for (size_t t = 0; t < mesh.indices.size() && area == 0; t += 3) {
+            const float *a = p + 3 * mesh.indices[t], *b = p + 3 * mesh.indices[t + 1],
+                        *c = p + 3 * mesh.indices[t + 2];
+            const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+            area += std::fabs(u[1] * v[2] - u[2] * v[1]) + std::fabs(u[2] * v[0] - u[0] * v[2]) +
+                    std::fabs(u[0] * v[1] - u[1] * v[0]);
+        }
     }
-    if (area == 0) throw std::runtime_error(input_name + ": every triangle has zero area: nothing to reorder");
+    if (area == 0)
+        throw std::runtime_error(input_name + ": every triangle has zero area at every keyframe: nothing to reorder");
     return mesh;
 }
 

@@ -55,7 +55,7 @@ AnimatedMesh load_animated_input(const CommonOptions& common, std::string& input
                                  std::vector<std::string>* files_read = nullptr);
 
 // load_animated_input's mesh, validated, and refused when it has nothing to draw (every
-// triangle of zero area at its first keyframe).
+// triangle of zero area at every keyframe).
 AnimatedMesh load_drawable_input(const CommonOptions& common, std::string& input_name,
                                  std::vector<std::string>* files_read = nullptr);
 

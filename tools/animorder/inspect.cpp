@@ -24,6 +24,14 @@ std::vector<float> clip_radii(const AnimatedMesh& mesh) {
     return radii;
 }
 
+// A name as the text shows it: as it is, or, when it is empty or holds a space or a control
+// character (a tab or a line break would cut its line), as a JSON string: quoted and escaped.
+std::string shown_name(const std::string& name) {
+    const bool plain = !name.empty() && std::none_of(name.begin(), name.end(),
+                                                     [](char c) { return uint8_t(c) <= 0x20 || uint8_t(c) == 0x7f; });
+    return plain ? name : nlohmann::json(name).dump();
+}
+
 void print_inspect_text(const AnimatedMesh& mesh, const std::string& input_name, const VertexCacheStats& cache,
                         unsigned cache_size) {
     std::printf("%s\n", input_name.c_str());
@@ -31,14 +39,14 @@ void print_inspect_text(const AnimatedMesh& mesh, const std::string& input_name,
                 mesh.vertex_count, mesh.joint_count, mesh.morph_target_count, mesh.keyframe_count());
     std::printf("  ACMR %.4f  ATVR %.4f  (FIFO cache of %u, current order)\n", cache.acmr, cache.atvr, cache_size);
     for (const Primitive& p : mesh.primitives)
-        std::printf("  primitive %-12s triangles %zu  %s  %s%s\n", p.name.c_str(), p.index_count / 3,
+        std::printf("  primitive %-12s triangles %zu  %s  %s%s\n", shown_name(p.name).c_str(), p.index_count / 3,
                     p.double_sided ? "double-sided" : "single-sided", alpha_mode_name(p.alpha_mode),
                     p.mirrored ? "  mirrored (clockwise front faces in the file)" : "");
     const std::vector<float> radii = clip_radii(mesh);
     for (size_t i = 0; i < mesh.clips.size(); ++i) {
         const Clip& c = mesh.clips[i];
-        std::printf("  clip %-12s %.3f s  %zu keyframes at %g/s  bounding radius %.4g\n", c.name.c_str(), c.duration_s,
-                    c.keyframe_count, c.sample_rate, radii[i]);
+        std::printf("  clip %-12s %.3f s  %zu keyframes at %g/s  bounding radius %.4g\n", shown_name(c.name).c_str(),
+                    c.duration_s, c.keyframe_count, c.sample_rate, radii[i]);
     }
 }
 

@@ -43,6 +43,7 @@ void add_common(CLI::App& command, animorder::tool::CommonOptions& common) {
     command
         .add_option("--clip", common.clips,
                     "A clip to keep (by name), or a clip file / folder of clip files to add (Mixamo style); repeatable")
+        ->allow_extra_args(false)  // one value a --clip: `--clip Idle FILE` leaves FILE the input
         ->check(kPath);
     command.add_option("--cache-size", common.cache_size, "FIFO vertex cache entries for ACMR and Tipsify")
         ->check(CLI::Range(3u, 1024u));
@@ -67,18 +68,21 @@ void add_method_options(CLI::App& command, animorder::tool::MethodOptions& optio
         options.view_list = {c.views};
         command.add_option("-l,--lambda", options.lambdas, std::string(lambda_help) + "; a list runs each value")
             ->delimiter(',')
+            ->allow_extra_args(false)  // a list is one comma-separated value
             ->capture_default_str()
             ->check(CLI::Range(0.0, 1000.0));
         command
             .add_option("-k,--clusters", options.cluster_list,
                         "single/joint: number of buffers k; a list runs each value")
             ->delimiter(',')
+            ->allow_extra_args(false)  // a list is one comma-separated value
             ->capture_default_str()
             ->check(CLI::Range(size_t(1), size_t(255)));
         command
             .add_option("--views", options.view_list,
                         "single/joint: clustering viewpoints (12, 42, 162, 642); a list runs each value")
             ->delimiter(',')
+            ->allow_extra_args(false)  // a list is one comma-separated value
             ->capture_default_str()
             ->check(kWholeNumber);
     } else {
@@ -240,6 +244,7 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(0.0, 1000.0));
     heatmap_cmd->add_option("--view", heatmap.view, "Direction from the character to the camera, x,y,z")
         ->delimiter(',')
+        ->allow_extra_args(false)  // x,y,z is one value: the input may follow
         ->expected(3);
     heatmap_cmd->add_option("--frame", heatmap.keyframe, "Keyframe (over all clips)")
         ->capture_default_str()

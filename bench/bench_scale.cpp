@@ -5,6 +5,8 @@
 //
 //   build/bench/bench_scale                    every case (heavy: minutes, gigabytes)
 //   build/bench/bench_scale clip60-single      one case (names below); --quick: tiny settings, a smoke run
+//   build/bench/bench_scale --rounds N CASE...  each case N times, each run in a process of its own: the
+//       fastest run's line (load from other work only adds time), then every run's wall time
 //   build/bench/bench_scale --baseline EXE [--rounds N] xbot-single clip60-single
 //       each case as an `optimize` command line, run by this build's animorder and by EXE, another
 //       build's (scripts/build-baseline.sh builds the one the issue's figures came from), one after
@@ -14,10 +16,11 @@
 //
 // Cases and their goals:
 //   ganfaul-joint   Ganfaul, joint over all 12 clips          <= 120 s, <= 3 GB
-//   xbot-single     Xbot, single over every clip              <= 12 s,  <= 0.7 GB
+//   xbot-single     Xbot, single over every clip              <= 0.7 GB (both faces of its
+//                   double-sided material drawn since issue 18: twice the work the 12 s was set for)
 //   clip60-single   Ganfaul Idle (13.8k triangles, 60 keyframes), single   <= 2.5 s
 //   xbot-single-sided  xbot-single on a copy whose materials are single-sided: the work the issue
-//                   measured (since issue 18 both faces of Xbot's double-sided material are drawn)
+//                   measured, <= 12 s, <= 0.7 GB
 //   engine-ratio    bench_overdraw's engine vs llvmpipe, 5 orders per node  >= 40x
 // Data from ../shared/data beside the repository (or $ANIMORDER_DATA); a case without its file
 // says so and is skipped.
@@ -35,6 +38,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -67,9 +71,11 @@ struct Case {
 
 const std::vector<Case> kCases = {
     {"ganfaul-joint", "mixamo-ganfaul/Ganfaul.gltf", {}, Method::Joint, "<= 120 s, <= 3 GB", 557.0, 120.0},
-    {"xbot-single", "glb-xbot/Xbot.glb", {}, Method::Single, "<= 12 s, <= 0.7 GB", 33.0, 12.0},
+    // Both faces of Xbot's double-sided material are drawn since issue 18: about twice the work the
+    // issue's 33 s -> 12 s was set for, which xbot-single-sided measures.
+    {"xbot-single", "glb-xbot/Xbot.glb", {}, Method::Single, "<= 0.7 GB (12 s: xbot-single-sided)", 33.0, 12.0},
     {"clip60-single", "mixamo-ganfaul/Ganfaul.gltf", {"Idle"}, Method::Single, "<= 2.5 s", 5.0, 2.5},
-    {"xbot-single-sided", "glb-xbot/Xbot.glb", {}, Method::Single, "<= 12 s, as the issue measured", 33.0, 12.0, true},
+    {"xbot-single-sided", "glb-xbot/Xbot.glb", {}, Method::Single, "<= 12 s, <= 0.7 GB", 33.0, 12.0, true},
 };
 
 fs::path data_folder() {
@@ -350,28 +356,71 @@ int main(int argc, char** argv) {
     }
     for (const Case& c : kCases) {
         if (!selected(c.name)) continue;
-        const pid_t child = fork();
-        if (child < 0) {
-            std::perror("fork");
-            return 1;
-        }
-        if (child == 0) {
-            try {
-                _exit(run_case(c, quick));
-            } catch (const std::exception& e) {
-                std::printf("%-17s failed: %s", c.name, e.what());
-                std::fflush(stdout);
-                _exit(2);
+        // Each round in a child process of its own (its peak resident set its own), its line read
+        // back through a pipe; load from other work only ever adds time, so the fastest is shown.
+        std::string fastest_line;
+        double fastest = 0, fastest_gb = 0;
+        std::vector<double> walls;
+        for (unsigned round = 0; round < rounds; ++round) {
+            int out[2];
+            if (::pipe(out) != 0) {
+                std::perror("pipe");
+                return 1;
+            }
+            std::fflush(stdout);
+            const Clock::time_point start = Clock::now();
+            const pid_t child = fork();
+            if (child < 0) {
+                std::perror("fork");
+                return 1;
+            }
+            if (child == 0) {
+                ::close(out[0]);
+                ::dup2(out[1], STDOUT_FILENO);
+                try {
+                    const int code = run_case(c, quick);
+                    std::fflush(stdout);
+                    _exit(code);
+                } catch (const std::exception& e) {
+                    std::printf("%-17s failed: %s", c.name, e.what());
+                    std::fflush(stdout);
+                    _exit(2);
+                }
+            }
+            ::close(out[1]);
+            std::string line;
+            char buffer[512];
+            for (ssize_t n; (n = ::read(out[0], buffer, sizeof buffer)) != 0;)
+                if (n > 0)
+                    line.append(buffer, size_t(n));
+                else if (errno != EINTR)
+                    break;
+            ::close(out[0]);
+            while (!line.empty() && line.back() == '\n') line.pop_back();
+            int status = 0;
+            struct rusage usage {};
+            wait4(child, &status, 0, &usage);
+            const double wall = std::chrono::duration<double>(Clock::now() - start).count();
+            walls.push_back(wall);
+            if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || line.find("skipped:") != std::string::npos) {
+                std::printf("%s\n", line.c_str());  // a failure or a skip: said once
+                fastest_line.clear();
+                break;
+            }
+            if (round == 0 || wall < fastest) {
+                fastest = wall;
+                fastest_line = line;
+                fastest_gb = double(usage.ru_maxrss) * 1024.0 / 1e9;  // ru_maxrss: KiB on Linux
             }
         }
-        int status = 0;
-        struct rusage usage {};
-        const Clock::time_point start = Clock::now();
-        wait4(child, &status, 0, &usage);
-        const double wall = std::chrono::duration<double>(Clock::now() - start).count();
-        // ru_maxrss is in KiB on Linux: the child's own peak resident set.
-        std::printf("  wall %.1f s  peak RSS %.2f GB  (goal %s)\n", wall, double(usage.ru_maxrss) * 1024.0 / 1e9,
-                    c.goal);
+        if (fastest_line.empty()) continue;
+        std::printf("%s  wall %.1f s  peak RSS %.2f GB  (goal %s)", fastest_line.c_str(), fastest, fastest_gb, c.goal);
+        if (rounds > 1) {
+            std::printf("  fastest of %u:", rounds);
+            for (const double w : walls) std::printf(" %.1f", w);
+            std::printf(" s");
+        }
+        std::printf("\n");
         std::fflush(stdout);
     }
     if (selected("engine-ratio") && !quick) engine_ratio();

@@ -231,7 +231,7 @@ if [ -x "$BIN/bench/bench_raster" ]; then
   step_stdout bench-raster-xbot.txt "$BIN/bench/bench_raster" $DATA/glb-xbot/Xbot.glb --simd all
 fi
 if [ -x "$BIN/bench/bench_scale" ]; then
-  step_stdout bench-scale.txt "$BIN/bench/bench_scale" ganfaul-joint xbot-single clip60-single
+  step_stdout bench-scale.txt "$BIN/bench/bench_scale" --rounds 3 ganfaul-joint xbot-single xbot-single-sided clip60-single
 fi
 # The per-clip cases against the engine that issue 19's "today" figures came from (built by
 # scripts/build-baseline.sh), each case run by both builds one after the other: a speed-up holds

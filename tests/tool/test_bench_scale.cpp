@@ -112,6 +112,26 @@ TEST_F(BenchScale, TheSingleSidedCopyLoadsAsTheSameCharacter) {
     EXPECT_TRUE(fs::is_empty(path("tmp")));
 }
 
+// --rounds without --baseline: each case N times, one line with the fastest run's wall time and
+// then every run's (the fastest is their minimum).
+TEST_F(BenchScale, RoundsShowTheFastestRunAndEveryRun) {
+    ANIMORDER_REQUIRE_OR_SKIP("data", fs::exists(kData / "mixamo-ganfaul" / "Ganfaul.gltf"),
+                              (kData / "mixamo-ganfaul" / "Ganfaul.gltf").string() + " is absent");
+    const test::Outcome o = run("--quick --rounds 3 clip60-single");
+    ASSERT_EQ(o.exit_code, 0) << o.out << o.err;
+    EXPECT_EQ(count(o.out, "clip60-single "), 1u) << o.out;
+    const size_t at = o.out.find("  wall ");
+    ASSERT_NE(at, std::string::npos) << o.out;
+    double wall = 0;
+    ASSERT_EQ(std::sscanf(o.out.c_str() + at, "  wall %lf s", &wall), 1) << o.out;
+    const size_t runs = o.out.find("fastest of 3:");
+    ASSERT_NE(runs, std::string::npos) << o.out;
+    double a = 0, b = 0, c = 0;
+    ASSERT_EQ(std::sscanf(o.out.c_str() + runs, "fastest of 3: %lf %lf %lf s", &a, &b, &c), 3) << o.out;
+    EXPECT_DOUBLE_EQ(wall, std::min({a, b, c})) << o.out;
+    EXPECT_TRUE(fs::is_empty(path("tmp")));
+}
+
 TEST_F(BenchScale, AFailingBaselineIsReported) {
     ANIMORDER_REQUIRE_OR_SKIP("data", fs::exists(kData / "mixamo-ganfaul" / "Ganfaul.gltf"),
                               (kData / "mixamo-ganfaul" / "Ganfaul.gltf").string() + " is absent");

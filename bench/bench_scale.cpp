@@ -16,8 +16,8 @@
 //
 // Cases and their goals:
 //   ganfaul-joint   Ganfaul, joint over all 12 clips          <= 120 s, <= 3 GB
-//   xbot-single     Xbot, single over every clip              <= 0.7 GB (both faces of its
-//                   double-sided material drawn since issue 18: twice the work the 12 s was set for)
+//   xbot-single     Xbot, single over every clip              <= 12 s, <= 0.7 GB (both faces of
+//                   its double-sided material drawn since issue 18: twice the work the 12 s was set for)
 //   clip60-single   Ganfaul Idle (13.8k triangles, 60 keyframes), single   <= 2.5 s
 //   xbot-single-sided  xbot-single on a copy whose materials are single-sided: the work the issue
 //                   measured, <= 12 s, <= 0.7 GB
@@ -69,11 +69,13 @@ struct Case {
     bool single_sided = false;
 };
 
+// Both faces of Xbot's double-sided material are drawn since issue 18: about twice the work the
+// issue's 33 s -> 12 s was set for, which xbot-single-sided measures.
+constexpr const char* kXbotAsItIsGoal = "<= 12 s, <= 0.7 GB; the 12 s was set for xbot-single-sided's work";
+
 const std::vector<Case> kCases = {
     {"ganfaul-joint", "mixamo-ganfaul/Ganfaul.gltf", {}, Method::Joint, "<= 120 s, <= 3 GB", 557.0, 120.0},
-    // Both faces of Xbot's double-sided material are drawn since issue 18: about twice the work the
-    // issue's 33 s -> 12 s was set for, which xbot-single-sided measures.
-    {"xbot-single", "glb-xbot/Xbot.glb", {}, Method::Single, "<= 0.7 GB (12 s: xbot-single-sided)", 33.0, 12.0},
+    {"xbot-single", "glb-xbot/Xbot.glb", {}, Method::Single, kXbotAsItIsGoal, 33.0, 12.0},
     {"clip60-single", "mixamo-ganfaul/Ganfaul.gltf", {"Idle"}, Method::Single, "<= 2.5 s", 5.0, 2.5},
     {"xbot-single-sided", "glb-xbot/Xbot.glb", {}, Method::Single, "<= 12 s, <= 0.7 GB", 33.0, 12.0, true},
 };

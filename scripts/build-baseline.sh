@@ -7,9 +7,10 @@
 #
 # Issue 19's goals are seconds on the machine that filed it, beside what the same commands took
 # there then ("today": Xbot single 33 s, a 60-keyframe clip about 5 s, Ganfaul joint 557 s). Their
-# ratio is the speed-up each goal asks, and a ratio measured in one run carries over to another
-# processor where seconds do not. BASELINE is the last commit before the issue's work began; its
-# Xbot run peaks at the issue's 0.71 GB. (It draws every triangle single-sided: Xbot's
+# ratio is the speed-up each goal asks, and a ratio measured in one run depends much less on the
+# processor than seconds do (though still on it: the wide vector code gains more on some).
+# BASELINE is the last commit before the issue's work began; its Xbot run peaks at the issue's
+# 0.71 GB. (It draws every triangle single-sided: Xbot's
 # double-sided material doubles the current build's work on Xbot, issue 18.)
 # Needs the repository's history (a full clone) and the packages of scripts/install-deps.sh.
 set -euo pipefail

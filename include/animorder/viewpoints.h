@@ -28,6 +28,11 @@ struct Framing {
     std::vector<float> centres;  // 3 per keyframe
     std::vector<float> radii;    // per keyframe: farthest vertex from its centre
     float radius = 0;            // the view radius R: the largest of radii
+
+    // Every keyframe framed is a point (R = 0: a clip that hides the mesh by scale 0): nothing is
+    // drawn from any view, and no camera can be placed at 3R. The methods and the evaluation
+    // leave such keyframes' nodes unscored.
+    bool shows_nothing() const { return !(radius > 0); }
 };
 Framing frame_keyframes(const float* keyframe_positions, size_t keyframe_count, size_t vertex_count,
                         const uint32_t* indices, size_t index_count);

@@ -631,7 +631,7 @@ ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patc
     // Keyframes that all shrink the mesh to a point (a clip that hides it by scale 0) draw nothing
     // at any node: every order passes no fragment, so one buffer, the patches in their own order,
     // serves every node (and no camera can be placed at 3R = 0).
-    if (!(framing.radius > 0)) {
+    if (framing.shows_nothing()) {
         BestState nothing_drawn{0.0,
                                 {std::vector<uint32_t>(patches.patch_count())},
                                 std::vector<uint32_t>(keyframes.size() * settings.views, 0)};

@@ -154,7 +154,7 @@ Nodes make_nodes(const uint32_t* indices, size_t index_count, const float* keyfr
         frame_keyframes(keyframe_positions, keyframe_count, vertex_count, indices, index_count), keyframes);
     // Keyframes that shrink the mesh (or a primitive framed on its own) to a point draw nothing from
     // any view: no node, no arc (and no camera at 3R = 0).
-    if (!(nodes.framing.radius > 0)) return nodes;
+    if (nodes.framing.shows_nothing()) return nodes;
     for (uint32_t k : keyframes)
         for (size_t v = 0; v < directions.size() / 3; ++v) {
             OverdrawNode node;

@@ -115,7 +115,7 @@ void for_each_evaluation_node(const AnimatedMesh& mesh, const Framing& all, cons
         const Framing framing = frame_subset(all, keyframes);  // R of this animation
         const size_t node_count = keyframes.size() * settings.views;
         begin(c, keyframes, framing, node_count);
-        if (!(framing.radius > 0)) {
+        if (framing.shows_nothing()) {
             // Every keyframe of the clip shrinks the mesh to a point: nothing is drawn at any of
             // its nodes (no pixel to count), and no camera can be placed at 3R = 0.
             done_before += node_count;

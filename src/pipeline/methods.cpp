@@ -268,7 +268,7 @@ AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double
         // by their own k clusters of the same nodes, the buffers then being the (opaque, blend)
         // cluster pairs the nodes take. A run that draws nothing (cluster_nodes' "nothing drawn")
         // keeps its one buffer as it is.
-        const bool drawn = framing.radius > 0;
+        const bool drawn = !framing.shows_nothing();
         if (drawn && has_blended_primitives(mesh) && !blend_clusters) {
             blended_orders_from_clusters(mesh, result.framing, framing.radius, result.runs.back());
             ClusteringResult& run = result.runs.back();

@@ -1,13 +1,15 @@
 #!/usr/bin/env bash
-# Set-up to result: installs dependencies, builds everything in Release, and runs the main job on
-# the bundled procedural character (no input file needed): Han & Sander's k-means ("single", k = 5
-# per clip), writing the buffers + lookup tables, then a quick evaluation against the baselines.
-# Results land in build/out/.
+# Set-up to result: installs what the tool needs, builds the tool alone (Release, warnings as
+# errors: the flags of scripts/test.sh, in the same build/ tree, so the tests build on top of it
+# and recompile nothing), and runs the main job on the bundled procedural character (no input
+# file needed): Han & Sander's k-means ("single", k = 5 per clip), writing the buffers + lookup
+# tables, then a quick evaluation against the baselines and a heatmap. Results land in build/out/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/install-deps.sh
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build build -j"$(nproc)"
+bash scripts/install-deps.sh --tool
+source scripts/configure.sh
+configure_build build -DANIMORDER_BUILD_TESTS=OFF -DANIMORDER_BUILD_BENCHMARKS=OFF
+cmake --build build -j"$(nproc)" --target animorder
 mkdir -p build/out
 build/animorder inspect
 build/animorder optimize --method single -o build/out/character --report build/out/optimize.json

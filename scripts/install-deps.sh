@@ -1,20 +1,48 @@
 #!/usr/bin/env bash
-# Installs the Debian packages animorder needs to build, test and benchmark. Idempotent: packages
-# already present are skipped, and apt is only asked when something is missing.
+# Installs the Debian packages animorder needs. Idempotent: packages already present are skipped,
+# and apt is only asked when something is missing.
+#   install-deps.sh          everything: build, tests, benchmarks, fuzzing, the JS and browser tests
+#   install-deps.sh --tool   only what the library and the animorder tool need (scripts/demo.sh)
 set -euo pipefail
 
-packages=(
+mode=all
+case "${1:-}" in
+  "") ;;
+  --tool) mode=tool ;;
+  *) echo "install-deps: unknown option '$1' (use --tool, or nothing for everything)" >&2; exit 2 ;;
+esac
+
+install_missing() {
+  local missing=() p
+  for p in "$@"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  [ ${#missing[@]} -gt 0 ] || return 0
+  echo "install-deps: installing ${missing[*]}" >&2
+  local sudo=""
+  [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+}
+
+tool_packages=(
   build-essential cmake pkg-config
+  ccache                                   # compiler cache, used when present (CMakeLists.txt)
   libtbb-dev                               # parallel node scoring
   libcli11-dev nlohmann-json3-dev          # the tool: options, JSON report
   libstb-dev                               # PNG heatmaps
   nettle-dev                               # batch: SHA-256 stamps of items' inputs and options
-  libgtest-dev libgmock-dev                # tests
-  libbenchmark-dev                         # benchmarks
-  libmeshoptimizer-dev                     # the meshopt baseline; an independent reference in tests
-  libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri  # OpenGL reference (llvmpipe)
+  libmeshoptimizer-dev                     # the meshopt baseline method
   libtinygltf-dev                          # glTF 2.0 in and out
   libassimp-dev                            # FBX, Collada, .X, .b3d, MD5, ...
+)
+install_missing "${tool_packages[@]}"
+[ "$mode" = all ] || exit 0
+
+packages=(
+  libgtest-dev libgmock-dev                # tests
+  libbenchmark-dev                         # benchmarks
+  libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri  # OpenGL reference (llvmpipe)
   clang libclang-rt-14-dev                 # scripts/fuzz.sh: clang 14 and its libFuzzer/ASan runtimes
 )
 
@@ -22,18 +50,7 @@ packages=(
 # counts), else Debian's.
 command -v node >/dev/null 2>&1 && command -v npm >/dev/null 2>&1 || packages+=(nodejs npm)
 
-missing=()
-for p in "${packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  echo "install-deps: installing ${missing[*]}" >&2
-  SUDO=""
-  [ "$(id -u)" -eq 0 ] || SUDO="sudo"
-  export DEBIAN_FRONTEND=noninteractive
-  $SUDO apt-get update -qq
-  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
-fi
+install_missing "${packages[@]}"
 
 # The Khronos glTF Validator (npm), pinned, into .tools/ of the repository (ignored by git).
 validator_version=2.0.0-dev.3.10
@@ -48,19 +65,7 @@ fi
 # glTF round trips of the ANIMORDER_animated_triangle_orders extension (tests/tool/test_gltf_pipelines.cpp,
 # js/gltf-transform-animorder): gltfpack and a JSON-schema checker from Debian; glTF-Transform and
 # gltf-pipeline from npm, pinned, into .tools/ (the JS package's own node_modules gets the same).
-gltf_tool_packages=(gltfpack python3-jsonschema)
-gltf_missing=()
-for p in "${gltf_tool_packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || gltf_missing+=("$p")
-done
-if [ ${#gltf_missing[@]} -gt 0 ]; then
-  echo "install-deps: installing ${gltf_missing[*]}" >&2
-  SUDO=""
-  [ "$(id -u)" -eq 0 ] || SUDO="sudo"
-  export DEBIAN_FRONTEND=noninteractive
-  $SUDO apt-get update -qq
-  $SUDO apt-get install -y -qq --no-install-recommends "${gltf_missing[@]}" >/dev/null
-fi
+install_missing gltfpack python3-jsonschema
 gltf_transform_version=4.5.1
 gltf_pipeline_version=4.3.1
 if [ ! -f "$here/.tools/node_modules/@gltf-transform/cli/package.json" ] ||
@@ -83,14 +88,7 @@ fi
 # The viewer and its browser tests (viewer/, tests/js): Debian's Chromium (headless, WebGL2 on
 # SwiftShader) and, from viewer/package-lock.json, three 0.187.0 and puppeteer-core 24.9.0 (no
 # browser download: the tests point puppeteer at /usr/bin/chromium).
-if ! dpkg-query -W -f='${Status}' chromium 2>/dev/null | grep -q "install ok installed"; then
-  echo "install-deps: installing chromium" >&2
-  SUDO=""
-  [ "$(id -u)" -eq 0 ] || SUDO="sudo"
-  export DEBIAN_FRONTEND=noninteractive
-  $SUDO apt-get update -qq
-  $SUDO apt-get install -y -qq --no-install-recommends chromium >/dev/null
-fi
+install_missing chromium
 if [ ! -f "$here/viewer/node_modules/three/package.json" ] ||
    ! grep -q '"version": "0.187.0"' "$here/viewer/node_modules/three/package.json" ||
    [ ! -f "$here/viewer/node_modules/puppeteer-core/package.json" ]; then

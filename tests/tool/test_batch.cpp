@@ -720,14 +720,14 @@ TEST_F(Batch, AShardChecksOnlyWhatItWritesAndTheMergeOnlyTheSummary) {
     EXPECT_NE(s["items"][2]["error"].get<std::string>().find("broken.obj"), std::string::npos) << s["items"][2];
 }
 
-// The README's Kubernetes Indexed Job runs its container command once per index: a pod whose
-// shard has a broken item completes (the failure is recorded, not retried), and the merge step
-// then lists it with exit code 3. The command is taken from the README as written.
+// The Kubernetes Indexed Job of docs/batch.md (once in the README) runs its container command once
+// per index: a pod whose shard has a broken item completes (the failure is recorded, not retried),
+// and the merge step then lists it with exit code 3. The command is taken from docs/batch.md as written.
 TEST_F(Batch, TheReadmesKubernetesCommandCompletesAShardWithAFailedItem) {
-    const std::string readme = test::slurp(fs::path(ANIMORDER_SOURCE_DIR) / "README.md");
+    const std::string readme = test::slurp(fs::path(ANIMORDER_SOURCE_DIR) / "docs" / "batch.md");
     const std::string marker = "command: [";
     const size_t at = readme.find(marker);
-    ASSERT_NE(at, std::string::npos) << "the README's Job has no command";
+    ASSERT_NE(at, std::string::npos) << "docs/batch.md's Job has no command";
     const size_t open = at + marker.size() - 1;
     const nlohmann::json words = nlohmann::json::parse(readme.substr(open, readme.find(']', open) - open + 1));
     ASSERT_GE(words.size(), 3u);

@@ -123,7 +123,7 @@ TEST_F(Cli, TheReadmesHeatmapsAreWhatTheirCommandDraws) {
 }
 
 namespace {
-// Every figure of the README's sample report (`sample`, "..." standing for what it leaves out)
+// Every figure of the manual's sample report (`sample`, "..." standing for what it leaves out)
 // against a real report: keys present, integers, strings and flags equal, decimals to the places
 // shown (within 0.005), times and output paths only present (they vary by machine and folder).
 void expect_sample_matches(const nlohmann::json& sample, const nlohmann::json& actual, const std::string& where) {
@@ -151,12 +151,12 @@ void expect_sample_matches(const nlohmann::json& sample, const nlohmann::json& a
 }
 }  // namespace
 
-// The README's sample report is the report of the command it names (the bundled character,
-// default settings), figure by figure except the times.
+// The manual's sample report (docs/cli.md, "The JSON report"; once in the README) is the report of
+// the command it names (the bundled character, default settings), figure by figure except the times.
 TEST_F(Cli, TheReadmesSampleReportIsARealOne) {
-    const std::string readme = test::slurp(fs::path(ANIMORDER_SOURCE_DIR) / "README.md");
+    const std::string readme = test::slurp(fs::path(ANIMORDER_SOURCE_DIR) / "docs" / "cli.md");
     const size_t command = readme.find("report of `build/animorder optimize -o build/out/character --report R.json`");
-    ASSERT_NE(command, std::string::npos) << "the README no longer names the sample report's command";
+    ASSERT_NE(command, std::string::npos) << "docs/cli.md no longer names the sample report's command";
     const size_t open = readme.find("```json\n", command), close = readme.find("```", open + 8);
     ASSERT_NE(open, std::string::npos);
     const nlohmann::json sample = nlohmann::json::parse(readme.substr(open + 8, close - open - 8));

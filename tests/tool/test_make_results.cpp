@@ -890,8 +890,8 @@ TEST_F(CommittedResults, RegenerateToTheCommittedFiles) {
             << svg;
 }
 
-// The committed notes, and README.md's Results and Performance sections outside the generated
-// block, carry no measured figure typed by hand: outside placeholders, every number with decimals,
+// The committed notes, README.md's Results and Performance sections outside the generated block,
+// and docs/benchmarks.md carry no measured figure typed by hand: outside placeholders, every number with decimals,
 // percentage or thousands separator is one of the paper's printed values or a setting listed here.
 // A new figure must be a placeholder (templates.h).
 TEST(CommittedNotes, CarryNoHandTypedMeasurements) {
@@ -932,4 +932,12 @@ TEST(CommittedNotes, CarryNoHandTypedMeasurements) {
     for (auto m = std::sregex_iterator(sections.begin(), sections.end(), number); m != std::sregex_iterator(); ++m)
         EXPECT_TRUE(allowed.count((*m)[1].str()))
             << "README.md: '" << (*m)[1].str() << "' is typed by hand; generate it (docs/results-notes/readme.md)";
+
+    // docs/benchmarks.md (how the results are made, what each benchmark measures: once README's
+    // "Results" and "Performance" sections) likewise, as a whole.
+    const std::string benchmarks = test::slurp(fs::path(ANIMORDER_SOURCE_DIR) / "docs" / "benchmarks.md");
+    ASSERT_NE(benchmarks.find("\n## Performance\n"), std::string::npos);
+    for (auto m = std::sregex_iterator(benchmarks.begin(), benchmarks.end(), number); m != std::sregex_iterator(); ++m)
+        EXPECT_TRUE(allowed.count((*m)[1].str()))
+            << "docs/benchmarks.md: '" << (*m)[1].str() << "' is typed by hand; put it in RESULTS.md's notes";
 }

@@ -214,7 +214,7 @@ fi
 if [ -x "$BIN/bench/bench_nehab06" ]; then
   step_stdout nehab06-bench.txt "$BIN/bench/bench_nehab06"
 fi
-# README's "Performance": Tipsify against meshoptimizer (medians of interleaved repetitions), the
+# docs/benchmarks.md, "Performance": Tipsify against meshoptimizer (medians of interleaved repetitions), the
 # overdraw engine against llvmpipe, and Han & Sander's preprocessing of Ganfaul Idle with its stages.
 if [ -x "$BIN/bench/bench_tipsify" ]; then
   step_stdout bench-tipsify.txt "$BIN/bench/bench_tipsify" --benchmark_repetitions=5 \

@@ -104,7 +104,7 @@ TEST_F(JsTest, ViewerInHeadlessChromium) {
     ANIMORDER_REQUIRE_OR_SKIP("browser", have_browser(why), why);
     optimise_character();
     if (HasFatalFailure()) return;
-    // The screenshot goes to the build folder (the README's image is a copy of it).
+    // The screenshot goes to the build folder (docs/viewer.md's image is a copy of it).
     run_browser_test(*this, dir_, "", fs::path(ANIMORDER_BINARY_DIR) / "viewer" / "screenshot.png", 10);
 }
 

@@ -199,7 +199,7 @@ TEST(GlCrosscheck, ThreeMeshesTwentyViewsThreeOrdersMatchOpenGL) {
     if (is_llvmpipe(*gl)) {
         EXPECT_EQ(procedural_exact, kProceduralExactOnLlvmpipe) << "of the 240 counts of the three procedural meshes";
         if (have_ganfaul) {
-            EXPECT_EQ(totals.exact, 313u) << "README: llvmpipe agrees on 313 of 320 counts";
+            EXPECT_EQ(totals.exact, 313u) << "DESIGN.md: llvmpipe agrees on 313 of 320 counts";
         }
     } else {
         std::printf("not llvmpipe (%s): the exact-match counts are not checked\n", gl->renderer().c_str());

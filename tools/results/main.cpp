@@ -27,7 +27,7 @@
 // and readme.md, README.md's block; both are templates whose measured figures are placeholders
 // resolved from RESULTS_DIR (templates.h). Section ids: settings, table1, characters, views, lambda,
 // clusters, clips, measured, materials, render-time, nehab06, performance, other. The .json files are
-// `animorder evaluate --report` outputs (README.md).
+// `animorder evaluate --report` outputs (docs/cli.md).
 //
 // Everything is read and checked before anything is written, so a malformed report gives one
 // line on stderr, exit code 1 and no output. The output is byte-deterministic: no date, fixed

@@ -1,0 +1,357 @@
+// Content stamps of batch items, hashed with nettle's SHA-256: the parts an item's outputs depend
+// on, the side files its loading read, and which part changed since its report was written.
+#include "batch_stamp.h"
+
+#include "animorder/atomic_write.h"
+#include "animorder/regular_file.h"
+
+#include <nettle/sha2.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <unordered_set>
+#include <utility>
+#include <vector>
+
+namespace animorder::tool {
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::ordered_json;
+
+class Sha256 {
+public:
+    Sha256() { sha256_init(&ctx_); }
+    void add(const std::string& text) {
+        const uint64_t n = text.size();  // length-prefixed, so concatenations cannot collide
+        sha256_update(&ctx_, sizeof n, reinterpret_cast<const uint8_t*>(&n));
+        sha256_update(&ctx_, text.size(), reinterpret_cast<const uint8_t*>(text.data()));
+    }
+    // A file's name and bytes (never its folder: a library moved whole keeps its stamps). A path
+    // that is no regular file (missing, a folder, a FIFO or a device, which would never end:
+    // checked on the open file) hashes as that: the item then fails to load it.
+    void add_file(const fs::path& path) {
+        add("file:" + path.filename().string());
+        RegularFile file(path.string());  // never opens a FIFO or a device (some act on open)
+        if (!file.ok()) return add(std::string(file.why()) == "a folder" ? "not a regular file" : file.why());
+        std::vector<uint8_t> block(1 << 16);
+        uint64_t total = 0;
+        for (size_t got; (got = file.read(block.data(), block.size())) > 0; total += got)
+            sha256_update(&ctx_, got, block.data());
+        add("bytes:" + std::to_string(total));
+    }
+    // What add_file adds for a file of this name holding `data`, from the bytes in memory.
+    void add_data(const fs::path& path, const std::string& data) {
+        add("file:" + path.filename().string());
+        sha256_update(&ctx_, data.size(), reinterpret_cast<const uint8_t*>(data.data()));
+        add("bytes:" + std::to_string(data.size()));
+    }
+    std::string hex() {
+        uint8_t digest[SHA256_DIGEST_SIZE];
+        sha256_digest(&ctx_, sizeof digest, digest);
+        static const char* digits = "0123456789abcdef";
+        std::string out;
+        for (uint8_t b : digest) out += {digits[b >> 4], digits[b & 15]};
+        return out;
+    }
+
+private:
+    sha256_ctx ctx_;
+};
+
+}  // namespace
+
+// The tool: its version and the bytes of its executable, since a rebuild that changes the outputs
+// may keep the version string.
+const std::string& tool_digest() {
+    static const std::string tool = [] {
+        Sha256 hash;
+        hash.add(ANIMORDER_VERSION);
+        std::error_code error;
+        const fs::path executable = fs::read_symlink("/proc/self/exe", error);
+        if (error)
+            hash.add("executable unknown");
+        else
+            hash.add_file(executable);
+        return hash.hex();
+    }();
+    return tool;
+}
+
+json read_json_file(const std::string& path) {
+    std::error_code error;
+    if (!fs::is_regular_file(path, error)) return json();
+    try {
+        return json::parse(read_text(path, "a report"));
+    } catch (const std::exception&) {
+        return json();  // unreadable: as if absent
+    }
+}
+
+// object[key] when it is a string, else "" (a report edited by hand is stale, never an error).
+std::string string_at(const json& object, const char* key) {
+    if (!object.is_object()) return "";
+    const auto it = object.find(key);
+    return it != object.end() && it->is_string() ? it->get<std::string>() : "";
+}
+
+namespace {
+
+// A file's name and bytes, hashed.
+std::string file_digest(const fs::path& path) {
+    Sha256 hash;
+    hash.add_file(path);
+    return hash.hex();
+}
+
+// A side file's path from the report's folder, as the report keeps it: "file" when it is UTF-8,
+// else "file_bytes" with every byte outside printable ASCII (and '%') as %XY, so that it reads
+// back as the same bytes (a JSON string cannot hold them).
+json side_file_name(const std::string& path) {
+    if (is_utf8(path)) return {{"file", path}};
+    std::string escaped;
+    static const char* digits = "0123456789ABCDEF";
+    for (const unsigned char c : path)
+        if (c < 0x20 || c >= 0x7f || c == '%')
+            escaped += {'%', digits[c >> 4], digits[c & 15]};
+        else
+            escaped += char(c);
+    return {{"file_bytes", escaped}};
+}
+
+std::string side_file_path(const json& entry) {
+    const std::string file = string_at(entry, "file");
+    if (!file.empty()) return file;
+    const std::string escaped = string_at(entry, "file_bytes");
+    std::string out;
+    for (size_t i = 0; i < escaped.size(); ++i) {
+        if (escaped[i] == '%' && i + 2 < escaped.size() && std::isxdigit(uint8_t(escaped[i + 1])) &&
+            std::isxdigit(uint8_t(escaped[i + 2]))) {
+            out += char(std::stoi(escaped.substr(i + 1, 2), nullptr, 16));
+            i += 2;
+        } else {
+            out += escaped[i];
+        }
+    }
+    return out;
+}
+
+// A file's path from the item report's folder, as the report names the files the item read.
+std::string from_report_folder(const PlannedItem& p, const std::string& file) {
+    std::error_code error;
+    // Both absolute first: relative() leaves a relative path whose folders are all missing as
+    // it is, and the result was empty (the absolute path was kept, tying the report to a place).
+    fs::path from_report = fs::relative(fs::absolute(file, error), fs::absolute(folder_of(p.report), error), error);
+    if (error || from_report.empty()) from_report = fs::absolute(file, error);
+    return from_report.generic_string();
+}
+
+// The parts of the item's stamp (StampParts) as its files are now.
+StampParts stamp_parts(const PlannedItem& p, const BatchOptions& batch) {
+    StampParts parts;
+    Sha256 settings;
+    settings.add(optimize_settings_json(p.options, p.plan, false).dump());
+    settings.add("max_memory:" + std::to_string(p.options.common.max_memory));
+    parts.settings = settings.hex();
+    Sha256 paths;
+    paths.add("input:" + p.item.input_as_written);
+    paths.add("output:" + p.item.output_as_written);
+    for (const std::string& c : p.item.clips_as_written) paths.add("clip:" + c);
+    parts.paths = paths.hex();
+    parts.eval = std::to_string(batch.eval_views) + "/" + std::to_string(batch.eval_resolution) +
+                 (batch.no_timings ? "/no-timings" : "");
+    for (const std::string& file : p.plan.inputs) {
+        Sha256 bytes;
+        bytes.add_file(file);
+        parts.inputs.emplace_back(from_report_folder(p, file), bytes.hex());
+    }
+    return parts;
+}
+
+std::string item_stamp(const StampParts& parts) {
+    Sha256 hash;
+    hash.add("animorder batch stamp 4");
+    hash.add(tool_digest());
+    hash.add(parts.settings);
+    hash.add(parts.paths);
+    hash.add("eval:" + parts.eval);
+    for (const auto& [file, digest] : parts.inputs) hash.add(digest);
+    return hash.hex();
+}
+
+}  // namespace
+
+Stamp stamp_of(const PlannedItem& p, const BatchOptions& batch) {
+    Stamp stamp{stamp_parts(p, batch), {}};
+    stamp.digest = item_stamp(stamp.parts);
+    return stamp;
+}
+
+json stamp_parts_json(const StampParts& parts) {
+    json inputs = json::array();
+    for (const auto& [file, digest] : parts.inputs) {
+        json entry = side_file_name(file);
+        entry["sha256"] = digest;
+        inputs.push_back(entry);
+    }
+    return {{"settings", parts.settings}, {"paths", parts.paths}, {"eval", parts.eval}, {"inputs", inputs}};
+}
+
+// The files loading read beyond the stamp's (an OBJ's .mtl: only the importer knows them, found
+// or not), each with its path from the report's folder and its digest taken as it was loaded,
+// for the report's "side_files". A missing file in a missing folder is left out: importers look
+// for names made from the input's path (assimp's MD5 reader tries "chars/chars/Bob.md5anim" and
+// names cut from the path; load_assimp runs it from the character's folder, so those no longer
+// depend on the spelling, but such guesses still name folders nobody made), and a file to
+// appear there would need its folder made first.
+json side_files(const PlannedItem& p, const std::vector<std::string>& files_read) {
+    std::unordered_set<std::string> known;
+    for (const std::string& input : p.plan.inputs) known.insert(file_identity(input));
+    json list = json::array();
+    std::unordered_set<std::string> listed;
+    for (const std::string& file : files_read) {
+        if (known.count(file_identity(file))) continue;
+        std::error_code error;
+        if (!fs::exists(file, error) && !fs::is_directory(folder_of(file), error)) continue;
+        const std::string name = from_report_folder(p, file);
+        if (!listed.insert(name).second) continue;
+        json entry = side_file_name(name);
+        // The digest of the path as kept (relative() normalises "dir/" to "dir"), as current_report
+        // will take it.
+        entry["sha256"] = file_digest(folder_of(p.report) / name);
+        list.push_back(entry);
+    }
+    return list;
+}
+
+std::string data_digest(const std::string& path, const std::string& data) {
+    Sha256 hash;
+    hash.add_data(path, data);
+    return hash.hex();
+}
+
+namespace {
+
+// The summary's figures in a report as run_item writes them: counts, ACMRs, and OVRs and the time
+// as numbers or null (no evaluation; --no-timings).
+bool summary_fields_hold(const json& batch) {
+    if (!batch.is_object() || string_at(batch, "status") != "ok") return false;
+    for (const char* key : {"triangles", "clips", "buffers", "index_bytes_added"})
+        if (!batch.contains(key) || !batch[key].is_number_unsigned()) return false;
+    for (const char* key : {"acmr_before", "acmr_after"})
+        if (!batch.contains(key) || !batch[key].is_number()) return false;
+    for (const char* key : {"ovr_before", "ovr_after", "time_s"})
+        if (!batch.contains(key) || !(batch[key].is_number() || batch[key].is_null())) return false;
+    return true;
+}
+
+// A file named from the item report's folder (as reports keep them), as the manifest would write
+// it: from the manifest's folder.
+std::string as_manifest_writes(const PlannedItem& p, const std::string& from_report) {
+    const fs::path out(p.item.output_as_written);
+    return (out.parent_path() / from_report).lexically_normal().generic_string();
+}
+
+// Which part of the stamp changed since the report was written (its "stamp_parts").
+Staleness stamp_change(const PlannedItem& p, const json& then, const StampParts& now) {
+    using S = Staleness;
+    if (string_at(then, "tool") != tool_digest())
+        return {S::kOtherBuild, "its result was written by another animorder build"};
+    const auto old = then.find("stamp_parts");
+    if (old == then.end() || !old->is_object())
+        return {S::kChanged, "its result is out of date: its inputs, options or paths changed since it ran"};
+    if (string_at(*old, "eval") != now.eval)
+        return {S::kOtherEvaluation, "its result was evaluated with other --eval-views/--eval-resolution/--no-timings"};
+    if (string_at(*old, "settings") != now.settings) return {S::kChanged, "its options changed since it ran"};
+    if (string_at(*old, "paths") != now.paths)
+        return {S::kChanged, "its input, output or clip paths in the manifest changed since it ran"};
+    std::vector<std::pair<std::string, std::string>> before;
+    if (old->contains("inputs") && (*old)["inputs"].is_array())
+        for (const json& entry : (*old)["inputs"])
+            before.emplace_back(side_file_path(entry), string_at(entry, "sha256"));
+    for (const auto& [file, digest] : now.inputs) {
+        const auto same_name =
+            std::find_if(before.begin(), before.end(), [&](const auto& b) { return b.first == file; });
+        if (same_name == before.end())
+            return {S::kChanged, "it now reads " + as_manifest_writes(p, file) + ", which it did not when it ran"};
+        if (same_name->second != digest)
+            return {S::kChanged, "its input " + as_manifest_writes(p, file) + " changed since it ran"};
+    }
+    for (const auto& [file, digest] : before) {
+        const auto still =
+            std::find_if(now.inputs.begin(), now.inputs.end(), [&](const auto& n) { return n.first == file; });
+        if (still == now.inputs.end())
+            return {S::kChanged, "it no longer reads " + as_manifest_writes(p, file) + ", which it read when it ran"};
+    }
+    return {S::kChanged, "its result is out of date: its inputs, options or paths changed since it ran"};
+}
+
+Staleness staleness_of_report(const PlannedItem& p, const Stamp& stamp, json* report_out) {
+    using S = Staleness;
+    json report = read_json_file(p.report);
+    if (!report.is_object() || !report.contains("batch") || !report["batch"].is_object())
+        return {S::kNoResult, "no result yet (not run, or its run did not finish)"};
+    const json& b = report["batch"];
+    if (string_at(b, "stamp") != stamp.digest) return stamp_change(p, b, stamp.parts);
+    if (!summary_fields_hold(b)) return {S::kChanged, "its report was edited: its figures are not as written"};
+    std::error_code error;
+    for (const std::string& out : p.plan.outputs)
+        if (!fs::is_regular_file(out, error))
+            return {S::kChanged, "its output " + output_as_written(p, out) + " is missing"};
+    // Every output but the report as it was written (a truncated or emptied one is not up to date).
+    const auto outputs = b.find("outputs");
+    if (outputs == b.end() || !outputs->is_array()) return {S::kChanged, "its report was edited: it lists no outputs"};
+    for (const std::string& out : p.plan.outputs) {
+        if (out == p.report) continue;
+        const std::string name = fs::path(out).filename().string();
+        const auto entry =
+            std::find_if(outputs->begin(), outputs->end(), [&](const json& e) { return string_at(e, "file") == name; });
+        if (entry == outputs->end() || string_at(*entry, "sha256") != file_digest(out))
+            return {S::kChanged, "its output " + output_as_written(p, out) + " changed since it was written"};
+    }
+    const auto side = b.find("side_files");
+    if (side != b.end()) {
+        if (!side->is_array()) return {S::kChanged, "its report was edited: its side files are not a list"};
+        for (const json& entry : *side) {
+            const std::string file = side_file_path(entry);
+            if (file.empty() || string_at(entry, "sha256") != file_digest(folder_of(p.report) / file))
+                return {S::kChanged, "its input " + as_manifest_writes(p, file) + " changed since it ran"};
+        }
+    }
+    if (report_out) *report_out = std::move(report);
+    return {};
+}
+
+}  // namespace
+
+// The same, and a failure the item's last run left (OUTPUT.animorder.error.json, with the stamp
+// and its parts of that run, the last attempt: a success removes it): named, with what changed
+// since.
+Staleness staleness(const PlannedItem& p, const Stamp& stamp, json* report_out) {
+    Staleness s = staleness_of_report(p, stamp, report_out);
+    if (s.kind == Staleness::kCurrent) return s;
+    const json failure = read_json_file(p.error);
+    const std::string error = string_at(failure, "error");
+    if (error.empty()) return s;
+    if (string_at(failure, "stamp") == stamp.digest)
+        return {Staleness::kChanged, "it failed when it last ran: " + error};
+    // The failure is the last attempt (a success removes it): what changed since, as far as known.
+    if (failure.contains("stamp_parts"))
+        s = stamp_change(p, failure, stamp.parts);
+    else if (s.kind == Staleness::kNoResult)
+        s = {Staleness::kChanged, "its inputs, options or build changed since"};
+    s.why += "; it failed when it last ran: " + error;
+    return s;
+}
+
+// The item's report when it is up to date, else null.
+json current_report(const PlannedItem& p, const Stamp& stamp) {
+    json report;
+    return staleness(p, stamp, &report).kind == Staleness::kCurrent ? report : json();
+}
+
+}  // namespace animorder::tool

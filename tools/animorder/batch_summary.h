@@ -1,0 +1,26 @@
+// The summary of a batch (SUMMARY.json and SUMMARY.md), merged from the items' files in manifest
+// order, and the exit codes of `animorder batch`.
+#pragma once
+
+#include "batch_item.h"
+#include "batch_stamp.h"
+#include "commands.h"
+
+#include <string>
+#include <vector>
+
+namespace animorder::tool {
+
+// Exit codes beyond 0 (all done) and 1 (an error before any work).
+constexpr int kExitItemsFailed = 3;       // at least one item failed (each has its error line)
+constexpr int kExitItemsMissing = 4;      // merge: some items have no up-to-date result yet
+constexpr int kExitFailedAndMissing = 5;  // merge: both (a farm learns of unfinished shards either way)
+constexpr int kExitNoSummary = 6;         // the items ran (or were merged) but the summary could not be written
+
+// Builds and writes the summary under `stem` (.json and .md) and returns the exit code it implies;
+// kExitNoSummary when it cannot be written. failed_now: per item, the error of this run's attempt
+// when it failed (empty otherwise).
+int summarise(const std::vector<PlannedItem>& items, const std::vector<Stamp>& stamps,
+              const std::vector<std::string>& failed_now, const std::string& stem, const BatchOptions& batch);
+
+}  // namespace animorder::tool

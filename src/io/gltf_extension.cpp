@@ -10,6 +10,7 @@
 #include "gltf_prune.h"
 
 #include <tiny_gltf.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>

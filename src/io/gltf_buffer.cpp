@@ -234,6 +234,18 @@ int append_buffer_view(tinygltf::Model& model, const void* data, size_t bytes, i
     return int(model.bufferViews.size() - 1);
 }
 
+int append_accessor(tinygltf::Model& model, int view, int component, int type, size_t count, const std::string& name) {
+    tinygltf::Accessor a;
+    a.bufferView = view;
+    a.byteOffset = 0;
+    a.componentType = component;
+    a.type = type;
+    a.count = count;
+    a.name = name;
+    model.accessors.push_back(a);
+    return int(model.accessors.size() - 1);
+}
+
 tinygltf::FsCallbacks regular_file_callbacks(const uint64_t* limit) {
     return {regular_file_exists, tinygltf::ExpandFilePath, read_regular_file, tinygltf::WriteWholeFile,
             const_cast<uint64_t*>(limit)};

@@ -1,4 +1,4 @@
-// Buffer views for the glTF writers (gltf_writer.cpp, gltf_animated_writer.cpp,
+// Buffer views and accessors for the glTF writers (gltf_writer.cpp, gltf_animated_writer.cpp,
 // gltf_extension.cpp), and a glTF file read into a tinygltf model and written back
 // (gltf_buffer.cpp). Internal to src/io.
 #pragma once
@@ -16,6 +16,10 @@ namespace animorder::io {
 // Appends bytes to buffer 0 (created when the model has none), 4-byte aligned, as a new buffer
 // view with the given target (0: none); returns the view's index.
 int append_buffer_view(tinygltf::Model& model, const void* data, size_t bytes, int target);
+
+// Appends an accessor over buffer view `view` (from its first byte) of `count` elements of the
+// given component type and type, named `name`; returns the accessor's index.
+int append_accessor(tinygltf::Model& model, int view, int component, int type, size_t count, const std::string& name);
 
 // tinygltf's file access, through RegularFile (animorder/regular_file.h): a FIFO, a device or a
 // folder is never opened (FileExists is false for it: tinygltf then looks in the current folder,

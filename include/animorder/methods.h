@@ -129,8 +129,8 @@ struct MethodSettings {
     bool measured_planar_units = false;
 };
 
-// Throws InvalidInput for settings no method can run with (non-finite λ, k outside 1..255, a
-// view count that is no icosphere, a separation outside 0..180°, ...).
+// Throws InvalidInput for settings no method can run with (non-finite λ, k outside
+// 1..kMaxClusters, a view count that is no icosphere, a separation outside 0..180°, ...).
 void validate_method_settings(const MethodSettings& settings);
 
 struct MethodResult {

@@ -120,7 +120,8 @@ UpdateRule parse_update(const std::string& name) {
 void validate_method_settings(const MethodSettings& settings) {
     if (!std::isfinite(settings.lambda)) throw InvalidInput("lambda must be a finite number");
     const ClusteringSettings& c = settings.clustering;
-    if (c.clusters == 0 || c.clusters > 255) throw InvalidInput("k (clusters) must be between 1 and 255");
+    if (c.clusters == 0 || c.clusters > kMaxClusters)
+        throw InvalidInput("k (clusters) must be between 1 and " + std::to_string(kMaxClusters));
     if (!(c.min_separation_deg >= 0 && c.min_separation_deg <= 180))
         throw InvalidInput("the minimum separation must be between 0 and 180 degrees");
     icosphere_subdivisions_for(c.views);  // throws for a count that is no icosphere

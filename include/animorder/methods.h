@@ -157,6 +157,11 @@ struct MethodResult {
 // statistics are of the orders before that step, ACMR after).
 MethodResult run_method(const AnimatedMesh& mesh, Method method, const MethodSettings& settings = {});
 
+// run_method for settings validate_method_settings has accepted already (the tool checks them
+// before it loads the input, so that a bad option is named first): the same run, without checking
+// them a second time.
+MethodResult run_validated_method(const AnimatedMesh& mesh, Method method, const MethodSettings& settings);
+
 // In `order` (a permutation of the mesh's triangles that keeps each primitive's in its range), each
 // later primitive of a file primitive (same source_mesh and source_primitive, source_mesh ≥ 0)
 // takes the first one's order, triangle for triangle. Throws InvalidInput when they differ in size

@@ -450,6 +450,10 @@ void tie_instances(const AnimatedMesh& mesh, std::vector<uint32_t>& order) {
 
 MethodResult run_method(const AnimatedMesh& mesh, Method method, const MethodSettings& settings) {
     validate_method_settings(settings);
+    return run_validated_method(mesh, method, settings);
+}
+
+MethodResult run_validated_method(const AnimatedMesh& mesh, Method method, const MethodSettings& settings) {
     validate_animated_mesh(mesh);
     if (mesh.keyframe_count() > 0 && settings.keyframe >= mesh.keyframe_count())
         throw InvalidInput("keyframe " + std::to_string(settings.keyframe) + " does not exist (the mesh has " +

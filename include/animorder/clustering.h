@@ -32,8 +32,13 @@ enum class OrderSource {
                // cluster's own nodes, greedy feedback-arc-set order, then sifting
 };
 
+// The most buffers a clip may have (k, and the (opaque, blend) pairs of blend_orders.h): the
+// runtime lookup table (selection_table.h, the sidecar's and glTF's cells) stores each cell's
+// buffer id, within its clip, in one byte.
+constexpr size_t kMaxClusters = 255;
+
 struct ClusteringSettings {
-    size_t clusters = 5;  // k
+    size_t clusters = 5;  // k, 1..kMaxClusters
     size_t views = 162;   // icosphere viewpoints (12, 42, 162, 642)
     unsigned resolution = 256;
     uint64_t seed = 1;

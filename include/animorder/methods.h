@@ -129,8 +129,8 @@ struct MethodSettings {
     bool measured_planar_units = false;
 };
 
-// Throws InvalidInput for settings no method can run with (non-finite λ, k outside 1..255, a
-// view count that is no icosphere, a separation outside 0..180°, ...).
+// Throws InvalidInput for settings no method can run with (non-finite λ, k outside
+// 1..kMaxClusters, a view count that is no icosphere, a separation outside 0..180°, ...).
 void validate_method_settings(const MethodSettings& settings);
 
 struct MethodResult {
@@ -156,6 +156,11 @@ struct MethodResult {
 // buffer, so every buffer gives them the first one's order (tie_instances; the k-means runs'
 // statistics are of the orders before that step, ACMR after).
 MethodResult run_method(const AnimatedMesh& mesh, Method method, const MethodSettings& settings = {});
+
+// run_method for settings validate_method_settings has accepted already (the tool checks them
+// before it loads the input, so that a bad option is named first): the same run, without checking
+// them a second time.
+MethodResult run_validated_method(const AnimatedMesh& mesh, Method method, const MethodSettings& settings);
 
 // In `order` (a permutation of the mesh's triangles that keeps each primitive's in its range), each
 // later primitive of a file primitive (same source_mesh and source_primitive, source_mesh ≥ 0)

@@ -242,7 +242,8 @@ void combine_with_blend_clusters(const AnimatedMesh& mesh, const BlendClustering
         throw InvalidInput("blend clusters do not match the run's nodes");
     std::map<std::pair<uint32_t, uint32_t>, uint32_t> pairs;
     for (size_t n = 0; n < run.assignment.size(); ++n) pairs[{run.assignment[n], blend.assignment[n]}] = 0;
-    if (pairs.size() > 255) throw InvalidInput("more than 255 buffers per clip");
+    if (pairs.size() > kMaxClusters)
+        throw InvalidInput("more than " + std::to_string(kMaxClusters) + " buffers per clip");
     std::vector<std::vector<uint32_t>> orders;
     for (auto& [pair, index] : pairs) {
         index = uint32_t(orders.size());

@@ -599,8 +599,8 @@ void finish(ClusteringResult& result, const MeshPatches& patches, const BestStat
 }
 
 void validate_settings(const std::vector<uint32_t>& keyframes, const ClusteringSettings& settings) {
-    if (settings.clusters == 0 || settings.clusters > 255)
-        throw InvalidInput("the number of clusters must be between 1 and 255, not " +
+    if (settings.clusters == 0 || settings.clusters > kMaxClusters)
+        throw InvalidInput("the number of clusters must be between 1 and " + std::to_string(kMaxClusters) + ", not " +
                            std::to_string(settings.clusters));
     if (keyframes.empty()) throw InvalidInput("clustering needs at least one keyframe");
     if (settings.max_iterations == 0) throw InvalidInput("clustering needs at least one iteration");

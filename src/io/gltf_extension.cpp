@@ -10,6 +10,7 @@
 #include "gltf_prune.h"
 
 #include <tiny_gltf.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -400,17 +401,6 @@ OrdersExtensionCheck read_orders_extension(const std::string& path) {
 
 namespace {
 
-int append_accessor(tinygltf::Model& model, int view, int component, int type, size_t count, const std::string& name) {
-    tinygltf::Accessor a;
-    a.bufferView = view;
-    a.componentType = component;
-    a.type = type;
-    a.count = count;
-    a.name = name;
-    model.accessors.push_back(a);
-    return int(model.accessors.size() - 1);
-}
-
 int append_indices(tinygltf::Model& model, const std::vector<uint32_t>& local, bool shorts, const std::string& name) {
     int view;
     if (shorts) {
@@ -419,7 +409,7 @@ int append_indices(tinygltf::Model& model, const std::vector<uint32_t>& local, b
     } else {
         view = io::append_buffer_view(model, local.data(), local.size() * 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
     }
-    const int a = append_accessor(
+    const int a = io::append_accessor(
         model, view, shorts ? TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT : TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
         TINYGLTF_TYPE_SCALAR, local.size(), name);
     if (!local.empty()) {
@@ -481,10 +471,10 @@ std::string gltf_with_extension_orders(const std::string& input_path, const std:
     }
     tinygltf::Value::Array clips;
     for (const ExtensionClip& c : root.clips) {
-        const int cells = append_accessor(model, io::append_buffer_view(model, c.cells.data(), c.cells.size(), 0),
-                                          TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_TYPE_SCALAR, c.cells.size(),
-                                          "animorder table " + c.name);
-        const int centers = append_accessor(
+        const int cells = io::append_accessor(model, io::append_buffer_view(model, c.cells.data(), c.cells.size(), 0),
+                                              TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_TYPE_SCALAR,
+                                              c.cells.size(), "animorder table " + c.name);
+        const int centers = io::append_accessor(
             model, io::append_buffer_view(model, c.centers.data(), c.centers.size() * 4, 0),
             TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, c.centers.size() / 3, "animorder centres " + c.name);
         Object clip;

@@ -14,7 +14,7 @@ namespace animorder::io {
 
 // Where the accessors, buffer views and buffers of the model a writer read ended up in the model
 // it wrote: old index -> new index, -1 for one left out; an empty list when none moved (so that
-// restore_from_input, gltf_buffer.h, can put back on each what tinygltf does not write).
+// restore_from_input in gltf_buffer.cpp can put back on each what tinygltf does not write).
 struct Renumbering {
     std::vector<int> accessors, views, buffers;
 };

@@ -34,18 +34,6 @@ namespace {
 
 const char* const kOrdersExtension = "ANIMORDER_animated_triangle_orders";
 
-int append_accessor(tinygltf::Model& model, int view, int component, int type, size_t count, const std::string& name) {
-    tinygltf::Accessor a;
-    a.bufferView = view;
-    a.byteOffset = 0;
-    a.componentType = component;
-    a.type = type;
-    a.count = count;
-    a.name = name;
-    model.accessors.push_back(a);
-    return int(model.accessors.size() - 1);
-}
-
 // The primitive's vertex indices (local to its vertices) of `count` orders stored one after the
 // other, as one SCALAR accessor of the smallest index type that holds them, over its own buffer
 // view (ELEMENT_ARRAY_BUFFER).
@@ -61,7 +49,7 @@ int append_indices(tinygltf::Model& model, const std::vector<uint32_t>& local, c
         view = io::append_buffer_view(model, local.data(), local.size() * 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
         component = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
     }
-    const int accessor = append_accessor(model, view, component, TINYGLTF_TYPE_SCALAR, local.size(), name);
+    const int accessor = io::append_accessor(model, view, component, TINYGLTF_TYPE_SCALAR, local.size(), name);
     if (!local.empty()) {
         model.accessors[size_t(accessor)].minValues = {double(*std::min_element(local.begin(), local.end()))};
         model.accessors[size_t(accessor)].maxValues = {double(largest)};
@@ -140,15 +128,15 @@ std::string gltf_with_orders(const std::string& input_path, const std::string& o
     tinygltf::Value::Array clips;
     for (size_t c = 0; c < mesh.clips.size() && c < buffers.tables.size(); ++c) {
         const SelectionTable& t = buffers.tables[c];
-        const int cells = append_accessor(model, io::append_buffer_view(model, t.cells.data(), t.cells.size(), 0),
-                                          TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_TYPE_SCALAR, t.cells.size(),
-                                          "animorder table " + mesh.clips[c].name);
+        const int cells = io::append_accessor(model, io::append_buffer_view(model, t.cells.data(), t.cells.size(), 0),
+                                              TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_TYPE_SCALAR,
+                                              t.cells.size(), "animorder table " + mesh.clips[c].name);
         std::vector<float> centres(
             framing.centres.begin() + ptrdiff_t(3 * mesh.clips[c].first_keyframe),
             framing.centres.begin() + ptrdiff_t(3 * (mesh.clips[c].first_keyframe + mesh.clips[c].keyframe_count)));
-        const int centre = append_accessor(model, io::append_buffer_view(model, centres.data(), centres.size() * 4, 0),
-                                           TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3,
-                                           mesh.clips[c].keyframe_count, "animorder centres " + mesh.clips[c].name);
+        const int centre = io::append_accessor(
+            model, io::append_buffer_view(model, centres.data(), centres.size() * 4, 0), TINYGLTF_COMPONENT_TYPE_FLOAT,
+            TINYGLTF_TYPE_VEC3, mesh.clips[c].keyframe_count, "animorder centres " + mesh.clips[c].name);
         tinygltf::Value::Object clip;
         clip["name"] = tinygltf::Value(mesh.clips[c].name);
         if (mesh.clips[c].source_animation >= 0) clip["animation"] = tinygltf::Value(mesh.clips[c].source_animation);

@@ -120,7 +120,8 @@ UpdateRule parse_update(const std::string& name) {
 void validate_method_settings(const MethodSettings& settings) {
     if (!std::isfinite(settings.lambda)) throw InvalidInput("lambda must be a finite number");
     const ClusteringSettings& c = settings.clustering;
-    if (c.clusters == 0 || c.clusters > 255) throw InvalidInput("k (clusters) must be between 1 and 255");
+    if (c.clusters == 0 || c.clusters > kMaxClusters)
+        throw InvalidInput("k (clusters) must be between 1 and " + std::to_string(kMaxClusters));
     if (!(c.min_separation_deg >= 0 && c.min_separation_deg <= 180))
         throw InvalidInput("the minimum separation must be between 0 and 180 degrees");
     icosphere_subdivisions_for(c.views);  // throws for a count that is no icosphere
@@ -449,6 +450,10 @@ void tie_instances(const AnimatedMesh& mesh, std::vector<uint32_t>& order) {
 
 MethodResult run_method(const AnimatedMesh& mesh, Method method, const MethodSettings& settings) {
     validate_method_settings(settings);
+    return run_validated_method(mesh, method, settings);
+}
+
+MethodResult run_validated_method(const AnimatedMesh& mesh, Method method, const MethodSettings& settings) {
     validate_animated_mesh(mesh);
     if (mesh.keyframe_count() > 0 && settings.keyframe >= mesh.keyframe_count())
         throw InvalidInput("keyframe " + std::to_string(settings.keyframe) + " does not exist (the mesh has " +

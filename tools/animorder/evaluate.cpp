@@ -215,7 +215,9 @@ int run_evaluate(const EvaluateOptions& options) {
         if (method_uses_clusters(n) && ks.size() > 1) label += " k=" + std::to_string(m.clustering.clusters);
         if (method_uses_clusters(n) && views.size() > 1) label += " views=" + std::to_string(m.clustering.views);
         note(options.common, "running " + label);
-        rows.push_back({about_input(options.common, [&, n = n, m = m] { return run_method(mesh, n, m); }), m});
+        // Each row's settings were validated with the plan (before loading): not checked again.
+        rows.push_back(
+            {about_input(options.common, [&, n = n, m = m] { return run_validated_method(mesh, n, m); }), m});
     }
     const double methods_s = seconds_since(start);
 

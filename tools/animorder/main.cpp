@@ -77,7 +77,7 @@ void add_method_options(CLI::App& command, animorder::tool::MethodOptions& optio
             ->delimiter(',')
             ->allow_extra_args(false)  // a list is one comma-separated value
             ->capture_default_str()
-            ->check(CLI::Range(size_t(1), size_t(255)));
+            ->check(CLI::Range(size_t(1), animorder::kMaxClusters));
         command
             .add_option("--views", options.view_list,
                         "single/joint: clustering viewpoints (12, 42, 162, 642); a list runs each value")
@@ -89,7 +89,7 @@ void add_method_options(CLI::App& command, animorder::tool::MethodOptions& optio
         command.add_option("-l,--lambda", m.lambda, lambda_help)->capture_default_str()->check(CLI::Range(0.0, 1000.0));
         command.add_option("-k,--clusters", c.clusters, "single/joint: number of buffers k")
             ->capture_default_str()
-            ->check(CLI::Range(size_t(1), size_t(255)));
+            ->check(CLI::Range(size_t(1), animorder::kMaxClusters));
         command.add_option("--views", c.views, "single/joint: clustering viewpoints (12, 42, 162, 642)")
             ->capture_default_str()
             ->check(kWholeNumber);

@@ -128,7 +128,8 @@ OptimizeProduct produce_optimize(const OptimizeOptions& options, const OptimizeP
                              " triangles, " + std::to_string(mesh.vertex_count) + " vertices, " +
                              std::to_string(mesh.keyframe_count()) + " keyframes (" + input_name + ")");
 
-    product.run = about_input(options.common, [&] { return run_method(mesh, method, settings); });
+    // plan_optimize validated the settings (before loading): they are not checked again.
+    product.run = about_input(options.common, [&] { return run_validated_method(mesh, method, settings); });
     const MethodResult& run = product.run;
     product.before = analyze_mesh_vertex_cache(mesh, mesh.indices, settings.cache_size);
     const VertexCacheStats& before = product.before;

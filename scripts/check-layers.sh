@@ -1,16 +1,18 @@
 #!/usr/bin/env bash
-# The layering rules of README "Layout", checked on the source tree (CTest runs it):
+# The layering rules of docs/ARCHITECTURE.md, checked on the source tree (CTest runs it):
 #  1. every public header include/animorder/X.h is defined by one source src/LAYER/X.cpp (except
 #     animorder.h, the manual, and invalid_input.h, which are declarations only);
-#  2. no source or public header includes a header of a higher layer, ground up:
-#     mesh (0) → algorithms (1) → assets (2) → pipeline (3) → io (4); the OpenGL reference
-#     (src/reference) sits beside the pipeline (3); tools may include anything;
+#  2. no source or header includes a header of a higher layer, ground up:
+#     mesh and support (0) → overdraw (1) → algorithms (2) → assets (3) → pipeline (4) → io (5);
+#     the OpenGL reference (src/reference) sits beside the pipeline (4); tools may include
+#     anything. Public headers count by their source's folder, private ones ("../DIR/x.h") by DIR;
 #  3. below io nothing includes a file-format, JSON or command-line library header.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-declare -A layer_of_dir=([mesh]=0 [algorithms]=1 [assets]=2 [pipeline]=3 [reference]=3 [io]=4)
+declare -A layer_of_dir=([mesh]=0 [support]=0 [overdraw]=1 [algorithms]=2 [assets]=3 [pipeline]=4 [reference]=4 [io]=5)
+io_layer=${layer_of_dir[io]}
 declare -A layer   # public header name → layer
-layer[animorder.h]=1
+layer[animorder.h]=${layer_of_dir[algorithms]}
 layer[invalid_input.h]=0
 failures=0
 fail() { echo "check-layers: $*" >&2; failures=$((failures + 1)); }
@@ -35,7 +37,14 @@ check_file() {  # file, its layer
         if [ -z "$l" ]; then fail "$file includes animorder/$included, which is no public header"; continue; fi
         [ "$l" -le "$own" ] || fail "$file (layer $own) includes animorder/$included (layer $l)"
     done < <(sed -n 's|^#include "animorder/\([^"]*\)".*|\1|p' "$file")
-    if [ "$own" -lt 4 ] && grep -qE '^#include [<"](tiny_gltf|assimp/|CLI/|nlohmann/|stb_)' "$file"; then
+    local dir
+    while read -r dir; do
+        [ -z "$dir" ] && continue
+        local d="${layer_of_dir[$dir]:-}"
+        if [ -z "$d" ]; then fail "$file includes a header of src/$dir, which is no layer"; continue; fi
+        [ "$d" -le "$own" ] || fail "$file (layer $own) includes a private header of src/$dir (layer $d)"
+    done < <(sed -n 's|^#include "\.\./\([a-z_]*\)/[^"]*".*|\1|p' "$file")
+    if [ "$own" -lt "$io_layer" ] && grep -qE '^#include [<"](tiny_gltf|assimp/|CLI/|nlohmann/|stb_)' "$file"; then
         fail "$file (layer $own) includes a file-format, JSON or CLI header"
     fi
 }

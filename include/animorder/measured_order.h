@@ -2,11 +2,11 @@
 // cluster's units (patches) by the overdraw graph measured over that cluster's own nodes, then
 // minimises the weight of its backward arcs. Not in Han & Sander 2017 (their update sorts by
 // integrated distance); the graph and the greedy order are Nehab, Barczak & Sander 2006 §4–5
-// (nehab06.h), here measured per cluster from the fragments k-means already keeps. No file I/O.
+// (nehab06.h, feedback_arc_set.h), here measured per cluster from the fragments k-means already keeps. No file I/O.
 #pragma once
 
 #include "animorder/kept_fragments.h"
-#include "animorder/nehab06.h"
+#include "animorder/feedback_arc_set.h"
 #include "animorder/rasterizer.h"
 
 #include <cstddef>

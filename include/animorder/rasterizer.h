@@ -106,7 +106,7 @@ public:
     // of blended primitives; every other triangle is opaque and writes depth.
     struct BlendFragments export_blend_fragments(const uint8_t* blended) const;
 
-    struct State;  // defined in rasterizer.cpp only
+    struct State;  // defined in src/overdraw/raster_state.h, private to the rasteriser's files
 
 private:
     std::unique_ptr<State> state_;

@@ -14,11 +14,11 @@
 // λ patches of the k-means, so the vertex cache cost stays the patches' (Tipsify-level).
 #include "animorder/measured_order.h"
 
-#include "fragment_encoding.h"
+#include "../overdraw/fragment_encoding.h"
 
 #include "animorder/invalid_input.h"
-#include "animorder/nehab06.h"
-#include "worker_threads.h"
+#include "animorder/feedback_arc_set.h"
+#include "../support/worker_threads.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>

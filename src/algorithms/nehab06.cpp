@@ -39,9 +39,9 @@
 #include "animorder/vertex_cache.h"
 #include "animorder/viewpoints.h"
 
-#include "fragment_encoding.h"
-#include "stopwatch.h"
-#include "worker_threads.h"
+#include "../overdraw/fragment_encoding.h"
+#include "../support/stopwatch.h"
+#include "../support/worker_threads.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -51,9 +51,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-#include <deque>
 #include <limits>
-#include <set>
 #include <string>
 #include <vector>
 
@@ -303,139 +301,6 @@ std::vector<Arc> arcs_from_sums(const std::vector<int64_t>& sums, size_t cluster
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
-
-std::vector<uint32_t> order_feedback_arc_set(size_t node_count, const Arc* arcs, size_t arc_count) {
-    if (node_count >= std::numeric_limits<uint32_t>::max()) throw InvalidInput("feedback arc set: too many nodes");
-    for (size_t i = 0; i < arc_count; ++i) {
-        const Arc& a = arcs[i];
-        if (a.from >= node_count || a.to >= node_count)
-            throw InvalidInput("feedback arc set: arc " + std::to_string(i) + " names node " +
-                               std::to_string(std::max(a.from, a.to)) + ", but there are " +
-                               std::to_string(node_count));
-        if (a.from == a.to) throw InvalidInput("feedback arc set: arc " + std::to_string(i) + " is a self-loop");
-        if (a.weight == 0) throw InvalidInput("feedback arc set: arc " + std::to_string(i) + " has weight 0");
-    }
-    // Out- and in-arcs per node (CSR), remaining arc counts and weights.
-    std::vector<uint32_t> out_start(node_count + 1, 0), in_start(node_count + 1, 0);
-    for (size_t i = 0; i < arc_count; ++i) {
-        ++out_start[arcs[i].from + 1];
-        ++in_start[arcs[i].to + 1];
-    }
-    for (size_t v = 0; v < node_count; ++v) {
-        out_start[v + 1] += out_start[v];
-        in_start[v + 1] += in_start[v];
-    }
-    std::vector<uint32_t> out_arc(arc_count), in_arc(arc_count);
-    {
-        std::vector<uint32_t> o(out_start.begin(), out_start.end() - 1), n(in_start.begin(), in_start.end() - 1);
-        for (size_t i = 0; i < arc_count; ++i) {
-            out_arc[o[arcs[i].from]++] = uint32_t(i);
-            in_arc[n[arcs[i].to]++] = uint32_t(i);
-        }
-    }
-    std::vector<size_t> out_degree(node_count), in_degree(node_count);
-    std::vector<int64_t> delta(node_count, 0);  // Σ out-weights − Σ in-weights of remaining arcs
-    for (size_t v = 0; v < node_count; ++v) {
-        out_degree[v] = out_start[v + 1] - out_start[v];
-        in_degree[v] = in_start[v + 1] - in_start[v];
-    }
-    for (size_t i = 0; i < arc_count; ++i) {
-        delta[arcs[i].from] += int64_t(arcs[i].weight);
-        delta[arcs[i].to] -= int64_t(arcs[i].weight);
-    }
-    // The greedy choice: largest |δ|, then lowest id.
-    auto key = [&](uint32_t v) { return std::make_pair(-(delta[v] < 0 ? -delta[v] : delta[v]), v); };
-    std::set<std::pair<int64_t, uint32_t>> candidates;
-    for (uint32_t v = 0; v < node_count; ++v) candidates.insert(key(v));
-
-    std::vector<bool> removed(node_count, false);
-    std::deque<uint32_t> sinks, sources;
-    for (uint32_t v = 0; v < node_count; ++v) {
-        if (out_degree[v] == 0)
-            sinks.push_back(v);
-        else if (in_degree[v] == 0)
-            sources.push_back(v);
-    }
-    std::vector<uint32_t> head, tail;  // order = head, then tail reversed
-    auto remove = [&](uint32_t v) {
-        removed[v] = true;
-        candidates.erase(key(v));
-        for (uint32_t i = out_start[v]; i < out_start[v + 1]; ++i) {
-            const Arc& a = arcs[out_arc[i]];
-            if (removed[a.to]) continue;
-            candidates.erase(key(a.to));
-            delta[a.to] += int64_t(a.weight);
-            candidates.insert(key(a.to));
-            if (--in_degree[a.to] == 0 && out_degree[a.to] != 0) sources.push_back(a.to);
-        }
-        for (uint32_t i = in_start[v]; i < in_start[v + 1]; ++i) {
-            const Arc& a = arcs[in_arc[i]];
-            if (removed[a.from]) continue;
-            candidates.erase(key(a.from));
-            delta[a.from] -= int64_t(a.weight);
-            candidates.insert(key(a.from));
-            if (--out_degree[a.from] == 0) sinks.push_back(a.from);
-        }
-    };
-    size_t left = node_count;
-    while (left > 0) {
-        bool progress = true;
-        while (progress) {
-            progress = false;
-            while (!sinks.empty()) {
-                const uint32_t v = sinks.front();
-                sinks.pop_front();
-                if (removed[v]) continue;
-                tail.push_back(v);
-                remove(v);
-                --left;
-                progress = true;
-            }
-            while (!sources.empty()) {
-                const uint32_t v = sources.front();
-                sources.pop_front();
-                if (removed[v]) continue;
-                if (out_degree[v] == 0) {  // became a sink meanwhile: the sinks' loop takes it
-                    sinks.push_back(v);
-                    progress = true;
-                    break;
-                }
-                head.push_back(v);
-                remove(v);
-                --left;
-                progress = true;
-                if (!sinks.empty()) break;  // sinks first, as the heuristic says
-            }
-        }
-        if (left == 0) break;
-        // Only cycles remain: the node with the largest |δ| goes to its winning side.
-        const uint32_t v = candidates.begin()->second;
-        if (delta[v] >= 0)
-            head.push_back(v);
-        else
-            tail.push_back(v);
-        remove(v);
-        --left;
-    }
-    head.insert(head.end(), tail.rbegin(), tail.rend());
-    return head;
-}
-
-FeedbackArcs count_feedback_arcs(const uint32_t* node_order, size_t node_count, const Arc* arcs, size_t arc_count) {
-    validate_triangle_order(node_order, node_count);  // a permutation check, whatever the items are
-    std::vector<uint32_t> position(node_count);
-    for (size_t i = 0; i < node_count; ++i) position[node_order[i]] = uint32_t(i);
-    FeedbackArcs result;
-    for (size_t i = 0; i < arc_count; ++i) {
-        if (arcs[i].from >= node_count || arcs[i].to >= node_count)
-            throw InvalidInput("count_feedback_arcs: arc " + std::to_string(i) + " names a missing node");
-        if (position[arcs[i].to] < position[arcs[i].from]) {
-            ++result.count;
-            result.weight += arcs[i].weight;
-        }
-    }
-    return result;
-}
 
 std::vector<Arc> build_overdraw_graph(const uint32_t* indices, size_t index_count, const float* keyframe_positions,
                                       size_t keyframe_count, size_t vertex_count, const uint32_t* keyframes,

@@ -13,7 +13,7 @@
 #include "animorder/animated_mesh.h"
 #include "animorder/skinning.h"
 
-#include "../algorithms/mat4.h"
+#include "../support/mat4.h"
 #include "lathe.h"
 
 #include <algorithm>
@@ -114,7 +114,7 @@ struct Builder {
     }
 };
 
-// Column-major 4×4 helpers (glTF layout); the product is multiply_mat4 (src/algorithms/mat4.h).
+// Column-major 4×4 helpers (glTF layout); the product is multiply_mat4 (src/support/mat4.h).
 Mat4 identity() { return {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}; }
 Mat4 translation(Vec3 t) {
     Mat4 m = identity();

@@ -15,7 +15,7 @@
 #include "animorder/load.h"
 #include "animorder/skinning.h"
 
-#include "../algorithms/worker_threads.h"
+#include "../support/worker_threads.h"
 #include "checked_size.h"
 #include "gltf_buffer.h"
 #include "transform.h"

@@ -2,7 +2,7 @@
 // to src/io.
 #pragma once
 
-#include "../algorithms/mat4.h"
+#include "../support/mat4.h"
 
 #include <array>
 #include <cmath>

@@ -4,7 +4,7 @@
 // nodes — every keyframe of every clip × random views, R per clip — in parallel, deterministic.
 #pragma once
 
-#include "../algorithms/worker_threads.h"
+#include "../support/worker_threads.h"
 #include "animorder/animated_mesh.h"
 #include "animorder/evaluation.h"
 #include "animorder/invalid_input.h"

@@ -1,9 +1,9 @@
-// Private to src/algorithms: how a pixel's fragment list is encoded and replayed.
+// Private to src/overdraw (and the layers above): how a pixel's fragment list is encoded and replayed.
 //
 // NodeFragments::fragments (rasterizer.h) packs one fragment into a uint32_t: the low 31 bits are
 // the triangle index; the top bit is set when the fragment's depth equals the previous fragment's
 // of the same pixel (fragments run nearest first), so the two are one depth group of which only
-// the one drawn first can pass. rasterizer.cpp writes it; rasterizer.cpp, kept_fragments.cpp and
+// the one drawn first can pass. rasterize_node.h writes it; fragment_scoring.cpp, kept_fragments.cpp and
 // nehab06.cpp read it. KeptNode's unit lists use the same scheme in 16 bits (kUnitTieBit).
 #pragma once
 

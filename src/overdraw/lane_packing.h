@@ -1,6 +1,6 @@
-// Private to src/algorithms: the table that packs the chosen lanes of an 8-lane vector to its
+// Private to src/overdraw: the table that packs the chosen lanes of an 8-lane vector to its
 // front with one permutation (AVX2's vpermd), used where a vectorised loop keeps some of its
-// elements (facing_filter.cpp's candidates, rasterizer.cpp's drawn triangles).
+// elements (facing_filter.cpp's candidates, rasterize_node.h's drawn triangles).
 #pragma once
 
 #include <cstdint>

@@ -11,7 +11,7 @@
 
 #include "animorder/invalid_input.h"
 
-#include "mat4.h"
+#include "../support/mat4.h"
 
 #include <cmath>
 

@@ -1,4 +1,4 @@
-// Private to src/algorithms: wall-clock seconds for the timings that results report
+// Private to the library (src/support): wall-clock seconds for the timings that results report
 // (ClusteringResult, Nehab06Result). Timings never change an output.
 #pragma once
 

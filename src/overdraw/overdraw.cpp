@@ -14,7 +14,7 @@
 #include "animorder/rasterizer.h"
 #include "animorder/triangle_order.h"
 #include "animorder/viewpoints.h"
-#include "worker_threads.h"
+#include "../support/worker_threads.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>

@@ -30,20 +30,18 @@ for header in include/animorder/*.h; do
 done
 
 check_file() {  # file, its layer
-    local file="$1" own="$2" included
-    while read -r included; do
-        [ -z "$included" ] && continue
-        local l="${layer[$included]:-}"
-        if [ -z "$l" ]; then fail "$file includes animorder/$included, which is no public header"; continue; fi
-        [ "$l" -le "$own" ] || fail "$file (layer $own) includes animorder/$included (layer $l)"
-    done < <(sed -n 's|^#include "animorder/\([^"]*\)".*|\1|p' "$file")
-    local dir
-    while read -r dir; do
-        [ -z "$dir" ] && continue
-        local d="${layer_of_dir[$dir]:-}"
-        if [ -z "$d" ]; then fail "$file includes a header of src/$dir, which is no layer"; continue; fi
-        [ "$d" -le "$own" ] || fail "$file (layer $own) includes a private header of src/$dir (layer $d)"
-    done < <(sed -n 's|^#include "\.\./\([a-z_]*\)/[^"]*".*|\1|p' "$file")
+    local file="$1" own="$2" kind name l what
+    # Each include of a library header: "public NAME" (animorder/NAME) or "private DIR" (../DIR/x.h).
+    while read -r kind name; do
+        if [ "$kind" = public ]; then
+            l="${layer[$name]:-}" what="animorder/$name"
+        else
+            l="${layer_of_dir[$name]:-}" what="a private header of src/$name"
+        fi
+        if [ -z "$l" ]; then fail "$file includes $what, which is in no layer"; continue; fi
+        [ "$l" -le "$own" ] || fail "$file (layer $own) includes $what (layer $l)"
+    done < <(sed -n -e 's|^#include "animorder/\([^"]*\)".*|public \1|p' \
+                    -e 's|^#include "\.\./\([a-z_]*\)/[^"]*".*|private \1|p' "$file")
     if [ "$own" -lt "$io_layer" ] && grep -qE '^#include [<"](tiny_gltf|assimp/|CLI/|nlohmann/|stb_)' "$file"; then
         fail "$file (layer $own) includes a file-format, JSON or CLI header"
     fi

@@ -12,9 +12,11 @@
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <set>
@@ -890,10 +892,10 @@ TEST_F(CommittedResults, RegenerateToTheCommittedFiles) {
             << svg;
 }
 
-// The committed notes, README.md's Results and Performance sections outside the generated block,
-// and docs/benchmarks.md carry no measured figure typed by hand: outside placeholders, every number with decimals,
-// percentage or thousands separator is one of the paper's printed values or a setting listed here.
-// A new figure must be a placeholder (templates.h).
+// The committed notes carry no measured figure typed by hand: outside placeholders, every number with
+// decimals, percentage or thousands separator is one of the paper's printed values or a setting
+// listed here. A new figure must be a placeholder (templates.h). README.md and the hand-written
+// pages of docs/ are scanned whole by CommittedDocs.CarryNoHandTypedMeasurements below.
 TEST(CommittedNotes, CarryNoHandTypedMeasurements) {
     const std::set<std::string> allowed = {
         "0.654",  "1.377",  "1.302",   "1.211", "1.153", "1.065", "1.166", "1.088",  // JCGT 2017 Table 1, Ganfaul
@@ -920,24 +922,199 @@ TEST(CommittedNotes, CarryNoHandTypedMeasurements) {
     }
     EXPECT_GE(files, 10u);  // notes-<section>.md and readme.md
 
-    // README.md's "Results" and "Performance" sections, outside the generated block, likewise.
-    const std::string readme = test::slurp(fs::path(ANIMORDER_SOURCE_DIR) / "README.md");
-    const size_t start = readme.find("\n## Results\n"),
-                 end = readme.find("\n## ", readme.find("\n## Performance\n") + 4);
-    ASSERT_NE(start, std::string::npos);
-    std::string sections = readme.substr(start, end == std::string::npos ? std::string::npos : end - start);
-    const size_t begin = sections.find(kBlockBegin), stop = sections.find(kBlockEnd);
-    ASSERT_TRUE(begin != std::string::npos && stop != std::string::npos && begin < stop);
-    sections.erase(begin, stop - begin);
-    for (auto m = std::sregex_iterator(sections.begin(), sections.end(), number); m != std::sregex_iterator(); ++m)
-        EXPECT_TRUE(allowed.count((*m)[1].str()))
-            << "README.md: '" << (*m)[1].str() << "' is typed by hand; generate it (docs/results-notes/readme.md)";
+    // README.md (outside the generated block) and every hand-written page of docs/: see
+    // CommittedDocs.CarryNoHandTypedMeasurements below, which scans them whole.
+}
 
-    // docs/benchmarks.md (how the results are made, what each benchmark measures: once README's
-    // "Results" and "Performance" sections) likewise, as a whole.
-    const std::string benchmarks = test::slurp(fs::path(ANIMORDER_SOURCE_DIR) / "docs" / "benchmarks.md");
-    ASSERT_NE(benchmarks.find("\n## Performance\n"), std::string::npos);
-    for (auto m = std::sregex_iterator(benchmarks.begin(), benchmarks.end(), number); m != std::sregex_iterator(); ++m)
-        EXPECT_TRUE(allowed.count((*m)[1].str()))
-            << "docs/benchmarks.md: '" << (*m)[1].str() << "' is typed by hand; put it in RESULTS.md's notes";
+namespace {
+
+// The hand-written pages: README.md and docs/*.md but RESULTS.md (generated, and checked above by
+// CommittedResults); docs/extension is the format's specification (its constants are the format).
+std::vector<fs::path> hand_written_pages() {
+    const fs::path source = ANIMORDER_SOURCE_DIR;
+    std::vector<fs::path> pages = {source / "README.md"};
+    for (const auto& entry : fs::directory_iterator(source / "docs"))
+        if (entry.path().extension() == ".md" && entry.path().filename() != "RESULTS.md") pages.push_back(entry.path());
+    std::sort(pages.begin(), pages.end());
+    return pages;
+}
+
+// A page's text with every run of white space one space (a figure may be wrapped anywhere).
+std::string normalised(const std::string& text) {
+    std::string out;
+    for (const char c : text)
+        if (!std::isspace(static_cast<unsigned char>(c))) out += c;
+        else if (!out.empty() && out.back() != ' ') out += ' ';
+    return out;
+}
+
+std::string f3(double value) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.3f", value);
+    return text;
+}
+
+// The last cell ("of the way to the bound") of the row `| NAME |` of the blend table of RESULTS.md's
+// section `### SECTION` (RESULTS.md is make_results' output from the committed reports:
+// CommittedResults checks it).
+std::string results_cell(const std::string& results, const std::string& section, const std::string& name) {
+    const size_t at = results.find("\nBlended primitives:", results.find("\n### " + section + "\n"));
+    if (at == std::string::npos) return "(no blend table in " + section + ")";
+    const size_t row = results.find("\n| " + name + " |", at), next = results.find("\n### ", at + 1);
+    if (row == std::string::npos || (next != std::string::npos && row > next)) return "(no row " + name + ")";
+    const std::string line = results.substr(row + 1, results.find('\n', row + 1) - row - 1);
+    const size_t last = line.rfind(" |"), before = line.rfind("| ", last - 1);
+    return line.substr(before + 2, last - before - 2);
+}
+
+struct CheckedFigures {
+    std::string page;  // relative to the source folder
+    std::string text;  // as the page must carry it (white space normalised)
+};
+
+// Figures of the hand-written pages that come from a committed report: the text each page must
+// carry, built here from the report. CommittedDocs.FiguresAreTheirReports checks them; the scan
+// for hand-typed measurements leaves exactly these texts out.
+std::vector<CheckedFigures> figures_from_reports() {
+    const fs::path source = ANIMORDER_SOURCE_DIR, reports = source / "docs" / "results" / "reports";
+    std::vector<CheckedFigures> figures;
+    // docs/cli.md, `measured` on Ganfaul Idle at λ = 0.85 and 3: measured/ganfaul-idle.json.
+    const json idle = json::parse(test::slurp(reports / "measured" / "ganfaul-idle.json"));
+    auto method = [&](const std::string& name, double lambda) -> const json& {
+        for (const json& m : idle.at("methods"))
+            if (m.at("name") == name && m.at("lambda").is_number() && m.at("lambda").get<double>() == lambda) return m;
+        throw std::runtime_error("measured/ganfaul-idle.json has no " + name + " at lambda " + std::to_string(lambda));
+    };
+    auto ovr = [&](const std::string& name, double lambda) { return f3(method(name, lambda).at("ovr_mean")); };
+    auto acmr = [&](const std::string& name, double lambda) { return f3(method(name, lambda).at("acmr")); };
+    figures.push_back({"docs/cli.md", "OVR " + ovr("single", 0.85) + " → " + ovr("measured", 0.85) +
+                                          " at λ = 0.85 (ACMR " + acmr("single", 0.85) + " → " + acmr("measured", 0.85) +
+                                          ") and " + ovr("single", 3) + " → " + ovr("measured", 3) + " at λ = 3 (ACMR " +
+                                          acmr("single", 3) + " → " + acmr("measured", 3) + ")"});
+    // docs/cli.md, issue 18's goals: RESULTS.md "Materials", from materials/bundled*.json.
+    const std::string results = test::slurp(source / "docs" / "RESULTS.md");
+    auto minus = [](std::string cell) { return cell.rfind('-', 0) == 0 ? "\u2212" + cell.substr(1) : cell; };
+    figures.push_back({"docs/cli.md", "k = 5 buffers go " + results_cell(results, "bundled", "single k=5") +
+                                          " of the way from original to the per-node centroid sort in mis-sorted pixels (" +
+                                          results_cell(results, "bundled-blend-clusters", "single k=5 --blend-clusters") +
+                                          " with `--blend-clusters`; goal 90%), static-sander07 " +
+                                          minus(results_cell(results, "bundled", "static-sander07")) +
+                                          " and static-nehab06 " +
+                                          minus(results_cell(results, "bundled", "static-nehab06")) +
+                                          " (goal: less than half)"});
+    return figures;
+}
+
+}  // namespace
+
+// Every figure of docs/ that a report holds (figures_from_reports) is the report's, to the digit.
+TEST(CommittedDocs, FiguresAreTheirReports) {
+    for (const CheckedFigures& f : figures_from_reports())
+        EXPECT_NE(normalised(test::slurp(fs::path(ANIMORDER_SOURCE_DIR) / f.page)).find(f.text), std::string::npos)
+            << f.page << " no longer carries, as the committed reports give it:\n  " << f.text
+            << "\n(regenerate the reports' figures there, or change figures_from_reports with the page)";
+}
+
+// README.md (outside its generated block) and every hand-written page of docs/ carry no measured
+// figure typed by hand. A measured figure: a number with decimals, a percentage, a number with a
+// thousands separator, a number with a unit of time, size, pixels or ratio (12 s, 6 GiB, 40×), a
+// count of a count ("313 of 320", "6 different buffers"). Not one: numbers with two dots or more
+// (versions, addresses), § numbers, link targets. What may stay: the figures a test checks
+// against their report (figures_from_reports), the paper's values and settings of `allowed`
+// above, and kAllowed below, each with its reason: a figure another test asserts, or a number that
+// is not a measurement (versions, option defaults, goals, constants). An entry found on no page
+// fails too, so the list stays as short as the pages need.
+TEST(CommittedDocs, CarryNoHandTypedMeasurements) {
+    struct Allowed {
+        const char* text;
+        const char* why;
+        const char* until = nullptr;  // the entry runs from `text` to the next `until` (included)
+    };
+    const Allowed kAllowed[] = {
+        {"```json { \"tool\": \"animorder\"", "docs/cli.md's sample report: test_cli's TheReadmesSampleReportIsARealOne "
+         "checks every figure but the times (the page says they vary) against a run", "```"},
+        {"glTF 2.0", "the format's version"},
+        {"OpenGL 4.5", "the API version asked for"},
+        {"Mesa llvmpipe 22.3", "the reference's version"},
+        {"assimp 5.2", "a version"},
+        {"glTF-Transform 4.5", "a version"},
+        {"gltf-pipeline 4.3", "a version"},
+        {"gltfpack 0.18", "a version"},
+        {"--tolerance 0.001", "reapply's default"},
+        {"3 and 7 minutes", "the install goals"},
+        {"optimizeOverdraw(1.05)", "meshoptimizer's threshold as the method calls it"},
+        {"200–650 s per clip, 1,700–3,400 s for a joint set", "the paper's Table 1 (I3D version)"},
+        {"313 of 320 counts of the cross-check and within 0.02%", "asserted by test_gl_crosscheck"},
+        {"pixel centres at +0.5", "OpenGL's rule"},
+        {"λ < 0.5", "the patch rule's limit"},
+        {"(x − 0.5)·256", "OpenGL's snapping"},
+        {"LESS against 1.0", "the depth test's clear value"},
+        {"within 2.6° of the poles", "the camera's constant (include/animorder/camera.h)"},
+        {"improving by 0.5%", "static-nehab06's stopping setting"},
+        {"fit in 6 GiB", "--fragment-memory's default"},
+        {"default 6 GiB", "--fragment-memory's default"},
+        {"about 64 MiB of fragments", "the re-rasterising chunk of the code"},
+        {"its 4 GiB", "the loading budget's default"},
+        {"over 1 GiB", "the glTF JSON limit"},
+        {"--timeout=24h", "a setting of the example job"},
+        {"target 10×", "issue 19's goal"},
+        {"target 20 s", "issue 19's goal"},
+        {"Xbot's 12 s", "issue 19's goal"},
+        {"meet 12 s", "issue 19's goal"},
+        {"the last 10 s", "the viewer's chart window"},
+        {"120,000 seeded queries", "asserted by test_js (RuntimeAnswersExactlyAsTheCRuntime)"},
+        {"tolerance of 1%", "the browser test's tolerance"},
+        {"beyond 1% of the view radius", "check's tolerance"},
+        {"at most every 10 s", "the progress interval"},
+        {"after 20 s of processor time plus 20 s per MiB", "the isolated loader's limit"},
+    };
+    const std::set<std::string> allowed = {"0.654", "1.377", "1.302", "1.211", "1.153", "1.065", "1.166", "1.088",
+                                           "1.48",  "13,795", "55,180", "220,720", "2,500", "0.7", "3.3", "0.85",
+                                           "1.25"};  // as in CommittedNotes above
+    const std::regex number(
+        "(^|[^\\w.,\xC2\xA7-])(\\d{1,3}(?:,\\d{3})+(?![\\d])|\\d+(?:\\.\\d+)+|\\d+)"
+        "( ?(?:%|×(?! ?\\d)|x\\b|s\\b|ms\\b|µs\\b|min\\b|h\\b|seconds?\\b|minutes?\\b|hours?\\b|[KMGT]i?B\\b|kB\\b|"
+        "bytes\\b|pixels\\b|px\\b)| of \\d+| (?:different|distinct) \\w+)?");
+    const std::regex link_target(R"(\]\([^)]*\))");
+    std::vector<size_t> used(std::size(kAllowed), 0);
+    const std::vector<CheckedFigures> checked = figures_from_reports();
+    const std::vector<fs::path> pages = hand_written_pages();
+    EXPECT_GE(pages.size(), 7u);  // README.md; docs/: ARCHITECTURE, DESIGN, batch, benchmarks, cli, viewer
+    for (const fs::path& page : pages) {
+        const std::string name = fs::relative(page, ANIMORDER_SOURCE_DIR).string();
+        std::string text = test::slurp(page);
+        if (name == "README.md") {
+            const size_t begin = text.find(kBlockBegin), stop = text.find(kBlockEnd);
+            ASSERT_TRUE(begin != std::string::npos && stop != std::string::npos && begin < stop);
+            text.erase(begin, stop - begin);
+        }
+        text = std::regex_replace(normalised(text), link_target, "]()");
+        for (const CheckedFigures& f : checked)
+            if (f.page == name)
+                for (size_t at = text.find(f.text); at != std::string::npos; at = text.find(f.text, at))
+                    text.replace(at, f.text.size(), "(checked)");
+        for (size_t a = 0; a < std::size(kAllowed); ++a)
+            for (size_t at = text.find(kAllowed[a].text); at != std::string::npos; at = text.find(kAllowed[a].text, at)) {
+                const size_t end = kAllowed[a].until ? text.find(kAllowed[a].until, at + std::strlen(kAllowed[a].text))
+                                                     : at + std::strlen(kAllowed[a].text);
+                ASSERT_NE(end, std::string::npos) << name << ": kAllowed's \"" << kAllowed[a].text << "\" has no end";
+                text.replace(at, end + (kAllowed[a].until ? std::strlen(kAllowed[a].until) : 0) - at, "(allowed)");
+                ++used[a];
+            }
+        for (auto m = std::sregex_iterator(text.begin(), text.end(), number); m != std::sregex_iterator(); ++m) {
+            const std::string figure = (*m)[2].str(), unit = (*m)[3].str();
+            if (std::count(figure.begin(), figure.end(), '.') >= 2) continue;  // a version, an address
+            const bool decimal = figure.find('.') != std::string::npos, thousands = figure.find(',') != std::string::npos;
+            if (!decimal && !thousands && unit.empty()) continue;                // a plain integer
+            if (unit.empty() && allowed.count(figure)) continue;
+            if (!unit.empty() && allowed.count(figure) && unit.find(" of ") == std::string::npos) continue;
+            const size_t at = size_t(m->position(2));
+            ADD_FAILURE() << name << ": '" << figure << unit << "' is typed by hand (\"…"
+                          << text.substr(at < 60 ? 0 : at - 60, 120)
+                          << "…\"); generate it, check it against its report (figures_from_reports), "
+                             "point at the report instead, or, if it is no measurement, allow it with its reason";
+        }
+    }
+    for (size_t a = 0; a < std::size(kAllowed); ++a)
+        EXPECT_GT(used[a], 0u) << "kAllowed's \"" << kAllowed[a].text << "\" is on no page: remove it";
 }

@@ -66,9 +66,28 @@ const std::vector<Method>& all_methods();
 const char* method_name(Method method);
 Method parse_method(const std::string& name);
 
-// Single, Joint, Measured, MeasuredJoint: k-means buffers; the joint ones span all clips.
+// What a method is: every property below is a column of the one method table (methods.cpp), so
+// a caller asks the method, never compares it with a list of names.
+//
+// Single, Joint, Measured, MeasuredJoint: k-means buffers; the joint ones span all clips, the
+// others run once per clip (method_runs_per_clip: their reports time each clip's run).
 bool method_is_clustered(Method method);
 bool method_is_joint(Method method);
+bool method_runs_per_clip(Method method);
+// What `optimize --joint` makes of a method: single and joint give joint, measured and
+// measured-joint give measured-joint. Throws InvalidInput for a method without a joint variant.
+bool method_has_joint_variant(Method method);
+Method method_joint_variant(Method method);
+
+// How a method's buffers order the triangles of blended (alphaMode BLEND) primitives, which are
+// drawn back to front (DESIGN.md "Blend error"):
+enum class BlendOrder {
+    AsInput,     // original: the file's order, as it is
+    Reversed,    // a single-buffer sort (and tipsify-per-frame): the reverse of its front-to-back order
+    PerCluster,  // k-means: each cluster's blended patches sorted back to front (run_han_sander)
+    PerNode,     // the oracle: sorted at every node
+};
+BlendOrder method_blend_order(Method method);
 
 // Which settings a method reads (reports print the others as null): λ (the patch threshold), and
 // k / views / the k-means settings.

@@ -40,21 +40,40 @@ namespace {
 struct MethodInfo {
     Method method;
     const char* name;
-    bool lambda, clusters, buffers, single_buffer;
+    bool lambda;           // reads λ (the patch threshold)
+    bool clusters;         // k-means: reads k, the views and the k-means settings
+    bool buffers;          // has orders to ship (not the oracle)
+    bool single_buffer;    // one order for the whole animation
+    bool joint;            // k-means over all clips at once
+    bool measured;         // k-means whose cluster orders come from measured overdraw (OrderSource)
+    Method joint_variant;  // k-means: what --joint makes of it
+    BlendOrder blend;
 };
+
+// A single-buffer method: one order for the whole animation.
+constexpr MethodInfo one_buffer(Method method, const char* name, bool lambda, BlendOrder blend) {
+    return {method, name, lambda, false, true, true, false, false, method, blend};
+}
+// Han & Sander's k-means and its variants: k buffers per clip, or for all clips (joint).
+constexpr MethodInfo k_means(Method method, const char* name, bool joint, bool measured, Method joint_variant) {
+    return {method, name, true, true, true, false, joint, measured, joint_variant, BlendOrder::PerCluster};
+}
 
 // The table every name, parse and property comes from.
 constexpr MethodInfo kMethods[] = {
-    {Method::Original, "original", false, false, true, true},
-    {Method::StaticSander07, "static-sander07", true, false, true, true},
-    {Method::StaticNehab06, "static-nehab06", false, false, true, true},
-    {Method::Meshopt, "meshopt", false, false, true, true},
-    {Method::TipsifyPerFrame, "tipsify-per-frame", true, false, true, false},
-    {Method::Single, "single", true, true, true, false},
-    {Method::Joint, "joint", true, true, true, false},
-    {Method::Oracle, "oracle", true, false, false, false},
-    {Method::Measured, "measured", true, true, true, false},
-    {Method::MeasuredJoint, "measured-joint", true, true, true, false},
+    one_buffer(Method::Original, "original", false, BlendOrder::AsInput),
+    one_buffer(Method::StaticSander07, "static-sander07", true, BlendOrder::Reversed),
+    one_buffer(Method::StaticNehab06, "static-nehab06", false, BlendOrder::Reversed),
+    one_buffer(Method::Meshopt, "meshopt", false, BlendOrder::Reversed),
+    // static-sander07 at every keyframe: a buffer per keyframe.
+    {Method::TipsifyPerFrame, "tipsify-per-frame", true, false, true, false, false, false, Method::TipsifyPerFrame,
+     BlendOrder::Reversed},
+    k_means(Method::Single, "single", false, false, Method::Joint),
+    k_means(Method::Joint, "joint", true, false, Method::Joint),
+    // A new order at every evaluation node: a bound, no buffers.
+    {Method::Oracle, "oracle", true, false, false, false, false, false, Method::Oracle, BlendOrder::PerNode},
+    k_means(Method::Measured, "measured", false, true, Method::MeasuredJoint),
+    k_means(Method::MeasuredJoint, "measured-joint", true, true, Method::MeasuredJoint),
 };
 
 const MethodInfo& info(Method method) {
@@ -98,11 +117,15 @@ Method parse_static_method(const std::string& name) {
 bool method_uses_lambda(Method method) { return info(method).lambda; }
 bool method_uses_clusters(Method method) { return info(method).clusters; }
 bool method_has_buffers(Method method) { return info(method).buffers; }
-bool method_is_clustered(Method method) {
-    return method == Method::Single || method == Method::Joint || method == Method::Measured ||
-           method == Method::MeasuredJoint;
+bool method_is_clustered(Method method) { return info(method).clusters; }
+bool method_is_joint(Method method) { return info(method).joint; }
+bool method_runs_per_clip(Method method) { return info(method).clusters && !info(method).joint; }
+bool method_has_joint_variant(Method method) { return info(method).clusters; }
+Method method_joint_variant(Method method) {
+    if (!info(method).clusters) throw InvalidInput(std::string(method_name(method)) + " has no joint variant");
+    return info(method).joint_variant;
 }
-bool method_is_joint(Method method) { return method == Method::Joint || method == Method::MeasuredJoint; }
+BlendOrder method_blend_order(Method method) { return info(method).blend; }
 
 const char* distance_name(DistanceVariant variant) { return variant == DistanceVariant::Jcgt ? "jcgt" : "i3d"; }
 DistanceVariant parse_distance(const std::string& name) {
@@ -341,8 +364,7 @@ void run_single_buffer(MethodResult& result, const AnimatedMesh& mesh, const Met
 void run_clustered(MethodResult& result, const AnimatedMesh& mesh, const MethodSettings& settings) {
     const bool joint = method_is_joint(result.method);
     ClusteringSettings clustering = settings.clustering;
-    if (result.method == Method::Measured || result.method == Method::MeasuredJoint)
-        clustering.order = OrderSource::Measured;
+    if (info(result.method).measured) clustering.order = OrderSource::Measured;
     AnimatedMethodResult r =
         run_han_sander(mesh, joint, settings.lambda, settings.cache_size, clustering, settings.blend_clusters,
                        clustering.order == OrderSource::Measured && settings.measured_planar_units);
@@ -477,9 +499,9 @@ MethodResult run_validated_method(const AnimatedMesh& mesh, Method method, const
             return result;
     }
     // Blended primitives are drawn back to front: every buffer of a single-buffer sorting method
-    // carries the reverse of its front-to-back order there (the input order stays as it is for
-    // original; single and joint sort them per cluster in run_han_sander).
-    if (method != Method::Original && method != Method::Single && method != Method::Joint)
+    // carries the reverse of its front-to-back order there (BlendOrder::Reversed); the input
+    // order stays as it is for original, and k-means sorts them per cluster in run_han_sander.
+    if (method_blend_order(method) == BlendOrder::Reversed)
         for (std::vector<uint32_t>& order : result.buffers.orders) reverse_blended_primitives(mesh, order);
     for (std::vector<uint32_t>& order : result.buffers.orders) tie_instances(mesh, order);
     // The time covers the method, not its ACMR (the oracle's ACMR sampling is part of its run).

@@ -285,14 +285,13 @@ int run_evaluate(const EvaluateOptions& options) {
         entry["ovr_pooled"] = r.overall.ovr_pooled;
         entry["per_clip"] = json::array();
         for (size_t c = 0; c < mesh.clips.size(); ++c)
-            entry["per_clip"].push_back({{"clip", mesh.clips[c].name},
-                                         {"ovr_mean", ovr_json(r.per_clip[c], r.per_clip[c].ovr_mean)},
-                                         {"ovr_pooled", ovr_json(r.per_clip[c], r.per_clip[c].ovr_pooled)},
-                                         {"nodes", r.per_clip[c].nodes},
-                                         {"time_s", (run.method == Method::Single || run.method == Method::Measured) &&
-                                                            c < run.run_seconds.size()
-                                                        ? json(run.run_seconds[c])
-                                                        : json(nullptr)}});
+            entry["per_clip"].push_back(
+                {{"clip", mesh.clips[c].name},
+                 {"ovr_mean", ovr_json(r.per_clip[c], r.per_clip[c].ovr_mean)},
+                 {"ovr_pooled", ovr_json(r.per_clip[c], r.per_clip[c].ovr_pooled)},
+                 {"nodes", r.per_clip[c].nodes},
+                 {"time_s", method_runs_per_clip(run.method) && c < run.run_seconds.size() ? json(run.run_seconds[c])
+                                                                                           : json(nullptr)}});
         const std::string lambda = method_uses_lambda(run.method) ? format_number(s.lambda) : "";
         const std::string k = method_uses_clusters(run.method) ? std::to_string(s.clustering.clusters) : "";
         const std::string v = method_uses_clusters(run.method) ? std::to_string(s.clustering.views) : "";

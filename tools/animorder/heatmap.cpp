@@ -20,12 +20,12 @@ namespace {
 
 // `heatmap --blend`: the transparent pass of one node (DESIGN.md "Blend error"), each pixel the
 // number of its blended fragment pairs drawn nearer-before-farther by the method's order (its
-// blended primitives reversed, as run_method ships them, except for original).
+// blended primitives reversed where run_method reverses them: BlendOrder::Reversed).
 int draw_blend_heatmap(const HeatmapOptions& options, const AnimatedMesh& mesh, Method method,
                        std::vector<uint32_t> order) {
     if (!has_blended_primitives(mesh))
         throw std::runtime_error("--blend: the input has no blended primitive (alphaMode BLEND)");
-    if (method != Method::Original) reverse_blended_primitives(mesh, order);
+    if (method_blend_order(method) == BlendOrder::Reversed) reverse_blended_primitives(mesh, order);
     const double length =
         std::sqrt(double(options.view[0]) * options.view[0] + double(options.view[1]) * options.view[1] +
                   double(options.view[2]) * options.view[2]);

@@ -76,13 +76,12 @@ nlohmann::ordered_json optimize_settings_json(const OptimizeOptions& options, co
 
 OptimizePlan plan_optimize(const OptimizeOptions& options) {
     OptimizePlan plan;
-    const bool measured =
-        options.method == method_name(Method::Measured) || options.method == method_name(Method::MeasuredJoint);
-    const Method method =
-        options.joint ? (measured ? Method::MeasuredJoint : Method::Joint) : parse_method(options.method);
-    if (options.joint && options.method != method_name(Method::Single) &&
-        options.method != method_name(Method::Joint) && options.method != method_name(kDefaultMethod) && !measured)
-        throw std::runtime_error("--joint applies to the single and measured methods, not " + options.method);
+    Method method = parse_method(options.method);
+    if (options.joint) {
+        if (!method_has_joint_variant(method))
+            throw std::runtime_error("--joint applies to the single and measured methods, not " + options.method);
+        method = method_joint_variant(method);
+    }
     if (!method_has_buffers(method))
         throw std::runtime_error(
             std::string(method_name(method)) +

@@ -1,9 +1,9 @@
 // Prerequisites of a test that a machine may lack (an OpenGL context, the Khronos glTF validator,
-// the real characters of ../shared/data): without one, the test is skipped with the reason, so
-// the skip shows in the CTest summary; and where the environment variable ANIMORDER_REQUIRE names
-// the component (a comma list of gl, validator, data, results, gltf-tools, node, browser; or all), the
+// the real characters of ../shared/data, strace, PID namespaces, ...): without one, the test is
+// skipped with the reason, so the skip shows in the CTest summary; and where the environment
+// variable ANIMORDER_REQUIRE names the component (a comma list of kComponents below, or all), the
 // test fails with the reason instead. .ci/run names every component CI has, so CI cannot pass by
-// skipping.
+// skipping. A test calls GTEST_SKIP itself only for what CI may lack too (the CPU's AVX2).
 //
 //   ANIMORDER_REQUIRE_OR_SKIP("data", fs::exists(path), path + " is absent");
 //
@@ -20,9 +20,30 @@
 namespace animorder::test {
 
 // The components a test can require; anything else in ANIMORDER_REQUIRE is a typo, and fails.
+//   gl          an OpenGL context (Mesa's llvmpipe over EGL will do)
+//   validator   the Khronos glTF validator (node, .tools/)
+//   data        the real characters of ../shared/data
+//   results     the committed results/ tables
+//   gltf-tools  gltfpack, glTF-Transform, gltf-pipeline, python3-jsonschema
+//   node        Node.js
+//   browser     headless Chromium and the viewer's npm packages
+//   strace      strace, with fault injection (-e inject=...:delay_enter=)
+//   namespaces  unshare -p -f --mount-proc (util-linux; root): a PID namespace
+//   root        running as root (files of another user, setresuid)
+//   proc        /proc mounted
+inline constexpr const char* kComponents[] = {"gl",      "validator", "data",       "results", "gltf-tools", "node",
+                                              "browser", "strace",    "namespaces", "root",    "proc"};
+
 inline bool known_component(const std::string& name) {
-    return name == "gl" || name == "validator" || name == "data" || name == "results" || name == "gltf-tools" ||
-           name == "node" || name == "browser";
+    for (const char* c : kComponents)
+        if (name == c) return true;
+    return false;
+}
+
+inline std::string known_components() {
+    std::string list;
+    for (const char* c : kComponents) list += std::string(c) + ", ";
+    return list + "all";
 }
 
 // Whether `requirement` (ANIMORDER_REQUIRE's value; null when unset) requires `component`.
@@ -44,7 +65,7 @@ inline bool requires_component(const char* requirement, const std::string& compo
             found = true;
         else if (!known_component(item))
             ADD_FAILURE() << "ANIMORDER_REQUIRE names an unknown component '" << item
-                          << "' (known: gl, validator, data, results, gltf-tools, node, browser, all)";
+                          << "' (known: " << known_components() << ")";
     }
     return found;
 }

@@ -31,6 +31,20 @@ TEST(Require, AllRequiresEveryComponent) {
     EXPECT_TRUE(test::requires_component("data,all", "gl"));
 }
 
+// The prerequisites of the signal tests (strace to slow a commit down, a PID namespace for a
+// container's first process) and of the /proc and root tests are components CI can require: they
+// called GTEST_SKIP themselves, and CI passed without running them.
+TEST(Require, TheSignalAndSystemPrerequisitesAreComponents) {
+    for (const char* c : {"strace", "namespaces", "root", "proc"}) {
+        EXPECT_TRUE(test::known_component(c)) << c;
+        EXPECT_TRUE(test::requires_component("all", c)) << c;
+        EXPECT_FALSE(test::requires_component("gl,data", c)) << c;
+    }
+    EXPECT_TRUE(test::requires_component("gl,strace,namespaces", "strace"));
+    EXPECT_TRUE(test::requires_component("gl,strace,namespaces", "namespaces"));
+    EXPECT_FALSE(test::requires_component("gl,strace", "namespaces"));
+}
+
 TEST(Require, UnknownNamesAreFailuresNotSilentlyIgnored) {
     EXPECT_NONFATAL_FAILURE(test::requires_component("gl,opengl", "gl"), "unknown component 'opengl'");
     EXPECT_NONFATAL_FAILURE(test::requires_component("gl", "gpu"), "unknown prerequisite 'gpu'");

@@ -14,8 +14,10 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <initializer_list>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace animorder::test {
 
@@ -83,6 +85,48 @@ inline std::filesystem::path shared_data_path(const std::string& relative = "") 
 #endif
 }
 
+// The files of ../shared/data a loop over characters reads. Every listed file is checked: a missing
+// one is recorded and the loop goes on with the rest (`continue`); after the loop,
+// ANIMORDER_REQUIRE_ALL_DATA skips naming every missing file, or fails where data is required. A
+// skip inside the loop left every character after the first absent one unchecked.
+//
+//   test::DataFiles data;
+//   for (const char* f : files) {
+//       if (!data.present(test::shared_data_path(f))) continue;
+//       ...
+//   }
+//   ANIMORDER_REQUIRE_ALL_DATA(data);
+class DataFiles {
+public:
+    // Whether every one of `paths` exists; those that do not are recorded.
+    bool present(std::initializer_list<std::filesystem::path> paths) {
+        bool all = true;
+        for (const std::filesystem::path& p : paths) {
+            ++checked_;
+            if (!std::filesystem::exists(p)) {
+                missing_.push_back(p.lexically_normal().string());
+                all = false;
+            }
+        }
+        return all;
+    }
+    bool present(const std::filesystem::path& path) { return present({path}); }
+
+    bool complete() const { return missing_.empty(); }
+    const std::vector<std::string>& missing() const { return missing_; }
+    // "2 of 9 files are absent (../shared/data): A, B"
+    std::string reason() const {
+        std::string list;
+        for (const std::string& m : missing_) list += (list.empty() ? "" : ", ") + m;
+        return std::to_string(missing_.size()) + " of " + std::to_string(checked_) +
+               " files are absent (../shared/data): " + list;
+    }
+
+private:
+    std::vector<std::string> missing_;
+    size_t checked_ = 0;
+};
+
 }  // namespace animorder::test
 
 // Skips the test with `reason` when `condition` is false, or fails it when ANIMORDER_REQUIRE
@@ -103,3 +147,8 @@ inline std::filesystem::path shared_data_path(const std::string& relative = "") 
 #define ANIMORDER_REQUIRE_DATA(data_path)                                 \
     ANIMORDER_REQUIRE_OR_SKIP("data", std::filesystem::exists(data_path), \
                               std::filesystem::path(data_path).string() + " is absent (../shared/data)")
+
+// After a loop over characters: skips naming every file test::DataFiles found missing (or fails,
+// when data is required); nothing when all were there.
+#define ANIMORDER_REQUIRE_ALL_DATA(data_files) \
+    ANIMORDER_REQUIRE_OR_SKIP("data", (data_files).complete(), (data_files).reason())

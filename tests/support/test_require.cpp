@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <filesystem>
 #include <string>
 
 namespace test = animorder::test;
@@ -68,4 +69,39 @@ TEST(Require, RequiredAndMissingFailsWithTheReason) {
     else
         ::unsetenv("ANIMORDER_REQUIRE");
     EXPECT_FALSE(::testing::Test::IsSkipped());
+}
+
+// A loop over characters records every missing file and goes on; at the end the skip (or, when
+// data is required, the failure) names all of them, not the first alone.
+namespace {
+// Globals: EXPECT_FATAL_FAILURE's statement cannot name the test's locals.
+test::DataFiles g_data;
+int g_ran = 0;
+void loop_over_files() {
+    for (const char* f : {"no-such-a.glb", "CMakeLists.txt", "no-such-b.glb", "README.md"}) {
+        if (!g_data.present(std::filesystem::path(ANIMORDER_SOURCE_DIR) / f)) continue;
+        ++g_ran;
+    }
+    ANIMORDER_REQUIRE_ALL_DATA(g_data);
+}
+}  // namespace
+
+TEST(Require, DataFilesNameEveryMissingFileAfterTheLoop) {
+    const char* before = std::getenv("ANIMORDER_REQUIRE");
+    const std::string saved = before ? before : "";
+    ::setenv("ANIMORDER_REQUIRE", "data", 1);
+    EXPECT_FATAL_FAILURE(loop_over_files(), "2 of 4 files are absent (../shared/data): ");
+    EXPECT_EQ(g_ran, 2) << "the files after a missing one still run";
+    ASSERT_EQ(g_data.missing().size(), 2u);
+    EXPECT_NE(g_data.reason().find("no-such-a.glb, "), std::string::npos) << g_data.reason();
+    EXPECT_NE(g_data.reason().find("no-such-b.glb"), std::string::npos) << g_data.reason();
+    EXPECT_FALSE(g_data.complete());
+
+    test::DataFiles all_there;
+    EXPECT_TRUE(all_there.present(std::filesystem::path(ANIMORDER_SOURCE_DIR) / "CMakeLists.txt"));
+    EXPECT_TRUE(all_there.complete());
+    if (before)
+        ::setenv("ANIMORDER_REQUIRE", saved.c_str(), 1);
+    else
+        ::unsetenv("ANIMORDER_REQUIRE");
 }

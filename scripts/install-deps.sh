@@ -44,6 +44,8 @@ packages=(
   libbenchmark-dev                         # benchmarks
   libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri  # OpenGL reference (llvmpipe)
   clang libclang-rt-14-dev                 # scripts/fuzz.sh: clang 14 and its libFuzzer/ASan runtimes
+  strace procps                            # signal tests: strace slows a commit down; pgrep finds the child
+  util-linux                               # unshare -p (a PID namespace); essential, so normally present
 )
 
 # Node.js runs the Khronos glTF Validator in the tests; any node >= 12 will do (the machine's own

@@ -63,8 +63,12 @@ TEST(AssimpCharacters, EveryCharacterInSharedDataLoadsWithItsClips) {
                           {"md2-dolphin/dolphin.md2", "", 500, 1},
                           {"md2-sydney/sydney.md2", "", 679, 16},
                           {"md2-faerie/faerie.md2", "", 654, 16}};
+    animorder::test::DataFiles data;  // every character is checked; the missing ones are named at the end
     for (const Case& c : cases) {
         SCOPED_TRACE(c.file);
+        bool present = data.present(kData + c.file);
+        if (*c.clips) present = data.present(kData + c.clips) && present;
+        if (!present) continue;
         std::vector<std::string> clips;
         if (*c.clips) clips.push_back(kData + c.clips);
         AnimatedMesh m;
@@ -79,6 +83,7 @@ TEST(AssimpCharacters, EveryCharacterInSharedDataLoadsWithItsClips) {
         std::printf("%-34s %5zu triangles %3zu joints %2zu clips %4zu keyframes\n", c.file, m.triangle_count(),
                     m.joint_count, m.clips.size(), m.keyframe_count());
     }
+    ANIMORDER_REQUIRE_ALL_DATA(data);
 }
 
 TEST(Md2, EveryFrameIsAKeyframeAndFrontsFaceOut) {
@@ -490,12 +495,13 @@ TEST(AssimpCharacters, TheJointCountIsTheSkeletonsAcrossMeshes) {
 // (MorphStressTest). Before assimp's morph channels were read, the morph files were refused
 // ("animates nothing").
 TEST(AssimpCharacters, GltfReadByAssimpMatchesTheGltfLoader) {
+    animorder::test::DataFiles data;
     for (const char* file :
          {"gltf-cesiumman/CesiumMan.glb", "gltf-fox/Fox.glb", "glb-robot-expressive/RobotExpressive.glb",
           "glb-horse-morph/Horse.glb", "gltf-animated-morph-sphere/AnimatedMorphSphere.gltf",
           "gltf-morph-stress-test/MorphStressTest.gltf"}) {
         SCOPED_TRACE(file);
-        ANIMORDER_REQUIRE_DATA(kData + file);
+        if (!data.present(kData + file)) continue;  // named at the end; the other files still run
         const AnimatedMesh gltf = load_character(kData + file);
         AnimatedMesh assimp;
         ASSERT_NO_THROW(assimp = load_assimp(kData + file));
@@ -519,6 +525,7 @@ TEST(AssimpCharacters, GltfReadByAssimpMatchesTheGltfLoader) {
         EXPECT_GT(size, 0.0);
         EXPECT_LE(worst, 1e-5 * size) << "largest difference " << worst << " in a character of size " << size;
     }
+    ANIMORDER_REQUIRE_ALL_DATA(data);
 }
 
 // The same on a file of one triangle (no data needed): a morph target moving vertex 2 by (0, 0, 2),

@@ -5,6 +5,7 @@
 
 #include "animorder/atomic_write.h"
 #include "support/files.h"
+#include "support/require.h"
 
 #include <signal.h>
 #include <sys/stat.h>
@@ -90,7 +91,7 @@ TEST_F(AtomicWrite, ASignalAfterTheCommitKeepsTheOutputs) {
 
 // /proc lets no file be created, yet access(W_OK) says yes to root: refused before any work.
 TEST_F(AtomicWrite, AFolderNoFileCanBeCreatedInIsRefused) {
-    if (!fs::is_directory("/proc/self")) GTEST_SKIP() << "no /proc on this system";
+    ANIMORDER_REQUIRE_OR_SKIP("proc", fs::is_directory("/proc/self"), "no /proc on this system");
     try {
         animorder::check_output_paths({"/proc/animorder-output.json"}, {});
         FAIL() << "an output in /proc was accepted";
@@ -104,7 +105,7 @@ TEST_F(AtomicWrite, AFolderNoFileCanBeCreatedInIsRefused) {
 // In a sticky folder (like /tmp) only a file's owner may replace it: known at the check, not at
 // the commit after the work. Needs root, to make a file of another user.
 TEST_F(AtomicWrite, AnotherUsersFileInAStickyFolderIsRefusedAtTheCheck) {
-    if (::geteuid() != 0) GTEST_SKIP() << "needs root, to make a file that belongs to another user";
+    ANIMORDER_REQUIRE_OR_SKIP("root", ::geteuid() == 0, "not root: a file of another user cannot be made");
     const fs::path sticky = path("sticky");
     fs::create_directory(sticky);
     ASSERT_EQ(::chmod(sticky.c_str(), 01777), 0);

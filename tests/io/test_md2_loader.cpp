@@ -149,12 +149,15 @@ TEST_F(Md2Loader, LoadingBudgetIsCheckedBeforeSampling) {
 TEST(Md2Characters, EveryMd2InSharedDataLoads) {
     const fs::path data = fs::path(ANIMORDER_SOURCE_DIR) / ".." / "shared" / "data";
     ANIMORDER_REQUIRE_DATA(data);
+    animorder::test::DataFiles files;  // every file is checked; the missing ones are named at the end
     for (const char* f : {"md2-dolphin/dolphin.md2", "md2-faerie/faerie.md2", "md2-sydney/sydney.md2"}) {
         SCOPED_TRACE(f);
+        if (!files.present(data / f)) continue;
         AnimatedMesh m;
         ASSERT_NO_THROW(m = load_md2((data / f).string()));
         EXPECT_GT(m.triangle_count(), 100u);
         EXPECT_GE(m.clips.size(), 1u);
         EXPECT_NO_THROW(validate_animated_mesh(m));
     }
+    ANIMORDER_REQUIRE_ALL_DATA(files);
 }

@@ -471,6 +471,84 @@ TEST(BlendError, HiddenBlendedFragmentsDoNotCount) {
     EXPECT_EQ(blend_counts(t, {0, 0, 1, 1}, {2, 3, 0, 1}).covered, 0u);
 }
 
+// Four blended quads seen head-on at 8 × 8, each pixel's layers known, and the mis-sorted pairs
+// of four orders added up by hand (the materials figures of `evaluate` rest on these sums).
+// Window space, pixels, y up (rows of the image: row 0 at the top, so y in [4, 8] is rows 0-3):
+//   A  z = −0.5 (nearest)  x in [0, 4], y in [0, 8]   triangles 0, 1
+//   D  z = −0.5 (A's depth) x in [0, 2], y in [4, 8]   triangles 6, 7
+//   B  z =  0              x in [2, 6], y in [0, 8]   triangles 2, 3
+//   C  z = +0.5 (farthest) x in [0, 8], y in [4, 8]   triangles 4, 5
+// Regions of 2 columns × 4 rows = 8 pixels each, layers nearest first:
+//   columns   bottom (y < 4)   top (y > 4)
+//   0-1       A                A=D, C   pairs (A,C), (D,C); A and D tie: no pair
+//   2-3       A, B             A, B, C  pairs (A,B); (A,B), (A,C), (B,C)
+//   4-5       B                B, C     pairs (B,C)
+//   6-7       -                C
+// covered: 7 regions × 8 = 56 pixels; with two layers or more: 4 regions, 32 pixels;
+// pairs: 8 · (2 + 1 + 3 + 1) = 56.
+// A pair is mis-sorted when its nearer quad is drawn first:
+//   C B A D (back to front): none.                                   0 pairs, 0 pixels
+//   A D B C (front to back): every pair.                            56 pairs, 32 pixels
+//   B A C D: (A,B) fine, (A,C) mis, (D,C) fine, (B,C) mis:
+//            top 0-1: 1, bottom 2-3: 0, top 2-3: 2, top 4-5: 1  →  8 · 4 = 32 pairs, 24 pixels
+//   C D A B: only (A,B) mis: bottom 2-3: 1, top 2-3: 1            → 16 pairs, 16 pixels
+TEST(BlendError, FourQuadsHeadOnHandCountedForFourOrders) {
+    Scene s(8);
+    s.rect(0, 0, 4, 8, -0.5f);  // A: 0, 1
+    s.rect(2, 0, 6, 8, 0.0f);   // B: 2, 3
+    s.rect(0, 4, 8, 8, 0.5f);   // C: 4, 5
+    s.rect(0, 4, 2, 8, -0.5f);  // D: 6, 7
+    const std::vector<uint8_t> blended(8, 1);
+    enum : uint32_t { A = 0, B = 1, C = 2, D = 3 };
+    const std::vector<std::vector<uint32_t>> quad_orders = {{C, B, A, D}, {A, D, B, C}, {B, A, C, D}, {C, D, A, B}};
+    std::vector<std::vector<uint32_t>> orders;
+    for (const auto& quads : quad_orders) {
+        std::vector<uint32_t> order;
+        for (uint32_t q : quads) order.insert(order.end(), {2 * q, 2 * q + 1});
+        orders.push_back(order);
+    }
+    std::vector<const uint32_t*> pointers;
+    for (const auto& o : orders) pointers.push_back(o.data());
+    const std::vector<uint32_t> ranks = make_rank_table(pointers, s.triangles());
+
+    NodeRasterizer r = s.rasterize();
+    const BlendFragments fragments = r.export_blend_fragments(blended.data());
+    EXPECT_EQ(fragments.covered, 56u);
+    EXPECT_EQ(fragments.pixels.size(), 32u);
+    EXPECT_EQ(fragments.fragments.size(), 8u * (3 + 2 + 3 + 2));  // the layers of the four regions
+
+    std::vector<BlendCounts> counts(orders.size());
+    score_blend(counts.data(), fragments, ranks.data(), orders.size());
+    const uint64_t pairs[] = {0, 56, 32, 16}, pixels[] = {0, 32, 24, 16};
+    for (size_t o = 0; o < orders.size(); ++o) {
+        SCOPED_TRACE(o);
+        EXPECT_EQ(counts[o].covered, 56u);
+        EXPECT_EQ(counts[o].pairs, 56u);
+        EXPECT_EQ(counts[o].missorted_pairs, pairs[o]);
+        EXPECT_EQ(counts[o].missorted_pixels, pixels[o]);
+        // The same, one order at a time.
+        BlendCounts alone;
+        const std::vector<uint32_t> one = make_rank_table({orders[o].data()}, s.triangles());
+        score_blend(&alone, fragments, one.data(), 1);
+        EXPECT_EQ(alone.missorted_pairs, pairs[o]);
+        EXPECT_EQ(alone.missorted_pixels, pixels[o]);
+    }
+
+    // The heatmap of B A C D, pixel by pixel (row 0 at the top).
+    const std::vector<uint32_t> image = missorted_per_pixel(fragments, 8, ranks.data(), orders.size(), 2);
+    ASSERT_EQ(image.size(), 64u);
+    for (unsigned row = 0; row < 8; ++row)
+        for (unsigned column = 0; column < 8; ++column) {
+            const uint32_t top[] = {1, 1, 2, 2, 1, 1, 0, 0};
+            EXPECT_EQ(image[row * 8 + column], row < 4 ? top[column] : 0u) << "row " << row << ", column " << column;
+        }
+    // Back to front: a blank heatmap; front to back: one per pair.
+    const std::vector<uint32_t> blank = missorted_per_pixel(fragments, 8, ranks.data(), orders.size(), 0);
+    EXPECT_EQ(std::accumulate(blank.begin(), blank.end(), 0u), 0u);
+    const std::vector<uint32_t> all = missorted_per_pixel(fragments, 8, ranks.data(), orders.size(), 1);
+    EXPECT_EQ(std::accumulate(all.begin(), all.end(), 0u), 56u);
+}
+
 TEST(BlendError, MatchesABruteForceTransparentPass) {
     // A second implementation from the raw fragments: per pixel, the opaque minimum depth, the
     // blended fragments strictly nearer, and every pair at different depths checked against the

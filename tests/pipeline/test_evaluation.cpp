@@ -14,6 +14,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <numeric>
 
 using namespace animorder;
@@ -198,5 +199,133 @@ TEST(Evaluation, SameNumbersWithOneOrTwoThreads) {
     for (size_t m = 0; m < methods.size(); ++m) {
         EXPECT_EQ(a[m].overall.ovr_mean, b[m].overall.ovr_mean);
         EXPECT_EQ(a[m].overall.ovr_pooled, b[m].overall.ovr_pooled);
+    }
+}
+
+namespace {
+
+// Closed axis-aligned cubes centred on the origin, each face two triangles wound counter-clockwise
+// seen from outside (checked: the normal points away from the centre), 12 triangles a cube in
+// the order of `halves`.
+AnimatedMesh nested_cubes(const std::vector<float>& halves) {
+    AnimatedMesh mesh;
+    for (const float h : halves) {
+        const uint32_t base = uint32_t(mesh.vertex_count);
+        for (uint32_t v = 0; v < 8; ++v)  // bit 0: +x, bit 1: +y, bit 2: +z
+            mesh.keyframe_positions.insert(mesh.keyframe_positions.end(),
+                                           {v & 1 ? h : -h, v & 2 ? h : -h, v & 4 ? h : -h});
+        mesh.vertex_count += 8;
+        for (uint32_t axis = 0; axis < 3; ++axis)
+            for (uint32_t side = 0; side < 2; ++side) {
+                // The face's corners in a cycle: the two other axes' bits 00, 10, 11, 01.
+                const uint32_t u = 1u << ((axis + 1) % 3), w = 1u << ((axis + 2) % 3), a = side ? 1u << axis : 0;
+                std::array<uint32_t, 4> q = {base + a, base + (a | u), base + (a | u | w), base + (a | w)};
+                const float* p = mesh.keyframe_positions.data();
+                auto corner = [&](uint32_t i, int d) { return double(p[3 * q[i] + d]); };
+                double normal_out = 0;  // (q1 − q0) × (q2 − q0) · (face centre): > 0 when counter-clockwise outside
+                for (int d = 0; d < 3; ++d) {
+                    const int e = (d + 1) % 3, f = (d + 2) % 3;
+                    const double n = (corner(1, e) - corner(0, e)) * (corner(2, f) - corner(0, f)) -
+                                     (corner(1, f) - corner(0, f)) * (corner(2, e) - corner(0, e));
+                    normal_out += n * (corner(0, d) + corner(2, d));
+                }
+                if (normal_out < 0) std::swap(q[1], q[3]);
+                mesh.indices.insert(mesh.indices.end(), {q[0], q[1], q[2], q[0], q[2], q[3]});
+            }
+    }
+    return mesh;
+}
+
+// The triangles of cubes `cubes` (12 each), in that order: one order drawing whole cubes.
+std::vector<uint32_t> cube_order(std::initializer_list<uint32_t> cubes) {
+    std::vector<uint32_t> order;
+    for (const uint32_t c : cubes)
+        for (uint32_t t = 0; t < 12; ++t) order.push_back(12 * c + t);
+    return order;
+}
+
+}  // namespace
+
+// evaluate_blend adds up, over its nodes, blend error a hand count gives. Three nested blended
+// cubes (half sizes 4, 2, 1: cubes 0, 1, 2) around an opaque one (half size 0.5: cube 3), all
+// single-sided, at a resolution of one pixel. The pixel's centre is the image centre, the ray from
+// the eye through the framing centre (the origin: every keyframe is a uniform scale of the cubes);
+// it enters each cube once, through a front face, so from every one of the random views each
+// blended cube gives that pixel exactly one fragment, nearest first cube 0, 1, 2, all in front of
+// the opaque cube (which hides none of them and is no layer). So at every node: covered = 1
+// pixel, pairs = 3 ((0,1), (0,2), (1,2)), and an order drawing whole cubes mis-sorts the pairs
+// whose nearer cube comes first:
+//   3 2 1 0 (back to front)  0 of 3     0 1 2 3 (front to back)  3 of 3
+//   1 2 0 3                  1 of 3 ((1,2) only: (0,1) and (0,2) are drawn farther first)
+//   0 2 1 3                  2 of 3 ((0,1) and (0,2); (1,2) is drawn 2 first, fine)
+// Clip 0 has 2 keyframes, clip 1 three; 5 views: 10 and 15 nodes, 25 in all; the rates are
+// Σ mis-sorted / Σ pairs and Σ pixels with a mis-sorted pair / Σ covered.
+// The bound sorts the blended triangles by their centroids' distance to the eye: for the three
+// triangles the ray meets (the same triangle of the same face of each cube, the cubes being
+// scales of one another: centroid s·c), |e − s·c|² = D² − 2D·s·(d·c) + s²|c|² with eye e = D·d,
+// D = 3R ≥ 3√3·4 (R: the largest cube's corner, over the keyframes of the clip), |c|² = 11/9 and
+// d·c ≥ a/3 ≥ 1/(3√3) (a = d·n of the face the ray enters, the largest component of d; the
+// centroid's other two coordinates are ±1/3). Cube s1 is nearer than cube s2 < s1 when
+// (11/9)(s1 + s2) < 2D(d·c), which holds as 11/9 · 6 = 7.3 < 2 · 3√3·4 / (3√3) = 8: the bound
+// draws the three back to front at every node, 0 mis-sorted.
+TEST(BlendEvaluation, NestedCubesAddUpToTheHandCountedPairs) {
+    AnimatedMesh mesh = nested_cubes({4.0f, 2.0f, 1.0f, 0.5f});
+    Primitive blended, opaque;
+    blended.name = "shells";
+    blended.alpha_mode = AlphaMode::Blend;
+    blended.index_count = 3 * 36;
+    blended.vertex_count = 24;
+    opaque.name = "core";
+    opaque.first_index = 3 * 36;
+    opaque.index_count = 3 * 12;
+    opaque.vertex_base = 24;
+    opaque.vertex_count = 8;
+    mesh.primitives = {blended, opaque};
+    // Five keyframes, each a uniform scale of the first (the framing centre stays the origin).
+    const std::vector<float> base = mesh.keyframe_positions;
+    for (const float scale : {1.25f, 0.8f, 1.5f, 0.9f})
+        for (const float x : base) mesh.keyframe_positions.push_back(scale * x);
+    Clip walk, wave;
+    walk.name = "walk";
+    walk.keyframe_count = 2;
+    wave.name = "wave";
+    wave.first_keyframe = 2;
+    wave.keyframe_count = 3;
+    mesh.clips = {walk, wave};
+    ASSERT_NO_THROW(validate_animated_mesh(mesh));
+
+    EvaluationSettings settings;
+    settings.views = 5;
+    settings.resolution = 1;
+    const std::vector<std::vector<uint32_t>> orders = {cube_order({3, 2, 1, 0}), cube_order({0, 1, 2, 3}),
+                                                       cube_order({1, 2, 0, 3}), cube_order({0, 2, 1, 3})};
+    std::vector<MethodBuffers> methods;
+    for (const auto& o : orders) methods.push_back(fixed(o));
+    const std::vector<BlendEvaluation> r = evaluate_blend(mesh, methods, settings);
+    ASSERT_EQ(r.size(), orders.size() + 1);  // + the bound
+
+    const uint64_t missorted_per_node[] = {0, 3, 1, 2, 0};  // the four orders, then the bound
+    const uint64_t clip_nodes[] = {10, 15};
+    for (size_t o = 0; o < r.size(); ++o) {
+        SCOPED_TRACE(o);
+        const uint64_t m = missorted_per_node[o], pixel = m > 0 ? 1 : 0;
+        const BlendSummary& all = r[o].overall;
+        EXPECT_EQ(all.nodes, 25u);
+        EXPECT_EQ(all.covered, 25u);
+        EXPECT_EQ(all.pairs, 75u);
+        EXPECT_EQ(all.missorted_pairs, 25 * m);
+        EXPECT_EQ(all.missorted_pixels, 25 * pixel);
+        EXPECT_DOUBLE_EQ(all.missorted_pair_fraction, double(m) / 3.0);  // 0, 1, 1/3, 2/3, 0
+        EXPECT_DOUBLE_EQ(all.missorted_pixel_fraction, double(pixel));   // 0, 1, 1, 1, 0
+        ASSERT_EQ(r[o].per_clip.size(), 2u);
+        for (size_t c = 0; c < 2; ++c) {
+            const BlendSummary& clip = r[o].per_clip[c];
+            EXPECT_EQ(clip.nodes, clip_nodes[c]) << "clip " << c;
+            EXPECT_EQ(clip.covered, clip_nodes[c]) << "clip " << c;
+            EXPECT_EQ(clip.pairs, 3 * clip_nodes[c]) << "clip " << c;
+            EXPECT_EQ(clip.missorted_pairs, m * clip_nodes[c]) << "clip " << c;
+            EXPECT_EQ(clip.missorted_pixels, pixel * clip_nodes[c]) << "clip " << c;
+            EXPECT_DOUBLE_EQ(clip.missorted_pair_fraction, double(m) / 3.0) << "clip " << c;
+        }
     }
 }

@@ -941,8 +941,9 @@ TEST_F(Batch, ADryRunSaysWhatWouldRunAndWhyAndWritesNothing) {
 // still ends on SIGTERM, as Kubernetes sends it when a pod is deleted: exit 143 (128 + 15), its
 // item unwritten. It ran on to the end before, until the grace period's SIGKILL.
 TEST_F(Batch, AsAContainersFirstProcessItEndsOnSigterm) {
-    if (run_shell("unshare -p -f --mount-proc true").exit_code != 0)
-        GTEST_SKIP() << "unshare missing: a PID namespace cannot be made here (unshare -p needs root)";
+    ANIMORDER_REQUIRE_OR_SKIP("namespaces", run_shell("unshare -p -f --mount-proc true").exit_code == 0,
+                              "a PID namespace cannot be made here: `unshare -p -f --mount-proc true` failed "
+                              "(unshare is in util-linux; -p needs root)");
     write("m.json", R"({"items": [{"options": "--views 642 --resolution 512", "output": "out/a"}]})");
     const std::string script = "unshare -p -f --mount-proc " + std::string(ANIMORDER_EXE) + " batch --eval-views 0 " +
                                manifest() + " 2> err.txt & u=$!; " +

@@ -986,7 +986,7 @@ TEST_F(CliOutputs, NoCommandWritesOverAFileItsLoadReadsOrIntoAClipFolder) {
 // A folder where no file can be created (/proc, where access() still answers yes to root) is
 // refused before any work, by every subcommand that writes.
 TEST_F(CliOutputs, AFolderNoFileCanBeCreatedInIsRefusedFirst) {
-    if (!fs::is_directory("/proc/self")) GTEST_SKIP() << "no /proc on this system";
+    ANIMORDER_REQUIRE_OR_SKIP("proc", fs::is_directory("/proc/self"), "no /proc on this system");
     const std::string in = path("in.glb").string();
     for (const std::string& args :
          {"optimize " + in + " -o /proc/animorder-out", "evaluate " + in + " -r /proc/animorder-r.json",
@@ -1118,8 +1118,11 @@ TEST_F(CliOutputs, AClipNameIsANameWhateverTheCurrentFolderHolds) {
 // temporaries behind (or, between moving a target aside and renaming its new file in, the target
 // missing). strace slows each rename down so that the signal lands during the commit.
 TEST_F(Cli, ASignalDuringTheCommitWaitsForItsEnd) {
-    if (test::run_captured("strace -o /dev/null true", dir_).exit_code != 0)
-        GTEST_SKIP() << "strace missing: the commit cannot be slowed down to signal it in the middle";
+    // The very injection the test uses: an strace without it (or none) cannot slow the commit down.
+    ANIMORDER_REQUIRE_OR_SKIP(
+        "strace", test::run_captured("strace -f -o /dev/null -e inject=rename:delay_enter=1 true", dir_).exit_code == 0,
+        "strace (Debian package strace) is not on PATH or cannot inject delays: the commit cannot be slowed "
+        "down to signal it in the middle");
     fs::create_directories(path("out"));
     const std::string script = "cd '" + dir_.string() + "' || exit 1; " +
                                "strace -f -o /dev/null -e inject=rename,renameat,renameat2:delay_enter=700000 " +

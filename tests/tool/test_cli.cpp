@@ -116,8 +116,8 @@ TEST_F(Cli, TheReadmesHeatmapsAreWhatTheirCommandDraws) {
         const test::Outcome o =
             run(std::string("heatmap -q --order ") + order + " --frame 55 --view 5,3,-10 --resolution 384 -o " + png);
         ASSERT_EQ(o.exit_code, 0) << o.err;
-        EXPECT_TRUE(test::slurp(png) ==
-                    test::slurp(fs::path(ANIMORDER_SOURCE_DIR) / "docs" / ("heatmap-" + std::string(order) + ".png")))
+        EXPECT_TRUE(test::slurp_existing(png) == test::slurp_existing(fs::path(ANIMORDER_SOURCE_DIR) / "docs" /
+                                                                      ("heatmap-" + std::string(order) + ".png")))
             << order << ": docs/heatmap-" << order << ".png is not what the command draws now";
     }
 }
@@ -228,7 +228,7 @@ TEST_F(Cli, OptimizeWritesIndicesAndReport) {
 TEST_F(Cli, OptimizeIsByteDeterministic) {
     ASSERT_EQ(run("optimize -q -o " + path("a").string()).exit_code, 0);
     ASSERT_EQ(run("optimize -q -o " + path("b").string()).exit_code, 0);
-    EXPECT_EQ(test::slurp(path("a.animorder.bin")), test::slurp(path("b.animorder.bin")));
+    EXPECT_EQ(test::slurp_existing(path("a.animorder.bin")), test::slurp_existing(path("b.animorder.bin")));
 }
 
 TEST_F(Cli, SingleWritesKBuffersPerClipAndReportsIterations) {
@@ -239,8 +239,8 @@ TEST_F(Cli, SingleWritesKBuffersPerClipAndReportsIterations) {
                   .exit_code,
               0);
     ASSERT_EQ(run("optimize --method single" + fast + " --threads 2 -o " + path("s2").string()).exit_code, 0);
-    EXPECT_EQ(test::slurp(path("s1.animorder.bin")),
-              test::slurp(path("s2.animorder.bin")));  // thread count changes nothing
+    EXPECT_EQ(test::slurp_existing(path("s1.animorder.bin")),
+              test::slurp_existing(path("s2.animorder.bin")));  // thread count changes nothing
     const nlohmann::json j = nlohmann::json::parse(test::slurp(path("r.json")));
     const nlohmann::json& m = j["methods"][0];
     EXPECT_EQ(m["name"], "single");
@@ -264,7 +264,7 @@ TEST_F(Cli, MeasuredOptimizesJointAndEvaluates) {
                   .exit_code,
               0);
     ASSERT_EQ(run("optimize --method measured" + fast + " --threads 2 -o " + path("m2").string()).exit_code, 0);
-    EXPECT_EQ(test::slurp(path("m1.animorder.bin")), test::slurp(path("m2.animorder.bin")));
+    EXPECT_EQ(test::slurp_existing(path("m1.animorder.bin")), test::slurp_existing(path("m2.animorder.bin")));
     const nlohmann::json j = nlohmann::json::parse(test::slurp(path("r.json")));
     EXPECT_EQ(j["methods"][0]["name"], "measured");
     EXPECT_EQ(j["methods"][0]["buffers"], 6);  // 3 per clip, 2 clips
@@ -772,8 +772,8 @@ TEST_F(Cli, Nehab06RunsInOptimizeAndEvaluateAndBeatsTheOriginalOrder) {
                   .exit_code,
               0);
     ASSERT_EQ(run("optimize --method static-nehab06" + fast + " --threads 2 -o " + path("n2").string()).exit_code, 0);
-    EXPECT_EQ(test::slurp(path("n1.animorder.bin")),
-              test::slurp(path("n2.animorder.bin")));  // thread count changes nothing
+    EXPECT_EQ(test::slurp_existing(path("n1.animorder.bin")),
+              test::slurp_existing(path("n2.animorder.bin")));  // thread count changes nothing
     const nlohmann::json j = nlohmann::json::parse(test::slurp(path("r.json")));
     EXPECT_EQ(j["methods"][0]["name"], "static-nehab06");
     EXPECT_EQ(j["methods"][0]["planar_clusters"], 16 * 4);  // 16 per primitive; the character has 4
@@ -875,7 +875,7 @@ protected:
         EXPECT_EQ(o.exit_code, 1) << args;
         EXPECT_EQ(test::line_count(o.err), 1u) << args << " → " << o.err;
         EXPECT_NE(o.err.find(what), std::string::npos) << args << " → " << o.err;
-        EXPECT_EQ(test::slurp(path("in.glb")), original_) << args << ": the input changed";
+        EXPECT_EQ(test::slurp_existing(path("in.glb")), original_) << args << ": the input changed";
     }
     std::string original_;
 };
@@ -939,14 +939,14 @@ TEST_F(CliOutputs, ReapplyOntoEitherInputIsRefused) {
     ASSERT_EQ(
         run("optimize -q --method original " + path("in.glb").string() + " -o " + path("opt.glb").string()).exit_code,
         0);
-    const std::string optimised = test::slurp(path("opt.glb"));
+    const std::string optimised = test::slurp_existing(path("opt.glb"));
     expect_refused(
         "reapply " + path("opt.glb").string() + " " + path("in.glb").string() + " -o " + path("in.glb").string(),
         "in.glb");
     expect_refused(
         "reapply " + path("opt.glb").string() + " " + path("in.glb").string() + " -o " + path("opt.glb").string(),
         "opt.glb");
-    EXPECT_EQ(test::slurp(path("opt.glb")), optimised);
+    EXPECT_EQ(test::slurp_existing(path("opt.glb")), optimised);
 }
 
 // Every subcommand checks its outputs against every file its load reads, not only the file named
@@ -970,7 +970,7 @@ TEST_F(CliOutputs, NoCommandWritesOverAFileItsLoadReadsOrIntoAClipFolder) {
          {"evaluate " + in + small + " -r " + bin_path, "evaluate " + in + small + " --csv " + bin_path,
           "heatmap " + in + " -o " + bin_path}) {
         expect_refused(args, "in.bin");
-        EXPECT_EQ(test::slurp(path("in.bin")), bin) << args << ": the buffer changed";
+        EXPECT_EQ(test::slurp_existing(path("in.bin")), bin) << args << ": the buffer changed";
     }
     fs::create_directories(path("clips"));
     fs::copy_file(path("in.glb"), path("clips/walk.glb"));

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -19,6 +20,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -56,6 +58,22 @@ protected:
         return files;
     }
 };
+
+// Starts `argv` (argv[0] the executable) in `folder`, its stdout and stderr into `log`, without
+// waiting for it: its pid, or -1 when it cannot be started (the child's failure to open the log or
+// run the program shows as exit code 126 or 127).
+pid_t start_in(const fs::path& folder, const std::vector<std::string>& argv, const fs::path& log) {
+    std::vector<char*> args;
+    for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+    args.push_back(nullptr);
+    const std::string where = folder.string(), log_path = log.string();
+    const pid_t child = fork();
+    if (child != 0) return child;
+    const int fd = ::open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd < 0 || ::chdir(where.c_str()) != 0 || dup2(fd, 1) < 0 || dup2(fd, 2) < 0) _exit(126);
+    ::execv(args[0], args.data());
+    _exit(127);
+}
 
 // Five items over the bundled character: single per clip, joint, two static methods.
 const char* kFiveItems = R"({"items": [
@@ -110,12 +128,24 @@ TEST_F(Batch, ThreeParallelShardsGiveTheFilesAndSummaryOfOneRun) {
     for (const auto& e : fs::directory_iterator(path("out"))) fs::remove(e.path());
     fs::remove(path("m.summary.json"));
     fs::remove(path("m.summary.md"));
-    std::string parallel;
-    for (int i = 0; i < 3; ++i)
-        parallel += std::string(ANIMORDER_EXE) + " batch -q --no-timings" + kEval + " --shard " + std::to_string(i) +
-                    "/3 " + manifest() + " > " + path("shard" + std::to_string(i) + ".txt").string() + " 2>&1 & ";
-    const int status = std::system(("cd " + dir_.string() + " && " + parallel + "wait").c_str());
-    ASSERT_EQ(WEXITSTATUS(status), 0);
+    // Each shard a process of its own, all three started before any is waited for, and each one's
+    // exit status checked (a shell's `A & B & C & wait` exits 0 whatever they do).
+    pid_t shards[3];
+    for (int i = 0; i < 3; ++i) {
+        std::vector<std::string> args = {ANIMORDER_EXE, "batch", "-q", "--no-timings"};
+        std::istringstream eval(kEval);
+        for (std::string word; eval >> word;) args.push_back(word);
+        args.insert(args.end(), {"--shard", std::to_string(i) + "/3", manifest()});
+        shards[i] = start_in(dir_, args, path("shard" + std::to_string(i) + ".txt"));
+        ASSERT_GT(shards[i], 0) << "cannot start shard " << i;
+    }
+    int statuses[3] = {-1, -1, -1};
+    for (int i = 0; i < 3; ++i) EXPECT_EQ(waitpid(shards[i], &statuses[i], 0), shards[i]) << "shard " << i;
+    for (int i = 0; i < 3; ++i) {
+        const std::string log = test::slurp(path("shard" + std::to_string(i) + ".txt"));
+        ASSERT_TRUE(WIFEXITED(statuses[i])) << "shard " << i << " did not exit: " << log;
+        ASSERT_EQ(WEXITSTATUS(statuses[i]), 0) << "shard " << i << ": " << log;
+    }
     EXPECT_NE(test::slurp(path("shard0.txt")).find("shard 0/3: 2 items: 2 done"), std::string::npos)
         << test::slurp(path("shard0.txt"));
     EXPECT_NE(test::slurp(path("shard2.txt")).find("shard 2/3: 1 items: 1 done"), std::string::npos)

@@ -10,11 +10,14 @@
 #include "support/require.h"
 
 #include <arpa/inet.h>
+#include <fcntl.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #include <algorithm>
+#include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -22,6 +25,8 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
+#include <utility>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -812,16 +817,100 @@ std::string entries_of(const fs::path& folder) {
 // writing it fails with "No space left on device". `exec` keeps the shell's PID ($$), so the link
 // carries the tool's PID. Afterwards the folder must be empty: no temporary (the link is it), no
 // output. Were the temporary named otherwise, the write would succeed and the link stay: a failure too.
+namespace {
+// A process's state letter and parent from /proc/PID/stat ('\0' when there is no such process).
+std::pair<char, pid_t> process_state(pid_t pid) {
+    std::ifstream in("/proc/" + std::to_string(pid) + "/stat");
+    std::string stat;
+    if (!std::getline(in, stat)) return {'\0', 0};
+    const size_t name_end = stat.rfind(')');  // the name, in parentheses, may hold anything
+    if (name_end == std::string::npos) return {'\0', 0};
+    std::istringstream rest(stat.substr(name_end + 1));
+    char state = '\0';
+    long parent = 0;
+    rest >> state >> parent;
+    return {state, pid_t(parent)};
+}
+
+// Whether `pid` is a process still running (a zombie has ended: only its exit status is left).
+bool running(pid_t pid) {
+    const char state = process_state(pid).first;
+    return state != '\0' && state != 'Z' && state != 'X';
+}
+
+// The running children of `parent`.
+std::vector<pid_t> running_children(pid_t parent) {
+    std::vector<pid_t> children;
+    std::error_code error;
+    for (const auto& entry : fs::directory_iterator("/proc", error)) {
+        const std::string name = entry.path().filename().string();
+        if (name.find_first_not_of("0123456789") != std::string::npos) continue;
+        const pid_t pid = pid_t(std::stol(name));
+        const auto [state, its_parent] = process_state(pid);
+        if (its_parent == parent && state != '\0' && state != 'Z' && state != 'X') children.push_back(pid);
+    }
+    return children;
+}
+}  // namespace
+
 // animorder killed while assimp reads a file (here one it loops on) leaves no reader running:
-// the isolated reader dies with it.
+// the isolated reader (a forked child of animorder, isolated_import.h) dies with it. The reader
+// must be seen running, reading the file, before the kill (else nothing was tested), and gone
+// after it.
 TEST_F(Cli, AKilledRunLeavesNoReaderBehind) {
+    ASSERT_TRUE(fs::is_directory("/proc/self")) << "the reader is found through /proc (Linux, as memfd_create)";
     const fs::path ply = path("never-ending-header.ply");
     std::ofstream(ply) << "ply\nformat ascii 1.0\ncomment Created ";
-    // A script, so that no shell's command line names the file: pgrep finds animorder processes only.
-    std::ofstream(path("kill.sh")) << std::string(ANIMORDER_EXE) << " inspect '" << ply.string()
-                                   << "' & sleep 1; kill -9 $!; sleep 1; pgrep -f never-ending-header | wc -l\n";
-    const test::Outcome o = test::run_captured("sh '" + path("kill.sh").string() + "'", dir_);
+    const std::string log = path("inspect.txt").string(), file = ply.string();
+    const pid_t animorder = fork();
+    ASSERT_GE(animorder, 0);
+    if (animorder == 0) {
+        const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        if (fd < 0 || dup2(fd, 1) < 0 || dup2(fd, 2) < 0) _exit(126);
+        execl(ANIMORDER_EXE, ANIMORDER_EXE, "inspect", file.c_str(), static_cast<char*>(nullptr));
+        _exit(127);
+    }
+    // The reader: animorder's child, there while the header is read (the reader's processor-time
+    // limit is 20 s; animorder still running is checked each round).
+    pid_t reader = 0;
+    int status = 0;
+    bool ended = false;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (!reader && std::chrono::steady_clock::now() < deadline) {
+        if (waitpid(animorder, &status, WNOHANG) == animorder) {
+            ended = true;
+            break;
+        }
+        const std::vector<pid_t> children = running_children(animorder);
+        if (!children.empty())
+            reader = children.front();
+        else
+            std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    if (!ended && reader) std::this_thread::sleep_for(std::chrono::milliseconds(300));  // well into the loop
+    const bool alive_before_kill = reader && running(reader);
+    std::string reader_command;
+    if (reader) std::getline(std::ifstream("/proc/" + std::to_string(reader) + "/cmdline"), reader_command);
+    if (!ended) {
+        kill(animorder, SIGKILL);
+        waitpid(animorder, &status, 0);
+    }
+    ASSERT_FALSE(ended) << "animorder ended before the kill: " << test::slurp(log);
+    ASSERT_NE(reader, 0) << "no reader was seen in 60 s: " << test::slurp(log);
+    ASSERT_TRUE(alive_before_kill) << "the reader " << reader << " had ended before the kill";
+    EXPECT_NE(reader_command.find("never-ending-header"), std::string::npos)
+        << "the child seen is not the reader of the file: " << reader_command;
+    // The reader dies with animorder (its parent-death signal), which may take a moment.
+    const auto gone_by = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (running(reader) && std::chrono::steady_clock::now() < gone_by)
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    EXPECT_FALSE(running(reader)) << "the reader " << reader << " outlived the killed animorder";
+    // And no process at all still names the file (the reader, were it another kind of child): a
+    // script, so that no shell's command line names the file.
+    std::ofstream(path("count.sh")) << "pgrep -f never-ending-header | wc -l\n";
+    const test::Outcome o = test::run_captured("sh '" + path("count.sh").string() + "'", dir_);
     EXPECT_EQ(o.out, "0\n") << o.err;
+    if (running(reader)) kill(reader, SIGKILL);  // a reader left behind: ended, now the test has failed
 }
 
 TEST_F(Cli, FailedWriteLeavesNoFileBehind) {

@@ -130,7 +130,8 @@ TEST_F(Cli, TheReadmesHeatmapsAreWhatTheirCommandDraws) {
 namespace {
 // Every figure of the manual's sample report (`sample`, "..." standing for what it leaves out)
 // against a real report: keys present, integers, strings and flags equal, decimals to the places
-// shown (within 0.005), times and output paths only present (they vary by machine and folder).
+// shown (within 0.005), arrays at least as long as the sample's (as long, where it shows every
+// entry), times and output paths only present (they vary by machine and folder).
 void expect_sample_matches(const nlohmann::json& sample, const nlohmann::json& actual, const std::string& where) {
     if (sample.is_object()) {
         ASSERT_TRUE(actual.is_object()) << where;
@@ -144,9 +145,23 @@ void expect_sample_matches(const nlohmann::json& sample, const nlohmann::json& a
         }
     } else if (sample.is_array()) {
         ASSERT_TRUE(actual.is_array()) << where;
-        for (size_t i = 0; i < sample.size(); ++i)
-            if (sample[i] != "..." && i < actual.size())
-                expect_sample_matches(sample[i], actual[i], where + "[" + std::to_string(i) + "]");
+        // The report has every entry the sample shows ("..." stands for entries left out, none or
+        // more): at least as many, none at all only where the sample's array is empty, and exactly
+        // as many where the sample leaves nothing out.
+        size_t shown = 0;
+        for (const nlohmann::json& entry : sample) shown += entry != "...";
+        ASSERT_GE(actual.size(), shown) << where << ": entries in the sample: " << shown;
+        if (!sample.empty()) {
+            ASSERT_FALSE(actual.empty()) << where << " is empty, not in the sample";
+        }
+        if (shown == sample.size()) {
+            EXPECT_EQ(actual.size(), sample.size()) << where << ": the sample shows the whole array";
+        }
+        for (size_t i = 0; i < sample.size(); ++i) {
+            if (sample[i] == "...") continue;
+            ASSERT_LT(i, actual.size()) << where << "[" << i << "] is not in the report";
+            expect_sample_matches(sample[i], actual[i], where + "[" + std::to_string(i) + "]");
+        }
     } else if (sample.is_number_float()) {
         ASSERT_TRUE(actual.is_number()) << where;
         EXPECT_NEAR(actual.get<double>(), sample.get<double>(), 0.005 + 1e-9) << where;

@@ -1,6 +1,6 @@
 // Measured cluster orders (measured_order.cpp): the overdraw graph from kept fragments on
 // hand-built scenes whose answer is known, the order it gives, and the local search against
-// brute force on small random graphs (every permutation of up to 8 units).
+// brute force on small random graphs (every permutation of up to 8 units) and on graphs worked by hand.
 #include "animorder/invalid_input.h"
 #include "animorder/measured_order.h"
 #include "animorder/nehab06.h"
@@ -315,8 +315,35 @@ std::vector<Arc> random_graph(std::mt19937& rng, size_t n) {
     return arcs;
 }
 
+// Whether no single move (remove a unit, insert it anywhere else) lowers `order`'s cost below
+// `weight`, by brute force over every move: what sifting guarantees once a pass moves nothing.
+::testing::AssertionResult no_single_move_lowers(const std::vector<uint32_t>& order, const std::vector<Arc>& arcs,
+                                                 uint64_t weight) {
+    const size_t n = order.size();
+    for (size_t from = 0; from < n; ++from)
+        for (size_t to = 0; to < n; ++to) {
+            std::vector<uint32_t> moved = order;
+            const uint32_t u = moved[from];
+            moved.erase(moved.begin() + long(from));
+            moved.insert(moved.begin() + long(to), u);
+            if (cost(moved, arcs) < weight)
+                return ::testing::AssertionFailure()
+                       << "moving unit " << u << " from " << from << " to " << to << " lowers the cost from " << weight
+                       << " to " << cost(moved, arcs);
+        }
+    return ::testing::AssertionSuccess();
+}
+
+// What sift_order guarantees (measured_order.h): the cost never rises, the weight it returns is
+// count_feedback_arcs of the order it leaves, and, once a pass moves nothing (well inside
+// max_passes at these sizes), no single move lowers the cost: a local optimum. A local optimum is
+// not always the optimum (the hand-worked DAG below), but for n <= 3 it is: with units x y z in
+// that order, the moves give w(yx) <= w(xy) (swap x, y) and w(zx) + w(zy) <= w(xz) + w(yz) (z to
+// the front); their sum is cost(x y z) <= cost(z y x), and z y x is the only order of three no
+// single move reaches. So there the result must equal the brute-force optimum over every order.
 TEST(Sifting, NeverRaisesTheCostAndEndsAtALocalOptimumAgainstBruteForce) {
     std::mt19937 rng(20170501);
+    size_t exact = 0;
     for (int trial = 0; trial < 300; ++trial) {
         const size_t n = 2 + trial % 7;  // 2..8 units
         const std::vector<Arc> arcs = random_graph(rng, n);
@@ -328,23 +355,64 @@ TEST(Sifting, NeverRaisesTheCostAndEndsAtALocalOptimumAgainstBruteForce) {
         std::vector<uint32_t> sorted = order;
         std::sort(sorted.begin(), sorted.end());
         for (size_t i = 0; i < n; ++i) ASSERT_EQ(sorted[i], i);  // still a permutation
+        ASSERT_EQ(after, count_feedback_arcs(order.data(), n, arcs.data(), arcs.size()).weight) << "trial " << trial;
         ASSERT_EQ(after, cost(order, arcs));
         ASSERT_LE(after, before);
-        ASSERT_GE(after, best_cost(n, arcs));
+        const uint64_t best = best_cost(n, arcs);
+        ASSERT_GE(after, best);
+        if (n <= 3) {
+            ASSERT_EQ(after, best) << "trial " << trial << ": a local optimum of " << n << " units is the optimum";
+            ++exact;
+        }
         // No single move (remove a unit, insert it anywhere) lowers the cost any more.
-        for (size_t from = 0; from < n; ++from)
-            for (size_t to = 0; to < n; ++to) {
-                std::vector<uint32_t> moved = order;
-                const uint32_t u = moved[from];
-                moved.erase(moved.begin() + long(from));
-                moved.insert(moved.begin() + long(to), u);
-                ASSERT_GE(cost(moved, arcs), after) << "trial " << trial;
-            }
+        ASSERT_TRUE(no_single_move_lowers(order, arcs, after)) << "trial " << trial;
         // The whole step is never worse than the greedy order nor than its start.
         MeasuredOrderStats stats;
         measured_unit_order(n, arcs.data(), arcs.size(), nullptr, order.data(), &stats);
         ASSERT_LE(stats.final_weight, stats.greedy_weight);
         ASSERT_LE(stats.final_weight, after);
+    }
+    EXPECT_EQ(exact, 86u);  // 43 trials of 2 units and 43 of 3, each compared with the optimum
+}
+
+// Sifting on graphs worked by hand: the order it leaves, its weight, and the brute-force optimum.
+TEST(Sifting, HandWorkedGraphsEndWhereTheStatementSays) {
+    // A 3-cycle 0→1 (3), 1→2 (2), 2→0 (1) from its worst order 2 1 0 (weight 5). Pass 1: unit 0
+    // moves left past 1 (−3; past 2 as well would be −2): 2 0 1, weight 2; unit 1 gains nothing;
+    // unit 2 moves right past 0 and 1 (+1 − 2 = −1): 0 1 2, weight 1, the lightest arc backward.
+    // Pass 2 moves nothing. The optimum (n = 3, as above).
+    {
+        const std::vector<Arc> arcs = {{0, 1, 3}, {1, 2, 2}, {2, 0, 1}};
+        std::vector<uint32_t> order = {2, 1, 0};
+        ASSERT_EQ(cost(order, arcs), 5u);
+        EXPECT_EQ(sift_order(order.data(), 3, arcs.data(), arcs.size(), nullptr), 1u);
+        EXPECT_EQ(order, (std::vector<uint32_t>{0, 1, 2}));
+        EXPECT_EQ(best_cost(3, arcs), 1u);
+    }
+    // A unit moves only when the cost drops strictly. The cycle 0→1→3→0 (weights 1) and 2→3 (1)
+    // in the optimal order 0 1 2 3 (weight 1, 3→0 backward): moving 0 to the end, past 1 and 3,
+    // ties (+1 − 1) and no move gains, so nothing moves. (Moving on ties, the cycle's units would
+    // go round it pass after pass and end elsewhere: 2 0 1 3.)
+    {
+        const std::vector<Arc> arcs = {{0, 1, 1}, {1, 3, 1}, {3, 0, 1}, {2, 3, 1}};
+        std::vector<uint32_t> order = {0, 1, 2, 3};
+        EXPECT_EQ(sift_order(order.data(), 4, arcs.data(), arcs.size(), nullptr), 1u);
+        EXPECT_EQ(order, (std::vector<uint32_t>{0, 1, 2, 3}));
+        EXPECT_EQ(best_cost(4, arcs), 1u);
+    }
+    // Local, not global: the acyclic 2→3 (10), 3→0 (1), 0→1 (10) in the order 0 1 2 3 has one
+    // backward arc, 3→0 (weight 1). Fixing it by one move drags a heavy arc backward with it (0
+    // after 1, or 3 before 2: +10 − 1), and moving 1 or 2 alone changes nothing, so sifting
+    // stays there although 2 3 0 1 has no backward arc.
+    {
+        const std::vector<Arc> arcs = {{2, 3, 10}, {3, 0, 1}, {0, 1, 10}};
+        std::vector<uint32_t> order = {0, 1, 2, 3};
+        EXPECT_EQ(sift_order(order.data(), 4, arcs.data(), arcs.size(), nullptr), 1u);
+        EXPECT_EQ(order, (std::vector<uint32_t>{0, 1, 2, 3}));
+        EXPECT_TRUE(no_single_move_lowers(order, arcs, 1));
+        EXPECT_EQ(best_cost(4, arcs), 0u);
+        const std::vector<uint32_t> best = {2, 3, 0, 1};
+        EXPECT_EQ(cost(best, arcs), 0u);
     }
 }
 

@@ -1,6 +1,6 @@
-// Small helpers shared by the tests that read files and run programs: reading a file whole,
-// counting lines, a scratch folder per test, running a command with its output captured, and the
-// Khronos glTF validator.
+// Small helpers shared by the tests that read files and run programs: reading a file whole (and
+// one that must be there, to compare it), counting lines, a scratch folder per test, running a
+// command with its output captured, and the Khronos glTF validator.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -21,6 +21,21 @@ inline std::string slurp(const std::filesystem::path& path) {
     std::stringstream ss;
     ss << in.rdbuf();
     return ss.str();
+}
+
+// The bytes of `path`, for a test that compares them: the test fails (at the caller's line, naming
+// the path) when the file is missing or empty, since slurp's "" for an absent file would compare
+// equal to another absent file's. A missing file reads as a text naming it, never as "".
+inline std::string slurp_existing(const std::filesystem::path& path, const char* file = __builtin_FILE(),
+                                  int line = __builtin_LINE()) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) {
+        ADD_FAILURE_AT(file, line) << path.string() << " is missing (or not a regular file)";
+        return "(missing file " + path.string() + ")";
+    }
+    std::string bytes = slurp(path);
+    if (bytes.empty()) ADD_FAILURE_AT(file, line) << path.string() << " is empty";
+    return bytes;
 }
 
 inline size_t line_count(const std::string& text) {

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -19,6 +20,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -57,6 +59,22 @@ protected:
     }
 };
 
+// Starts `argv` (argv[0] the executable) in `folder`, its stdout and stderr into `log`, without
+// waiting for it: its pid, or -1 when it cannot be started (the child's failure to open the log or
+// run the program shows as exit code 126 or 127).
+pid_t start_in(const fs::path& folder, const std::vector<std::string>& argv, const fs::path& log) {
+    std::vector<char*> args;
+    for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+    args.push_back(nullptr);
+    const std::string where = folder.string(), log_path = log.string();
+    const pid_t child = fork();
+    if (child != 0) return child;
+    const int fd = ::open(log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd < 0 || ::chdir(where.c_str()) != 0 || dup2(fd, 1) < 0 || dup2(fd, 2) < 0) _exit(126);
+    ::execv(args[0], args.data());
+    _exit(127);
+}
+
 // Five items over the bundled character: single per clip, joint, two static methods.
 const char* kFiveItems = R"({"items": [
   {"name": "walk-single", "clips": ["walk"], "options": "-k 2 --views 12 --resolution 32 --max-iterations 2", "output": "out/walk"},
@@ -73,16 +91,16 @@ TEST_F(Batch, ThreeParallelShardsGiveTheFilesAndSummaryOfOneRun) {
     const test::Outcome one = run("batch -q --no-timings" + kEval + " " + manifest());
     ASSERT_EQ(one.exit_code, 0) << one.err;
     const std::map<std::string, std::string> single_run = outputs();
-    const std::string summary_json = test::slurp(path("m.summary.json")),
-                      summary_md = test::slurp(path("m.summary.md"));
+    const std::string summary_json = test::slurp_existing(path("m.summary.json")),
+                      summary_md = test::slurp_existing(path("m.summary.md"));
     ASSERT_EQ(single_run.size(), 5u * 3u);  // sidecar, its description and the item report each
     for (const auto& [name, bytes] : single_run) EXPECT_NE(name[0], '.') << name << ": a temporary was left";
 
     // Each item's files are exactly what `animorder optimize` writes alone with the same options.
     ASSERT_EQ(run("optimize -q --clip walk " + kFast + " -o " + path("alone").string()).exit_code, 0);
-    EXPECT_EQ(test::slurp(path("alone.animorder.bin")), single_run.at("walk.animorder.bin"));
+    EXPECT_EQ(test::slurp_existing(path("alone.animorder.bin")), single_run.at("walk.animorder.bin"));
     ASSERT_EQ(run("optimize -q --method joint " + kFast + " -o " + path("alone-joint").string()).exit_code, 0);
-    EXPECT_EQ(test::slurp(path("alone-joint.animorder.bin")), single_run.at("joint.animorder.bin"));
+    EXPECT_EQ(test::slurp_existing(path("alone-joint.animorder.bin")), single_run.at("joint.animorder.bin"));
 
     // The summary's numbers: the input order's ACMR from inspect, the triangles, the clips, the
     // buffers of single (k per clip) and joint (k), the index bytes those buffers add.
@@ -110,12 +128,24 @@ TEST_F(Batch, ThreeParallelShardsGiveTheFilesAndSummaryOfOneRun) {
     for (const auto& e : fs::directory_iterator(path("out"))) fs::remove(e.path());
     fs::remove(path("m.summary.json"));
     fs::remove(path("m.summary.md"));
-    std::string parallel;
-    for (int i = 0; i < 3; ++i)
-        parallel += std::string(ANIMORDER_EXE) + " batch -q --no-timings" + kEval + " --shard " + std::to_string(i) +
-                    "/3 " + manifest() + " > " + path("shard" + std::to_string(i) + ".txt").string() + " 2>&1 & ";
-    const int status = std::system(("cd " + dir_.string() + " && " + parallel + "wait").c_str());
-    ASSERT_EQ(WEXITSTATUS(status), 0);
+    // Each shard a process of its own, all three started before any is waited for, and each one's
+    // exit status checked (a shell's `A & B & C & wait` exits 0 whatever they do).
+    pid_t shards[3];
+    for (int i = 0; i < 3; ++i) {
+        std::vector<std::string> args = {ANIMORDER_EXE, "batch", "-q", "--no-timings"};
+        std::istringstream eval(kEval);
+        for (std::string word; eval >> word;) args.push_back(word);
+        args.insert(args.end(), {"--shard", std::to_string(i) + "/3", manifest()});
+        shards[i] = start_in(dir_, args, path("shard" + std::to_string(i) + ".txt"));
+        ASSERT_GT(shards[i], 0) << "cannot start shard " << i;
+    }
+    int statuses[3] = {-1, -1, -1};
+    for (int i = 0; i < 3; ++i) EXPECT_EQ(waitpid(shards[i], &statuses[i], 0), shards[i]) << "shard " << i;
+    for (int i = 0; i < 3; ++i) {
+        const std::string log = test::slurp(path("shard" + std::to_string(i) + ".txt"));
+        ASSERT_TRUE(WIFEXITED(statuses[i])) << "shard " << i << " did not exit: " << log;
+        ASSERT_EQ(WEXITSTATUS(statuses[i]), 0) << "shard " << i << ": " << log;
+    }
     EXPECT_NE(test::slurp(path("shard0.txt")).find("shard 0/3: 2 items: 2 done"), std::string::npos)
         << test::slurp(path("shard0.txt"));
     EXPECT_NE(test::slurp(path("shard2.txt")).find("shard 2/3: 1 items: 1 done"), std::string::npos)
@@ -124,8 +154,8 @@ TEST_F(Batch, ThreeParallelShardsGiveTheFilesAndSummaryOfOneRun) {
     const test::Outcome merge = run("batch -q --merge --no-timings" + kEval + " " + manifest());
     ASSERT_EQ(merge.exit_code, 0) << merge.err;
     EXPECT_EQ(outputs(), single_run);
-    EXPECT_EQ(test::slurp(path("m.summary.json")), summary_json);
-    EXPECT_EQ(test::slurp(path("m.summary.md")), summary_md);
+    EXPECT_EQ(test::slurp_existing(path("m.summary.json")), summary_json);
+    EXPECT_EQ(test::slurp_existing(path("m.summary.md")), summary_md);
 
     // The shard index from a farm's environment.
     const test::Outcome k8s = test::run_captured("env JOB_COMPLETION_INDEX=1 " + std::string(ANIMORDER_EXE) +
@@ -150,7 +180,7 @@ TEST_F(Batch, CsvManifestIsTheJsonManifest) {
     ASSERT_EQ(run("batch -q --eval-views 0 " + manifest()).exit_code, 0);
     const test::Outcome csv = run("batch -q --eval-views 0 " + path("m.csv").string());
     ASSERT_EQ(csv.exit_code, 0) << csv.err;
-    EXPECT_EQ(test::slurp(path("out/a.animorder.bin")), test::slurp(path("out/b.animorder.bin")));
+    EXPECT_EQ(test::slurp_existing(path("out/a.animorder.bin")), test::slurp_existing(path("out/b.animorder.bin")));
     const nlohmann::json s = nlohmann::json::parse(test::slurp(path("m.summary.json")));
     EXPECT_TRUE(s["items"][0]["ovr_after"].is_null());  // --eval-views 0
 }
@@ -188,7 +218,7 @@ TEST_F(Batch, KilledRunResumesWithoutRedoingFinishedItems) {
         const bool report = fs::exists(stem + ".animorder.report.json");
         if (report) {
             EXPECT_TRUE(fs::exists(stem + ".animorder.bin") && fs::exists(stem + ".animorder.json")) << stem;
-            reports[stem] = test::slurp(stem + ".animorder.report.json");
+            reports[stem] = test::slurp_existing(stem + ".animorder.report.json");
             ++finished;
         }
     }
@@ -201,7 +231,7 @@ TEST_F(Batch, KilledRunResumesWithoutRedoingFinishedItems) {
               std::string::npos)
         << again.out;
     for (const auto& [stem, bytes] : reports)  // wall times included: a redone item would differ
-        EXPECT_EQ(test::slurp(stem + ".animorder.report.json"), bytes) << stem;
+        EXPECT_EQ(test::slurp_existing(stem + ".animorder.report.json"), bytes) << stem;
     for (const auto& [name, bytes] : outputs())
         EXPECT_NE(name[0], '.') << name << ": the killed run's temporary remains";
     const nlohmann::json s = nlohmann::json::parse(test::slurp(path("m.summary.json")));
@@ -455,7 +485,7 @@ TEST_F(Batch, HostileFilesNeitherHangTheRunNorGetReplaced) {
     const test::Outcome optimize = run_from(dir_, "optimize -q --method original s.gltf -o s.glb", dir_);
     EXPECT_EQ(optimize.exit_code, 1);
     EXPECT_NE(optimize.err.find("s.animorder.bin: is an input of this run"), std::string::npos) << optimize.err;
-    EXPECT_EQ(test::slurp(path("s.animorder.bin")), triangle_bytes(0));
+    EXPECT_EQ(test::slurp_existing(path("s.animorder.bin")), triangle_bytes(0));
     EXPECT_FALSE(fs::exists(path("s.glb")));
 }
 
@@ -481,10 +511,10 @@ TEST_F(Batch, AChangedBufferOrMaterialFileRerunsItsItem) {
 
     write("my buf.bin", triangle_bytes(0.5f));
     EXPECT_NE(run(batch).out.find("2 items: 1 done, 1 up to date"), std::string::npos);
-    const std::string opaque = test::slurp(path("out/quad.animorder.bin"));
+    const std::string opaque = test::slurp_existing(path("out/quad.animorder.bin"));
     write("quad.mtl", "newmtl skin\nKd 1 0 0\nd 0.5\n");  // now blended: the sidecar flags it
     EXPECT_NE(run(batch).out.find("2 items: 1 done, 1 up to date"), std::string::npos);
-    EXPECT_NE(test::slurp(path("out/quad.animorder.bin")), opaque);
+    EXPECT_NE(test::slurp_existing(path("out/quad.animorder.bin")), opaque);
 }
 
 // A manifest reached by another spelling of its path, a report edited by hand, a folder named
@@ -517,14 +547,15 @@ TEST_F(Batch, SpellingsEditsAndThreadCountsDoNotChangeWhatIsUpToDate) {
                       .exit_code,
                   0);
         for (const auto& e : fs::directory_iterator(path("lib/out")))
-            files[t][e.path().filename().string()] = test::slurp(e.path());
+            files[t][e.path().filename().string()] = test::slurp_existing(e.path());
     }
+    EXPECT_EQ(files[0].count("walk.animorder.bin"), 1u) << "no sidecar to compare";
     EXPECT_EQ(files[0], files[1]);
     // The reports name the paths as the manifest writes them: the same bytes from another folder.
     ASSERT_EQ(run_from(path("lib"), "batch " + flags + "--force --threads 1 m.json", dir_).exit_code, 0);
     std::map<std::string, std::string> from_lib;
     for (const auto& e : fs::directory_iterator(path("lib/out")))
-        from_lib[e.path().filename().string()] = test::slurp(e.path());
+        from_lib[e.path().filename().string()] = test::slurp_existing(e.path());
     EXPECT_EQ(from_lib, files[0]);
     EXPECT_NE(from_lib["walk.animorder.report.json"].find(R"("sidecar": "out/walk.animorder.bin")"), std::string::npos)
         << from_lib["walk.animorder.report.json"];
@@ -764,8 +795,8 @@ TEST_F(Batch, ADamagedOutputIsRedoneNotTakenAsUpToDate) {
                         {"name": "orig", "method": "original", "output": "out/orig"}]})");
     const std::string args = "batch -q --eval-views 0 --no-timings " + manifest();
     ASSERT_EQ(run(args).exit_code, 0);
-    const std::string bin = test::slurp(path("out/walk.animorder.bin")),
-                      json = test::slurp(path("out/orig.animorder.json"));
+    const std::string bin = test::slurp_existing(path("out/walk.animorder.bin")),
+                      json = test::slurp_existing(path("out/orig.animorder.json"));
     write("out/walk.animorder.bin", "");
     std::string changed = json;
     changed[changed.size() / 2] ^= 1;  // the same size, one bit off
@@ -773,8 +804,8 @@ TEST_F(Batch, ADamagedOutputIsRedoneNotTakenAsUpToDate) {
     const test::Outcome again = run(args);
     EXPECT_EQ(again.exit_code, 0) << again.err;
     EXPECT_NE(again.out.find("2 done, 0 up to date"), std::string::npos) << again.out;
-    EXPECT_EQ(test::slurp(path("out/walk.animorder.bin")), bin);
-    EXPECT_EQ(test::slurp(path("out/orig.animorder.json")), json);
+    EXPECT_EQ(test::slurp_existing(path("out/walk.animorder.bin")), bin);
+    EXPECT_EQ(test::slurp_existing(path("out/orig.animorder.json")), json);
     EXPECT_NE(run(args).out.find("0 done, 2 up to date"), std::string::npos);
 }
 
@@ -784,11 +815,11 @@ TEST_F(Batch, ADamagedOutputIsRedoneNotTakenAsUpToDate) {
 // date again and its error file goes.
 TEST_F(Batch, AnItemThatFailsNowIsFailedInTheSummaryAndItsErrorGoesOnceUpToDate) {
     ASSERT_EQ(run("subdivide -q --levels 0 --clip walk -o " + path("in.glb").string()).exit_code, 0);
-    const std::string input = test::slurp(path("in.glb"));
+    const std::string input = test::slurp_existing(path("in.glb"));
     write("m.json", R"({"items": [{"name": "slow", "input": "in.glb",
                   "options": "-k 3 --views 42 --resolution 64 --max-iterations 3", "output": "out/slow"}]})");
     ASSERT_EQ(run("batch -q --eval-views 0 " + manifest()).exit_code, 0);
-    const std::string bin = test::slurp(path("out/slow.animorder.bin"));
+    const std::string bin = test::slurp_existing(path("out/slow.animorder.bin"));
 
     // --force, and the input edited once the item runs (after its stamp: the "running" line).
     const pid_t child = fork();
@@ -817,7 +848,7 @@ TEST_F(Batch, AnItemThatFailsNowIsFailedInTheSummaryAndItsErrorGoesOnceUpToDate)
     EXPECT_EQ(s["failed"], 1) << s;
     EXPECT_EQ(s["items"][0]["status"], "failed");
     EXPECT_FALSE(s["items"][0]["error"].get<std::string>().empty());
-    EXPECT_EQ(test::slurp(path("out/slow.animorder.bin")), bin) << "the earlier result was replaced";
+    EXPECT_EQ(test::slurp_existing(path("out/slow.animorder.bin")), bin) << "the earlier result was replaced";
     EXPECT_TRUE(fs::exists(path("out/slow.animorder.error.json")));
 
     write("in.glb", input);
@@ -849,12 +880,12 @@ TEST_F(Batch, AFailedRowIsTheSameFromAnyFolderAndSummaryTakesItsJsonName) {
                                       {"method": "original", "output": "out/b"}]})");
     const std::string options = " -q --no-timings --eval-views 0 --threads 1 ";
     EXPECT_EQ(run_from(path("lib"), "batch" + options + "m.json", dir_).exit_code, 3);
-    const std::string from_lib = test::slurp(path("lib/m.summary.json"));
+    const std::string from_lib = test::slurp_existing(path("lib/m.summary.json"));
     EXPECT_NE(from_lib.find("missing.glb"), std::string::npos) << from_lib;
     EXPECT_EQ(run_from(dir_, "batch" + options + "lib/m.json", dir_).exit_code, 3);
-    EXPECT_EQ(test::slurp(path("lib/m.summary.json")), from_lib);
+    EXPECT_EQ(test::slurp_existing(path("lib/m.summary.json")), from_lib);
     EXPECT_EQ(run_from(dir_, "batch" + options + "--merge --summary lib/s.json lib/m.json", dir_).exit_code, 3);
-    EXPECT_EQ(test::slurp(path("lib/s.json")), from_lib);
+    EXPECT_EQ(test::slurp_existing(path("lib/s.json")), from_lib);
     EXPECT_TRUE(fs::exists(path("lib/s.md")));
     EXPECT_FALSE(fs::exists(path("lib/s.json.json")));
 }
@@ -968,7 +999,7 @@ TEST_F(Batch, AReportIsTheSameBytesFromAnyFolderWhenTheImporterProbes) {
                                    "output": "out/bob"}]})");
     const std::string report = path("out/bob.animorder.report.json").string();
     ASSERT_EQ(run_from(dir_, "batch -q --eval-views 0 --no-timings m.json", dir_).exit_code, 0);
-    const std::string first = test::slurp(report);
+    const std::string first = test::slurp_existing(report);
     const nlohmann::json side = nlohmann::json::parse(first)["batch"]["side_files"];
     ASSERT_EQ(side.size(), 1u) << side;  // the anim beside the mesh, looked for and missing
     EXPECT_EQ(side[0]["file"], "../chars/Bob.md5anim");
@@ -976,7 +1007,7 @@ TEST_F(Batch, AReportIsTheSameBytesFromAnyFolderWhenTheImporterProbes) {
         const test::Outcome o = run_from(spelling == manifest() ? fs::path("/") : dir_,
                                          "batch -q --eval-views 0 --no-timings --force '" + spelling + "'", dir_);
         ASSERT_EQ(o.exit_code, 0) << o.err;
-        EXPECT_EQ(test::slurp(report), first) << spelling;
+        EXPECT_EQ(test::slurp_existing(report), first) << spelling;
     }
 }
 

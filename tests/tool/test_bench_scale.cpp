@@ -1,6 +1,7 @@
 // bench_scale --baseline end to end, on its smoke settings (--quick): a build compared with itself
 // writes the same buffers (the single-sided Xbot copy included) and leaves nothing in the temporary
-// folder; a baseline that fails, and bad options, give exit code 1 and a line saying why.
+// folder, a baseline that writes other buffers is said to differ; a baseline that fails, and bad
+// options, give exit code 1 and a line saying why.
 #include <gtest/gtest.h>
 
 #include "support/files.h"
@@ -9,6 +10,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -51,6 +53,46 @@ TEST_F(BenchScale, ABuildAgainstItselfWritesTheSameBuffers) {
     EXPECT_NE(o.out.find("xbot-single-sided speed-up "), std::string::npos) << o.out;
     EXPECT_NE(o.out.find("(the goal asks 2.75x: 33 s -> 12.0 s)"), std::string::npos) << o.out;
     EXPECT_TRUE(fs::is_empty(path("tmp"))) << "bench_scale left its scratch folders behind";
+}
+
+// A baseline whose buffers really differ: a wrapper script that runs this build's animorder, then
+// changes the last byte of the sidecar it wrote. bench_scale compares the two builds' .bin files
+// byte for byte: it says "differ" (and, the runs having succeeded, still exits 0: the comparison
+// is reported, not a failure). A baseline that succeeds without writing a sidecar is "not found".
+TEST_F(BenchScale, ABaselineWithOtherBuffersIsSaidToDiffer) {
+    ANIMORDER_REQUIRE_OR_SKIP("data", fs::exists(kData / "mixamo-ganfaul" / "Ganfaul.gltf"),
+                              (kData / "mixamo-ganfaul" / "Ganfaul.gltf").string() + " is absent");
+    const fs::path altering = path("altering-baseline.sh");
+    std::ofstream(altering) << "#!/bin/sh\n"
+                            << "'" << ANIMORDER_EXE << "' \"$@\" || exit $?\n"
+                            << "out=\n"
+                            << "while [ $# -gt 0 ]; do [ \"$1\" = -o ] && out=$2; shift; done\n"
+                            << "f=\"$out.animorder.bin\"\n"
+                            << "[ -s \"$f\" ] || exit 3\n"
+                            << "at=$(( $(wc -c < \"$f\") - 1 ))\n"
+                            << "old=$(od -An -tu1 -j \"$at\" -N1 \"$f\" | tr -d ' ')\n"
+                            << "if [ \"$old\" = 65 ]; then new='\\102'; else new='\\101'; fi\n"  // 'B' or 'A'
+                            << "printf \"$new\" | dd of=\"$f\" bs=1 seek=\"$at\" conv=notrunc 2>/dev/null\n";
+    fs::permissions(altering, fs::perms::owner_all);
+    const test::Outcome o = run("--quick --baseline " + altering.string() + " clip60-single");
+    EXPECT_EQ(o.exit_code, 0) << o.out << o.err;
+    EXPECT_EQ(count(o.out, "this build  wall"), 1u) << o.out;
+    EXPECT_EQ(count(o.out, "baseline    wall"), 1u) << o.out;
+    EXPECT_EQ(count(o.out, "(fastest of 1; " + altering.string() + ")"), 1u) << o.out;
+    EXPECT_EQ(count(o.out, "buffers differ"), 1u) << o.out;
+    EXPECT_EQ(count(o.out, "buffers identical"), 0u) << o.out;
+    EXPECT_TRUE(fs::is_empty(path("tmp"))) << "bench_scale left its scratch folders behind";
+
+    // A baseline that exits 0 and writes nothing.
+    const fs::path silent = path("silent-baseline.sh");
+    std::ofstream(silent) << "#!/bin/sh\nexit 0\n";
+    fs::permissions(silent, fs::perms::owner_all);
+    const test::Outcome none = run("--quick --baseline " + silent.string() + " clip60-single");
+    EXPECT_EQ(none.exit_code, 0) << none.out << none.err;
+    EXPECT_EQ(count(none.out, "buffers not found (no .animorder.bin)"), 1u) << none.out;
+    EXPECT_EQ(count(none.out, "buffers differ"), 0u) << none.out;
+    EXPECT_EQ(count(none.out, "buffers identical"), 0u) << none.out;
+    EXPECT_TRUE(fs::is_empty(path("tmp")));
 }
 
 TEST_F(BenchScale, EachRoundsRatioAndTheirMedianAreThePrintedTimes) {

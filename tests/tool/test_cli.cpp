@@ -10,11 +10,14 @@
 #include "support/require.h"
 
 #include <arpa/inet.h>
+#include <fcntl.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #include <algorithm>
+#include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -22,6 +25,8 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
+#include <utility>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -116,8 +121,8 @@ TEST_F(Cli, TheReadmesHeatmapsAreWhatTheirCommandDraws) {
         const test::Outcome o =
             run(std::string("heatmap -q --order ") + order + " --frame 55 --view 5,3,-10 --resolution 384 -o " + png);
         ASSERT_EQ(o.exit_code, 0) << o.err;
-        EXPECT_TRUE(test::slurp(png) ==
-                    test::slurp(fs::path(ANIMORDER_SOURCE_DIR) / "docs" / ("heatmap-" + std::string(order) + ".png")))
+        EXPECT_TRUE(test::slurp_existing(png) == test::slurp_existing(fs::path(ANIMORDER_SOURCE_DIR) / "docs" /
+                                                                      ("heatmap-" + std::string(order) + ".png")))
             << order << ": docs/heatmap-" << order << ".png is not what the command draws now";
     }
 }
@@ -125,7 +130,8 @@ TEST_F(Cli, TheReadmesHeatmapsAreWhatTheirCommandDraws) {
 namespace {
 // Every figure of the manual's sample report (`sample`, "..." standing for what it leaves out)
 // against a real report: keys present, integers, strings and flags equal, decimals to the places
-// shown (within 0.005), times and output paths only present (they vary by machine and folder).
+// shown (within 0.005), arrays at least as long as the sample's (as long, where it shows every
+// entry), times and output paths only present (they vary by machine and folder).
 void expect_sample_matches(const nlohmann::json& sample, const nlohmann::json& actual, const std::string& where) {
     if (sample.is_object()) {
         ASSERT_TRUE(actual.is_object()) << where;
@@ -139,9 +145,23 @@ void expect_sample_matches(const nlohmann::json& sample, const nlohmann::json& a
         }
     } else if (sample.is_array()) {
         ASSERT_TRUE(actual.is_array()) << where;
-        for (size_t i = 0; i < sample.size(); ++i)
-            if (sample[i] != "..." && i < actual.size())
-                expect_sample_matches(sample[i], actual[i], where + "[" + std::to_string(i) + "]");
+        // The report has every entry the sample shows ("..." stands for entries left out, none or
+        // more): at least as many, none at all only where the sample's array is empty, and exactly
+        // as many where the sample leaves nothing out.
+        size_t shown = 0;
+        for (const nlohmann::json& entry : sample) shown += entry != "...";
+        ASSERT_GE(actual.size(), shown) << where << ": entries in the sample: " << shown;
+        if (!sample.empty()) {
+            ASSERT_FALSE(actual.empty()) << where << " is empty, not in the sample";
+        }
+        if (shown == sample.size()) {
+            EXPECT_EQ(actual.size(), sample.size()) << where << ": the sample shows the whole array";
+        }
+        for (size_t i = 0; i < sample.size(); ++i) {
+            if (sample[i] == "...") continue;
+            ASSERT_LT(i, actual.size()) << where << "[" << i << "] is not in the report";
+            expect_sample_matches(sample[i], actual[i], where + "[" + std::to_string(i) + "]");
+        }
     } else if (sample.is_number_float()) {
         ASSERT_TRUE(actual.is_number()) << where;
         EXPECT_NEAR(actual.get<double>(), sample.get<double>(), 0.005 + 1e-9) << where;
@@ -228,7 +248,7 @@ TEST_F(Cli, OptimizeWritesIndicesAndReport) {
 TEST_F(Cli, OptimizeIsByteDeterministic) {
     ASSERT_EQ(run("optimize -q -o " + path("a").string()).exit_code, 0);
     ASSERT_EQ(run("optimize -q -o " + path("b").string()).exit_code, 0);
-    EXPECT_EQ(test::slurp(path("a.animorder.bin")), test::slurp(path("b.animorder.bin")));
+    EXPECT_EQ(test::slurp_existing(path("a.animorder.bin")), test::slurp_existing(path("b.animorder.bin")));
 }
 
 TEST_F(Cli, SingleWritesKBuffersPerClipAndReportsIterations) {
@@ -239,8 +259,8 @@ TEST_F(Cli, SingleWritesKBuffersPerClipAndReportsIterations) {
                   .exit_code,
               0);
     ASSERT_EQ(run("optimize --method single" + fast + " --threads 2 -o " + path("s2").string()).exit_code, 0);
-    EXPECT_EQ(test::slurp(path("s1.animorder.bin")),
-              test::slurp(path("s2.animorder.bin")));  // thread count changes nothing
+    EXPECT_EQ(test::slurp_existing(path("s1.animorder.bin")),
+              test::slurp_existing(path("s2.animorder.bin")));  // thread count changes nothing
     const nlohmann::json j = nlohmann::json::parse(test::slurp(path("r.json")));
     const nlohmann::json& m = j["methods"][0];
     EXPECT_EQ(m["name"], "single");
@@ -264,7 +284,7 @@ TEST_F(Cli, MeasuredOptimizesJointAndEvaluates) {
                   .exit_code,
               0);
     ASSERT_EQ(run("optimize --method measured" + fast + " --threads 2 -o " + path("m2").string()).exit_code, 0);
-    EXPECT_EQ(test::slurp(path("m1.animorder.bin")), test::slurp(path("m2.animorder.bin")));
+    EXPECT_EQ(test::slurp_existing(path("m1.animorder.bin")), test::slurp_existing(path("m2.animorder.bin")));
     const nlohmann::json j = nlohmann::json::parse(test::slurp(path("r.json")));
     EXPECT_EQ(j["methods"][0]["name"], "measured");
     EXPECT_EQ(j["methods"][0]["buffers"], 6);  // 3 per clip, 2 clips
@@ -772,8 +792,8 @@ TEST_F(Cli, Nehab06RunsInOptimizeAndEvaluateAndBeatsTheOriginalOrder) {
                   .exit_code,
               0);
     ASSERT_EQ(run("optimize --method static-nehab06" + fast + " --threads 2 -o " + path("n2").string()).exit_code, 0);
-    EXPECT_EQ(test::slurp(path("n1.animorder.bin")),
-              test::slurp(path("n2.animorder.bin")));  // thread count changes nothing
+    EXPECT_EQ(test::slurp_existing(path("n1.animorder.bin")),
+              test::slurp_existing(path("n2.animorder.bin")));  // thread count changes nothing
     const nlohmann::json j = nlohmann::json::parse(test::slurp(path("r.json")));
     EXPECT_EQ(j["methods"][0]["name"], "static-nehab06");
     EXPECT_EQ(j["methods"][0]["planar_clusters"], 16 * 4);  // 16 per primitive; the character has 4
@@ -812,16 +832,100 @@ std::string entries_of(const fs::path& folder) {
 // writing it fails with "No space left on device". `exec` keeps the shell's PID ($$), so the link
 // carries the tool's PID. Afterwards the folder must be empty: no temporary (the link is it), no
 // output. Were the temporary named otherwise, the write would succeed and the link stay: a failure too.
+namespace {
+// A process's state letter and parent from /proc/PID/stat ('\0' when there is no such process).
+std::pair<char, pid_t> process_state(pid_t pid) {
+    std::ifstream in("/proc/" + std::to_string(pid) + "/stat");
+    std::string stat;
+    if (!std::getline(in, stat)) return {'\0', 0};
+    const size_t name_end = stat.rfind(')');  // the name, in parentheses, may hold anything
+    if (name_end == std::string::npos) return {'\0', 0};
+    std::istringstream rest(stat.substr(name_end + 1));
+    char state = '\0';
+    long parent = 0;
+    rest >> state >> parent;
+    return {state, pid_t(parent)};
+}
+
+// Whether `pid` is a process still running (a zombie has ended: only its exit status is left).
+bool running(pid_t pid) {
+    const char state = process_state(pid).first;
+    return state != '\0' && state != 'Z' && state != 'X';
+}
+
+// The running children of `parent`.
+std::vector<pid_t> running_children(pid_t parent) {
+    std::vector<pid_t> children;
+    std::error_code error;
+    for (const auto& entry : fs::directory_iterator("/proc", error)) {
+        const std::string name = entry.path().filename().string();
+        if (name.find_first_not_of("0123456789") != std::string::npos) continue;
+        const pid_t pid = pid_t(std::stol(name));
+        const auto [state, its_parent] = process_state(pid);
+        if (its_parent == parent && state != '\0' && state != 'Z' && state != 'X') children.push_back(pid);
+    }
+    return children;
+}
+}  // namespace
+
 // animorder killed while assimp reads a file (here one it loops on) leaves no reader running:
-// the isolated reader dies with it.
+// the isolated reader (a forked child of animorder, isolated_import.h) dies with it. The reader
+// must be seen running, reading the file, before the kill (else nothing was tested), and gone
+// after it.
 TEST_F(Cli, AKilledRunLeavesNoReaderBehind) {
+    ASSERT_TRUE(fs::is_directory("/proc/self")) << "the reader is found through /proc (Linux, as memfd_create)";
     const fs::path ply = path("never-ending-header.ply");
     std::ofstream(ply) << "ply\nformat ascii 1.0\ncomment Created ";
-    // A script, so that no shell's command line names the file: pgrep finds animorder processes only.
-    std::ofstream(path("kill.sh")) << std::string(ANIMORDER_EXE) << " inspect '" << ply.string()
-                                   << "' & sleep 1; kill -9 $!; sleep 1; pgrep -f never-ending-header | wc -l\n";
-    const test::Outcome o = test::run_captured("sh '" + path("kill.sh").string() + "'", dir_);
+    const std::string log = path("inspect.txt").string(), file = ply.string();
+    const pid_t animorder = fork();
+    ASSERT_GE(animorder, 0);
+    if (animorder == 0) {
+        const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        if (fd < 0 || dup2(fd, 1) < 0 || dup2(fd, 2) < 0) _exit(126);
+        execl(ANIMORDER_EXE, ANIMORDER_EXE, "inspect", file.c_str(), static_cast<char*>(nullptr));
+        _exit(127);
+    }
+    // The reader: animorder's child, there while the header is read (the reader's processor-time
+    // limit is 20 s; animorder still running is checked each round).
+    pid_t reader = 0;
+    int status = 0;
+    bool ended = false;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (!reader && std::chrono::steady_clock::now() < deadline) {
+        if (waitpid(animorder, &status, WNOHANG) == animorder) {
+            ended = true;
+            break;
+        }
+        const std::vector<pid_t> children = running_children(animorder);
+        if (!children.empty())
+            reader = children.front();
+        else
+            std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    if (!ended && reader) std::this_thread::sleep_for(std::chrono::milliseconds(300));  // well into the loop
+    const bool alive_before_kill = reader && running(reader);
+    std::string reader_command;
+    if (reader) std::getline(std::ifstream("/proc/" + std::to_string(reader) + "/cmdline"), reader_command);
+    if (!ended) {
+        kill(animorder, SIGKILL);
+        waitpid(animorder, &status, 0);
+    }
+    ASSERT_FALSE(ended) << "animorder ended before the kill: " << test::slurp(log);
+    ASSERT_NE(reader, 0) << "no reader was seen in 60 s: " << test::slurp(log);
+    ASSERT_TRUE(alive_before_kill) << "the reader " << reader << " had ended before the kill";
+    EXPECT_NE(reader_command.find("never-ending-header"), std::string::npos)
+        << "the child seen is not the reader of the file: " << reader_command;
+    // The reader dies with animorder (its parent-death signal), which may take a moment.
+    const auto gone_by = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (running(reader) && std::chrono::steady_clock::now() < gone_by)
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    EXPECT_FALSE(running(reader)) << "the reader " << reader << " outlived the killed animorder";
+    // And no process at all still names the file (the reader, were it another kind of child): a
+    // script, so that no shell's command line names the file.
+    std::ofstream(path("count.sh")) << "pgrep -f never-ending-header | wc -l\n";
+    const test::Outcome o = test::run_captured("sh '" + path("count.sh").string() + "'", dir_);
     EXPECT_EQ(o.out, "0\n") << o.err;
+    if (running(reader)) kill(reader, SIGKILL);  // a reader left behind: ended, now the test has failed
 }
 
 TEST_F(Cli, FailedWriteLeavesNoFileBehind) {
@@ -875,7 +979,7 @@ protected:
         EXPECT_EQ(o.exit_code, 1) << args;
         EXPECT_EQ(test::line_count(o.err), 1u) << args << " → " << o.err;
         EXPECT_NE(o.err.find(what), std::string::npos) << args << " → " << o.err;
-        EXPECT_EQ(test::slurp(path("in.glb")), original_) << args << ": the input changed";
+        EXPECT_EQ(test::slurp_existing(path("in.glb")), original_) << args << ": the input changed";
     }
     std::string original_;
 };
@@ -939,14 +1043,14 @@ TEST_F(CliOutputs, ReapplyOntoEitherInputIsRefused) {
     ASSERT_EQ(
         run("optimize -q --method original " + path("in.glb").string() + " -o " + path("opt.glb").string()).exit_code,
         0);
-    const std::string optimised = test::slurp(path("opt.glb"));
+    const std::string optimised = test::slurp_existing(path("opt.glb"));
     expect_refused(
         "reapply " + path("opt.glb").string() + " " + path("in.glb").string() + " -o " + path("in.glb").string(),
         "in.glb");
     expect_refused(
         "reapply " + path("opt.glb").string() + " " + path("in.glb").string() + " -o " + path("opt.glb").string(),
         "opt.glb");
-    EXPECT_EQ(test::slurp(path("opt.glb")), optimised);
+    EXPECT_EQ(test::slurp_existing(path("opt.glb")), optimised);
 }
 
 // Every subcommand checks its outputs against every file its load reads, not only the file named
@@ -970,7 +1074,7 @@ TEST_F(CliOutputs, NoCommandWritesOverAFileItsLoadReadsOrIntoAClipFolder) {
          {"evaluate " + in + small + " -r " + bin_path, "evaluate " + in + small + " --csv " + bin_path,
           "heatmap " + in + " -o " + bin_path}) {
         expect_refused(args, "in.bin");
-        EXPECT_EQ(test::slurp(path("in.bin")), bin) << args << ": the buffer changed";
+        EXPECT_EQ(test::slurp_existing(path("in.bin")), bin) << args << ": the buffer changed";
     }
     fs::create_directories(path("clips"));
     fs::copy_file(path("in.glb"), path("clips/walk.glb"));

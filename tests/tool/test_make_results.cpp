@@ -479,10 +479,11 @@ TEST_F(MakeResults, OutputIsByteIdenticalAcrossRuns) {
     write_everything();
     ASSERT_EQ(run(dir_ / "in", dir_ / "a").exit_code, 0);
     ASSERT_EQ(run(dir_ / "in", dir_ / "b").exit_code, 0);
-    EXPECT_EQ(test::slurp(dir_ / "a" / "RESULTS.md"), test::slurp(dir_ / "b" / "RESULTS.md"));
+    EXPECT_EQ(test::slurp_existing(dir_ / "a" / "RESULTS.md"), test::slurp_existing(dir_ / "b" / "RESULTS.md"));
     size_t compared = 0;
     for (const auto& entry : fs::directory_iterator(dir_ / "a" / "results")) {
-        EXPECT_EQ(test::slurp(entry.path()), test::slurp(dir_ / "b" / "results" / entry.path().filename()))
+        EXPECT_EQ(test::slurp_existing(entry.path()),
+                  test::slurp_existing(dir_ / "b" / "results" / entry.path().filename()))
             << entry.path();
         ++compared;
     }
@@ -874,10 +875,11 @@ TEST_F(CommittedResults, RegenerateToTheCommittedFiles) {
             (dir_ / "README.md").string() + " " + reports.string() + " " + (dir_ / "docs").string(),
         dir_);
     ASSERT_EQ(o.exit_code, 0) << o.err;
-    EXPECT_TRUE(test::slurp(dir_ / "docs" / "RESULTS.md") == test::slurp(source / "docs" / "RESULTS.md"))
+    EXPECT_TRUE(test::slurp_existing(dir_ / "docs" / "RESULTS.md") ==
+                test::slurp_existing(source / "docs" / "RESULTS.md"))
         << "docs/RESULTS.md differs from what make_results writes from docs/results/reports (diff "
         << (dir_ / "docs" / "RESULTS.md") << "); regenerate it, never edit it";
-    EXPECT_TRUE(test::slurp(dir_ / "README.md") == test::slurp(source / "README.md"))
+    EXPECT_TRUE(test::slurp_existing(dir_ / "README.md") == test::slurp_existing(source / "README.md"))
         << "README.md's generated block differs from what make_results writes from docs/results/reports";
     std::vector<std::string> ours, committed;
     for (const auto& e : fs::directory_iterator(dir_ / "docs" / "results"))
@@ -888,7 +890,8 @@ TEST_F(CommittedResults, RegenerateToTheCommittedFiles) {
     std::sort(committed.begin(), committed.end());
     EXPECT_EQ(ours, committed);
     for (const std::string& svg : ours)
-        EXPECT_TRUE(test::slurp(dir_ / "docs" / "results" / svg) == test::slurp(source / "docs" / "results" / svg))
+        EXPECT_TRUE(test::slurp_existing(dir_ / "docs" / "results" / svg) ==
+                    test::slurp_existing(source / "docs" / "results" / svg))
             << svg;
 }
 

@@ -70,12 +70,12 @@ TEST_F(SubdivideCli, TooManyLevelsIsAClearError) {
 
 TEST_F(SubdivideCli, RefusesToOverwriteTheInputAndOtherExtensions) {
     ASSERT_EQ(run("subdivide -q --levels 1 --clip wave -o " + path("in.glb").string()).exit_code, 0);
-    const std::string before = test::slurp(path("in.glb"));
+    const std::string before = test::slurp_existing(path("in.glb"));
     const test::Outcome same =
         run("subdivide -q " + path("in.glb").string() + " --levels 1 -o " + path("in.glb").string());
     EXPECT_NE(same.exit_code, 0);
     EXPECT_NE(same.err.find("refusing to overwrite the input"), std::string::npos) << same.err;
-    EXPECT_EQ(test::slurp(path("in.glb")), before);
+    EXPECT_EQ(test::slurp_existing(path("in.glb")), before);
     const test::Outcome obj = run("subdivide -q --levels 1 -o " + path("x.obj").string());
     EXPECT_NE(obj.exit_code, 0);
     EXPECT_NE(obj.err.find(".glb or .gltf"), std::string::npos) << obj.err;

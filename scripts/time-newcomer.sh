@@ -22,12 +22,23 @@ demo_goal=180 test_goal=420
 
 if [ "$purge" = 1 ]; then
   # Every package name install-deps.sh lists, as it lists them (one per array entry).
-  mapfile -t packages < <(sed -n '/^tool_packages=(/,/^)/p; /^packages=(/,/^)/p' "$here/scripts/install-deps.sh" |
+  # Every package name install-deps.sh lists that is installed and that a fresh Debian does not
+  # have (not essential or important: apt would refuse to remove util-linux, say, and everything
+  # with it), as install-deps.sh lists them (one per array entry).
+  mapfile -t listed < <(sed -n '/^tool_packages=(/,/^)/p; /^packages=(/,/^)/p' "$here/scripts/install-deps.sh" |
     grep -v '^[a-z_]*=(\|^)' | sed 's/#.*//' | tr ' ' '\n' | grep -v '^$' | grep -v '^build-essential$\|^cmake$\|^pkg-config$')
-  packages+=(gltfpack python3-jsonschema chromium)
+  listed+=(gltfpack python3-jsonschema chromium)
+  packages=()
+  for p in "${listed[@]}"; do
+    fields=$(dpkg-query -W -f='${Status} ${Essential} ${Priority}' "$p" 2>/dev/null || true)
+    case "$fields" in
+      "install ok installed no "*) case "$fields" in *important | *required) ;; *) packages+=("$p") ;; esac ;;
+      "install ok installed "*) ;;  # essential
+    esac
+  done
   echo "time-newcomer: removing ${packages[*]}" >&2
-  DEBIAN_FRONTEND=noninteractive apt-get purge -y -qq "${packages[@]}" >/dev/null 2>&1 || true
-  DEBIAN_FRONTEND=noninteractive apt-get autoremove -y -qq >/dev/null 2>&1 || true
+  DEBIAN_FRONTEND=noninteractive apt-get purge -y -qq "${packages[@]}" >/dev/null
+  DEBIAN_FRONTEND=noninteractive apt-get autoremove -y -qq >/dev/null
   apt-get clean
 fi
 

@@ -24,7 +24,8 @@ here="$(cd "$(dirname "$0")/.." && pwd)"
 data="${FUZZ_DATA:-$here/../shared/data}"
 build="$here/build-fuzz"
 
-command -v clang++ >/dev/null || { echo "fuzz.sh: clang++ not found (scripts/install-deps.sh)" >&2; exit 2; }
+bash "$here/scripts/install-deps.sh" --fuzz
+command -v clang++ >/dev/null || { echo "fuzz.sh: clang++ not found (scripts/install-deps.sh --fuzz)" >&2; exit 2; }
 if [ ! -f "$build/CMakeCache.txt" ]; then
   CC=clang CXX=clang++ cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DANIMORDER_FUZZ=ON \
     -DANIMORDER_BUILD_TESTS=OFF -DANIMORDER_BUILD_BENCHMARKS=OFF >/dev/null

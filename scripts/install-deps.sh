@@ -1,15 +1,17 @@
 #!/usr/bin/env bash
 # Installs the Debian packages animorder needs. Idempotent: packages already present are skipped,
 # and apt is only asked when something is missing.
-#   install-deps.sh          everything: build, tests, benchmarks, fuzzing, the JS and browser tests
+#   install-deps.sh          build, tests, benchmarks, the JS and browser tests (scripts/test.sh)
 #   install-deps.sh --tool   only what the library and the animorder tool need (scripts/demo.sh)
+#   install-deps.sh --fuzz   the tool's packages and clang 14 with its libFuzzer runtime (scripts/fuzz.sh)
 set -euo pipefail
 
 mode=all
 case "${1:-}" in
   "") ;;
   --tool) mode=tool ;;
-  *) echo "install-deps: unknown option '$1' (use --tool, or nothing for everything)" >&2; exit 2 ;;
+  --fuzz) mode=fuzz ;;
+  *) echo "install-deps: unknown option '$1' (use --tool, --fuzz, or nothing)" >&2; exit 2 ;;
 esac
 
 install_missing() {
@@ -37,13 +39,16 @@ tool_packages=(
   libassimp-dev                            # FBX, Collada, .X, .b3d, MD5, ...
 )
 install_missing "${tool_packages[@]}"
+if [ "$mode" = fuzz ]; then
+  install_missing clang libclang-rt-14-dev  # clang 14 and its libFuzzer/ASan runtimes
+  exit 0
+fi
 [ "$mode" = all ] || exit 0
 
 packages=(
   libgtest-dev libgmock-dev                # tests
   libbenchmark-dev                         # benchmarks
   libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri  # OpenGL reference (llvmpipe)
-  clang libclang-rt-14-dev                 # scripts/fuzz.sh: clang 14 and its libFuzzer/ASan runtimes
   strace procps                            # signal tests: strace slows a commit down; pgrep finds the child
   util-linux                               # unshare -p (a PID namespace); essential, so normally present
 )

@@ -49,6 +49,11 @@ struct ClusteringSettings {
     // when the mean node OVR has not improved on its best for this many iterations, and the best
     // iteration's buffers and assignment are returned.
     size_t patience = 4;
+    // Stops ("settled") once an assignment's mean node OVR is not below the previous one's by
+    // this fraction of it (0: never; `measured` uses kMeasuredSettledGain): the measured update
+    // improves its buffers a little at every iteration, and its last dozen iterations move a few
+    // nodes each for a gain in the fifth decimal.
+    double settled_gain = 0;
     DistanceVariant distance = DistanceVariant::Jcgt;
     UpdateRule update = UpdateRule::Monotone;
     OrderSource order = OrderSource::Distance;
@@ -81,7 +86,7 @@ struct ClusteringResult {
     std::vector<uint32_t> assignment;
     std::vector<ClusteringIteration> iterations;
     bool converged = false;            // the last iteration reassigned no node
-    std::string stop_reason;           // "converged", "stalled" (patience ran out), "iteration cap", or
+    std::string stop_reason;           // "converged", "settled" (settled_gain), "stalled" (patience ran out), "iteration cap", or
                                        // "nothing drawn" (every keyframe a point: one buffer, no iteration)
     size_t best_iteration = 0;         // 0-based: the iteration whose buffers and assignment these are
     double seconds_rasterization = 0;  // rasterising every node once (kept for all iterations)

@@ -21,6 +21,23 @@ struct MeshPatches {
 
 MeshPatches build_mesh_patches(const AnimatedMesh& mesh, double lambda, unsigned cache_size = kDefaultCacheSize);
 
+// Each vertex's first vertex (lowest id) at bit-identical coordinates in keyframe 0: the mesh's
+// surface, whatever its vertex buffer splits (flat shading, hard edges, UV seams). A flat-shaded
+// mesh, three vertices per triangle, has about one sixth as many distinct ones.
+std::vector<uint32_t> joined_vertices(const AnimatedMesh& mesh);
+
+// The same patches over the surface rather than the vertex buffer: the vertices joined as
+// joined_vertices says, so faces that share no vertex but a position are neighbours, as they
+// are on screen (on a flat-shaded mesh build_mesh_patches gives one patch per triangle: no face
+// shares a vertex). The cache order inside a patch is Tipsify's over the joined vertices.
+// max_triangles > 0 makes pieces along that cache order: a patch of max_triangles or more cut
+// into the fewest pieces of at most max_triangles, sized as equally as can be, and smaller
+// patches of one primitive that follow each other packed while the pack stays within
+// max_triangles (so at λ >= 3, single-triangle patches, runs of max_triangles). (`measured`'s
+// units on flat-shaded meshes: methods.h.)
+MeshPatches build_welded_patches(const AnimatedMesh& mesh, double lambda, size_t max_triangles = 0,
+                                 unsigned cache_size = kDefaultCacheSize);
+
 // Nehab, Barczak & Sander 2006's planar clusters as the units instead of λ patches (the measured
 // method's alternative units): each primitive's triangles clustered by normal (cluster_by_normals,
 // positions of `keyframe`) into as many clusters as `like` has patches there, each Tipsified on

@@ -234,7 +234,17 @@ struct AnimatedMethodResult {
     double seconds_patches = 0;
 };
 
-// planar_units: the units are build_planar_units' (of keyframe 0), not the λ patches.
+// planar_units: the units are build_planar_units' (of keyframe 0), not the λ patches. The
+// measured order (settings.order Measured) on a flat-shaded mesh — at most half as many distinct
+// positions as vertices (joined_vertices): faces share no vertex, so every λ patch is one
+// triangle, and its graph and sifting grow with the square of the units a pixel sees — takes as
+// its units build_welded_patches' pieces of at most kMeasuredSurfaceUnitTriangles: its time and
+// memory stay near single's, its OVR below (docs/RESULTS.md, issue 46's note). The vertex cache
+// gains nothing from λ there (no vertex is shared: ACMR 3 whatever the order).
+constexpr size_t kMeasuredSurfaceUnitTriangles = 8;
+// `measured`'s ClusteringSettings::settled_gain (unless set): k-means stops once an iteration
+// lowers the mean node OVR by less than this fraction.
+constexpr double kMeasuredSettledGain = 1e-4;
 AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double lambda, unsigned cache_size,
                                     const ClusteringSettings& settings, bool blend_clusters = false,
                                     bool planar_units = false);

@@ -453,11 +453,13 @@ size_t keep_improved_orders(const Nodes& nodes, const std::vector<uint32_t>& ass
 // The stopping rule after an assignment (lines 18–19, "if no cluster assignment has changed"),
 // with two guards the paper does not need: patience (no new best mean OVR for that many
 // iterations: k-means is cycling) and the iteration cap. Empty: go on.
-std::string stop_after_assignment(size_t iteration, const ClusteringIteration& log, size_t best_iteration,
-                                  const ClusteringSettings& settings) {
+std::string stop_after_assignment(size_t iteration, const ClusteringIteration& log, double previous_ovr,
+                                  size_t best_iteration, const ClusteringSettings& settings) {
     const bool settled = iteration > 0 && log.reassigned == 0;
     const bool stalled = iteration >= best_iteration + settings.patience;
     if (settled) return "converged";
+    if (settings.settled_gain > 0 && iteration > 0 && log.mean_ovr > previous_ovr * (1 - settings.settled_gain))
+        return "settled";
     if (stalled) return "stalled";
     if (iteration + 1 >= settings.max_iterations) return "iteration cap";
     return {};
@@ -602,7 +604,8 @@ ClusteringResult cluster_nodes(const AnimatedMesh& mesh, const MeshPatches& patc
             best = {log.mean_ovr, result.patch_orders, result.assignment};
             result.best_iteration = iteration;
         }
-        const std::string stop = stop_after_assignment(iteration, log, result.best_iteration, settings);
+        const double previous_ovr = result.iterations.empty() ? log.mean_ovr : result.iterations.back().mean_ovr;
+        const std::string stop = stop_after_assignment(iteration, log, previous_ovr, result.best_iteration, settings);
         if (!stop.empty()) {
             result.converged = stop == "converged";
             result.stop_reason = stop;

@@ -32,12 +32,13 @@
 namespace animorder {
 namespace {
 
-// Open-addressing table: key (min unit << 32 | max unit) → pixels with min in front, with max
-// in front (signed: nodes are also removed). Linear probing, grown at half load.
+// Open-addressing table: key (min unit << 32 | max unit) → pixels with min in front minus pixels
+// with max in front (signed: nodes are also removed; only the net makes an arc). Linear probing,
+// grown at half load.
 struct PairTable {
     struct Slot {
         uint64_t key = UINT64_MAX;
-        int64_t min_front = 0, max_front = 0;
+        int64_t net = 0;
     };
     std::vector<Slot> slots = std::vector<Slot>(1024);
     size_t used = 0;
@@ -53,15 +54,14 @@ struct PairTable {
         for (size_t i = hash(key) & mask;; i = (i + 1) & mask)
             if (slots[i].key == key || slots[i].key == UINT64_MAX) return slots[i];
     }
-    void add(uint64_t key, int64_t min_front, int64_t max_front) {
+    void add(uint64_t key, int64_t net) {
         if (2 * (used + 1) > slots.size()) grow();
         Slot& s = find(key);
         if (s.key == UINT64_MAX) {
             s.key = key;
             ++used;
         }
-        s.min_front += min_front;
-        s.max_front += max_front;
+        s.net += net;
     }
     void grow() {
         std::vector<Slot> old(slots.size() * 2);
@@ -71,26 +71,28 @@ struct PairTable {
     }
 };
 
-// Counts of pixels where `front` is strictly in front of `back`: a dense matrix or a table.
+// Per pair of units (lo < hi), pixels where lo is strictly in front of hi minus pixels where hi
+// is in front of lo: a dense triangle or a table.
 struct PairCounts {
     size_t units = 0;
-    std::vector<int64_t> dense;  // [front · units + back], when units <= kDenseMeasuredUnits
+    std::vector<int64_t> dense;  // [hi · (hi − 1) / 2 + lo], when units <= kDenseMeasuredUnits
     PairTable sparse;
     explicit PairCounts(size_t unit_count) : units(unit_count) {
-        if (units <= kDenseMeasuredUnits) dense.assign(units * units, 0);
+        if (units <= kDenseMeasuredUnits) dense.assign(units * (units - (units > 0)) / 2, 0);
     }
+    static size_t slot(uint32_t lo, uint32_t hi) { return size_t(hi) * (hi - 1) / 2 + lo; }
     void add(uint32_t front, uint32_t back, int64_t sign) {
-        if (!dense.empty()) {
-            dense[size_t(front) * units + back] += sign;
-        } else {
-            const uint32_t lo = std::min(front, back), hi = std::max(front, back);
-            sparse.add(uint64_t(lo) << 32 | hi, front == lo ? sign : 0, front == lo ? 0 : sign);
-        }
+        const uint32_t lo = std::min(front, back), hi = std::max(front, back);
+        const int64_t net = front == lo ? sign : -sign;
+        if (units <= kDenseMeasuredUnits)
+            dense[slot(lo, hi)] += net;
+        else
+            sparse.add(uint64_t(lo) << 32 | hi, net);
     }
     void merge(const PairCounts& other) {
         for (size_t i = 0; i < dense.size(); ++i) dense[i] += other.dense[i];
         for (const PairTable::Slot& s : other.sparse.slots)
-            if (s.key != UINT64_MAX) sparse.add(s.key, s.min_front, s.max_front);
+            if (s.key != UINT64_MAX) sparse.add(s.key, s.net);
     }
 };
 
@@ -207,32 +209,31 @@ void MeasuredPairCounts::add(const KeptNode* const* nodes, size_t node_count, in
 std::vector<Arc> MeasuredPairCounts::arcs() const {
     const PairCounts& c = state_->counts;
     std::vector<Arc> arcs;
-    auto net = [&](uint32_t lo, uint32_t hi, int64_t min_front, int64_t max_front) {
-        if (min_front > max_front)
-            arcs.push_back({lo, hi, uint64_t(min_front - max_front)});
-        else if (max_front > min_front)
-            arcs.push_back({hi, lo, uint64_t(max_front - min_front)});
+    auto net = [&](uint32_t lo, uint32_t hi, int64_t n) {
+        if (n > 0)
+            arcs.push_back({lo, hi, uint64_t(n)});
+        else if (n < 0)
+            arcs.push_back({hi, lo, uint64_t(-n)});
     };
-    if (!c.dense.empty()) {
+    if (c.units <= kDenseMeasuredUnits) {
         for (uint32_t lo = 0; lo < c.units; ++lo)
-            for (uint32_t hi = lo + 1; hi < c.units; ++hi)
-                net(lo, hi, c.dense[size_t(lo) * c.units + hi], c.dense[size_t(hi) * c.units + lo]);
+            for (uint32_t hi = lo + 1; hi < c.units; ++hi) net(lo, hi, c.dense[PairCounts::slot(lo, hi)]);
     } else {
         // In key order, whatever the table's layout: bucketed by the lower unit, then each
         // bucket (a unit's few hundred pairs at most) sorted by the higher one.
         std::vector<size_t> first(c.units + 1, 0);
         for (const PairTable::Slot& s : c.sparse.slots)
-            if (s.key != UINT64_MAX && s.min_front != s.max_front) ++first[(s.key >> 32) + 1];
+            if (s.key != UINT64_MAX && s.net != 0) ++first[(s.key >> 32) + 1];
         std::partial_sum(first.begin(), first.end(), first.begin());
         std::vector<PairTable::Slot> all(first[c.units]);
         std::vector<size_t> fill(first.begin(), first.end() - 1);
         for (const PairTable::Slot& s : c.sparse.slots)
-            if (s.key != UINT64_MAX && s.min_front != s.max_front) all[fill[s.key >> 32]++] = s;
+            if (s.key != UINT64_MAX && s.net != 0) all[fill[s.key >> 32]++] = s;
         for (size_t lo = 0; lo < c.units; ++lo)
             std::sort(all.begin() + long(first[lo]), all.begin() + long(first[lo + 1]),
                       [](const PairTable::Slot& a, const PairTable::Slot& b) { return a.key < b.key; });
         arcs.reserve(all.size());
-        for (const PairTable::Slot& s : all) net(uint32_t(s.key >> 32), uint32_t(s.key), s.min_front, s.max_front);
+        for (const PairTable::Slot& s : all) net(uint32_t(s.key >> 32), uint32_t(s.key), s.net);
     }
     return arcs;
 }

@@ -18,18 +18,23 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <string>
+#include <unordered_map>
 
 namespace animorder {
 
-MeshPatches build_mesh_patches(const AnimatedMesh& mesh, double lambda, unsigned cache_size) {
-    validate_mesh_topology(mesh);  // Tipsify and the patches read the indices only
+namespace {
+
+// λ patches of every primitive over `indices` (the mesh's, or the same triangles with other
+// vertex ids): Tipsify, then Sander 2007's patch cutting.
+MeshPatches patches_over(const AnimatedMesh& mesh, const uint32_t* indices, double lambda, unsigned cache_size) {
     MeshPatches result;
     result.cache_order.reserve(mesh.triangle_count());
     result.patch_starts.push_back(0);
     for (size_t prim = 0; prim < mesh.primitives.size(); ++prim) {
         const Primitive& primitive = mesh.primitives[prim];
-        const uint32_t* source = mesh.indices.data() + primitive.first_index;
+        const uint32_t* source = indices + primitive.first_index;
         const size_t triangles = primitive.index_count / 3;
         std::vector<uint32_t> order(triangles);
         const TipsifyResult tipsified =
@@ -48,6 +53,78 @@ MeshPatches build_mesh_patches(const AnimatedMesh& mesh, double lambda, unsigned
         }
     }
     return result;
+}
+
+}  // namespace
+
+MeshPatches build_mesh_patches(const AnimatedMesh& mesh, double lambda, unsigned cache_size) {
+    validate_mesh_topology(mesh);  // Tipsify and the patches read the indices only
+    return patches_over(mesh, mesh.indices.data(), lambda, cache_size);
+}
+
+std::vector<uint32_t> joined_vertices(const AnimatedMesh& mesh) {
+    validate_animated_mesh(mesh, std::vector<uint32_t>{0});
+    const float* positions = mesh.keyframe(0);
+    struct Key {
+        uint32_t x, y, z;
+        bool operator==(const Key& o) const { return x == o.x && y == o.y && z == o.z; }
+    };
+    struct Hash {
+        size_t operator()(const Key& k) const {
+            const uint64_t h = (uint64_t(k.x) * 0x9E3779B97F4A7C15ULL) ^ (uint64_t(k.y) * 0xC2B2AE3D27D4EB4FULL) ^
+                               (uint64_t(k.z) * 0x165667B19E3779F9ULL);
+            return size_t(h ^ (h >> 29));
+        }
+    };
+    std::unordered_map<Key, uint32_t, Hash> seen;
+    seen.reserve(mesh.vertex_count);
+    std::vector<uint32_t> first(mesh.vertex_count);
+    for (size_t v = 0; v < mesh.vertex_count; ++v) {
+        Key key;
+        std::memcpy(&key.x, positions + 3 * v, sizeof(float));
+        std::memcpy(&key.y, positions + 3 * v + 1, sizeof(float));
+        std::memcpy(&key.z, positions + 3 * v + 2, sizeof(float));
+        first[v] = seen.emplace(key, uint32_t(v)).first->second;
+    }
+    return first;
+}
+
+MeshPatches build_welded_patches(const AnimatedMesh& mesh, double lambda, size_t max_triangles,
+                                 unsigned cache_size) {
+    // Each vertex replaced by the first one at its coordinates: a face then shares the vertices
+    // of its neighbours across a hard edge (flat shading) or a UV seam, as Tipsify's adjacency
+    // needs.
+    const std::vector<uint32_t> first = joined_vertices(mesh);
+    std::vector<uint32_t> welded(mesh.indices.size());
+    for (size_t i = 0; i < welded.size(); ++i) welded[i] = first[mesh.indices[i]];
+    MeshPatches patches = patches_over(mesh, welded.data(), lambda, cache_size);
+    if (max_triangles == 0) return patches;
+    // Pieces along the cache order: a patch of max_triangles or more cut into the fewest pieces
+    // of at most max_triangles, sized as equally as can be; smaller patches of one primitive
+    // that follow each other packed together while the pack stays within max_triangles.
+    const uint64_t most = max_triangles;
+    MeshPatches pieces;
+    pieces.cache_order = std::move(patches.cache_order);
+    pieces.patch_starts.push_back(0);
+    const auto cut = [&](uint32_t end, uint32_t primitive) {
+        pieces.patch_starts.push_back(end);
+        pieces.patch_primitive.push_back(primitive);
+    };
+    for (size_t p = 0; p < patches.patch_count(); ++p) {
+        const uint32_t begin = patches.patch_starts[p], end = patches.patch_starts[p + 1];
+        const uint32_t primitive = patches.patch_primitive[p];
+        const bool packing = pieces.patch_starts.back() < begin;  // smaller patches wait in a pack
+        if (end - begin >= most) {
+            if (packing) cut(begin, patches.patch_primitive[p - 1]);
+            const uint64_t count = (end - begin + most - 1) / most;
+            for (uint64_t i = 1; i <= count; ++i) cut(uint32_t(begin + uint64_t(end - begin) * i / count), primitive);
+            continue;
+        }
+        if (packing && (patches.patch_primitive[p - 1] != primitive || end - pieces.patch_starts.back() > most))
+            cut(begin, patches.patch_primitive[p - 1]);
+        if (p + 1 == patches.patch_count()) cut(end, primitive);
+    }
+    return pieces;
 }
 
 MeshPatches build_planar_units(const AnimatedMesh& mesh, const MeshPatches& like, size_t keyframe,

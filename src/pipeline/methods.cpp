@@ -252,7 +252,23 @@ AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double
     AnimatedMethodResult result;
     const auto start = std::chrono::steady_clock::now();
     result.patches = build_mesh_patches(mesh, lambda, cache_size);
-    if (planar_units) result.patches = build_planar_units(mesh, result.patches, 0, cache_size);
+    if (planar_units) {
+        result.patches = build_planar_units(mesh, result.patches, 0, cache_size);
+    } else if (settings.order == OrderSource::Measured) {
+        const std::vector<uint32_t> first = joined_vertices(mesh);
+        size_t distinct = 0;
+        for (size_t v = 0; v < first.size(); ++v) distinct += first[v] == v;
+        if (2 * distinct <= mesh.vertex_count) {
+            MeshPatches pieces = build_welded_patches(mesh, lambda, kMeasuredSurfaceUnitTriangles, cache_size);
+            if (settings.log)
+                settings.log("units: flat-shaded (" + std::to_string(distinct) + " positions for " +
+                             std::to_string(mesh.vertex_count) + " vertices): " + std::to_string(pieces.patch_count()) +
+                             " pieces of at most " + std::to_string(kMeasuredSurfaceUnitTriangles) +
+                             " triangles of the surface's patches, not the " +
+                             std::to_string(result.patches.patch_count()) + " patches of the vertex buffer");
+            result.patches = std::move(pieces);
+        }
+    }
     result.seconds_patches = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     result.framing = frame_animated_mesh(mesh);
 
@@ -364,7 +380,10 @@ void run_single_buffer(MethodResult& result, const AnimatedMesh& mesh, const Met
 void run_clustered(MethodResult& result, const AnimatedMesh& mesh, const MethodSettings& settings) {
     const bool joint = method_is_joint(result.method);
     ClusteringSettings clustering = settings.clustering;
-    if (info(result.method).measured) clustering.order = OrderSource::Measured;
+    if (info(result.method).measured) {
+        clustering.order = OrderSource::Measured;
+        if (clustering.settled_gain == 0) clustering.settled_gain = kMeasuredSettledGain;
+    }
     AnimatedMethodResult r =
         run_han_sander(mesh, joint, settings.lambda, settings.cache_size, clustering, settings.blend_clusters,
                        clustering.order == OrderSource::Measured && settings.measured_planar_units);

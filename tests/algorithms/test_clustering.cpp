@@ -14,7 +14,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstring>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -145,6 +148,116 @@ TEST(Clustering, AssignsEachNodeToItsBestBufferAndImproves) {
             }
         }
     }
+}
+
+namespace {
+// The same mesh with each vertex replaced by the first at the same coordinates (an ordered map
+// of the coordinates' bits: a second implementation of build_welded_patches' joining).
+AnimatedMesh welded_by_map(const AnimatedMesh& m) {
+    std::map<std::array<uint32_t, 3>, uint32_t> first;
+    AnimatedMesh welded = m;
+    for (uint32_t& v : welded.indices) {
+        std::array<uint32_t, 3> key;
+        std::memcpy(key.data(), m.keyframe(0) + 3 * size_t(v), sizeof key);
+        v = first.emplace(key, v).first->second;  // indices ascend: the first is the lowest id
+    }
+    return welded;
+}
+}  // namespace
+
+// A flat-shaded mesh has one λ patch per triangle (no face shares a vertex); its surface patches
+// are the patches of the mesh with equal positions joined, and cut into pieces of at most
+// max_triangles they stay in the same cache order, each patch in the fewest pieces, sized within
+// one triangle of each other.
+TEST(MeshPatches, SurfacePatchesOfAFlatShadedMeshAreThoseOfItsJoinedCopyCutIntoPieces) {
+    const AnimatedMesh flat = test::flat_shaded(character());
+    const MeshPatches degenerate = build_mesh_patches(flat, 0.85);
+    EXPECT_GE(degenerate.patch_count(), flat.triangle_count() * 9 / 10);
+    const MeshPatches reference = build_mesh_patches(welded_by_map(flat), 0.85);
+    const MeshPatches surface = build_welded_patches(flat, 0.85);
+    EXPECT_EQ(surface.cache_order, reference.cache_order);
+    EXPECT_EQ(surface.patch_starts, reference.patch_starts);
+    EXPECT_EQ(surface.patch_primitive, reference.patch_primitive);
+    EXPECT_LT(surface.patch_count() * 10, degenerate.patch_count());
+    // Pieces: every boundary of a patch of `most` or more triangles is a piece boundary, such a
+    // patch is cut in ceil(n / most) pieces sized within one of each other, and the pieces
+    // between are whole smaller patches of one primitive, packed: each pack within `most`, and
+    // the next small patch of its primitive would not have fitted.
+    std::vector<uint32_t> patch_at(flat.triangle_count());  // surface patch of each cache position
+    for (size_t p = 0; p < surface.patch_count(); ++p)
+        for (uint32_t i = surface.patch_starts[p]; i < surface.patch_starts[p + 1]; ++i) patch_at[i] = uint32_t(p);
+    const auto patch_size = [&](size_t p) { return size_t(surface.patch_starts[p + 1] - surface.patch_starts[p]); };
+    for (const size_t most : {1u, 3u, 8u}) {
+        SCOPED_TRACE("pieces of at most " + std::to_string(most));
+        const MeshPatches pieces = build_welded_patches(flat, 0.85, most);
+        EXPECT_EQ(pieces.cache_order, surface.cache_order);
+        ASSERT_EQ(pieces.patch_starts.size(), pieces.patch_count() + 1);
+        ASSERT_EQ(pieces.patch_starts.back(), flat.triangle_count());
+        for (size_t q = 0; q < pieces.patch_count(); ++q) {
+            const uint32_t begin = pieces.patch_starts[q], end = pieces.patch_starts[q + 1];
+            ASSERT_LT(begin, end);
+            EXPECT_LE(end - begin, most);
+            const size_t p = patch_at[begin];
+            EXPECT_EQ(pieces.patch_primitive[q], surface.patch_primitive[p]);
+            if (patch_size(p) >= most) {  // a cut of a large patch
+                const size_t count = (patch_size(p) + most - 1) / most;
+                EXPECT_GE(end - begin, patch_size(p) / count);
+                EXPECT_LE(end - begin, (patch_size(p) + count - 1) / count);
+                EXPECT_LE(end, surface.patch_starts[p + 1]);
+                continue;
+            }
+            ASSERT_EQ(begin, surface.patch_starts[p]);  // a pack of whole small patches
+            size_t last = p;
+            while (surface.patch_starts[last + 1] < end) ++last;
+            ASSERT_EQ(surface.patch_starts[last + 1], end);
+            for (size_t x = p; x <= last; ++x) {
+                EXPECT_LT(patch_size(x), most);
+                EXPECT_EQ(surface.patch_primitive[x], surface.patch_primitive[p]);
+            }
+            const size_t next = last + 1;
+            if (next < surface.patch_count() && patch_size(next) < most &&
+                surface.patch_primitive[next] == surface.patch_primitive[p]) {
+                EXPECT_GT(end - begin + patch_size(next), most);
+            }
+        }
+    }
+    // At λ = 3 every surface patch is one triangle: the pieces are runs of `most` of them.
+    const MeshPatches runs = build_welded_patches(flat, 3.0, 8);
+    EXPECT_LT(runs.patch_count() * 7, flat.triangle_count());
+    // The joining: a flat-shaded mesh has the smooth one's distinct positions (its seams joined).
+    const std::vector<uint32_t> first = joined_vertices(flat);
+    size_t distinct = 0;
+    for (size_t v = 0; v < first.size(); ++v) {
+        distinct += first[v] == v;
+        EXPECT_LE(first[v], v);
+    }
+    EXPECT_LE(2 * distinct, flat.vertex_count);
+    // On the smooth character the joining changes little: seams only.
+    const MeshPatches smooth = build_mesh_patches(character(), 0.85);
+    EXPECT_GT(2 * build_welded_patches(character(), 0.85).patch_count(), smooth.patch_count());
+}
+
+// settled_gain: k-means stops at the first iteration (after the first) whose mean OVR is not
+// below the previous iteration's by that fraction; the same run without it shows where that is.
+TEST(Clustering, SettledGainStopsAtTheFirstIterationThatGainsLess) {
+    const AnimatedMesh& m = character();
+    const MeshPatches patches = build_mesh_patches(m, 0.85);
+    ClusteringSettings s = small_settings();
+    s.order = OrderSource::Measured;
+    const ClusteringResult full = cluster_nodes(m, patches, framing_of(m), walk_keyframes(5), s);
+    ASSERT_GE(full.iterations.size(), 3u);
+    // The gain of iteration 2 over 1 (0-based 1 over 0), and a fraction just above it.
+    const double gain = 1 - full.iterations[1].mean_ovr / full.iterations[0].mean_ovr;
+    ASSERT_GT(gain, 0);
+    s.settled_gain = gain * 1.01;
+    const ClusteringResult settled = cluster_nodes(m, patches, framing_of(m), walk_keyframes(5), s);
+    EXPECT_EQ(settled.stop_reason, "settled");
+    ASSERT_EQ(settled.iterations.size(), 2u);
+    EXPECT_EQ(settled.iterations[1].mean_ovr, full.iterations[1].mean_ovr);
+    // Just below it, the run goes on past iteration 2.
+    s.settled_gain = gain * 0.99;
+    const ClusteringResult on = cluster_nodes(m, patches, framing_of(m), walk_keyframes(5), s);
+    EXPECT_GT(on.iterations.size(), 2u);
 }
 
 TEST(Clustering, PaperUpdateRunsAndKeepsItsBestIteration) {

@@ -107,3 +107,28 @@ TEST(Methods, EveryClusteredMethodMisSortsNoMoreBlendedPairsThanSingle) {
         EXPECT_LE(blend[i].overall.missorted_pair_fraction, single + 0.05)
             << method_name(clustered[i]) << " against single's " << single;
 }
+
+// measured on a flat-shaded mesh (no face shares a vertex, so every λ patch is one triangle) takes
+// the surface patches in pieces of kMeasuredSurfaceUnitTriangles as its units, at λ = 0.85 and 3;
+// single keeps the λ patches (its outputs do not change), and on a smooth mesh measured keeps
+// them too.
+TEST(Methods, MeasuredTakesSurfacePiecesAsUnitsWhereThePatchesAreSingleTriangles) {
+    const AnimatedMesh smooth = make_procedural_character();
+    const AnimatedMesh flat = test::flat_shaded(smooth);
+    MethodSettings settings;
+    settings.clustering.clusters = 3;
+    settings.clustering.views = 12;
+    settings.clustering.resolution = 48;
+    settings.clustering.max_iterations = 3;
+    const size_t pieces = build_welded_patches(flat, settings.lambda, kMeasuredSurfaceUnitTriangles).patch_count();
+    EXPECT_LT(2 * pieces, build_mesh_patches(flat, settings.lambda).patch_count());
+    EXPECT_EQ(run_method(flat, Method::Measured, settings).patch_count, pieces);
+    MethodSettings fine = settings;
+    fine.lambda = 3;
+    const size_t runs = build_welded_patches(flat, 3, kMeasuredSurfaceUnitTriangles).patch_count();
+    EXPECT_LT(2 * runs, flat.triangle_count());
+    EXPECT_EQ(run_method(flat, Method::Measured, fine).patch_count, runs);
+    EXPECT_EQ(run_method(flat, Method::Single, settings).patch_count, build_mesh_patches(flat, settings.lambda).patch_count());
+    EXPECT_EQ(run_method(smooth, Method::Measured, settings).patch_count,
+              build_mesh_patches(smooth, settings.lambda).patch_count());
+}

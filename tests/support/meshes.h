@@ -94,4 +94,17 @@ inline void expect_position(const AnimatedMesh& m, size_t keyframe, size_t v, do
     EXPECT_NEAR(p[2], z, tolerance) << "keyframe " << keyframe << " vertex " << v;
 }
 
+// The mesh flat-shaded: every corner its own vertex (three per triangle), at the same positions
+// in every keyframe; no two faces share a vertex.
+inline AnimatedMesh flat_shaded(const AnimatedMesh& m) {
+    AnimatedMesh flat = m;
+    flat.vertex_count = m.indices.size();
+    flat.keyframe_positions.assign(m.keyframe_count() * flat.vertex_count * 3, 0.0f);
+    for (size_t k = 0; k < m.keyframe_count(); ++k)
+        for (size_t i = 0; i < m.indices.size(); ++i)
+            std::copy(m.keyframe(k) + 3 * m.indices[i], m.keyframe(k) + 3 * m.indices[i] + 3, flat.keyframe(k) + 3 * i);
+    for (size_t i = 0; i < flat.indices.size(); ++i) flat.indices[i] = uint32_t(i);
+    return flat;
+}
+
 }  // namespace animorder::test

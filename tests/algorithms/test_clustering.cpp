@@ -240,23 +240,24 @@ TEST(MeshPatches, SurfacePatchesOfAFlatShadedMeshAreThoseOfItsJoinedCopyCutIntoP
 // settled_gain: k-means stops at the first iteration (after the first) whose mean OVR is not
 // below the previous iteration's by that fraction; the same run without it shows where that is.
 TEST(Clustering, SettledGainStopsAtTheFirstIterationThatGainsLess) {
-    const AnimatedMesh& m = character();
-    const MeshPatches patches = build_mesh_patches(m, 0.85);
     ClusteringSettings s = small_settings();
     s.order = OrderSource::Measured;
-    const ClusteringResult full = cluster_nodes(m, patches, framing_of(m), walk_keyframes(5), s);
+    const auto run = [&s, patches = build_mesh_patches(character(), 0.85)] {
+        return cluster_nodes(character(), patches, framing_of(character()), walk_keyframes(5), s);
+    };
+    const ClusteringResult full = run();
     ASSERT_GE(full.iterations.size(), 3u);
     // The gain of iteration 2 over 1 (0-based 1 over 0), and a fraction just above it.
     const double gain = 1 - full.iterations[1].mean_ovr / full.iterations[0].mean_ovr;
     ASSERT_GT(gain, 0);
     s.settled_gain = gain * 1.01;
-    const ClusteringResult settled = cluster_nodes(m, patches, framing_of(m), walk_keyframes(5), s);
+    const ClusteringResult settled = run();
     EXPECT_EQ(settled.stop_reason, "settled");
     ASSERT_EQ(settled.iterations.size(), 2u);
     EXPECT_EQ(settled.iterations[1].mean_ovr, full.iterations[1].mean_ovr);
     // Just below it, the run goes on past iteration 2.
     s.settled_gain = gain * 0.99;
-    const ClusteringResult on = cluster_nodes(m, patches, framing_of(m), walk_keyframes(5), s);
+    const ClusteringResult on = run();
     EXPECT_GT(on.iterations.size(), 2u);
 }
 

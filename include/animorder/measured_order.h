@@ -33,9 +33,10 @@ std::vector<Arc> measured_overdraw_graph(const NodeFragments* const* nodes, size
 
 // The counts behind measured_overdraw_graph for a set of nodes that grows and shrinks: k-means
 // moves a few nodes between clusters each iteration, and a cluster's graph follows them without
-// measuring its other nodes again. Few units (<= kDenseMeasuredUnits) keep a dense matrix of
-// unit_count² counts, more a hash table of the pairs met. Integer counts: the arcs are the same
-// whatever the order of the updates and the thread count.
+// measuring its other nodes again. Each pair keeps its net count (pixels with the lower unit in
+// front minus pixels with the higher in front): few units (<= kDenseMeasuredUnits) in a dense
+// triangle of unit_count · (unit_count − 1) / 2 counts, more in a hash table of the pairs met.
+// Integer counts: the arcs are the same whatever the order of the updates and the thread count.
 constexpr size_t kDenseMeasuredUnits = 1024;
 
 class MeasuredPairCounts {

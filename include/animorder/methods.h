@@ -238,9 +238,11 @@ struct AnimatedMethodResult {
 // measured order (settings.order Measured) on a flat-shaded mesh — at most half as many distinct
 // positions as vertices (joined_vertices): faces share no vertex, so every λ patch is one
 // triangle, and its graph and sifting grow with the square of the units a pixel sees — takes as
-// its units build_welded_patches' pieces of at most kMeasuredSurfaceUnitTriangles: its time and
-// memory stay near single's, its OVR below (docs/RESULTS.md, issue 46's note). The vertex cache
-// gains nothing from λ there (no vertex is shared: ACMR 3 whatever the order).
+// its units build_welded_patches' pieces of at most min(kMeasuredSurfaceUnitTriangles,
+// ceil(triangles / kDenseMeasuredUnits)) triangles, when that is 2 or more (a flat-shaded mesh of
+// up to 1024 triangles keeps its single triangles: they cost little there): its time and memory
+// stay near single's, its OVR below (docs/RESULTS.md, issue 46's note). The vertex cache gains
+// nothing from λ there (no vertex is shared: ACMR 3 whatever the order).
 constexpr size_t kMeasuredSurfaceUnitTriangles = 8;
 // `measured`'s ClusteringSettings::settled_gain (unless set): k-means stops once an iteration
 // lowers the mean node OVR by less than this fraction.

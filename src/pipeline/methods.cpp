@@ -18,6 +18,7 @@
 #include "animorder/evaluation.h"
 #include "animorder/invalid_input.h"
 #include "animorder/mesh_patches.h"
+#include "animorder/measured_order.h"
 #include "animorder/meshopt_order.h"
 #include "animorder/nehab06.h"
 #include "animorder/selection_table.h"
@@ -258,12 +259,16 @@ AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double
         const std::vector<uint32_t> first = joined_vertices(mesh);
         size_t distinct = 0;
         for (size_t v = 0; v < first.size(); ++v) distinct += first[v] == v;
-        if (2 * distinct <= mesh.vertex_count) {
-            MeshPatches pieces = build_welded_patches(mesh, lambda, kMeasuredSurfaceUnitTriangles, cache_size);
+        // Pieces only as large as needed to bring the units near a dense graph's size: a small
+        // flat-shaded mesh keeps its single triangles (they cost little there).
+        const size_t most = std::min<size_t>(kMeasuredSurfaceUnitTriangles,
+                                             (mesh.triangle_count() + kDenseMeasuredUnits - 1) / kDenseMeasuredUnits);
+        if (2 * distinct <= mesh.vertex_count && most >= 2) {
+            MeshPatches pieces = build_welded_patches(mesh, lambda, most, cache_size);
             if (settings.log)
                 settings.log("units: flat-shaded (" + std::to_string(distinct) + " positions for " +
                              std::to_string(mesh.vertex_count) + " vertices): " + std::to_string(pieces.patch_count()) +
-                             " pieces of at most " + std::to_string(kMeasuredSurfaceUnitTriangles) +
+                             " pieces of at most " + std::to_string(most) +
                              " triangles of the surface's patches, not the " +
                              std::to_string(result.patches.patch_count()) + " patches of the vertex buffer");
             result.patches = std::move(pieces);

@@ -16,11 +16,11 @@
 #include "animorder/triangle_order.h"
 #include "animorder/viewpoints.h"
 
+#include "joined_vertices.h"
+
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <string>
-#include <unordered_map>
 
 namespace animorder {
 
@@ -64,29 +64,7 @@ MeshPatches build_mesh_patches(const AnimatedMesh& mesh, double lambda, unsigned
 
 std::vector<uint32_t> joined_vertices(const AnimatedMesh& mesh) {
     validate_animated_mesh(mesh, std::vector<uint32_t>{0});
-    const float* positions = mesh.keyframe(0);
-    struct Key {
-        uint32_t x, y, z;
-        bool operator==(const Key& o) const { return x == o.x && y == o.y && z == o.z; }
-    };
-    struct Hash {
-        size_t operator()(const Key& k) const {
-            const uint64_t h = (uint64_t(k.x) * 0x9E3779B97F4A7C15ULL) ^ (uint64_t(k.y) * 0xC2B2AE3D27D4EB4FULL) ^
-                               (uint64_t(k.z) * 0x165667B19E3779F9ULL);
-            return size_t(h ^ (h >> 29));
-        }
-    };
-    std::unordered_map<Key, uint32_t, Hash> seen;
-    seen.reserve(mesh.vertex_count);
-    std::vector<uint32_t> first(mesh.vertex_count);
-    for (size_t v = 0; v < mesh.vertex_count; ++v) {
-        Key key;
-        std::memcpy(&key.x, positions + 3 * v, sizeof(float));
-        std::memcpy(&key.y, positions + 3 * v + 1, sizeof(float));
-        std::memcpy(&key.z, positions + 3 * v + 2, sizeof(float));
-        first[v] = seen.emplace(key, uint32_t(v)).first->second;
-    }
-    return first;
+    return first_vertex_at_each_position(mesh.keyframe(0), mesh.vertex_count);
 }
 
 MeshPatches build_welded_patches(const AnimatedMesh& mesh, double lambda, size_t max_triangles,

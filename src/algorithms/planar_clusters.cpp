@@ -20,6 +20,8 @@
 // ties go to the lower cluster id, then the lower triangle id, so the result is deterministic.
 #include "animorder/planar_clusters.h"
 
+#include "joined_vertices.h"
+
 #include "animorder/invalid_input.h"
 #include "animorder/tipsify.h"
 #include "animorder/triangle_order.h"
@@ -107,20 +109,7 @@ FaceAdjacency face_adjacency(const uint32_t* indices, size_t triangles, size_t v
 // so a UV or normal seam (split vertices at one position) does not cut the surface in two.
 std::vector<uint32_t> weld_indices(const uint32_t* indices, size_t index_count, const float* positions,
                                    size_t vertex_count) {
-    std::vector<uint32_t> by_position(vertex_count);
-    for (size_t v = 0; v < vertex_count; ++v) by_position[v] = uint32_t(v);
-    auto less = [positions](uint32_t a, uint32_t b) {
-        const int c = std::memcmp(positions + 3 * size_t(a), positions + 3 * size_t(b), 3 * sizeof(float));
-        return c != 0 ? c < 0 : a < b;
-    };
-    std::sort(by_position.begin(), by_position.end(), less);
-    std::vector<uint32_t> canonical(vertex_count);
-    for (size_t i = 0; i < vertex_count; ++i) {
-        const uint32_t v = by_position[i];
-        const bool same = i > 0 && std::memcmp(positions + 3 * size_t(v), positions + 3 * size_t(by_position[i - 1]),
-                                               3 * sizeof(float)) == 0;
-        canonical[v] = same ? canonical[by_position[i - 1]] : v;
-    }
+    const std::vector<uint32_t> canonical = first_vertex_at_each_position(positions, vertex_count);
     std::vector<uint32_t> welded(indices, indices + index_count);
     for (uint32_t& i : welded) i = canonical[i];
     return welded;

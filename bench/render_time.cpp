@@ -35,6 +35,7 @@
 #include "gl_context.h"
 
 #include "animorder/animated_mesh.h"
+#include "animorder/atomic_write.h"
 #include "animorder/camera.h"
 #include "animorder/evaluation.h"
 #include "animorder/invalid_input.h"
@@ -335,8 +336,11 @@ int run(const Options& options) {
         corr_fragments, 100.0 * base_seconds / totals[0].seconds, base_seconds);
 
     if (!options.json.empty()) {
-        FILE* f = std::fopen(options.json.c_str(), "w");
-        if (!f) throw std::runtime_error("cannot write " + options.json);
+        // Written in memory, then to the file atomically (src/io/atomic_write.cpp), as every output.
+        char* text = nullptr;
+        size_t text_size = 0;
+        FILE* f = ::open_memstream(&text, &text_size);
+        if (!f) throw std::runtime_error("out of memory writing " + options.json);
         std::fprintf(f, "{\n  \"tool\": \"render_time\",\n  \"input\": %s,\n  \"renderer\": %s,\n",
                      json_string(input_name).c_str(), json_string(renderer).c_str());
         const char* threads = std::getenv("LP_NUM_THREADS");
@@ -363,7 +367,11 @@ int run(const Options& options) {
                      "  \"correlation_time_fragments\": %.17g,\n  \"unshaded_seconds\": %.17g,\n"
                      "  \"seconds_methods\": %.17g,\n  \"seconds_total\": %.17g\n}\n",
                      t_ratio, o_ratio, corr, corr_fragments, base_seconds, seconds_methods, total_seconds);
-        if (std::fclose(f) != 0) throw std::runtime_error("cannot write " + options.json);
+        const bool closed = std::fclose(f) == 0;
+        const std::string json = closed ? std::string(text, text_size) : std::string();
+        std::free(text);
+        if (!closed) throw std::runtime_error("out of memory writing " + options.json);
+        write_file_atomically(options.json, json);
     }
     return 0;
 }

@@ -53,6 +53,9 @@ struct Clip {
     size_t keyframe_count = 0;
     int source_animation = -1;  // glTF input: the animation it was sampled from; −1 otherwise
     double start_time_s = 0;    // glTF input: the animation time of keyframe 0 (first key time)
+    // A clip file made for a differently proportioned skeleton: how it was retargeted onto the
+    // character, naming the largest difference (assimp_loader.h); empty when applied as it is.
+    std::string retargeted = {};
 };
 
 struct AnimatedMesh {

@@ -40,7 +40,9 @@ std::string file_identity(const std::string& path);
 // names a folder instead: empty, ending in '/', ending in "." or "..", or an existing folder.
 void check_output_stem(const std::string& stem);
 
-// The outputs of one run. add() writes each to a temporary beside its target; commit() renames
+// The outputs of one run. add() writes each to a temporary beside its target (a new file under a
+// random name, created exclusively and never through a link, so nothing planted in the folder can
+// redirect it); commit() renames
 // them all into place. If any add() or the commit fails, or the set is destroyed uncommitted,
 // every temporary is removed and no target has been touched (a rename that fails mid-commit
 // restores the files already replaced from their backups). A SIGINT, SIGTERM or SIGHUP (whose
@@ -77,8 +79,8 @@ private:
 bool process_may_run(long pid);
 
 // What runs killed part-way left beside `target` (SIGKILL, or a signal during a commit): its
-// temporaries (".NAME.tmpPID") whose process is gone are removed, and so are such backups
-// (".NAME.oldPID") while the target exists (a backup whose target is missing may be the only copy
+// temporaries (".NAME.tmpPID-RANDOM", or ".NAME.tmpPID" from earlier versions) whose process is
+// gone are removed, and so are such backups (".NAME.oldPID-RANDOM") while the target exists (a backup whose target is missing may be the only copy
 // of the file it replaced: kept). A process id cannot tell a live process on another machine
 // sharing the folder, nor one that took the id since: so a temporary whose inode has not changed
 // for an hour before `now` is removed whatever its process id (a temporary lives seconds).

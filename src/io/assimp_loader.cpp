@@ -118,6 +118,13 @@ void add_morph_weights(const aiMeshMorphAnim* channel, double tick, std::vector<
             if (key->mValues[j] < weights.size()) weights[key->mValues[j]] += share * key->mWeights[j];
 }
 
+// How a clip's channels are applied to the character's nodes: `scale` empty, as they are;
+// otherwise per node, NaN to keep the character's own rest translation (a bone offset), or the
+// factor the clip's translations are scaled by (1 where the node is no root joint).
+struct Retarget {
+    std::vector<double> scale;
+};
+
 struct Flat {
     std::vector<const aiNode*> nodes;  // parents first
     std::vector<int> parent;
@@ -181,6 +188,11 @@ const aiScene* import(Assimp::Importer& importer, const std::string& path, std::
                         " bytes (raise it with --max-memory)");
     importer.SetIOHandler(new RegularFilesOnly(opened, budget));  // the importer owns it
     importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+    // An FBX joint's pivots and pre-rotation (Mixamo's joint orientations) folded into the joint's
+    // own node. Kept as helper nodes ("J_$AssimpFbx$_PreRotation", ...), libassimp 5.2.5 still keys
+    // the whole chain on J's channel, so each key applied its translation and pre-rotation twice:
+    // a Mixamo run put the witch's left foot above her hips.
+    importer.SetPropertyBool(AI_CONFIG_IMPORT_FBX_PRESERVE_PIVOTS, false);
     io::begin_parsing(file.ok() ? file.size() : 0, options);  // a file assimp loops on is stopped
     const aiScene* scene =
         importer.ReadFile(path, aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_JoinIdenticalVertices |
@@ -442,14 +454,24 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
     }
 
     // Every node's global transform with `anim` (or none: the rest pose) at `tick`.
-    auto globals = [&](const aiAnimation* anim, double tick) {
+    // A retargeted clip (`retarget`) keeps the character's bone offsets and scales its root joints'
+    // translations (retarget_for below).
+    auto globals = [&](const aiAnimation* anim, double tick, const Retarget& retarget) {
         std::vector<aiMatrix4x4> local(flat.nodes.size()), global(flat.nodes.size());
         for (size_t n = 0; n < flat.nodes.size(); ++n) local[n] = flat.nodes[n]->mTransformation;
         if (anim)
             for (unsigned c = 0; c < anim->mNumChannels; ++c) {
                 const auto found = flat.by_name.find(anim->mChannels[c]->mNodeName.C_Str());
-                if (found != flat.by_name.end())
-                    local[found->second] = interpolate(anim->mChannels[c], tick, local[found->second]);
+                if (found == flat.by_name.end()) continue;
+                aiMatrix4x4& m = local[found->second];
+                m = interpolate(anim->mChannels[c], tick, m);
+                if (retarget.scale.empty()) continue;
+                const double scale = retarget.scale[found->second];
+                const aiMatrix4x4& own = flat.nodes[found->second]->mTransformation;
+                if (std::isnan(scale))
+                    m.a4 = own.a4, m.b4 = own.b4, m.c4 = own.c4;
+                else
+                    m.a4 = ai_real(m.a4 * scale), m.b4 = ai_real(m.b4 * scale), m.c4 = ai_real(m.c4 * scale);
             }
         for (size_t n = 0; n < flat.nodes.size(); ++n)
             global[n] = flat.parent[n] >= 0 ? global[size_t(flat.parent[n])] * local[n] : local[n];
@@ -487,8 +509,9 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
             }
         return of;
     };
-    auto add_keyframe = [&](const aiAnimation* anim, const MorphChannels& morphs, double tick) {
-        const std::vector<aiMatrix4x4> global = globals(anim, tick);
+    auto add_keyframe = [&](const aiAnimation* anim, const MorphChannels& morphs, double tick,
+                            const Retarget& retarget) {
+        const std::vector<aiMatrix4x4> global = globals(anim, tick, retarget);
         for (size_t i = 0; i < parts.size(); ++i) {
             const ai_real det = global[parts[i].node].Determinant();  // an affine transform's: its 3 × 3 block's
             mirrored_in_some[i] |= det < 0;
@@ -553,21 +576,32 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
         }
     };
 
-    // A clip file made for another character is refused (the rule, see load_assimp in io.h):
-    // clips drive joints by name, and Mixamo rigs share their joint names, but not their bone
-    // lengths. The clip file carries the skeleton it was made for, so every node of it that the
-    // character has too, below one of the character's joints (a bone: the root joint's own
-    // placement is motion, not shape), must have the character's rest translation within
-    // kMaxBoneChange of the character's size (the diagonal of its joints' rest-pose bounding
-    // box). Measured on ../shared/data (pg-barbarian, pg-goblin, pg-witch, every clip file
-    // against every character): a character's own clip files differ by 0 (identical rest
-    // skeletons), another character's by 3.9% to 24%.
-    constexpr double kMaxBoneChange = 0.02;
-    std::vector<bool> is_bone(flat.nodes.size(), false), below_bone(flat.nodes.size(), false);
+    // A clip file made for another skeleton (Mixamo rigs share their joint names, not their bone
+    // lengths) is retargeted as engines play such clips: joints bound by name, the clip's rotations
+    // (and scales) put on the character's own bone offsets, and the root joints' translations (the
+    // hips: a bone whose parent is no bone) scaled by the ratio of their rest offsets (the hip
+    // heights), so the character walks its own stride. A clip file is applied as it is when every
+    // node of its skeleton that the character has too, below one of the character's joints, has
+    // the character's rest translation within kSameSkeleton of the character's size (the diagonal
+    // of its joints' rest-pose bounding box: exporters round); otherwise it is retargeted, with a
+    // note naming the largest difference (Clip::retargeted), and refused only when its skeleton
+    // lacks one of the character's skinned joints. On ../shared/data a character's own clip files
+    // differ by 0 (identical rest skeletons), another character's by 3.9% to 24%.
+    constexpr double kSameSkeleton = 1e-3;
+    std::vector<bool> is_bone(flat.nodes.size(), false), below_bone(flat.nodes.size(), false),
+        root_joint(flat.nodes.size(), false);
     for (const Part& part : parts)
         for (size_t n : part.bone_node) is_bone[n] = true;
     for (size_t n = 0; n < flat.nodes.size(); ++n)  // parents first
         if (flat.parent[n] >= 0) below_bone[n] = is_bone[size_t(flat.parent[n])] || below_bone[size_t(flat.parent[n])];
+    // A root joint, or one of assimp's pivot helper nodes of one ("J_$AssimpFbx$_Translation" for an
+    // FBX joint J), which carry its translation.
+    auto joint_name = [](const std::string& name) { return name.substr(0, name.find("_$AssimpFbx$")); };
+    for (size_t n = 0; n < flat.nodes.size(); ++n) {
+        if (below_bone[n]) continue;
+        const auto joint = flat.by_name.find(joint_name(flat.nodes[n]->mName.C_Str()));
+        root_joint[n] = joint != flat.by_name.end() && is_bone[joint->second] && !below_bone[joint->second];
+    }
     double size = 0;
     {
         std::vector<aiMatrix4x4> rest(flat.nodes.size());
@@ -582,13 +616,15 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
         }
         size = double((high - low).Length());
     }
+    auto translation = [](const aiMatrix4x4& m) { return aiVector3D(m.a4, m.b4, m.c4); };
     // An .md5anim is exempt: its baseframe is no bind pose (it holds what its frames do not key,
     // and Doom 3's key every channel of a moving joint), so a character's own animation, given as
-    // a clip file, differs there (Bob's 'lamp' by 8.8%).
-    auto check_clip_skeleton = [&](const ClipSource& source) {
-        if (!source.scene || !(size > 0) || !std::isfinite(size)) return;
-        const std::string extension = io::lower_extension(source.file);
-        if (extension == ".md5anim") return;
+    // a clip file, differs there (Bob's 'lamp' by 8.8%): applied as it is.
+    auto retarget_for = [&](const ClipSource& source, std::string& note) {
+        Retarget retarget;
+        if (!source.scene || !(size > 0) || !std::isfinite(size)) return retarget;
+        if (io::lower_extension(source.file) == ".md5anim") return retarget;
+        std::map<std::string, const aiNode*> theirs_by_name;
         double worst = 0;
         const aiNode* worst_node = nullptr;
         size_t worst_char = 0;
@@ -597,28 +633,54 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
             const aiNode* node = stack.back();
             stack.pop_back();
             for (unsigned c = 0; c < node->mNumChildren; ++c) stack.push_back(node->mChildren[c]);
+            theirs_by_name.emplace(node->mName.C_Str(), node);
             const auto found = flat.by_name.find(node->mName.C_Str());
             if (found == flat.by_name.end() || !below_bone[found->second]) continue;
-            const aiMatrix4x4& mine = flat.nodes[found->second]->mTransformation;
-            const aiMatrix4x4& theirs = node->mTransformation;
             const double d =
-                double((aiVector3D(theirs.a4, theirs.b4, theirs.c4) - aiVector3D(mine.a4, mine.b4, mine.c4)).Length());
+                double((translation(node->mTransformation) - translation(flat.nodes[found->second]->mTransformation))
+                           .Length());
             if (!(d <= worst)) worst = d, worst_node = node, worst_char = found->second;
         }
-        if (worst_node && !(worst <= kMaxBoneChange * size)) {
-            const aiMatrix4x4& mine = flat.nodes[worst_char]->mTransformation;
-            const aiMatrix4x4& theirs = worst_node->mTransformation;
-            char numbers[200];
-            std::snprintf(
-                numbers, sizeof numbers,
-                "(%.4g, %.4g, %.4g) in the clip and (%.4g, %.4g, %.4g) in the character: %.1f%% of its size %.4g",
-                theirs.a4, theirs.b4, theirs.c4, mine.a4, mine.b4, mine.c4, 100 * worst / size, size);
-            std::string joint = worst_node->mName.C_Str();
-            joint = joint.substr(0, joint.find("_$AssimpFbx$"));  // assimp's pivot helper nodes
-            throw LoadError(source.file + ": made for another skeleton than " + path + "'s: joint '" + joint +
-                            "' is at " + numbers + " (at most " + std::to_string(int(kMaxBoneChange * 100)) +
-                            "% is accepted)");
+        size_t missing = 0;
+        std::string first_missing;
+        for (size_t n = 0; n < flat.nodes.size(); ++n)
+            if (is_bone[n] && !theirs_by_name.count(flat.nodes[n]->mName.C_Str()))
+                if (missing++ == 0) first_missing = flat.nodes[n]->mName.C_Str();
+        if (missing)
+            throw LoadError(source.file + ": made for another skeleton than " + path + "'s: it has no joint '" +
+                            first_missing + "' (" + std::to_string(missing) + " of the character's " +
+                            std::to_string(std::count(is_bone.begin(), is_bone.end(), true)) +
+                            " skinned joints missing), so it cannot drive the character");
+        if (!worst_node || worst <= kSameSkeleton * size) return retarget;
+        retarget.scale.assign(flat.nodes.size(), 1.0);
+        std::string scaled;
+        for (size_t n = 0; n < flat.nodes.size(); ++n) {
+            if (below_bone[n]) retarget.scale[n] = NAN;
+            if (!root_joint[n]) continue;
+            const auto theirs = theirs_by_name.find(flat.nodes[n]->mName.C_Str());
+            if (theirs == theirs_by_name.end()) continue;
+            const double mine_length = double(translation(flat.nodes[n]->mTransformation).Length()),
+                         their_length = double(translation(theirs->second->mTransformation).Length());
+            if (mine_length > 1e-6 * size && their_length > 1e-6 * size && std::isfinite(mine_length / their_length)) {
+                retarget.scale[n] = mine_length / their_length;
+                if (scaled.empty() && std::fabs(retarget.scale[n] - 1) > 1e-6) {
+                    char factor[120];
+                    std::snprintf(factor, sizeof factor, "; root translation of '%s' scaled by %.4g",
+                                  joint_name(flat.nodes[n]->mName.C_Str()).c_str(), retarget.scale[n]);
+                    scaled = factor;
+                }
+            }
         }
+        // + 0: "0" for a zero of either sign.
+        const aiVector3D t = translation(worst_node->mTransformation) + aiVector3D(0, 0, 0),
+                         m = translation(flat.nodes[worst_char]->mTransformation) + aiVector3D(0, 0, 0);
+        char numbers[200];
+        std::snprintf(numbers, sizeof numbers,
+                      "(%.4g, %.4g, %.4g) in the clip and (%.4g, %.4g, %.4g) in the character: %.1f%% of its size %.4g",
+                      t.x, t.y, t.z, m.x, m.y, m.z, 100 * worst / size, size);
+        note = "retargeted onto the character's bone offsets (largest difference: joint '" +
+               joint_name(worst_node->mName.C_Str()) + "' at " + numbers + ")" + scaled;
+        return retarget;
     };
 
     // Every clip's time range and keyframe count first, so that the loading budget is checked
@@ -658,11 +720,13 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
     }
     io::check_keyframe_budget(path, total_keyframes, mesh.vertex_count, options);
     mesh.keyframe_positions.reserve(std::max<size_t>(total_keyframes, 1) * mesh.vertex_count * 3);  // no regrowth
-    for (const ClipSource& source : sources)
-        if (!source.file.empty()) check_clip_skeleton(source);
+    std::vector<Retarget> retargets(sources.size());
+    std::vector<std::string> retarget_notes(sources.size());
+    for (size_t i = 0; i < sources.size(); ++i)
+        if (!sources[i].file.empty()) retargets[i] = retarget_for(sources[i], retarget_notes[i]);
 
     if (sources.empty()) {
-        add_keyframe(nullptr, morph_channels(nullptr), 0);
+        add_keyframe(nullptr, morph_channels(nullptr), 0, Retarget{});
         mesh.clips.push_back({"static", 0.0, options.sample_rate, 0, 1});
     }
     for (size_t s = 0; s < sources.size(); ++s) {
@@ -673,10 +737,12 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
         clip.sample_rate = options.sample_rate;
         clip.first_keyframe = mesh.keyframe_count();
         clip.keyframe_count = at.keyframes;
+        clip.retargeted = retarget_notes[s];
         const MorphChannels morphs = morph_channels(sources[s].animation);
         for (size_t f = 0; f < clip.keyframe_count; ++f)
             add_keyframe(sources[s].animation, morphs,
-                         std::min(at.first + double(f) / options.sample_rate * at.ticks_per_second, at.last));
+                         std::min(at.first + double(f) / options.sample_rate * at.ticks_per_second, at.last),
+                         retargets[s]);
         mesh.clips.push_back(clip);
     }
     for (size_t i = 0; i < parts.size(); ++i) {

@@ -16,6 +16,7 @@
 #include <ctime>
 #include <filesystem>
 #include <memory>
+#include <random>
 #include <mutex>
 #include <unordered_map>
 #include <unordered_set>
@@ -36,13 +37,51 @@ fs::path resolved(const std::string& path) {
 
 bool same_file(const std::string& a, const std::string& b) { return file_identity(a) == file_identity(b); }
 
-// What a temporary adds to its target's name: "." before, ".tmp" or ".old" and a process id after.
-constexpr size_t kTemporaryExtra = 1 + 4 + 10;
+// What a temporary adds to its target's name: "." before; ".tmp" or ".old", a process id, "-" and
+// 16 random hex digits after.
+constexpr size_t kTemporaryExtra = 1 + 4 + 10 + 1 + 16;
 
+// A name for a temporary of `target` ("tmp") or a backup of it ("old"): its process id, so a later
+// run knows whether the process that made it is gone (remove_stale_temporaries), and 64 random
+// bits, so that nobody can plant a file or a link under it in advance (a container's PID is 1).
 std::string temporary_name(const fs::path& target, const char* kind) {
+    static std::mutex mutex;
+    static std::random_device device;
+    uint64_t bits = 0;
+    {
+        const std::lock_guard<std::mutex> lock(mutex);
+        bits = (uint64_t(device()) << 32) ^ uint64_t(device());
+    }
+    char suffix[18];
+    std::snprintf(suffix, sizeof suffix, "-%016llx", static_cast<unsigned long long>(bits));
     const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
-    // Unique per process, so concurrent runs never share a temporary.
-    return (folder / ("." + target.filename().string() + "." + kind + std::to_string(::getpid()))).string();
+    return (folder / ("." + target.filename().string() + "." + kind + std::to_string(::getpid()) + suffix)).string();
+}
+
+// A new file of its own under a fresh temporary name of `target`: created exclusively (never
+// one that exists, never through a link: a name taken by then is another's, and another random
+// name is tried), so nothing planted in the folder can redirect the write. Returns the open
+// descriptor and sets `name`; -1 with errno set when no file can be created.
+int create_temporary(const fs::path& target, std::string& name) {
+    for (int attempt = 0; attempt < 64; ++attempt) {
+        name = temporary_name(target, "tmp");
+        const int fd = ::open(name.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+        if (fd >= 0 || errno != EEXIST) return fd;
+    }
+    return -1;  // errno is EEXIST: 64 random names all taken
+}
+
+// Renames `from` to `to` unless `to` exists (then false with `error` set to EEXIST): a backup
+// never replaces a file that appeared under its name. Falls back to a plain rename where the file
+// system cannot refuse to replace.
+bool rename_without_replacing(const std::string& from, const std::string& to, std::error_code& error) {
+    error.clear();
+    if (::renameat2(AT_FDCWD, from.c_str(), AT_FDCWD, to.c_str(), RENAME_NOREPLACE) == 0) return true;
+    if (errno == EINVAL || errno == ENOSYS) {
+        if (::rename(from.c_str(), to.c_str()) == 0) return true;
+    }
+    error = std::error_code(errno, std::generic_category());
+    return false;
 }
 
 // A temporary lives from its first write to the commit (seconds; its backup only during the
@@ -78,9 +117,16 @@ void remove_stale_temporaries(const std::string& target, std::time_t now) {
          it.increment(error)) {
         const std::string name = it->path().filename().string();
         if (name.size() <= prefix.size() + 3 || name.compare(0, prefix.size(), prefix) != 0) continue;
-        const std::string kind = name.substr(prefix.size(), 3), pid = name.substr(prefix.size() + 3);
+        // ".NAME.tmpPID-RANDOM" (and ".NAME.tmpPID", as earlier versions named them).
+        const std::string kind = name.substr(prefix.size(), 3), rest = name.substr(prefix.size() + 3);
+        const size_t dash = rest.find('-');
+        const std::string pid = rest.substr(0, dash), random = dash == std::string::npos ? "" : rest.substr(dash + 1);
         if ((kind != "tmp" && kind != "old") || pid.empty() || pid.size() > 9 ||
-            !std::all_of(pid.begin(), pid.end(), [](char c) { return c >= '0' && c <= '9'; }))
+            !std::all_of(pid.begin(), pid.end(), [](char c) { return c >= '0' && c <= '9'; }) ||
+            (dash != std::string::npos &&
+             (random.size() != 16 || !std::all_of(random.begin(), random.end(), [](char c) {
+                 return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f');
+             }))))
             continue;
         if (process_may_run(std::stol(pid)) && !untouched_for_an_hour(it->path(), now)) continue;
         std::error_code ignored;
@@ -200,9 +246,9 @@ void untrack_temporary(size_t& slot) {
 // everywhere, /proc and /sys included, where creating fails; so the temporary's own name is
 // created (never one that exists) and removed.
 std::string creation_error(const fs::path& target) {
-    const std::string probe = temporary_name(target, "tmp");
-    const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
-    if (fd < 0) return errno == EEXIST ? std::string() : std::strerror(errno);
+    std::string probe;
+    const int fd = create_temporary(target, probe);
+    if (fd < 0) return std::strerror(errno);
     ::close(fd);
     ::unlink(probe.c_str());
     return {};
@@ -310,14 +356,24 @@ void OutputSet::add(const std::string& path, const std::string& data) {
     check_writable_target(path, false);  // creating the temporary below is the probe
     for (const Pending& p : pending_)
         if (same_file(p.target, path)) throw OutputError(path + ": named twice as an output (" + p.target + ")");
-    const std::string temp = temporary_name(path, "tmp");
-    std::FILE* file = std::fopen(temp.c_str(), "wb");
-    if (!file) throw OutputError(path + ": cannot create " + temp + ": " + std::strerror(errno));
+    std::string temp;
+    const int fd = create_temporary(path, temp);
+    if (fd < 0) throw OutputError(path + ": cannot create a temporary beside it: " + std::strerror(errno));
     pending_.push_back({path, temp, track_temporary(temp)});
-    const bool written = std::fwrite(data.data(), 1, data.size(), file) == data.size();
-    const bool flushed = std::fflush(file) == 0 && ::fsync(::fileno(file)) == 0;
-    const bool closed = std::fclose(file) == 0;
-    if (!written || !flushed || !closed) throw OutputError(path + ": write failed: " + std::strerror(errno));
+    size_t written = 0;
+    errno = 0;
+    while (written < data.size()) {
+        const ssize_t n = ::write(fd, data.data() + written, std::min<size_t>(data.size() - written, size_t(1) << 30));
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) break;
+        written += size_t(n);
+    }
+    const int write_error = written == data.size() ? 0 : errno ? errno : EIO;
+    const bool synced = write_error == 0 && ::fsync(fd) == 0;
+    const int sync_error = synced ? 0 : errno;
+    const bool closed = ::close(fd) == 0;
+    if (write_error || !synced || !closed)
+        throw OutputError(path + ": write failed: " + std::strerror(write_error ? write_error : sync_error ? sync_error : errno));
     if (observer_) observer_(path, data);
 }
 
@@ -339,8 +395,11 @@ void OutputSet::commit() {
     };
     for (const Pending& p : pending_) {
         if (!fs::exists(p.target)) continue;
-        const std::string backup = temporary_name(p.target, "old");
-        fs::rename(p.target, backup, error);
+        std::string backup = temporary_name(p.target, "old");
+        for (int attempt = 0; !rename_without_replacing(p.target, backup, error) && error == std::errc::file_exists &&
+                              attempt < 64;
+             ++attempt)
+            backup = temporary_name(p.target, "old");
         if (error == std::errc::no_such_file_or_directory) continue;  // gone meanwhile: nothing to keep
         if (error) roll_back(p.target + ": cannot replace: " + error.message());
         backups.emplace_back(p.target, backup);

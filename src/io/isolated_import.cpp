@@ -161,6 +161,7 @@ void write_mesh(Writer& w, const AnimatedMesh& m, const std::vector<std::string>
         w.f64(c.sample_rate);
         w.u64(c.first_keyframe);
         w.u64(c.keyframe_count);
+        w.str(c.retargeted);
     }
     w.array(m.keyframe_positions);
     w.u64(m.joint_count);
@@ -319,13 +320,14 @@ AnimatedMesh read_mesh(Reader& r, const std::string& path, const LoadOptions& op
         p.alpha_mode = AlphaMode((material >> 1) & 3);
         p.mirrored = (material & 8) != 0;
     }
-    m.clips.resize(r.count(4 * 8));
+    m.clips.resize(r.count(5 * 8));
     for (Clip& c : m.clips) {
         c.name = r.str();
         c.duration_s = r.f64();
         c.sample_rate = r.f64();
         c.first_keyframe = r.u64();
         c.keyframe_count = r.u64();
+        c.retargeted = r.str();
     }
     // The budget before the largest allocation: keyframes × vertices × 3 floats.
     const uint64_t floats = r.u64();

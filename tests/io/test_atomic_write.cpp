@@ -15,6 +15,8 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <regex>
+#include <set>
 #include <string>
 
 namespace fs = std::filesystem;
@@ -87,6 +89,35 @@ TEST_F(AtomicWrite, ASignalAfterTheCommitKeepsTheOutputs) {
     });
     EXPECT_TRUE(WIFSIGNALED(status));
     EXPECT_EQ(entries(), "a.bin ");
+}
+
+// A temporary's name cannot be guessed, and it is created as a new file, never through a link:
+// links planted under the names earlier versions used (".NAME.tmpPID", ".NAME.oldPID": a
+// container's PID is 1) lead nowhere, the file they point at is untouched, and the output is a
+// file of its own. Two runs writing one target in the same process use different temporaries.
+TEST_F(AtomicWrite, APlantedLinkCannotRedirectAnOutput) {
+    const fs::path victim = path("victim.txt");
+    std::ofstream(victim) << "precious";
+    std::ofstream(path("out.glb")) << "old output";  // so the commit makes a backup too
+    const std::string pid = std::to_string(::getpid());
+    for (const std::string kind : {"tmp", "old"}) fs::create_symlink(victim, path(".out.glb." + kind + pid));
+    OutputSet first, second;
+    first.add(path("out.glb").string(), "new output");
+    second.add(path("out.glb").string(), "other output");
+    const std::regex temporary("\\.out\\.glb\\.tmp" + pid + "-[0-9a-f]{16}");
+    std::set<std::string> temporaries;
+    for (const auto& e : fs::directory_iterator(dir_)) {
+        const std::string name = e.path().filename().string();
+        if (!std::regex_match(name, temporary)) continue;
+        temporaries.insert(name);
+        EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(e.path()))) << name << " is not a file of its own";
+    }
+    EXPECT_EQ(temporaries.size(), 2u) << "in the folder: " << entries();
+    first.commit();
+    EXPECT_EQ(test::slurp(victim), "precious");
+    EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(path("out.glb"))));
+    EXPECT_EQ(test::slurp(path("out.glb")), "new output");
+    for (const std::string kind : {"tmp", "old"}) EXPECT_TRUE(fs::is_symlink(path(".out.glb." + kind + pid)));
 }
 
 // /proc lets no file be created, yet access(W_OK) says yes to root: refused before any work.
@@ -164,11 +195,17 @@ TEST_F(AtomicWrite, LeftOverTemporariesGoOnceTheirProcessIsGoneOrAnHourHasPassed
         ::waitpid(child, nullptr, 0);
         return child;
     }();
-    for (const std::string& name : {".out.glb.tmp" + std::to_string(gone), std::string(".out.glb.tmp1"),
-                                    std::string(".out.glb.old1"), std::string(".other.glb.old1")})
+    const std::string random = "-0123456789abcdef";
+    for (const std::string& name : {".out.glb.tmp" + std::to_string(gone), ".out.glb.tmp" + std::to_string(gone) + random,
+                                    ".out.glb.old" + std::to_string(gone) + random, std::string(".out.glb.tmp1"),
+                                    std::string(".out.glb.old1"), std::string(".other.glb.old1"),
+                                    ".out.glb.tmp" + std::to_string(gone) + "-not-ours"})
         std::ofstream(path(name)) << "left";
     animorder::remove_stale_temporaries(target);
     EXPECT_FALSE(fs::exists(path(".out.glb.tmp" + std::to_string(gone))));
+    EXPECT_FALSE(fs::exists(path(".out.glb.tmp" + std::to_string(gone) + random)));
+    EXPECT_FALSE(fs::exists(path(".out.glb.old" + std::to_string(gone) + random)));
+    EXPECT_TRUE(fs::exists(path(".out.glb.tmp" + std::to_string(gone) + "-not-ours"))) << "a name not of ours went";
     EXPECT_TRUE(fs::exists(path(".out.glb.tmp1")));  // PID 1 runs: it may be writing it now
     EXPECT_TRUE(fs::exists(path(".out.glb.old1")));
     const std::time_t later = std::time(nullptr) + 3601 + 5;

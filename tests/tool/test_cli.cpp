@@ -827,11 +827,6 @@ std::string entries_of(const fs::path& folder) {
 }
 }  // namespace
 
-// A write that fails after its temporary file exists: the output folder is there, but the
-// temporary of the sidecar's .bin (the tool names it .NAME.tmpPID) is a link to /dev/full, so
-// writing it fails with "No space left on device". `exec` keeps the shell's PID ($$), so the link
-// carries the tool's PID. Afterwards the folder must be empty: no temporary (the link is it), no
-// output. Were the temporary named otherwise, the write would succeed and the link stay: a failure too.
 namespace {
 // A process's state letter and parent from /proc/PID/stat ('\0' when there is no such process).
 std::pair<char, pid_t> process_state(pid_t pid) {
@@ -928,17 +923,42 @@ TEST_F(Cli, AKilledRunLeavesNoReaderBehind) {
     if (running(reader)) kill(reader, SIGKILL);  // a reader left behind: ended, now the test has failed
 }
 
+// A write that fails after its temporary file exists: the process may write no file larger than
+// 512 bytes (`ulimit -f 1`, with SIGXFSZ ignored so that the write fails with "File too large"
+// instead of killing the tool), and the sidecar's .bin is larger. Afterwards the folder must be
+// empty: no temporary, no output.
 TEST_F(Cli, FailedWriteLeavesNoFileBehind) {
-    ASSERT_TRUE(fs::exists("/dev/full"));
     const fs::path out = path("out");
     fs::create_directories(out);
-    const test::Outcome o =
-        test::run_captured("ln -s /dev/full '" + (out / ".o.animorder.bin.tmp").string() + "'$$ && exec " +
-                               std::string(ANIMORDER_EXE) + " optimize -q -o '" + (out / "o").string() + "'",
-                           dir_);
+    const test::Outcome o = test::run_captured("trap '' XFSZ; ulimit -f 1 && exec " + std::string(ANIMORDER_EXE) +
+                                                   " optimize -q -o '" + (out / "o").string() + "'",
+                                               dir_);
     EXPECT_NE(o.exit_code, 0);
     EXPECT_NE(o.err.find("o.animorder.bin: write failed"), std::string::npos) << o.err;
     EXPECT_EQ(entries_of(out), "");
+}
+
+// Links planted in the output folder under the names of the tool's temporaries and backups (as
+// earlier versions named them: ".NAME.tmpPID", ".NAME.oldPID"; `exec` keeps the shell's PID, $$, so
+// they carry the tool's) redirect nothing: the file they lead to is untouched, and the output is a
+// file of its own (the link was renamed into place as the output, once).
+TEST_F(Cli, PlantedLinksDoNotRedirectAnOutput) {
+    const fs::path out = path("out"), victim = path("victim.txt");
+    fs::create_directories(out);
+    std::ofstream(victim) << "precious";
+    std::ofstream(out / "o.animorder.json") << "an earlier output";
+    std::string plant;
+    for (const std::string name :
+         {".o.animorder.bin.tmp", ".o.animorder.json.tmp", ".o.animorder.bin.old", ".o.animorder.json.old"})
+        plant += "ln -s '" + victim.string() + "' '" + (out / name).string() + "'$$ && ";
+    const test::Outcome o = test::run_captured(plant + "exec " + std::string(ANIMORDER_EXE) +
+                                                   " optimize -q --method original -o '" + (out / "o").string() + "'",
+                                               dir_);
+    ASSERT_EQ(o.exit_code, 0) << o.err;
+    EXPECT_EQ(test::slurp(victim), "precious");
+    for (const std::string name : {"o.animorder.bin", "o.animorder.json"})
+        EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(out / name))) << name;
+    EXPECT_EQ(test::slurp(out / "o.animorder.json").substr(0, 1), "{");
 }
 
 // The second of the outputs fails (o.animorder.json is a folder) after the first (the .bin) was
@@ -1180,7 +1200,8 @@ TEST_F(CliView, ScratchFoldersOfGoneProcessesAreRemoved) {
     EXPECT_TRUE(fs::exists(alive)) << "a running process's scratch folder was removed";
 }
 
-// What killed runs left beside an output (temporaries ".NAME.tmpPID", backups ".NAME.oldPID") is
+// What killed runs left beside an output (temporaries ".NAME.tmpPID-RANDOM", backups
+// ".NAME.oldPID-RANDOM", and ".NAME.tmpPID" as earlier versions named them) is
 // removed by the next run that writes it, once that process is gone: a running process's stays,
 // and so does a backup whose target is missing (it may be the only copy of the file it replaced).
 TEST_F(CliOutputs, AKilledRunsTemporariesGoWithTheNextRun) {
@@ -1190,14 +1211,15 @@ TEST_F(CliOutputs, AKilledRunsTemporariesGoWithTheNextRun) {
     ASSERT_EQ(::waitpid(gone, nullptr, 0), gone);
     const std::string dead = std::to_string(gone), alive = std::to_string(::getpid());
     for (const std::string& name :
-         {".out.animorder.bin.tmp" + dead, ".out.animorder.json.tmp" + alive, ".s.glb.tmp" + dead, ".s.glb.old" + dead})
+         {".out.animorder.bin.tmp" + dead, ".out.animorder.json.tmp" + alive, ".s.glb.tmp" + dead + "-0123456789abcdef",
+          ".s.glb.old" + dead})
         std::ofstream(path(name)) << "left by a killed run";
     const std::string in = path("in.glb").string();
     ASSERT_EQ(run("optimize -q --method original " + in + " -o " + path("out").string()).exit_code, 0);
     EXPECT_FALSE(fs::exists(path(".out.animorder.bin.tmp" + dead)));
     EXPECT_TRUE(fs::exists(path(".out.animorder.json.tmp" + alive))) << "a running process's temporary went";
     ASSERT_EQ(run("subdivide -q --levels 0 " + in + " -o " + path("s.glb").string()).exit_code, 0);
-    EXPECT_FALSE(fs::exists(path(".s.glb.tmp" + dead)));
+    EXPECT_FALSE(fs::exists(path(".s.glb.tmp" + dead + "-0123456789abcdef")));
     EXPECT_TRUE(fs::exists(path(".s.glb.old" + dead))) << "the backup went while its target was missing";
     ASSERT_EQ(run("subdivide -q --levels 0 " + in + " -o " + path("s.glb").string()).exit_code, 0);
     EXPECT_FALSE(fs::exists(path(".s.glb.old" + dead))) << "a backup of a replaced file stayed";

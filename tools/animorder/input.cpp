@@ -118,6 +118,8 @@ AnimatedMesh load_animated_input(const CommonOptions& common, std::string& input
         note(common, "loaded " + common.input + ": " + std::to_string(mesh.triangle_count()) + " triangles, " +
                          std::to_string(mesh.clips.size()) + " clips, " + std::to_string(mesh.keyframe_count()) +
                          " keyframes");
+        for (const Clip& clip : mesh.clips)
+            if (!clip.retargeted.empty()) note(common, "clip '" + clip.name + "': " + clip.retargeted);
     }
     if (!clip_names.empty()) mesh = select_clips(mesh, clip_names);
     return mesh;

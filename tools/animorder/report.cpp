@@ -11,6 +11,11 @@ nlohmann::ordered_json report_header(const AnimatedMesh& mesh, const std::string
     report["input"] = input_name;
     report["triangles"] = mesh.triangle_count();
     report["vertices"] = mesh.vertex_count;
+    // Clip files made for a differently proportioned skeleton, and how each was retargeted.
+    nlohmann::ordered_json retargeted = nlohmann::ordered_json::array();
+    for (const Clip& clip : mesh.clips)
+        if (!clip.retargeted.empty()) retargeted.push_back({{"clip", clip.name}, {"note", clip.retargeted}});
+    if (!retargeted.empty()) report["retargeted_clips"] = retargeted;
     return report;
 }
 

@@ -5,6 +5,7 @@
 #include <stb_image.h>
 #include <array>
 #include <nlohmann/json.hpp>
+#include "http_request.h"
 #include "support/files.h"
 #include "support/gltf_builder.h"
 #include "support/require.h"
@@ -13,11 +14,14 @@
 #include <fcntl.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
+#include <sys/time.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <csignal>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -1146,7 +1150,9 @@ TEST_F(CliOutputs, ExtensionsAreReadInAnyCase) {
 
 // `view`: a port that is taken is refused before any work (it was found only after optimising the
 // bundled character, whose scratch folder then stayed behind), and the scratch folders that
-// killed runs left are removed once their process is gone.
+// killed runs left are removed once their process is gone. The server's hardening (issue 50):
+// stalled clients delay neither other clients nor the end, a wrong Host is refused, links out of
+// the repository are not followed, and the log escapes what a URL holds.
 class CliView : public Cli {
 protected:
     void SetUp() override {
@@ -1157,11 +1163,151 @@ protected:
         std::ofstream(path("root/viewer/node_modules/three/build/three.module.js")) << "\n";
         fs::create_directories(path("tmp"));
     }
+    void TearDown() override {
+        if (server_ > 0) {
+            ::kill(server_, SIGKILL);
+            ::waitpid(server_, nullptr, 0);
+        }
+        Cli::TearDown();
+    }
     std::string view(const std::string& args) {
         return "env TMPDIR=" + path("tmp").string() + " " + std::string(ANIMORDER_EXE) +
                " view --no-open --viewer-root " + path("root").string() + " " + args;
     }
+    // `animorder view --no-open --port 0 --viewer-root ROOT ARGS...` started in the background
+    // (TMPDIR in the scratch folder, stdout and stderr in view-out.txt and view-err.txt); the port
+    // it printed, or 0 when it printed none in 20 s.
+    unsigned start_view(const std::vector<std::string>& args) {
+        std::vector<std::string> argv = {ANIMORDER_EXE, "view",          "--no-open",          "--port",
+                                         "0",           "--viewer-root", path("root").string()};
+        argv.insert(argv.end(), args.begin(), args.end());
+        std::vector<char*> pointers;
+        for (std::string& a : argv) pointers.push_back(a.data());
+        pointers.push_back(nullptr);
+        const std::string out = path("view-out.txt").string(), err = path("view-err.txt").string(),
+                          tmp = path("tmp").string();
+        server_ = ::fork();
+        if (server_ < 0) return 0;
+        if (server_ == 0) {
+            const int o = ::open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644),
+                      e = ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+            if (o < 0 || e < 0 || ::dup2(o, 1) < 0 || ::dup2(e, 2) < 0 || ::setenv("TMPDIR", tmp.c_str(), 1) != 0)
+                ::_exit(126);
+            ::execv(ANIMORDER_EXE, pointers.data());
+            ::_exit(127);
+        }
+        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+        while (std::chrono::steady_clock::now() < deadline) {
+            const std::string printed = test::slurp(out);
+            const size_t at = printed.find("127.0.0.1:"), slash = printed.find('/', at + 10);
+            if (at != std::string::npos && slash != std::string::npos)
+                return unsigned(std::stoul(printed.substr(at + 10, slash - at - 10)));
+            if (::waitpid(server_, nullptr, WNOHANG) == server_) {
+                server_ = -1;
+                return 0;
+            }
+            std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        }
+        return 0;
+    }
+    // Whether the server started by start_view has ended within `bound` (its exit status in `status`).
+    bool view_ends_within(std::chrono::milliseconds bound, int& status) {
+        const auto deadline = std::chrono::steady_clock::now() + bound;
+        do {
+            if (::waitpid(server_, &status, WNOHANG) == server_) {
+                server_ = -1;
+                return true;
+            }
+            std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        } while (std::chrono::steady_clock::now() < deadline);
+        return false;
+    }
+    // A model of `bytes` bytes (zeros) at `name` in the scratch folder: bigger than the socket
+    // buffers, a client that never reads stalls the server's sending.
+    std::string big_model(const std::string& name, size_t bytes) {
+        std::ofstream(path(name)) << "glTF";
+        fs::resize_file(path(name), bytes);
+        return path(name).string();
+    }
+
+    pid_t server_ = -1;
 };
+
+namespace {
+// A connection to 127.0.0.1:`port` (-1 when refused); with `receive_buffer` > 0 its receive
+// buffer that small (set before connecting, so that the window stays small).
+int connect_to(unsigned port, int receive_buffer = 0) {
+    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+    if (fd < 0) return -1;
+    if (receive_buffer > 0) ::setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &receive_buffer, sizeof receive_buffer);
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    address.sin_port = htons(uint16_t(port));
+    if (::connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0) {
+        ::close(fd);
+        return -1;
+    }
+    return fd;
+}
+
+// `request` sent on a new connection, and what came back until the server closed it or `bound`
+// passed (then what came so far).
+std::string http_exchange(unsigned port, const std::string& request,
+                          std::chrono::milliseconds bound = std::chrono::milliseconds(10000)) {
+    const int fd = connect_to(port);
+    if (fd < 0) return "";
+    const timeval slice{0, 100000};
+    ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &slice, sizeof slice);
+    ::send(fd, request.data(), request.size(), MSG_NOSIGNAL);
+    std::string response;
+    char buffer[4096];
+    const auto deadline = std::chrono::steady_clock::now() + bound;
+    while (std::chrono::steady_clock::now() < deadline) {
+        const ssize_t n = ::recv(fd, buffer, sizeof buffer, 0);
+        if (n == 0 || (n < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR)) break;
+        if (n > 0) response.append(buffer, size_t(n));
+    }
+    ::close(fd);
+    return response;
+}
+
+// The status code of `response` (0 when it is none).
+int status_of(const std::string& response) {
+    if (response.rfind("HTTP/1.1 ", 0) != 0 || response.size() < 12) return 0;
+    return std::atoi(response.substr(9, 3).c_str());
+}
+
+// GET `target` as a browser sends it to 127.0.0.1:`port`.
+std::string get_request(unsigned port, const std::string& target) {
+    return "GET " + target + " HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) + "\r\n\r\n";
+}
+
+// Clients that stall the server: `readers` that ask for /model.glb and never read it, `halves`
+// that send half a request and nothing more (the connections, to be closed by the caller).
+std::vector<int> stall(unsigned port, int readers, int halves) {
+    std::vector<int> fds;
+    for (int i = 0; i < readers; ++i) {
+        const int fd = connect_to(port, 4096);
+        if (fd < 0) continue;
+        const std::string request = get_request(port, "/model.glb");
+        ::send(fd, request.data(), request.size(), MSG_NOSIGNAL);
+        fds.push_back(fd);
+    }
+    for (int i = 0; i < halves; ++i) {
+        const int fd = connect_to(port);
+        if (fd < 0) continue;
+        ::send(fd, "GET /viewer/ HT", 15, MSG_NOSIGNAL);
+        fds.push_back(fd);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the server has taken them up
+    return fds;
+}
+
+void close_all(const std::vector<int>& fds) {
+    for (const int fd : fds) ::close(fd);
+}
+}  // namespace
 
 TEST_F(CliView, ATakenPortIsRefusedBeforeAnyWorkAndLeavesNothing) {
     const int taken = ::socket(AF_INET, SOCK_STREAM, 0);
@@ -1198,6 +1344,185 @@ TEST_F(CliView, ScratchFoldersOfGoneProcessesAreRemoved) {
     EXPECT_EQ(o.exit_code, 0) << o.err;
     EXPECT_FALSE(fs::exists(dead)) << "a gone process's scratch folder stayed";
     EXPECT_TRUE(fs::exists(alive)) << "a running process's scratch folder was removed";
+}
+
+// Clients that stall (three ask for a model bigger than the socket buffers and never read it, two
+// send half a request) do not delay another: its answer comes at once (it waited for the stalled
+// ones to go away, or 5 s for each half request).
+TEST_F(CliView, StalledClientsDelayNoOther) {
+    const unsigned port = start_view({"-q", "--seconds", "60", big_model("big.glb", size_t(32) << 20)});
+    ASSERT_NE(port, 0u) << test::slurp(path("view-err.txt"));
+    const std::vector<int> stalled = stall(port, 3, 2);
+    ASSERT_EQ(stalled.size(), 5u);
+    const auto start = std::chrono::steady_clock::now();
+    const std::string response = http_exchange(port, get_request(port, "/viewer/"), std::chrono::milliseconds(3000));
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    close_all(stalled);
+    EXPECT_EQ(status_of(response), 200) << response;
+    EXPECT_NE(response.find("<html>"), std::string::npos) << response;
+    EXPECT_LT(seconds, 3.0);
+}
+
+// With clients stalled as above, view ends at its --seconds (it stayed until they went away),
+// and on SIGTERM (std::signal restarted the blocked send), within a few seconds either way.
+TEST_F(CliView, StalledClientsDelayNeitherTheEndNorASignal) {
+    const std::string model = big_model("big.glb", size_t(32) << 20);
+    for (const bool signal : {false, true}) {
+        SCOPED_TRACE(signal ? "SIGTERM" : "--seconds");
+        const unsigned port = start_view({"-q", "--seconds", signal ? "60" : "2", model});
+        ASSERT_NE(port, 0u) << test::slurp(path("view-err.txt"));
+        const auto start = std::chrono::steady_clock::now();
+        const std::vector<int> stalled = stall(port, 3, 2);
+        if (signal) ::kill(server_, SIGTERM);
+        int status = 0;
+        const bool ended = view_ends_within(std::chrono::milliseconds(signal ? 3000 : 5000), status);
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        close_all(stalled);
+        EXPECT_TRUE(ended) << "still serving after " << seconds << " s";
+        if (ended) {
+            EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;
+        }
+        if (!signal) {
+            EXPECT_GE(seconds, 1.0);
+        }
+        if (HasFailure()) return;
+    }
+    EXPECT_TRUE(fs::is_empty(path("tmp"))) << entries_of(path("tmp"));
+}
+
+// Only Host 127.0.0.1:PORT, localhost:PORT or [::1]:PORT is served (a page rebound to 127.0.0.1
+// by DNS rebinding sends its own name): any other Host gets 421, an HTTP/1.1 request without Host
+// 400; HTTP/1.0 may leave it out (no browser does).
+TEST_F(CliView, AWrongHostIsRefused) {
+    const std::string model = path("m.glb").string();
+    std::ofstream(model) << "glTF model";
+    const unsigned port = start_view({"-q", "--seconds", "60", model});
+    ASSERT_NE(port, 0u) << test::slurp(path("view-err.txt"));
+    const std::string p = std::to_string(port), other = std::to_string(port == 65535 ? 1 : port + 1);
+    const std::vector<std::pair<std::string, int>> cases = {{"Host: 127.0.0.1:" + p, 200},
+                                                            {"Host: localhost:" + p, 200},
+                                                            {"host:LOCALHOST:" + p, 200},
+                                                            {"Host: [::1]:" + p, 200},
+                                                            {"Host: evil.example:" + p, 421},
+                                                            {"Host: evil.example", 421},
+                                                            {"Host: 127.0.0.1:" + other, 421},
+                                                            {"Host: 127.0.0.1", 421},
+                                                            {"Host: 10.0.0.1:" + p, 421},
+                                                            {"Host: localhost.evil.example:" + p, 421},
+                                                            {"Host:", 421}};
+    for (const auto& [host, expected] : cases) {
+        const std::string response = http_exchange(port, "GET /model.glb HTTP/1.1\r\n" + host + "\r\n\r\n");
+        EXPECT_EQ(status_of(response), expected) << host << ": " << response;
+        if (expected == 421) {
+            EXPECT_EQ(response.find("glTF model"), std::string::npos) << host;
+            EXPECT_EQ(test::line_count(response.substr(response.find("\r\n\r\n") + 4)), 1u) << response;
+        }
+    }
+    EXPECT_EQ(status_of(http_exchange(port, "GET /model.glb HTTP/1.1\r\n\r\n")), 400);
+    EXPECT_EQ(status_of(http_exchange(
+                  port, "GET /model.glb HTTP/1.1\r\nHost: 127.0.0.1:" + p + "\r\nHost: evil.example\r\n\r\n")),
+              400);
+    EXPECT_EQ(status_of(http_exchange(port, "GET /model.glb HTTP/1.0\r\n\r\n")), 200);
+}
+
+// A link in viewer/node_modules leads nowhere outside the repository (site.root): not to `/`, not
+// to a folder beside it, not to the root itself; a link to a folder inside it (as `npm link` of
+// js/ makes) is followed. The repository here is the scratch viewer root.
+TEST_F(CliView, LinksOutOfTheRepositoryAreNotFollowed) {
+    fs::create_directories(path("outside"));
+    std::ofstream(path("outside/secret.txt")) << "secret\n";
+    fs::create_directories(path("root/js/runtime"));
+    std::ofstream(path("root/js/runtime/animorder.js")) << "export {};\n";
+    fs::create_symlink("/", path("root/viewer/node_modules/evil"));
+    fs::create_symlink(path("outside"), path("root/viewer/node_modules/beside"));
+    fs::create_symlink("../..", path("root/viewer/node_modules/up"));
+    fs::create_symlink("../../js", path("root/viewer/node_modules/animorder"));
+    fs::create_symlink(path("outside/secret.txt"), path("root/viewer/node_modules/three/build/secret.txt"));
+    fs::create_symlink(path("outside/secret.txt"), path("root/viewer/secret.txt"));
+    const std::string model = path("m.glb").string();
+    std::ofstream(model) << "glTF";
+    const unsigned port = start_view({"-q", "--seconds", "60", model});
+    ASSERT_NE(port, 0u) << test::slurp(path("view-err.txt"));
+    const std::string outside = path("outside").string().substr(1);  // below the link to `/`
+    const std::vector<std::pair<std::string, int>> cases = {
+        {"/viewer/node_modules/evil/etc/passwd", 404},
+        {"/viewer/node_modules/evil/" + outside + "/secret.txt", 404},
+        {"/viewer/node_modules/beside/secret.txt", 404},
+        {"/viewer/node_modules/up/viewer/index.html", 404},
+        {"/viewer/node_modules/three/build/secret.txt", 404},
+        {"/viewer/secret.txt", 404},
+        {"/viewer/node_modules/animorder/runtime/animorder.js", 200},
+        {"/viewer/node_modules/three/build/three.module.js", 200}};
+    for (const auto& [target, expected] : cases) {
+        const std::string response = http_exchange(port, get_request(port, target));
+        EXPECT_EQ(status_of(response), expected) << target << ": " << response;
+        EXPECT_EQ(response.find("secret"), std::string::npos) << target;
+        EXPECT_EQ(response.find("root:"), std::string::npos) << target;
+    }
+}
+
+// Without -q the 404 line quotes the URL with its control bytes and non-ASCII bytes as \xNN (an
+// escape sequence in a URL reached the terminal as it came).
+TEST_F(CliView, ControlBytesOfAUrlAreLoggedEscaped) {
+    const std::string model = path("m.glb").string();
+    std::ofstream(model) << "glTF";
+    const unsigned port = start_view({"--seconds", "60", model});
+    ASSERT_NE(port, 0u) << test::slurp(path("view-err.txt"));
+    EXPECT_EQ(status_of(http_exchange(port, get_request(port, "/viewer/a\x1b[2J\x01\x7f\xff\\b"))), 404);
+    ::kill(server_, SIGTERM);
+    int status = 0;
+    ASSERT_TRUE(view_ends_within(std::chrono::milliseconds(5000), status));
+    const std::string log = test::slurp(path("view-err.txt"));
+    EXPECT_NE(log.find("view: 404 /viewer/a\\x1b[2J\\x01\\x7f\\xff\\x5cb\n"), std::string::npos) << log;
+    EXPECT_TRUE(std::none_of(log.begin(), log.end(), [](char c) {
+        return (c < 0x20 && c != '\n') || c == 0x7f || (c & 0x80);
+    })) << log;
+}
+
+// The request parser (tools/animorder/http_request.cpp) on its own: the shapes it takes and
+// refuses, the Host check and the log's escaping. fuzz/fuzz_http_request.cpp runs it on any bytes.
+TEST(CliViewRequest, ParsesOnlyWellFormedHeads) {
+    using animorder::tool::HttpParse;
+    using animorder::tool::HttpRequest;
+    using animorder::tool::parse_http_request;
+    HttpRequest r;
+    ASSERT_EQ(parse_http_request("GET /viewer/x.js?v=1 HTTP/1.1\r\nhOsT:  localhost:8417 \t\r\nA: b\r\n\r\nbody", r),
+              HttpParse::complete);
+    EXPECT_EQ(r.method, "GET");
+    EXPECT_EQ(r.target, "/viewer/x.js");
+    EXPECT_EQ(r.minor_version, 1);
+    EXPECT_TRUE(r.has_host);
+    EXPECT_EQ(r.host, "localhost:8417");
+    ASSERT_EQ(parse_http_request("HEAD /a\x1b\xff HTTP/1.0\r\n\r\n", r), HttpParse::complete);
+    EXPECT_EQ(r.target, "/a\x1b\xff");
+    EXPECT_FALSE(r.has_host);
+    EXPECT_EQ(parse_http_request("GET / HTTP/1.1\r\nHost: a\r\n", r), HttpParse::incomplete);
+    EXPECT_EQ(parse_http_request("", r), HttpParse::incomplete);
+    for (const char* bad :
+         {"garbage\r\n\r\n", "GET / HTTP/1.1\r\n\r\n", "GET  / HTTP/1.0\r\n\r\n", "GET / HTTP/2.0\r\n\r\n",
+          "GET / HTTP/1.0 x\r\n\r\n", "G(T / HTTP/1.0\r\n\r\n", "GET / HTTP/1.0\r\nNo colon\r\n\r\n",
+          "GET / HTTP/1.0\r\n folded: x\r\n\r\n", "GET / HTTP/1.0\r\nA: b\nHost: x\r\n\r\n",
+          "GET / HTTP/1.0\r\nA: b\rc\r\n\r\n", "GET / HTTP/1.1\r\nHost: a\r\nHost: b\r\n\r\n", "\r\n\r\n"})
+        EXPECT_EQ(parse_http_request(bad, r), HttpParse::bad) << bad;
+    EXPECT_EQ(parse_http_request(std::string("GET /\0 HTTP/1.0\r\n\r\n", 20), r), HttpParse::bad);
+    const std::string big = "GET / HTTP/1.1\r\nHost: localhost:1\r\nX: " + std::string(8192, 'x');
+    EXPECT_EQ(parse_http_request(big, r), HttpParse::too_large);
+    EXPECT_EQ(parse_http_request(big + "\r\n\r\n", r), HttpParse::too_large);
+}
+
+TEST(CliViewRequest, HostCheckAndEscaping) {
+    using animorder::tool::escape_for_log;
+    using animorder::tool::host_is_loopback;
+    EXPECT_TRUE(host_is_loopback("127.0.0.1:8417", 8417));
+    EXPECT_TRUE(host_is_loopback("LocalHost:8417", 8417));
+    EXPECT_TRUE(host_is_loopback("[::1]:8417", 8417));
+    EXPECT_TRUE(host_is_loopback("localhost", 80));
+    EXPECT_FALSE(host_is_loopback("localhost", 8417));
+    EXPECT_FALSE(host_is_loopback("127.0.0.1:8418", 8417));
+    EXPECT_FALSE(host_is_loopback("127.0.0.1:84170", 8417));
+    EXPECT_FALSE(host_is_loopback("evil.example:8417", 8417));
+    EXPECT_FALSE(host_is_loopback("", 8417));
+    EXPECT_EQ(escape_for_log("/a b\x1b\t\\\x80\xff~"), "/a b\\x1b\\x09\\x5c\\x80\\xff~");
 }
 
 // What killed runs left beside an output (temporaries ".NAME.tmpPID-RANDOM", backups

@@ -3,37 +3,77 @@
 // in the default browser. Without FILE it first optimises the bundled character (subdivide
 // --levels 0, then optimize --method single) into a temporary folder, and serves the un-optimised
 // file too (/original.glb) so the page can compare the original order with the optimised ones.
-// The server is deliberately tiny: GET and HEAD, one request per connection, requests up to 8 KiB
-// read with a 5 s timeout, files only below the viewer's folders (no "..", no "%", no links out),
-// nothing but loopback.
+// The server is deliberately tiny: GET and HEAD, one request per connection, nothing but loopback.
+// What a client can and cannot do to it:
+// - Connections are served at once by a pool of kWorkers threads; when all are busy, new ones
+//   wait in the listen backlog (not refused) until a worker is free. A connection has kReadSeconds
+//   to send its request head (at most 8 KiB, http_request.h) and then kResponseSeconds to take
+//   the whole response; no single socket call waits longer than about a second, so a client that
+//   stalls (sends half a request, or never reads) holds one worker until its deadline, never the
+//   others, nor the end of `--seconds`, nor SIGINT/SIGTERM.
+// - `--seconds` and SIGINT/SIGTERM (handlers without SA_RESTART, the workers blocking both) end
+//   the server within about a second whatever the clients do: the workers' sockets are shut down,
+//   the workers joined, and the scratch folder removed.
+// - Files only below the viewer's folders (no "..", no "%", no backslash; real paths checked, see
+//   resolve()), and requests whose Host is not this server's loopback address and port are refused
+//   (421: a page rebound to 127.0.0.1 by DNS rebinding cannot read the model).
+// - Without -q, refused requests are logged with their URL's control bytes and non-ASCII bytes
+//   written as \xNN.
 #include "commands.h"
+#include "http_request.h"
 
 #include "animorder/atomic_write.h"
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
+#include <poll.h>
+#include <pthread.h>
 #include <sys/socket.h>
 #include <sys/time.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
+#include <cerrno>
 #include <chrono>
+#include <condition_variable>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <deque>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
+#include <mutex>
 #include <stdexcept>
 #include <string>
+#include <thread>
+#include <vector>
 
 namespace fs = std::filesystem;
 
 namespace animorder::tool {
 namespace {
 
+using Clock = std::chrono::steady_clock;
+
+constexpr size_t kWorkers = 16;                          // connections served at once (a browser opens at most 6)
+constexpr int kBacklog = 64;                             // connections that wait while every worker is busy
+constexpr int kReadSeconds = 10;                         // to send the request head, from the connection's accept
+constexpr int kResponseSeconds = 60;                     // to take the whole response, from the end of the request
+constexpr auto kSlice = std::chrono::milliseconds(250);  // the accept loop's longest wait
+
 volatile std::sig_atomic_t interrupted = 0;  // Ctrl-C / SIGTERM: stop serving, remove the scratch folder
 void on_signal(int) { interrupted = 1; }
+
+// SIGINT and SIGTERM set `interrupted`; without SA_RESTART, so that a wait under way returns at once.
+void install_signal_handlers() {
+    struct sigaction action {};
+    action.sa_handler = on_signal;
+    sigemptyset(&action.sa_mask);
+    action.sa_flags = 0;
+    sigaction(SIGINT, &action, nullptr);
+    sigaction(SIGTERM, &action, nullptr);
+}
 
 std::string content_type(const fs::path& path) {
     const std::string e = path.extension().string();
@@ -48,30 +88,72 @@ std::string content_type(const fs::path& path) {
     return "application/octet-stream";
 }
 
-void send_all(int fd, const std::string& bytes) {
-    size_t sent = 0;
-    while (sent < bytes.size()) {
-        const ssize_t n = ::send(fd, bytes.data() + sent, bytes.size() - sent, MSG_NOSIGNAL);
-        if (n <= 0) return;  // the browser went away: nothing to do
-        sent += size_t(n);
-    }
-}
-
-void respond(int fd, int code, const std::string& status, const std::string& type, const std::string& body, bool head,
-             const std::string& extra = "") {
-    std::string header = "HTTP/1.1 " + std::to_string(code) + " " + status + "\r\nContent-Type: " + type +
-                         "\r\nContent-Length: " + std::to_string(body.size()) +
-                         "\r\nCache-Control: no-store\r\nConnection: close\r\n" + extra + "\r\n";
-    send_all(fd, head ? header : header + body);
-}
-
 struct Site {
     fs::path root;      // the folder holding viewer/ and js/
     fs::path model;     // served as /model.glb
     fs::path original;  // served as /original.glb (may be empty)
+    unsigned port = 0;  // the port listened on (the Host check)
+    bool quiet = false;
 };
 
-// The file a URL path names, or empty when it names none we serve.
+// One client's socket, the time by which what is under way (reading the request, then sending
+// the response) must be done, and the server's stop flag.
+struct Connection {
+    int fd;
+    const std::atomic<bool>& stopping;
+    Clock::time_point deadline;
+    // Whether to go on: before the deadline, and the server not stopping.
+    bool may_go_on() const { return !stopping && Clock::now() < deadline; }
+};
+
+// Whether a socket call that failed may be tried again (it timed out after its second, or a
+// signal came).
+bool try_again(int error) { return error == EAGAIN || error == EWOULDBLOCK || error == EINTR; }
+
+// `size` bytes sent whole; false when the client went away, the deadline passed or the server stops.
+bool send_all(const Connection& c, const char* data, size_t size) {
+    size_t sent = 0;
+    while (sent < size) {
+        if (!c.may_go_on()) return false;
+        const ssize_t n = ::send(c.fd, data + sent, size - sent, MSG_NOSIGNAL);
+        if (n < 0 && try_again(errno)) continue;
+        if (n <= 0) return false;  // the browser went away: nothing to do
+        sent += size_t(n);
+    }
+    return true;
+}
+
+// The response head, then `body` unless the request was HEAD (`length`: the body's length).
+std::string response_head(int code, const std::string& status, const std::string& type, size_t length,
+                          const std::string& extra = "") {
+    return "HTTP/1.1 " + std::to_string(code) + " " + status + "\r\nContent-Type: " + type +
+           "\r\nContent-Length: " + std::to_string(length) + "\r\nCache-Control: no-store\r\nConnection: close\r\n" +
+           extra + "\r\n";
+}
+
+// A short answer: status line, headers and `body` (not for HEAD).
+void respond(const Connection& c, int code, const std::string& status, const std::string& type, const std::string& body,
+             bool head, const std::string& extra = "") {
+    std::string bytes = response_head(code, status, type, body.size(), extra);
+    if (!head) bytes += body;
+    send_all(c, bytes.data(), bytes.size());
+}
+
+// Whether the canonical path `path` is `base` or lies below it.
+bool inside(const fs::path& path, const fs::path& base) {
+    const auto [b, p] = std::mismatch(base.begin(), base.end(), path.begin(), path.end());
+    (void)p;
+    return b == base.end();
+}
+
+// The file a URL path names, or empty when it names none we serve. Its real path (links
+// followed) must lie below the real viewer/ for /viewer/..., below the real js/ for /js/...; for
+// /viewer/node_modules/PACKAGE/... (PACKAGE one name, or @scope/name) it must lie below the real
+// path of viewer/node_modules/PACKAGE, and that folder's real path must lie strictly below the
+// real site.root. So a package npm installed, or one linked to a folder inside the repository
+// (viewer/node_modules/animorder -> ../../js), is served; a link to anywhere outside the
+// repository (`npm link` of a folder elsewhere, or of `/`), or to the repository's root itself,
+// is not, nor is a link inside a package that leads out of it.
 fs::path resolve(const Site& site, const std::string& url) {
     if (url == "/model.glb") return site.model;
     if (url == "/original.glb") return site.original;
@@ -81,62 +163,203 @@ fs::path resolve(const Site& site, const std::string& url) {
     for (const char* prefix : {"/viewer/", "/js/"}) {
         if (url.rfind(prefix, 0) != 0) continue;
         fs::path path = site.root / url.substr(1);
-        if (!url.empty() && url.back() == '/') path /= "index.html";
+        if (url.back() == '/') path /= "index.html";
         std::error_code ec;
         const fs::path real = fs::canonical(path, ec);
-        const fs::path base =
-            fs::canonical(site.root / std::string(prefix).substr(1, std::string(prefix).size() - 2), ec);
-        if (ec || !fs::is_regular_file(real)) return {};
-        // The real path must stay below its folder (a link inside the viewer may not lead out of it),
-        // except for viewer/node_modules, which npm may link.
-        const std::string r = real.string(), b = base.string() + "/";
-        if (r.rfind(b, 0) != 0 && url.rfind("/viewer/node_modules/", 0) != 0) return {};
-        return real;
+        if (ec || !fs::is_regular_file(real, ec)) return {};
+        const std::string modules = "/viewer/node_modules/";
+        if (url.rfind(modules, 0) != 0) {
+            const std::string folder(prefix + 1, std::char_traits<char>::length(prefix) - 2);
+            const fs::path base = fs::canonical(site.root / folder, ec);
+            return !ec && inside(real, base) ? real : fs::path();
+        }
+        const std::string rest = url.substr(modules.size());
+        size_t cut = rest.find('/');
+        if (!rest.empty() && rest[0] == '@' && cut != std::string::npos) cut = rest.find('/', cut + 1);
+        if (cut == 0 || cut == std::string::npos) return {};
+        const fs::path package = fs::canonical(site.root / "viewer" / "node_modules" / rest.substr(0, cut), ec);
+        if (ec) return {};
+        const fs::path root = fs::canonical(site.root, ec);
+        if (ec || package == root || !inside(package, root)) return {};
+        return inside(real, package) ? real : fs::path();
     }
     return {};
 }
 
-void serve_one(int fd, const Site& site, bool quiet) {
-    timeval timeout{5, 0};
-    setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof timeout);
-    std::string request;
+// The request head, read until it is complete, bad or too large; incomplete when the client went
+// away, the deadline passed or the server stops first.
+HttpParse read_request(const Connection& c, HttpRequest& request) {
+    std::string bytes;
     char buffer[2048];
-    while (request.find("\r\n\r\n") == std::string::npos && request.size() < 8192) {
-        const ssize_t n = ::recv(fd, buffer, sizeof buffer, 0);
-        if (n <= 0) return;
-        request.append(buffer, size_t(n));
+    while (c.may_go_on()) {
+        const ssize_t n = ::recv(c.fd, buffer, sizeof buffer, 0);
+        if (n < 0 && try_again(errno)) continue;
+        if (n <= 0) break;
+        bytes.append(buffer, size_t(n));
+        const HttpParse parsed = parse_http_request(bytes, request);
+        if (parsed != HttpParse::incomplete) return parsed;
     }
-    const size_t line_end = request.find("\r\n");
-    const std::string line = request.substr(0, line_end);
-    const size_t a = line.find(' '), b = line.find(' ', a + 1);
-    if (line_end == std::string::npos || a == std::string::npos || b == std::string::npos) {
-        respond(fd, 400, "Bad Request", "text/plain", "bad request\n", false);
+    return HttpParse::incomplete;
+}
+
+// The file at `path` as a 200 response (its head only for HEAD), read and sent in pieces.
+void send_file(const Connection& c, const fs::path& path, std::ifstream& in, size_t size, bool head) {
+    const std::string start = response_head(200, "OK", content_type(path), size);
+    if (!send_all(c, start.data(), start.size()) || head) return;
+    std::vector<char> piece(1 << 16);
+    size_t left = size;
+    while (left > 0 && in) {
+        in.read(piece.data(), std::streamsize(std::min(left, piece.size())));
+        const size_t got = size_t(in.gcount());
+        if (got == 0 || !send_all(c, piece.data(), got)) return;
+        left -= got;
+    }
+}
+
+// One connection: its request read and answered, each within its deadline.
+void serve_one(int fd, const Site& site, const std::atomic<bool>& stopping) {
+    const timeval second{1, 0};  // no single call waits longer: the deadlines and the stop flag are checked between
+    setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &second, sizeof second);
+    setsockopt(fd, SOL_SOCKET, SO_SNDTIMEO, &second, sizeof second);
+    Connection c{fd, stopping, Clock::now() + std::chrono::seconds(kReadSeconds)};
+    HttpRequest request;
+    const HttpParse parsed = read_request(c, request);
+    if (parsed == HttpParse::incomplete) return;
+    c.deadline = Clock::now() + std::chrono::seconds(kResponseSeconds);
+    if (parsed == HttpParse::too_large) {
+        respond(c, 431, "Request Header Fields Too Large", "text/plain", "request head over 8 KiB\n", false);
         return;
     }
-    const std::string method = line.substr(0, a);
-    std::string url = line.substr(a + 1, b - a - 1);
-    url = url.substr(0, url.find('?'));
-    const bool head = method == "HEAD";
-    if (method != "GET" && !head) {
-        respond(fd, 405, "Method Not Allowed", "text/plain", "GET or HEAD only\n", false);
+    if (parsed == HttpParse::bad) {
+        respond(c, 400, "Bad Request", "text/plain", "bad request\n", false);
+        return;
+    }
+    const std::string& url = request.target;
+    // HTTP/1.0 may leave Host out (no browser does, so no rebound page can); HTTP/1.1 may not (the parser refuses it).
+    if (request.has_host && !host_is_loopback(request.host, site.port)) {
+        if (!site.quiet)
+            std::fprintf(stderr, "view: 421 %s (Host: %s)\n", escape_for_log(url).c_str(),
+                         escape_for_log(request.host).c_str());
+        respond(c, 421, "Misdirected Request", "text/plain",
+                "only Host 127.0.0.1:" + std::to_string(site.port) + " or localhost:" + std::to_string(site.port) +
+                    " is served\n",
+                false);
+        return;
+    }
+    const bool head = request.method == "HEAD";
+    if (request.method != "GET" && !head) {
+        respond(c, 405, "Method Not Allowed", "text/plain", "GET or HEAD only\n", false);
         return;
     }
     if (url == "/") {
-        respond(fd, 302, "Found", "text/plain", "", head,
+        respond(c, 302, "Found", "text/plain", "", head,
                 "Location: /viewer/?file=/model.glb" +
                     std::string(site.original.empty() ? "" : "&original=/original.glb") + "\r\n");
         return;
     }
     const fs::path path = resolve(site, url);
-    std::ifstream in(path, std::ios::binary);
-    if (path.empty() || !in) {
-        if (!quiet) std::fprintf(stderr, "view: 404 %s\n", url.c_str());
-        respond(fd, 404, "Not Found", "text/plain", "not found\n", head);
+    std::error_code ec;
+    const size_t size = path.empty() ? 0 : size_t(fs::file_size(path, ec));
+    std::ifstream in;
+    if (!path.empty() && !ec) in.open(path, std::ios::binary);
+    if (path.empty() || ec || !in) {
+        if (!site.quiet) std::fprintf(stderr, "view: 404 %s\n", escape_for_log(url).c_str());
+        respond(c, 404, "Not Found", "text/plain", "not found\n", head);
         return;
     }
-    const std::string body((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    respond(fd, 200, "OK", content_type(path), body, head);
+    send_file(c, path, in, size, head);
 }
+
+// The workers: kWorkers threads that each serve one accepted connection at a time. The accept
+// loop hands a connection over only while a worker is idle (wait_for_idle), so the others wait in
+// the listen backlog. stop() (also on destruction) shuts down the sockets being served, so that
+// their workers return at once, and joins the workers.
+class Pool {
+public:
+    explicit Pool(const Site& site) : site_(site) {
+        // SIGINT and SIGTERM go to the accept loop's thread (its poll returns at once), not to a worker.
+        sigset_t block, old;
+        sigemptyset(&block);
+        sigaddset(&block, SIGINT);
+        sigaddset(&block, SIGTERM);
+        pthread_sigmask(SIG_BLOCK, &block, &old);
+        try {
+            for (size_t i = 0; i < kWorkers; ++i) workers_.emplace_back([this] { work(); });
+        } catch (...) {
+            pthread_sigmask(SIG_SETMASK, &old, nullptr);
+            stop();
+            throw;
+        }
+        pthread_sigmask(SIG_SETMASK, &old, nullptr);
+    }
+    ~Pool() { stop(); }
+    Pool(const Pool&) = delete;
+    Pool& operator=(const Pool&) = delete;
+
+    // Whether a worker is idle (and not yet promised a connection), waiting up to `wait` for one.
+    bool wait_for_idle(Clock::duration wait) {
+        std::unique_lock<std::mutex> lock(mutex_);
+        return idle_changed_.wait_for(lock, wait, [this] { return idle_ > waiting_.size(); });
+    }
+
+    // `fd`, an accepted connection, to an idle worker (which closes it).
+    void hand_over(int fd) {
+        {
+            std::lock_guard<std::mutex> lock(mutex_);
+            waiting_.push_back(fd);
+        }
+        work_.notify_one();
+    }
+
+    // The workers told to stop (the sockets they serve shut down) and joined; connections not yet
+    // taken closed.
+    void stop() {
+        {
+            std::lock_guard<std::mutex> lock(mutex_);
+            stopping_ = true;
+            for (const int fd : active_) ::shutdown(fd, SHUT_RDWR);
+        }
+        work_.notify_all();
+        for (std::thread& worker : workers_)
+            if (worker.joinable()) worker.join();
+        for (const int fd : waiting_) ::close(fd);
+        waiting_.clear();
+    }
+
+private:
+    // A worker: takes connections until the pool stops.
+    void work() {
+        std::unique_lock<std::mutex> lock(mutex_);
+        for (;;) {
+            ++idle_;
+            idle_changed_.notify_all();
+            work_.wait(lock, [this] { return stopping_ || !waiting_.empty(); });
+            --idle_;
+            if (stopping_) return;
+            const int fd = waiting_.front();
+            waiting_.pop_front();
+            active_.push_back(fd);
+            lock.unlock();
+            try {
+                serve_one(fd, site_, stopping_);
+            } catch (...) {
+                // out of memory while answering: this connection only
+            }
+            lock.lock();
+            active_.erase(std::find(active_.begin(), active_.end(), fd));
+            ::close(fd);  // under the lock: stop() never shuts down a number already reused
+        }
+    }
+
+    const Site& site_;
+    std::mutex mutex_;
+    std::condition_variable work_, idle_changed_;
+    std::deque<int> waiting_;  // handed over, not yet taken
+    std::vector<int> active_;  // being served
+    size_t idle_ = 0;
+    std::atomic<bool> stopping_{false};
+    std::vector<std::thread> workers_;
+};
 
 // The bundled character, optimised, in `dir`: char.glb (input) and character.glb (optimised).
 void make_bundled(const fs::path& dir, bool quiet) {
@@ -185,6 +408,7 @@ struct Resources {
 
 int run_view(const ViewOptions& options) {
     Site site;
+    site.quiet = options.common.quiet;
     site.root = options.viewer_root.empty() ? fs::path(ANIMORDER_SOURCE_DIR) : fs::path(options.viewer_root);
     if (!fs::is_regular_file(site.root / "viewer" / "index.html"))
         throw std::runtime_error("the viewer is not at " + (site.root / "viewer").string() + " (give --viewer-root)");
@@ -193,7 +417,7 @@ int run_view(const ViewOptions& options) {
                                  " (run scripts/install-deps.sh)");
     // The port first: one that is taken is refused before any work.
     Resources held;
-    held.server = ::socket(AF_INET, SOCK_STREAM, 0);
+    held.server = ::socket(AF_INET, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
     if (held.server < 0) throw std::runtime_error("cannot open a socket");
     const int server = held.server;
     const int yes = 1;
@@ -202,7 +426,7 @@ int run_view(const ViewOptions& options) {
     address.sin_family = AF_INET;
     address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);  // loopback only
     address.sin_port = htons(options.port);
-    if (::bind(server, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0 || ::listen(server, 16) != 0)
+    if (::bind(server, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0 || ::listen(server, kBacklog) != 0)
         throw std::runtime_error("cannot listen on 127.0.0.1:" + std::to_string(options.port) + " (try --port 0)");
 
     std::error_code error;
@@ -228,7 +452,8 @@ int run_view(const ViewOptions& options) {
 
     socklen_t length = sizeof address;
     getsockname(server, reinterpret_cast<sockaddr*>(&address), &length);
-    const std::string url = "http://127.0.0.1:" + std::to_string(ntohs(address.sin_port)) + "/";
+    site.port = ntohs(address.sin_port);
+    const std::string url = "http://127.0.0.1:" + std::to_string(site.port) + "/";
     std::printf("animorder view: serving %s on %s\n", site.model.string().c_str(), url.c_str());
     std::fflush(stdout);
     if (options.open) {
@@ -236,21 +461,21 @@ int run_view(const ViewOptions& options) {
         if (std::system(command.c_str()) != 0 && !options.common.quiet)
             std::fprintf(stderr, "view: could not start a browser; open %s\n", url.c_str());
     }
-    const auto start = std::chrono::steady_clock::now();
-    std::signal(SIGINT, on_signal);
-    std::signal(SIGTERM, on_signal);
-    while (!interrupted &&
-           (options.seconds == 0 || std::chrono::steady_clock::now() - start < std::chrono::seconds(options.seconds))) {
-        timeval wait{1, 0};  // wake up now and then to honour --seconds and signals
-        fd_set ready;
-        FD_ZERO(&ready);
-        FD_SET(server, &ready);
-        if (::select(server + 1, &ready, nullptr, nullptr, &wait) <= 0) continue;
-        const int client = ::accept(server, nullptr, nullptr);
-        if (client < 0) continue;
-        serve_one(client, site, options.common.quiet);
-        ::close(client);
+    const Clock::time_point end =
+        options.seconds == 0 ? Clock::time_point::max() : Clock::now() + std::chrono::seconds(options.seconds);
+    install_signal_handlers();
+    Pool pool(site);  // after `held`: the workers are joined before the scratch folder goes
+    for (Clock::time_point now = Clock::now(); !interrupted && now < end; now = Clock::now()) {
+        // Wake up at least every kSlice to honour --seconds and signals (a signal ends poll at once).
+        const auto slice = std::chrono::duration_cast<std::chrono::milliseconds>(
+            std::min<Clock::duration>(kSlice, end - now) + std::chrono::microseconds(999));
+        if (!pool.wait_for_idle(slice)) continue;  // every worker busy: new connections wait in the backlog
+        pollfd ready{server, POLLIN, 0};
+        if (::poll(&ready, 1, int(slice.count())) <= 0) continue;
+        const int client = ::accept4(server, nullptr, nullptr, SOCK_CLOEXEC);
+        if (client >= 0) pool.hand_over(client);
     }
+    pool.stop();
     return 0;  // `held` closes the socket and removes the scratch folder
 }
 

@@ -4,7 +4,9 @@
 Each seed is a tiny valid file of its format, built byte by byte here so that the fuzzers start
 from inputs that reach deep into the parsers: sidecars (animorder_runtime.h's format), glTF 2.0
 (.glb and .gltf with an embedded buffer: static, morph-target and translation animation, one-joint
-skin), MD2 (one triangle, two frames) and IQM v2 (static, and one-joint skinned with an animation).
+skin), MD2 (one triangle, two frames), IQM v2 (static, and one-joint skinned with an animation) and
+the HTTP request heads `animorder view` reads (a browser's GET, HEAD over HTTP/1.0 without Host, a
+foreign Host, a URL with control bytes, half a request).
 """
 import base64
 import json
@@ -182,3 +184,12 @@ anim = u32(6, 0, 2) + f32(10) + u32(0)
 write("iqm", "skinned.iqm",
       iqm(b"\0bone\0walk\0", [(0, 7, 3, tri), (4, 1, 4, bytes(12)), (5, 1, 4, bytes([255, 0, 0, 0]) * 3)], u32(0, 1, 2),
           joint, pose, anim, struct.pack("<2H", 0, 100), counts=(1, 1, 1, 2, 1)))
+
+# --- HTTP request heads (animorder view) ---------------------------------------------------------
+write("http_request", "browser_get.txt",
+      b"GET /viewer/node_modules/three/build/three.module.js?v=1 HTTP/1.1\r\nHost: 127.0.0.1:8417\r\n"
+      b"User-Agent: Mozilla/5.0\r\nAccept: */*\r\nConnection: keep-alive\r\n\r\n")
+write("http_request", "head_http10.txt", b"HEAD /model.glb HTTP/1.0\r\n\r\n")
+write("http_request", "foreign_host.txt", b"GET /model.glb HTTP/1.1\r\nhost:  evil.example:8417 \t\r\n\r\n")
+write("http_request", "control_bytes.txt", b"GET /viewer/a\x1b[2J\xff\\b HTTP/1.1\r\nHost: [::1]:8417\r\n\r\n")
+write("http_request", "half.txt", b"GET /viewer/ HTTP/1.1\r\nHost: localhost:84")

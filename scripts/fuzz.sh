@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (fuzz/) with clang in build-fuzz/ and runs each for
 # SECONDS_PER_TARGET seconds (default 30): fuzz_runtime (the sidecar runtime header), fuzz_gltf,
-# fuzz_md2, fuzz_iqm (the loaders), fuzz_gltf_extension (the ANIMORDER_animated_triangle_orders reader). Each target starts from a temporary corpus: the committed
-# seeds in fuzz/corpus/<target>/ plus, when ../shared/data is there, its small files of that
-# format (read only, copied to the temporary folder). Exits non-zero when any target finds a
-# crash, leak, timeout or out-of-memory, printing the path of the input that triggers it.
+# fuzz_md2, fuzz_iqm (the loaders), fuzz_gltf_extension (the ANIMORDER_animated_triangle_orders
+# reader), fuzz_http_request (the request parser of `animorder view`). Each target starts from a
+# temporary corpus: the committed seeds in fuzz/corpus/<name>/ (the target's name without
+# "fuzz_") plus, when ../shared/data is there, its small files of that format (read only, copied
+# to the temporary folder). Exits non-zero when any target finds a crash, leak, timeout or
+# out-of-memory, printing the path of the input that triggers it.
 #
 #   scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]      e.g. scripts/fuzz.sh 60 fuzz_runtime
 #
@@ -17,7 +19,7 @@ set -euo pipefail
 seconds="${1:-30}"
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(fuzz_runtime fuzz_gltf fuzz_md2 fuzz_iqm fuzz_gltf_extension)
+[ ${#targets[@]} -gt 0 ] || targets=(fuzz_runtime fuzz_gltf fuzz_md2 fuzz_iqm fuzz_gltf_extension fuzz_http_request)
 case "$seconds" in '' | *[!0-9]*) echo "fuzz.sh: SECONDS_PER_TARGET must be a number" >&2; exit 2 ;; esac
 
 here="$(cd "$(dirname "$0")/.." && pwd)"

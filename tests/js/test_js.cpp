@@ -142,7 +142,7 @@ TEST_F(JsTest, ViewServesOnlyTheViewer) {
     const test::Outcome o = run("node " + sh(source_dir + "/viewer/test/server.mjs") + " " + sh(ANIMORDER_EXE) + " " +
                                 sh(path("char.glb")));
     EXPECT_EQ(o.exit_code, 0) << o.out << o.err;
-    EXPECT_EQ(test::line_count(o.out), 17u) << o.out;
+    EXPECT_EQ(test::line_count(o.out), 20u) << o.out;
     EXPECT_EQ(o.out.find("FAIL"), std::string::npos) << o.out;
 }
 

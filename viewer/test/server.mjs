@@ -1,6 +1,7 @@
 // node viewer/test/server.mjs ANIMORDER_EXE GLB — `animorder view GLB` answers only what it should:
 // the viewer's files, the model, GET/HEAD only; nothing above its folders (.., %2e, backslashes,
-// absolute paths), a 404 for the rest, a 400 for garbage, a one-line error for a missing file.
+// absolute paths), a 404 for the rest, a 421 for another Host, a 400 for garbage and for HTTP/1.1
+// without Host, a one-line error for a missing file.
 // Prints one line per request; exit 0 when every status is the expected one.
 import { spawn, spawnSync } from 'node:child_process';
 import net from 'node:net';
@@ -21,24 +22,30 @@ function status(raw) {
         socket.on('error', () => resolve(0));
     });
 }
+// A browser's request line for each case (with its Host), then raw ones.
+const host = `Host: 127.0.0.1:${port}\r\n`;
 const cases = [
-    ['GET / HTTP/1.1\r\n\r\n', 302],
-    ['GET /viewer/ HTTP/1.1\r\n\r\n', 200],
-    ['GET /viewer/viewer.js?x=1 HTTP/1.1\r\n\r\n', 200],
-    ['GET /js/runtime/animorder.js HTTP/1.1\r\n\r\n', 200],
-    ['GET /viewer/node_modules/three/build/three.module.js HTTP/1.1\r\n\r\n', 200],
-    ['GET /model.glb HTTP/1.1\r\n\r\n', 200],
-    ['HEAD /model.glb HTTP/1.1\r\n\r\n', 200],
-    ['GET /original.glb HTTP/1.1\r\n\r\n', 404],  // none given
-    ['GET /viewer/../CMakeLists.txt HTTP/1.1\r\n\r\n', 404],
-    ['GET /viewer/%2e%2e/CMakeLists.txt HTTP/1.1\r\n\r\n', 404],
-    ['GET /viewer/..\\CMakeLists.txt HTTP/1.1\r\n\r\n', 404],
-    ['GET /CMakeLists.txt HTTP/1.1\r\n\r\n', 404],
-    ['GET /etc/passwd HTTP/1.1\r\n\r\n', 404],
-    ['GET /js/ HTTP/1.1\r\n\r\n', 404],
-    ['POST /model.glb HTTP/1.1\r\n\r\n', 405],
+    ['GET / HTTP/1.1', 302],
+    ['GET /viewer/ HTTP/1.1', 200],
+    ['GET /viewer/viewer.js?x=1 HTTP/1.1', 200],
+    ['GET /js/runtime/animorder.js HTTP/1.1', 200],
+    ['GET /viewer/node_modules/three/build/three.module.js HTTP/1.1', 200],
+    ['GET /model.glb HTTP/1.1', 200],
+    ['HEAD /model.glb HTTP/1.1', 200],
+    ['GET /original.glb HTTP/1.1', 404],  // none given
+    ['GET /viewer/../CMakeLists.txt HTTP/1.1', 404],
+    ['GET /viewer/%2e%2e/CMakeLists.txt HTTP/1.1', 404],
+    ['GET /viewer/..\\CMakeLists.txt HTTP/1.1', 404],
+    ['GET /CMakeLists.txt HTTP/1.1', 404],
+    ['GET /etc/passwd HTTP/1.1', 404],
+    ['GET /js/ HTTP/1.1', 404],
+    ['POST /model.glb HTTP/1.1', 405],
+].map(([line, expected]) => [`${line}\r\n${host}\r\n`, expected]).concat([
+    ['GET /model.glb HTTP/1.1\r\nHost: evil.example\r\n\r\n', 421],  // DNS rebinding
+    ['GET /model.glb HTTP/1.1\r\n\r\n', 400],  // HTTP/1.1 without Host
+    ['GET /model.glb HTTP/1.0\r\n\r\n', 200],  // HTTP/1.0 may leave it out
     ['garbage\r\n\r\n', 400],
-];
+]);
 let failures = 0;
 for (const [raw, expected] of cases) {
     const got = await status(raw);

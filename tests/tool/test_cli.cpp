@@ -1336,13 +1336,17 @@ TEST_F(CliView, ScratchFoldersOfGoneProcessesAreRemoved) {
     if (gone == 0) ::_exit(0);
     ASSERT_EQ(::waitpid(gone, nullptr, 0), gone);
     const fs::path dead = path("tmp/animorder-view-" + std::to_string(gone));
+    const fs::path dead_now = path("tmp/animorder-view-" + std::to_string(gone) + "-0123456789abcdef");  // as named now
     const fs::path alive = path("tmp/animorder-view-" + std::to_string(::getpid()));
-    fs::create_directories(dead);
-    std::ofstream(dead / "char.glb") << "left by a killed run";
+    for (const fs::path& folder : {dead, dead_now}) {
+        fs::create_directories(folder);
+        std::ofstream(folder / "char.glb") << "left by a killed run";
+    }
     fs::create_directories(alive);
     const test::Outcome o = test::run_captured(view("-q --seconds 1 --port 0 " + path("in.glb").string()), dir_);
     EXPECT_EQ(o.exit_code, 0) << o.err;
     EXPECT_FALSE(fs::exists(dead)) << "a gone process's scratch folder stayed";
+    EXPECT_FALSE(fs::exists(dead_now)) << "a gone process's scratch folder stayed";
     EXPECT_TRUE(fs::exists(alive)) << "a running process's scratch folder was removed";
 }
 

@@ -1,8 +1,8 @@
 // animorder view [FILE] — serves the viewer page (viewer/, with js/ and three.js from
 // viewer/node_modules) and FILE as /model.glb on 127.0.0.1 only, prints the address and opens it
 // in the default browser. Without FILE it first optimises the bundled character (subdivide
-// --levels 0, then optimize --method single) into a temporary folder, and serves the un-optimised
-// file too (/original.glb) so the page can compare the original order with the optimised ones.
+// --levels 0, then optimize --method single) into a new scratch folder of its own (random name,
+// mode 0700), and serves the un-optimised file too (/original.glb) so the page can compare the original order with the optimised ones.
 // The server is deliberately tiny: GET and HEAD, one request per connection, nothing but loopback.
 // What a client can and cannot do to it:
 // - Connections are served at once by a pool of kWorkers threads; when all are busy, new ones
@@ -29,6 +29,7 @@
 #include <poll.h>
 #include <pthread.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/time.h>
 #include <unistd.h>
 
@@ -40,10 +41,12 @@
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <deque>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <random>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -382,8 +385,9 @@ void remove_stale_scratch_folders(const fs::path& temp) {
     const std::string prefix = "animorder-view-";
     std::error_code error;
     for (auto it = fs::directory_iterator(temp, error); !error && it != fs::directory_iterator(); it.increment(error)) {
+        // "animorder-view-PID-RANDOM" (and "animorder-view-PID", as earlier versions named them).
         const std::string name = it->path().filename().string(),
-                          pid = name.substr(std::min(name.size(), prefix.size()));
+                          rest = name.substr(std::min(name.size(), prefix.size())), pid = rest.substr(0, rest.find('-'));
         if (name.rfind(prefix, 0) != 0 || pid.empty() || pid.size() > 9 ||
             !std::all_of(pid.begin(), pid.end(), [](char c) { return c >= '0' && c <= '9'; }) ||
             process_may_run(std::stol(pid)))
@@ -435,8 +439,21 @@ int run_view(const ViewOptions& options) {
     fs::path& scratch = held.scratch;
     if (options.common.input.empty()) {
         if (error) throw std::runtime_error("no folder for temporary files: " + error.message());
-        scratch = temp / ("animorder-view-" + std::to_string(::getpid()));
-        fs::create_directories(scratch);
+        // A new folder of its own, under a name nobody can plant a link or folder at in advance
+        // (the temporary folder is shared; a container's PID is 1): mkdir fails on any existing name.
+        std::random_device random;
+        for (int attempt = 0;; ++attempt) {
+            char suffix[20];
+            std::snprintf(suffix, sizeof suffix, "-%08x%08x", random(), random());
+            const fs::path candidate = temp / ("animorder-view-" + std::to_string(::getpid()) + suffix);
+            if (::mkdir(candidate.c_str(), 0700) == 0) {
+                scratch = candidate;
+                break;
+            }
+            if (errno != EEXIST || attempt == 63)
+                throw std::runtime_error("cannot create a scratch folder in " + temp.string() + ": " +
+                                         std::strerror(errno));
+        }
         if (!options.common.quiet) std::fprintf(stderr, "view: optimising the bundled character (about 25 s)\n");
         make_bundled(scratch, options.common.quiet);
         site.model = scratch / "character.glb";

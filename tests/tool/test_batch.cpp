@@ -1033,3 +1033,38 @@ TEST_F(Batch, CsvErrorsNameTheirLineAndTheMarkdownSummaryEscapesNames) {
     EXPECT_NE(md.find("\n| a/b | original |"), std::string::npos) << md;
     EXPECT_NE(md.find("\n| \\*em\\* \\<i\\>x\\</i\\> \\`c\\` | original |"), std::string::npos) << md;
 }
+
+// A shard that is empty or malformed is refused before any work, in one line: in a farm whose
+// index variable is unset, `--shard "$JOB_COMPLETION_INDEX/4"` reads "/4" and `--shard "$SHARD"`
+// reads "" (which ran every item, in every process of the job).
+TEST_F(Batch, AnEmptyOrMalformedShardIsRefusedBeforeAnyWork) {
+    write("m.json",
+          R"({"items": [{"method": "original", "output": "out/a"}, {"method": "original", "output": "out/b"}]})");
+    for (const char* shard : {"", "/4", "3/", "/", "4/4", "-1/4", "x/4", "1/x", " ", "\t", " 1/4", "1/4 ", "1 /4",
+                              "1/0", "+1/4", "1/4/2", "env/", "1//4"}) {
+        for (const char* mode : {"", " --dry-run"}) {
+            const test::Outcome o =
+                run("batch -q --eval-views 0" + std::string(mode) + " --shard '" + shard + "' " + manifest());
+            EXPECT_EQ(o.exit_code, 1) << "'" << shard << "'" << mode << ": " << o.out;
+            EXPECT_EQ(test::line_count(o.err), 1u) << "'" << shard << "'" << mode << ": " << o.err;
+            EXPECT_NE(o.err.find("--shard"), std::string::npos) << o.err;
+            EXPECT_EQ(o.out, "") << "'" << shard << "'" << mode;
+            EXPECT_TRUE(outputs().empty()) << "'" << shard << "'" << mode;
+        }
+    }
+    // As a farm's command writes it, with the variable unset.
+    const std::string exe = ANIMORDER_EXE;
+    for (const char* shard : {"\"$JOB_COMPLETION_INDEX/4\"", "\"$SHARD\"", "\"$SHARD\"/2"}) {
+        const test::Outcome o = run_shell("env -u JOB_COMPLETION_INDEX -u SHARD sh -c '" + exe +
+                                          " batch -q --eval-views 0 --shard " + shard + " " + manifest() + "'");
+        EXPECT_EQ(o.exit_code, 1) << shard;
+        EXPECT_NE(o.err.find("is empty (an unset variable"), std::string::npos) << shard << ": " << o.err;
+        EXPECT_TRUE(outputs().empty()) << shard;
+    }
+    // A well-formed shard still runs its own items.
+    const test::Outcome one = run("batch -q --eval-views 0 --shard 01/2 " + manifest());
+    EXPECT_EQ(one.exit_code, 0) << one.err;
+    EXPECT_NE(one.out.find("shard 1/2: 1 items: 1 done"), std::string::npos) << one.out;
+    EXPECT_TRUE(fs::exists(path("out/b.animorder.bin")));
+    EXPECT_FALSE(fs::exists(path("out/a.animorder.bin")));
+}

@@ -213,7 +213,7 @@ int print_plan(const std::vector<PlannedItem>& items, std::pair<size_t, size_t> 
 int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
     const std::vector<ManifestItem> manifest = read_manifest(batch.manifest);
     std::pair<size_t, size_t> shard = {0, 1};
-    if (!batch.shard.empty()) shard = parse_shard(batch.shard);
+    if (batch.shard_given || !batch.shard.empty()) shard = parse_shard(batch.shard);
     check_merge_options(batch);
 
     // Every item planned and every output of every item checked before any work: folders exist
@@ -231,7 +231,7 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
     // Only what this process writes is checked for writing (a shard its own items' files, the
     // merge the summary, a whole run everything); the files of the job's other processes are
     // checked against every input and every other output only.
-    const bool sharded = shard.second > 1 || !batch.shard.empty();
+    const bool sharded = shard.second > 1 || batch.shard_given || !batch.shard.empty();
     std::vector<std::string> written, others, inputs = {batch.manifest}, folders;
     std::vector<std::string>& summary_files = batch.merge || !sharded ? written : others;
     summary_files.insert(summary_files.end(), {summary + ".json", summary + ".md"});

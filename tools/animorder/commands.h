@@ -120,10 +120,11 @@ namespace animorder::tool {
 struct BatchOptions {
     std::string manifest;
     bool quiet = false;
-    std::string shard;       // "I/N", "env/N" (JOB_COMPLETION_INDEX or SLURM_ARRAY_TASK_ID), empty: all
-    bool merge = false;      // only build the summary from the items' reports
-    std::string summary;     // SUMMARY → SUMMARY.json and SUMMARY.md (default: beside the manifest)
-    size_t eval_views = 10;  // OVR before/after per item: random views per keyframe (0: no OVR)
+    std::string shard;         // "I/N", "env/N" (JOB_COMPLETION_INDEX or SLURM_ARRAY_TASK_ID)
+    bool shard_given = false;  // --shard given: its text must then be I/N or env/N (even empty, it is no "all")
+    bool merge = false;        // only build the summary from the items' reports
+    std::string summary;       // SUMMARY → SUMMARY.json and SUMMARY.md (default: beside the manifest)
+    size_t eval_views = 10;    // OVR before/after per item: random views per keyframe (0: no OVR)
     unsigned eval_resolution = 256;
     bool no_timings = false;        // wall times left out: identical work gives byte-identical files
     bool force = false;             // redo items even when up to date

@@ -383,7 +383,10 @@ int main(int argc, char** argv) {
         if (*evaluate_cmd) return run_evaluate(evaluate);
         if (*heatmap_cmd) return run_heatmap(heatmap);
         if (*subdivide_cmd) return run_subdivide(subdivide);
-        if (*batch_cmd) return run_batch(batch, parse_batch_item);
+        if (*batch_cmd) {
+            batch.shard_given = batch_cmd->count("--shard") > 0;  // --shard "" is an error, not every item
+            return run_batch(batch, parse_batch_item);
+        }
         if (*view_cmd) return run_view(view);
         if (*check_cmd) return run_check(check);
         if (*reapply_cmd) return run_reapply(reapply);

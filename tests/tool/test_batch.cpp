@@ -1068,3 +1068,58 @@ TEST_F(Batch, AnEmptyOrMalformedShardIsRefusedBeforeAnyWork) {
     EXPECT_TRUE(fs::exists(path("out/b.animorder.bin")));
     EXPECT_FALSE(fs::exists(path("out/a.animorder.bin")));
 }
+
+// An item's files outside the manifest's folder (an output with "..", an absolute one, one
+// through a link to a folder elsewhere) are refused before any work, in one line naming the item
+// and the path, unless --allow-outside; with it they are written, and resume as any other. The
+// manifest lives in lib/, the outside folder is elsewhere/: both in the test's folder.
+TEST_F(Batch, OutputsOutsideTheManifestsFolderNeedAllowOutside) {
+    fs::create_directories(path("lib/out"));
+    fs::create_directories(path("elsewhere"));
+    fs::create_symlink("../elsewhere", path("lib/link"));
+    const std::string lib_manifest = path("lib/m.json").string();
+    const std::vector<std::string> outside = {"../elsewhere/a", path("elsewhere/b").string(), "out/../../elsewhere/c",
+                                              "link/d"};
+    const auto files_in = [&](const char* folder) {
+        size_t n = 0;
+        for (const auto& e : fs::directory_iterator(path(folder))) n += e.is_regular_file();
+        return n;
+    };
+    for (const std::string& output : outside) {
+        write("lib/m.json", R"({"items": [{"name": "in", "method": "original", "output": "out/in"},
+                                          {"name": "out", "method": "original", "output": ")" +
+                                output + "\"}]}");
+        for (const char* mode : {"", " --dry-run", " --shard 1/2", " --merge"}) {
+            const test::Outcome o = run("batch -q --eval-views 0" + std::string(mode) + " " + lib_manifest);
+            EXPECT_EQ(o.exit_code, 1) << output << mode;
+            EXPECT_EQ(test::line_count(o.err), 1u) << output << mode << ": " << o.err;
+            EXPECT_NE(o.err.find("item 2 (out): the output " + output), std::string::npos) << o.err;
+            EXPECT_NE(o.err.find("--allow-outside"), std::string::npos) << o.err;
+        }
+        EXPECT_EQ(files_in("elsewhere"), 0u) << output;
+        EXPECT_EQ(files_in("lib/out"), 0u) << output;  // before any work: not even the item inside
+    }
+    // Allowed: written where they lead, and up to date on the next run and in the merge.
+    std::string items;
+    for (size_t i = 0; i < outside.size(); ++i)
+        items += std::string(i ? "," : "") + R"({"method": "original", "output": ")" + outside[i] + "\"}";
+    write("lib/m.json", "{\"items\": [" + items + "]}");
+    const test::Outcome allowed = run("batch -q --eval-views 0 --allow-outside " + lib_manifest);
+    EXPECT_EQ(allowed.exit_code, 0) << allowed.err;
+    for (const char* name : {"a", "b", "c", "d"})
+        for (const char* ext : {".animorder.bin", ".animorder.json", ".animorder.report.json"})
+            EXPECT_TRUE(fs::exists(path("elsewhere/" + std::string(name) + ext))) << name << ext;
+    const test::Outcome again = run("batch -q --eval-views 0 --allow-outside " + lib_manifest);
+    EXPECT_NE(again.out.find("4 items: 0 done, 4 up to date"), std::string::npos) << again.out << again.err;
+    EXPECT_EQ(run("batch -q --eval-views 0 --allow-outside --merge " + lib_manifest).exit_code, 0);
+    EXPECT_EQ(nlohmann::json::parse(test::slurp(path("lib/m.summary.json")))["ok"], 4);
+    // Paths that only pass through folders and come back inside are inside.
+    fs::create_directories(path("lib/sub"));
+    write("lib/m.json", R"({"items": [{"method": "original", "output": "sub/../out/x"},
+                                      {"method": "original", "output": ")" +
+                            path("lib/out/y").string() + "\"}]}");
+    const test::Outcome inside = run("batch -q --eval-views 0 " + lib_manifest);
+    EXPECT_EQ(inside.exit_code, 0) << inside.err;
+    EXPECT_TRUE(fs::exists(path("lib/out/x.animorder.bin")));
+    EXPECT_TRUE(fs::exists(path("lib/out/y.animorder.bin")));
+}

@@ -68,21 +68,16 @@ void drop_timings(json& value) {
 
 json number_or_null(double v, bool have) { return have ? json(v) : json(nullptr); }
 
-// Where a file is, whether or not it exists yet: its folder resolved, then its name. A commit
-// renames a new file into place, so an output keeps its place but not its inode.
-std::string place_of(const std::string& path) {
-    const fs::path p(path);
-    std::error_code error;
-    const fs::path folder = fs::weakly_canonical(fs::absolute(folder_of(path), error), error);
-    return (folder / p.filename()).string();
-}
-
-// Every output of the batch by place_of, for checking the files an item's loading read (an
-// importer's side files are known only then).
-using OutputsByPlace = std::unordered_map<std::string, std::string>;
+// Every output of the batch by its place (Places: its folder resolved, then its name; a commit
+// renames a new file into place, so an output keeps its place but not its inode), for checking
+// the files an item's loading read (an importer's side files are known only then).
+struct OutputsByPlace {
+    std::unordered_map<std::string, std::string> outputs;
+    Places places;
+};
 
 // Runs one item into one OutputSet (the report, with its stamp, last): all files or none.
-void run_item(const PlannedItem& p, const Stamp& stamp, const BatchOptions& batch, const OutputsByPlace& all_outputs) {
+void run_item(const PlannedItem& p, const Stamp& stamp, const BatchOptions& batch, OutputsByPlace& all_outputs) {
     const Clock::time_point start = Clock::now();
     std::vector<std::string> files_of_item = p.plan.outputs;
     files_of_item.push_back(p.error);
@@ -97,10 +92,10 @@ void run_item(const PlannedItem& p, const Stamp& stamp, const BatchOptions& batc
     OptimizeProduct product = produce_optimize(p.options, p.plan, files, [&](const std::vector<std::string>& read) {
         for (const std::string& file : read) {
             std::error_code error;  // the file as named, and where a link there leads
-            auto output = all_outputs.find(place_of(file));
-            if (output == all_outputs.end())
-                output = all_outputs.find(fs::weakly_canonical(fs::absolute(file, error), error).string());
-            if (output != all_outputs.end())
+            auto output = all_outputs.outputs.find(all_outputs.places.of(file).string());
+            if (output == all_outputs.outputs.end())
+                output = all_outputs.outputs.find(fs::weakly_canonical(fs::absolute(file, error), error).string());
+            if (output != all_outputs.outputs.end())
                 throw OutputError(output->second + ": is an input of this run (loading " + p.options.common.input +
                                   " reads it): refusing to overwrite the input; name another output");
         }
@@ -220,6 +215,8 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
     // and are writable, no output is any item's input or the manifest, no file is named twice.
     std::vector<PlannedItem> items;
     for (size_t i = 0; i < manifest.size(); ++i) items.push_back(plan_item(manifest[i], i, batch, parse_item));
+    Places places;
+    if (!batch.allow_outside) check_outputs_inside(items, batch.manifest, places);
     std::string summary = batch.summary;
     if (file_extension(summary) == ".json" || file_extension(summary) == ".md")  // --summary S.json: S
         summary.erase(summary.size() - file_extension(summary).size());
@@ -247,12 +244,14 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
     outputs.insert(outputs.end(), others.begin(), others.end());
     // A dry run writes nothing, not even the probes that check a folder takes a new file.
     check_output_paths(outputs, inputs, folders, batch.dry_run ? 0 : written.size());
-    OutputsByPlace outputs_by_place;
-    for (const std::string& output : outputs) outputs_by_place.emplace(place_of(output), output);
 
     if (batch.merge) return merge_shards(items, summary, batch);  // it stamps every item
 
     if (batch.dry_run) return print_plan(items, shard, sharded, batch);
+
+    OutputsByPlace outputs_by_place{{}, std::move(places)};
+    for (const std::string& output : outputs)
+        outputs_by_place.outputs.emplace(outputs_by_place.places.of(output).string(), output);
 
     // A shard stamps its own items only, each when its turn comes (so that an input edited while
     // earlier items run is read as it is then).

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <stdexcept>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 namespace animorder::tool {
@@ -31,11 +32,15 @@ std::string stem_of(const std::string& output) {
     return ext == ".glb" || ext == ".gltf" ? output.substr(0, output.size() - ext.size()) : output;
 }
 
+std::string item_label(const ManifestItem& item, size_t index) {
+    return (item.line ? "line " + std::to_string(item.line) : "item " + std::to_string(index + 1)) + " (" + item.name +
+           ")";
+}
+
 PlannedItem plan_item(const ManifestItem& item, size_t index, const BatchOptions& batch, const ItemParser& parse) {
     PlannedItem p;
     p.item = item;
-    const std::string label = (item.line ? "line " + std::to_string(item.line) : "item " + std::to_string(index + 1)) +
-                              " (" + item.name + ")";
+    const std::string label = item_label(item, index);
     // The item's own fields first, its options last (so an option missing its value says so).
     std::vector<std::string> args = {"-o", item.output};
     if (!item.input.empty()) args.push_back(item.input);
@@ -79,6 +84,48 @@ std::string output_as_written(const PlannedItem& p, const std::string& out) {
 fs::path folder_of(const std::string& path) {
     const fs::path p(path);
     return p.has_parent_path() ? p.parent_path() : fs::path(".");
+}
+
+fs::path Places::folder(const fs::path& folder) {
+    const auto known = folders_.find(folder.string());
+    if (known != folders_.end()) return known->second;
+    std::error_code error;
+    fs::path where = fs::weakly_canonical(fs::absolute(folder, error), error);
+    if (error) where = fs::absolute(folder, error).lexically_normal();
+    return folders_.emplace(folder.string(), where).first->second;
+}
+
+fs::path Places::of(const std::string& path) { return folder(folder_of(path)) / fs::path(path).filename(); }
+
+namespace {
+
+// Whether `place` is `folder` or lies under it (both resolved: no "..", no links).
+bool lies_in(const fs::path& place, const fs::path& folder) {
+    auto p = place.begin();
+    for (const fs::path& part : folder) {
+        if (part.empty()) continue;  // a trailing separator
+        if (p == place.end() || *p != part) return false;
+        ++p;
+    }
+    return true;
+}
+
+}  // namespace
+
+void check_outputs_inside(const std::vector<PlannedItem>& items, const std::string& manifest, Places& places) {
+    const fs::path home = places.folder(folder_of(manifest));
+    for (size_t i = 0; i < items.size(); ++i) {
+        const PlannedItem& p = items[i];
+        std::vector<std::string> files = p.plan.outputs;
+        files.push_back(p.error);
+        for (const std::string& file : files) {
+            const fs::path place = places.of(file);
+            if (lies_in(place, home)) continue;
+            throw std::runtime_error(item_label(p.item, i) + ": the output " + output_as_written(p, file) +
+                                     " lies outside the manifest's folder (" + place.string() + ", not under " +
+                                     home.string() + "): batch writes outside it only with --allow-outside");
+        }
+    }
 }
 
 // What a run killed part-way left of an item (atomic_write.h's remove_stale_temporaries), removed

@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <filesystem>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 namespace animorder::tool {
@@ -19,6 +20,9 @@ struct PlannedItem {
     OptimizePlan plan;
     std::string report, error;  // OUT.animorder.report.json, OUT.animorder.error.json
 };
+
+// An item as errors name it: its CSV line or its number, and its name.
+std::string item_label(const ManifestItem& item, size_t index);
 
 // The item's optimize options (its fields first, its options last; batch's own options refused:
 // outputs, clips and threads) and plan; an error names the item's line or number and name.
@@ -32,6 +36,23 @@ std::string output_as_written(const PlannedItem& p, const std::string& out);
 
 // A path's folder ("." for a bare name).
 std::filesystem::path folder_of(const std::string& path);
+
+// Where files are, whether or not they exist yet, each folder resolved once (links and ".."; a
+// library's many items share a few folders): the folder's weakly_canonical path, then the name.
+class Places {
+public:
+    std::filesystem::path of(const std::string& path);
+    std::filesystem::path folder(const std::filesystem::path& folder);
+
+private:
+    std::unordered_map<std::string, std::filesystem::path> folders_;
+};
+
+// Refuses, in one line naming the item and the path, a file some item writes (its outputs, report
+// and error file) that lies outside the manifest's folder once ".." and links to folders are
+// resolved: `../../x.glb`, an absolute path elsewhere, or a link out (batch --allow-outside
+// writes there).
+void check_outputs_inside(const std::vector<PlannedItem>& items, const std::string& manifest, Places& places);
 
 // What a run killed part-way left of an item (atomic_write.h's remove_stale_temporaries), removed
 // when the item is redone or found up to date.

@@ -130,6 +130,7 @@ struct BatchOptions {
     bool force = false;             // redo items even when up to date
     bool item_failures_ok = false;  // exit 0 when items failed (not with --merge)
     bool dry_run = false;           // write nothing: print which items would run and why (JSON on stdout)
+    bool allow_outside = false;     // items may write outside the manifest's folder (.., absolute paths, links out)
     unsigned threads = 0;
 };
 using ItemParser = std::function<OptimizeOptions(const std::vector<std::string>& args)>;

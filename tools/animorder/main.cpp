@@ -300,6 +300,9 @@ int main(int argc, char** argv) {
                         "whose retry would only fail the same items again");
     batch_cmd->add_flag("--dry-run", batch.dry_run,
                         "Write nothing: print which of the shard's items would run and why (JSON on stdout)");
+    batch_cmd->add_flag("--allow-outside", batch.allow_outside,
+                        "Let items write outside the manifest's folder (an output with .., an absolute one, a link "
+                        "to a folder elsewhere); refused without it");
     batch_cmd->add_option("--threads", batch.threads, "Worker threads per item (0: all cores)")
         ->capture_default_str()
         ->check(kWholeNumber)

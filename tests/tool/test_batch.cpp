@@ -1123,3 +1123,61 @@ TEST_F(Batch, OutputsOutsideTheManifestsFolderNeedAllowOutside) {
     EXPECT_TRUE(fs::exists(path("lib/out/x.animorder.bin")));
     EXPECT_TRUE(fs::exists(path("lib/out/y.animorder.bin")));
 }
+
+// A report that carries its item's stamp but a figure no run gives (an OVR of 1e308 or below 1, an
+// ACMR outside 1/triangles..3, a negative count or time, a number JSON cannot hold) is not a
+// result: the merge counts the item as missing and says so in one line naming the report and the
+// field (it merged 1e308 as valid), and the next run redoes the item.
+TEST_F(Batch, AReportWithImplausibleFiguresIsRejectedAtTheMerge) {
+    write("m.json",
+          R"({"items": [{"name": "a", "method": "original", "output": "out/a"},
+                        {"name": "b", "method": "original", "output": "out/b"}]})");
+    const std::string options = "batch -q --eval-views 1 --eval-resolution 32 ";
+    ASSERT_EQ(run(options + manifest()).exit_code, 0);
+    const std::string original = test::slurp_existing(path("out/a.animorder.report.json"));
+    const nlohmann::json report = nlohmann::json::parse(original);
+    ASSERT_TRUE(report["batch"]["ovr_after"].is_number()) << report["batch"];
+    ASSERT_GE(report["batch"]["triangles"].get<double>(), 2.0);
+    const std::vector<std::pair<std::string, nlohmann::json>> edits = {
+        {"ovr_after", 1e308},  {"ovr_after", -1},  {"ovr_before", 0.5},  {"ovr_after", "NaN"},     {"ovr_after", 2000},
+        {"acmr_after", 1e308}, {"acmr_before", 0}, {"acmr_after", -0.5}, {"acmr_after", 3.5},      {"triangles", -5},
+        {"triangles", 1e308},  {"buffers", 1.5},   {"clips", "two"},     {"index_bytes_added", 7}, {"time_s", -1},
+        {"time_s", 1e308},     {"keyframes", -1}};
+    for (const auto& [field, value] : edits) {
+        nlohmann::json edited = report;
+        edited["batch"][field] = value;
+        write("out/a.animorder.report.json", edited.dump(2));
+        const test::Outcome merged = run(options + "--merge " + manifest());
+        const std::string what = field + " = " + value.dump();
+        EXPECT_EQ(merged.exit_code, 4) << what << ": " << merged.err;
+        EXPECT_EQ(test::line_count(merged.err), 1u) << what << ": " << merged.err;
+        EXPECT_NE(merged.err.find("out/a.animorder.report.json was edited: " + field + " is "), std::string::npos)
+            << what << ": " << merged.err;
+        const nlohmann::json s = nlohmann::json::parse(test::slurp(path("m.summary.json")));
+        EXPECT_EQ(s["items"][0]["status"], "missing") << what;
+        EXPECT_TRUE(s["items"][0]["ovr_after"].is_null()) << what;
+        EXPECT_NE(s["items"][0]["error"].get<std::string>().find(field), std::string::npos) << s["items"][0];
+        EXPECT_EQ(s["items"][1]["status"], "ok") << what;
+    }
+    // Numbers that JSON cannot hold (NaN, Infinity) or a double cannot (1e400): a damaged report.
+    const std::string figure = "\"ovr_after\": " + report["batch"]["ovr_after"].dump();
+    ASSERT_NE(original.find(figure), std::string::npos) << original;
+    for (const char* literal : {"NaN", "Infinity", "1e400", "-1e400"}) {
+        std::string damaged = original;
+        damaged.replace(damaged.find(figure), figure.size(), std::string("\"ovr_after\": ") + literal);
+        write("out/a.animorder.report.json", damaged);
+        const test::Outcome merged = run(options + "--merge " + manifest());
+        EXPECT_EQ(merged.exit_code, 4) << literal << ": " << merged.err;
+        EXPECT_NE(merged.err.find("out/a.animorder.report.json is damaged"), std::string::npos)
+            << literal << ": " << merged.err;
+        EXPECT_EQ(nlohmann::json::parse(test::slurp(path("m.summary.json")))["items"][0]["status"], "missing");
+    }
+    // The next run redoes the item (a report the merge refuses is never up to date), and the merge
+    // is clean again.
+    const test::Outcome again = run(options + manifest());
+    EXPECT_EQ(again.exit_code, 0) << again.err;
+    EXPECT_NE(again.out.find("1 done, 1 up to date"), std::string::npos) << again.out;
+    const test::Outcome clean = run(options + "--merge " + manifest());
+    EXPECT_EQ(clean.exit_code, 0) << clean.err;
+    EXPECT_EQ(clean.err, "");
+}

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -236,17 +237,58 @@ std::string data_digest(const std::string& path, const std::string& data) {
 
 namespace {
 
-// The summary's figures in a report as run_item writes them: counts, ACMRs, and OVRs and the time
-// as numbers or null (no evaluation; --no-timings).
-bool summary_fields_hold(const json& batch) {
-    if (!batch.is_object() || string_at(batch, "status") != "ok") return false;
-    for (const char* key : {"triangles", "clips", "buffers", "index_bytes_added"})
-        if (!batch.contains(key) || !batch[key].is_number_unsigned()) return false;
-    for (const char* key : {"acmr_before", "acmr_after"})
-        if (!batch.contains(key) || !batch[key].is_number()) return false;
-    for (const char* key : {"ovr_before", "ovr_after", "time_s"})
-        if (!batch.contains(key) || !(batch[key].is_number() || batch[key].is_null())) return false;
-    return true;
+// The most a plausible OVR or wall time may be: far beyond any character's (an OVR of 1000 is a
+// thousand layers on every pixel seen), so that only an edited figure is refused.
+constexpr double kMaxOvr = 1000;
+constexpr double kMaxSeconds = 366.0 * 24 * 3600;
+
+// What is wrong with the summary's figures in a report ("" when nothing): each as run_item writes
+// it, with values its definitions allow (DESIGN.md): counts are whole numbers, the index bytes
+// added are (buffers - 1) x triangles x 12, an ACMR (misses per triangle: at least the first
+// vertex's, at most three) lies from 1/triangles to 3, an OVR (fragments that passed over pixels
+// seen, a mean of per-view ratios) is 0 when nothing was seen and otherwise from 1 to the triangle
+// count (and at most kMaxOvr), or null without evaluation; a wall time is from 0 to a year, or
+// null (--no-timings). Every number is finite (a JSON number too large for a double reads as
+// infinite).
+std::string implausible_figure(const json& batch) {
+    if (!batch.is_object() || string_at(batch, "status") != "ok") return "its status is not \"ok\"";
+    const auto value = [&](const char* key) { return std::string(key) + " is " + batch[key].dump(); };
+    for (const char* key : {"triangles", "clips", "buffers", "index_bytes_added"}) {
+        if (!batch.contains(key)) return std::string(key) + " is missing";
+        if (!batch[key].is_number_unsigned()) return value(key) + ", not a whole number from 0";
+    }
+    if (batch.contains("keyframes") && !batch["keyframes"].is_number_unsigned())
+        return value("keyframes") + ", not a whole number from 0";
+    const uint64_t triangles = batch["triangles"].get<uint64_t>(), buffers = batch["buffers"].get<uint64_t>();
+    const uint64_t extra = buffers > 0 ? buffers - 1 : 0;
+    const bool fits = triangles == 0 || extra <= UINT64_MAX / 12 / triangles;
+    if (!fits || batch["index_bytes_added"].get<uint64_t>() != extra * triangles * 12)
+        return value("index_bytes_added") + ", not (buffers - 1) x triangles x 12";
+    const double t = double(triangles);
+    for (const char* key : {"acmr_before", "acmr_after"}) {
+        if (!batch.contains(key)) return std::string(key) + " is missing";
+        if (!batch[key].is_number() || !std::isfinite(batch[key].get<double>())) return value(key) + ", not a number";
+        const double acmr = batch[key].get<double>();
+        const bool plausible = triangles == 0 ? acmr == 0 : acmr >= (1 - 1e-9) / t && acmr <= 3;
+        if (!plausible) return value(key) + ", not an ACMR (from 1/triangles to 3)";
+    }
+    for (const char* key : {"ovr_before", "ovr_after"}) {
+        if (!batch.contains(key)) return std::string(key) + " is missing";
+        if (batch[key].is_null()) continue;
+        if (!batch[key].is_number() || !std::isfinite(batch[key].get<double>())) return value(key) + ", not a number";
+        const double ovr = batch[key].get<double>();
+        if (ovr != 0 && !(ovr >= 1 - 1e-9 && ovr <= std::min(t, kMaxOvr) * (1 + 1e-9)))
+            return value(key) + ", not an OVR (0 when nothing was seen, else from 1 to the triangles and at most " +
+                   std::to_string(int(kMaxOvr)) + ")";
+    }
+    if (!batch.contains("time_s")) return "time_s is missing";
+    if (!batch["time_s"].is_null()) {
+        const json& time = batch["time_s"];
+        if (!time.is_number() || !std::isfinite(time.get<double>()) || time.get<double>() < 0 ||
+            time.get<double>() > kMaxSeconds)
+            return value("time_s") + ", not a wall time (seconds from 0 to a year)";
+    }
+    return "";
 }
 
 // A file named from the item report's folder (as reports keep them), as the manifest would write
@@ -293,12 +335,20 @@ Staleness stamp_change(const PlannedItem& p, const json& then, const StampParts&
 Staleness staleness_of_report(const PlannedItem& p, const Stamp& stamp, json* report_out) {
     using S = Staleness;
     json report = read_json_file(p.report);
+    // A report is put in place whole (OutputSet): one that is there but unreadable was damaged or
+    // edited, which the merge says as it does of a figure no run gives.
+    std::error_code error;
+    const auto edited = [&](const std::string& what) {
+        return Staleness{S::kEditedReport, "its report " + output_as_written(p, p.report) + " " + what};
+    };
+    if (report.is_null() && fs::exists(p.report, error)) return edited("is damaged: not JSON that batch can read");
+    if (report.is_null()) return {S::kNoResult, "no result yet (not run, or its run did not finish)"};
     if (!report.is_object() || !report.contains("batch") || !report["batch"].is_object())
-        return {S::kNoResult, "no result yet (not run, or its run did not finish)"};
+        return edited("was edited: it holds no \"batch\" object");
     const json& b = report["batch"];
     if (string_at(b, "stamp") != stamp.digest) return stamp_change(p, b, stamp.parts);
-    if (!summary_fields_hold(b)) return {S::kChanged, "its report was edited: its figures are not as written"};
-    std::error_code error;
+    const std::string implausible = implausible_figure(b);
+    if (!implausible.empty()) return edited("was edited: " + implausible);
     for (const std::string& out : p.plan.outputs)
         if (!fs::is_regular_file(out, error))
             return {S::kChanged, "its output " + output_as_written(p, out) + " is missing"};

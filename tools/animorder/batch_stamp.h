@@ -33,9 +33,10 @@ struct Stamp {
 // Why an item's result is not up to date, as far as its files tell ("" when it is: its report
 // carries the stamp the item has now, the summary's figures as written, every output present as
 // it was written, and every side file it lists with its digest). `kind` tells the merge which
-// hint to add.
+// hint to add; kEditedReport: the report carries the stamp, but a figure no run gives (the merge
+// says so on stderr).
 struct Staleness {
-    enum Kind { kCurrent, kNoResult, kOtherBuild, kOtherEvaluation, kChanged } kind = kCurrent;
+    enum Kind { kCurrent, kNoResult, kOtherBuild, kOtherEvaluation, kChanged, kEditedReport } kind = kCurrent;
     std::string why;
 };
 

@@ -24,22 +24,23 @@ using json = nlohmann::ordered_json;
 
 // Why an item has no up-to-date result, for the merge's summary (with what to do about it when
 // the merge itself is the cause).
-std::string why_missing(const PlannedItem& p, const Stamp& stamp) {
-    const Staleness s = staleness(p, stamp);
+std::string why_missing(const Staleness& s) {
     if (s.kind == Staleness::kOtherBuild) return s.why + " (run the merge with the build that ran the items)";
     if (s.kind == Staleness::kOtherEvaluation) return s.why + " (give the merge the same)";
     return s.why;
 }
 
 // `failed_now`: the error of this run's attempt, when the item failed in it (its earlier report,
-// still matching, does not make it ok).
-json summary_row(const PlannedItem& p, const Stamp& stamp, const std::string& failed_now) {
+// still matching, does not make it ok). `merge`: a report whose figures no run gives is also told
+// on stderr, one line (the item then counts as missing, as if it had no report).
+json summary_row(const PlannedItem& p, const Stamp& stamp, const std::string& failed_now, bool merge) {
     json row = {{"name", p.item.name},
                 {"input", p.item.input_as_written.empty() ? "(bundled)" : p.item.input_as_written},
                 {"output", p.item.output_as_written},
                 {"method", method_name(p.plan.method)}};
-    const json report = failed_now.empty() ? current_report(p, stamp) : json();
-    if (report.is_object()) {
+    json report;
+    const Staleness s = failed_now.empty() ? staleness(p, stamp, &report) : Staleness{Staleness::kChanged, ""};
+    if (s.kind == Staleness::kCurrent) {
         const json& b = report["batch"];
         for (const char* key : {"triangles", "clips", "buffers", "acmr_before", "acmr_after", "ovr_before", "ovr_after",
                                 "index_bytes_added", "time_s"})
@@ -48,13 +49,19 @@ json summary_row(const PlannedItem& p, const Stamp& stamp, const std::string& fa
         row["error"] = nullptr;
         return row;
     }
+    if (merge && s.kind == Staleness::kEditedReport) {
+        std::string line = p.item.name + ": " + s.why;
+        for (char& c : line)
+            if (c == '\n' || c == '\r') c = ' ';
+        std::fprintf(stderr, "animorder: batch: %s; counted as missing\n", line.c_str());
+    }
     const json failure = read_json_file(p.error);
     const bool failed = !failed_now.empty() || string_at(failure, "stamp") == stamp.digest;
     for (const char* key : {"triangles", "clips", "buffers", "acmr_before", "acmr_after", "ovr_before", "ovr_after",
                             "index_bytes_added", "time_s"})
         row[key] = nullptr;
     row["status"] = failed ? "failed" : "missing";
-    row["error"] = !failed_now.empty() ? failed_now : failed ? string_at(failure, "error") : why_missing(p, stamp);
+    row["error"] = !failed_now.empty() ? failed_now : failed ? string_at(failure, "error") : why_missing(s);
     return row;
 }
 
@@ -109,7 +116,7 @@ int write_summary(const std::vector<PlannedItem>& items, const std::vector<Stamp
     json rows = json::array();
     size_t ok = 0, failed = 0, missing = 0;
     for (size_t i = 0; i < items.size(); ++i) {
-        rows.push_back(summary_row(items[i], stamps[i], failed_now[i]));
+        rows.push_back(summary_row(items[i], stamps[i], failed_now[i], batch.merge));
         const std::string status = rows.back()["status"].get<std::string>();
         (status == "ok" ? ok : status == "failed" ? failed : missing) += 1;
     }

@@ -110,25 +110,51 @@ std::vector<std::string> options_from_json(const json& value, const std::string&
     throw std::runtime_error(where + ": \"options\" must be a string, a list or an object");
 }
 
+// The first key given twice in one object, found in a pass of its own over the text (the parser
+// keeps the last of two equal keys). The parser's callback form found them too, but it was
+// quadratic in the items: after each item it searched the list so far for discarded values.
+class DuplicateKeys : public nlohmann::json_sax<json> {
+public:
+    std::string duplicate;
+
+    bool null() override { return true; }
+    bool boolean(bool) override { return true; }
+    bool number_integer(number_integer_t) override { return true; }
+    bool number_unsigned(number_unsigned_t) override { return true; }
+    bool number_float(number_float_t, const string_t&) override { return true; }
+    bool string(string_t&) override { return true; }
+    bool binary(binary_t&) override { return true; }
+    bool start_object(std::size_t) override {
+        keys_.emplace_back();
+        return true;
+    }
+    bool key(string_t& key) override {
+        if (!keys_.empty() && !keys_.back().insert(key).second && duplicate.empty()) duplicate = key;
+        return true;
+    }
+    bool end_object() override {
+        if (!keys_.empty()) keys_.pop_back();
+        return true;
+    }
+    bool start_array(std::size_t) override { return true; }
+    bool end_array() override { return true; }
+    bool parse_error(std::size_t, const std::string&, const json::exception&) override { return false; }
+
+private:
+    std::vector<std::unordered_set<std::string>> keys_;  // the keys of each object being parsed
+};
+
 std::vector<ManifestItem> parse_json_manifest(const std::string& text, const std::string& path) {
     json doc;
-    // The parser keeps the last of two equal keys; a manifest that says one thing twice is refused.
-    std::vector<std::unordered_set<std::string>> keys;  // the keys of each object being parsed
-    std::string duplicate;
-    const json::parser_callback_t no_duplicate_keys = [&](int, json::parse_event_t event, json& parsed) {
-        if (event == json::parse_event_t::object_start) keys.emplace_back();
-        if (event == json::parse_event_t::object_end && !keys.empty()) keys.pop_back();
-        if (event == json::parse_event_t::key && !keys.empty()) {
-            std::string key = parsed.get<std::string>();
-            if (!keys.back().insert(key).second && duplicate.empty()) duplicate = std::move(key);
-        }
-        return true;
-    };
     try {
-        doc = json::parse(text, no_duplicate_keys);
+        doc = json::parse(text);
     } catch (const json::exception& e) {
         throw std::runtime_error(path + ": not valid JSON: " + e.what());
     }
+    // A manifest that says one thing twice is refused.
+    DuplicateKeys keys;
+    json::sax_parse(text, &keys);
+    const std::string& duplicate = keys.duplicate;
     if (!duplicate.empty())
         throw std::runtime_error(path + ": the key \"" + duplicate + "\" appears twice in one object");
     const json* list = &doc;

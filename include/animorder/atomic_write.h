@@ -32,6 +32,11 @@ public:
 void check_output_paths(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs,
                         const std::vector<std::string>& input_folders = {}, size_t written_here = SIZE_MAX);
 
+// The same for `count` outputs named by output(i) (a batch's, which its items hold: not copied).
+void check_output_paths(size_t count, const std::function<const std::string&(size_t)>& output,
+                        const std::vector<std::string>& inputs, const std::vector<std::string>& input_folders,
+                        size_t written_here);
+
 // A key equal for two paths exactly when they name the same file: its device and inode when it
 // exists, else its path with links and "." / ".." resolved.
 std::string file_identity(const std::string& path);

@@ -314,33 +314,78 @@ void check_output_stem(const std::string& stem) {
                           ": names a folder; give a file name the outputs extend (e.g. out/hero)");
 }
 
+namespace {
+
+// file_identity for many paths in few folders (a library's batch checks thousands of outputs
+// against thousands of inputs): a file that does not exist yet is its folder resolved, once per
+// folder, then its name, as resolved() would give it.
+class Identities {
+public:
+    std::string of(const std::string& path) {
+        struct stat st {};
+        if (::stat(path.c_str(), &st) == 0)
+            return "inode " + std::to_string(st.st_dev) + ":" + std::to_string(st.st_ino);
+        const fs::path p(path);
+        const fs::path name = p.filename();
+        if (name.empty() || name == "." || name == "..") return file_identity(path);
+        const std::string folder = p.has_parent_path() ? p.parent_path().string() : std::string(".");
+        auto known = folders_.find(folder);
+        if (known == folders_.end()) known = folders_.emplace(folder, resolved(folder)).first;
+        return "path " + (known->second / name).string();
+    }
+
+private:
+    std::unordered_map<std::string, fs::path> folders_;
+};
+
+}  // namespace
+
 void check_output_paths(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs,
                         const std::vector<std::string>& input_folders, size_t written_here) {
-    // Each path resolved once (a library's batch checks thousands against thousands).
-    std::unordered_set<std::string> input_files;
+    check_output_paths(
+        outputs.size(), [&](size_t i) -> const std::string& { return outputs[i]; }, inputs, input_folders,
+        written_here);
+}
+
+void check_output_paths(size_t count, const std::function<const std::string&(size_t)>& output,
+                        const std::vector<std::string>& inputs, const std::vector<std::string>& input_folders,
+                        size_t written_here) {
+    // Each path resolved once, each folder once (a library's batch checks thousands against
+    // thousands, many of them one shared input).
+    Identities identities;
+    std::unordered_set<std::string> input_files, inputs_seen;
     for (const std::string& input : inputs)
-        if (!input.empty()) input_files.insert(file_identity(input));
+        if (!input.empty() && inputs_seen.insert(input).second) input_files.insert(identities.of(input));
     std::unordered_map<std::string, std::string> folders;  // identity → the folder as named
     for (const std::string& folder : input_folders)
         if (!folder.empty()) folders.emplace(file_identity(folder), folder);
-    std::unordered_map<std::string, size_t> output_files;
-    for (size_t i = 0; i < outputs.size(); ++i) {
-        if (i < written_here) check_writable_target(outputs[i]);
-        const std::string identity = file_identity(outputs[i]);
+    std::unordered_map<std::string, std::string> output_folders;  // folder as named → its identity
+    // The outputs by their identities' hashes (a library's outputs are many: their identities are
+    // not kept, but worked out again for the outputs whose hashes match).
+    std::unordered_multimap<size_t, size_t> output_files;
+    for (size_t i = 0; i < count; ++i) {
+        const std::string& path = output(i);
+        if (i < written_here) check_writable_target(path);
+        const std::string identity = identities.of(path);
         if (input_files.count(identity))
-            throw OutputError(outputs[i] +
-                              ": is an input of this run: refusing to overwrite the input; name another output");
+            throw OutputError(path + ": is an input of this run: refusing to overwrite the input; name another output");
         if (!folders.empty()) {
-            const fs::path target(outputs[i]);
-            const auto folder = folders.find(
-                file_identity(target.has_parent_path() ? target.parent_path().string() : std::string(".")));
+            const fs::path target(path);
+            const std::string named = target.has_parent_path() ? target.parent_path().string() : std::string(".");
+            auto known = output_folders.find(named);
+            if (known == output_folders.end()) known = output_folders.emplace(named, file_identity(named)).first;
+            const auto folder = folders.find(known->second);
             if (folder != folders.end())
-                throw OutputError(outputs[i] + ": lies in " + folder->second +
+                throw OutputError(path + ": lies in " + folder->second +
                                   ", a folder every file of which this run reads (a clip folder): a later run would "
                                   "read the output as an input; name an output outside it");
         }
-        const auto [first, added] = output_files.emplace(identity, i);
-        if (!added) throw OutputError(outputs[i] + ": named twice as an output (" + outputs[first->second] + ")");
+        const size_t hash = std::hash<std::string>{}(identity);
+        const auto [same_hash, end] = output_files.equal_range(hash);
+        for (auto other = same_hash; other != end; ++other)
+            if (identities.of(output(other->second)) == identity)
+                throw OutputError(path + ": named twice as an output (" + output(other->second) + ")");
+        output_files.emplace(hash, i);
     }
 }
 

@@ -1181,3 +1181,41 @@ TEST_F(Batch, AReportWithImplausibleFiguresIsRejectedAtTheMerge) {
     EXPECT_EQ(clean.exit_code, 0) << clean.err;
     EXPECT_EQ(clean.err, "");
 }
+
+// A file that many items read is read and hashed once in a run, not once per item (a dry run over
+// 100k items sharing one character re-hashed it 100k times): strace counts the opens of the
+// shared glTF's buffer, which only the stamps read, in a dry run over 2000 items. The shared
+// digest is each item's own: an item run alone is up to date in the plan of all of them.
+TEST_F(Batch, AnInputSharedByManyItemsIsReadOnceInARun) {
+    ANIMORDER_REQUIRE_OR_SKIP("strace", run_shell("strace -f -o /dev/null -e trace=openat true").exit_code == 0,
+                              "strace is not installed (it counts the opens of the shared input)");
+    write("tri.bin", triangle_bytes(0));
+    write("tri.gltf", triangle_gltf("tri.bin"));
+    // A file changed in the 2 seconds before it is hashed is read again by each item (its times
+    // could not yet tell a second change): the plan below reads these once they have settled.
+    const auto settled = std::chrono::steady_clock::now() + std::chrono::milliseconds(2200);
+    const size_t count = 2000;
+    std::string items;
+    for (size_t i = 0; i < count; ++i)
+        items += std::string(i ? "," : "") + R"({"input": "tri.gltf", "method": "original", "output": "out/i)" +
+                 std::to_string(i) + "\"}";
+    write("one.json", R"({"items": [{"input": "tri.gltf", "method": "original", "output": "out/i0"}]})");
+    ASSERT_EQ(run("batch -q --eval-views 0 " + path("one.json").string()).exit_code, 0);
+    write("m.json", "{\"items\": [" + items + "]}");
+    std::this_thread::sleep_until(settled);
+    // Only the opens stop the program where seccomp filters are there (else every call does).
+    const bool filtered = run_shell("strace --seccomp-bpf -f -o /dev/null -e trace=openat true").exit_code == 0;
+    const test::Outcome plan =
+        run_shell(std::string(filtered ? "strace --seccomp-bpf" : "strace") + " -f -o '" + path("trace.txt").string() +
+                  "' -e trace=openat,open " + ANIMORDER_EXE + " batch -q --eval-views 0 --dry-run " + manifest());
+    ASSERT_EQ(plan.exit_code, 0) << plan.err;
+    const nlohmann::json p = nlohmann::json::parse(plan.out);
+    ASSERT_EQ(p["items"].size(), count);
+    EXPECT_EQ(p["skip"], 1);
+    EXPECT_EQ(p["items"][0]["why"], "up to date");
+    EXPECT_EQ(p["items"][1]["why"], "no result yet (not run, or its run did not finish)");
+    std::istringstream trace(test::slurp(path("trace.txt")));
+    size_t opened = 0;
+    for (std::string line; std::getline(trace, line);) opened += line.find("tri.bin\"") != std::string::npos;
+    EXPECT_EQ(opened, 1u) << "the shared buffer was opened " << opened << " times for " << count << " items";
+}

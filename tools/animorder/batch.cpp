@@ -4,13 +4,16 @@
 // optimize.h) whose files — glTF, sidecar, sidecar description and the item report
 // OUT.animorder.report.json — appear together or not at all (OutputSet). The item report holds
 // the item's stamp: a SHA-256 (nettle) of the tool version, the item's resolved options, its paths
-// as the manifest writes them and the bytes of every file it reads as known before loading, plus
-// the side files the importer opened (an OBJ's .mtl), each with its digest. An item whose report
-// carries the stamp it would have now, with its side files unchanged and every output present,
-// is up to date and skipped (`--dry-run` says which items would run and why: the report keeps the
-// stamp's parts); so a run killed at any moment and started
-// again redoes only the items it had not finished, and a changed option or input re-runs only the
-// items it affects. A failing item leaves OUT.animorder.error.json (its stamp and the error) and
+// as the manifest writes them and the bytes of every file it reads as known before loading (a
+// file that many items share read once in a run), plus the side files the importer opened (an
+// OBJ's .mtl), each with its digest. Items that differ only in their outputs share one parse and
+// plan (batch_item's SharedPlan), so that a library of many is planned at the cost of few. An
+// item whose report carries the stamp it would have now, figures that a run can give, its side
+// files unchanged and every output present, is up to date and skipped (`--dry-run` says which
+// items would run and why: the report keeps the stamp's parts); so a run killed at any moment
+// and started again redoes only the items it had not finished, and a changed option or input
+// re-runs only the items it affects. Every file an item writes lies in the manifest's folder
+// (--allow-outside lets them out). A failing item leaves OUT.animorder.error.json (its stamp and the error) and
 // the batch goes on. `--shard I/N` runs items i with i % N == I (and reads their files only);
 // the summary (SUMMARY.json and SUMMARY.md) is always merged from the items' files in manifest
 // order, so it is the same whichever process ran which item.
@@ -41,6 +44,7 @@
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 #include <utility>
 #include <vector>
 
@@ -79,9 +83,11 @@ struct OutputsByPlace {
 // Runs one item into one OutputSet (the report, with its stamp, last): all files or none.
 void run_item(const PlannedItem& p, const Stamp& stamp, const BatchOptions& batch, OutputsByPlace& all_outputs) {
     const Clock::time_point start = Clock::now();
-    std::vector<std::string> files_of_item = p.plan.outputs;
+    std::vector<std::string> files_of_item = p.outputs;
     files_of_item.push_back(p.error);
     remove_stale_temporaries(files_of_item);
+    const OptimizeOptions options = p.run_options();
+    const OptimizePlan plan = p.run_plan();
     OutputSet files;
     json written = json::array();  // each output but the report: its name and digest
     files.observe([&](const std::string& path, const std::string& data) {
@@ -89,14 +95,14 @@ void run_item(const PlannedItem& p, const Stamp& stamp, const BatchOptions& batc
         written.push_back({{"file", fs::path(path).filename().string()}, {"sha256", data_digest(path, data)}});
     });
     json side;  // digests as loaded: an edit while the method runs makes the item stale
-    OptimizeProduct product = produce_optimize(p.options, p.plan, files, [&](const std::vector<std::string>& read) {
+    OptimizeProduct product = produce_optimize(options, plan, files, [&](const std::vector<std::string>& read) {
         for (const std::string& file : read) {
             std::error_code error;  // the file as named, and where a link there leads
             auto output = all_outputs.outputs.find(all_outputs.places.of(file).string());
             if (output == all_outputs.outputs.end())
                 output = all_outputs.outputs.find(fs::weakly_canonical(fs::absolute(file, error), error).string());
             if (output != all_outputs.outputs.end())
-                throw OutputError(output->second + ": is an input of this run (loading " + p.options.common.input +
+                throw OutputError(output->second + ": is an input of this run (loading " + options.common.input +
                                   " reads it): refusing to overwrite the input; name another output");
         }
         side = side_files(p, read);
@@ -114,7 +120,7 @@ void run_item(const PlannedItem& p, const Stamp& stamp, const BatchOptions& batc
         evaluation.views = batch.eval_views;
         evaluation.resolution = batch.eval_resolution;
         evaluation.threads = batch.threads;
-        evaluation.progress = progress_printer(p.options.common, "evaluating OVR before and after");
+        evaluation.progress = progress_printer(options.common, "evaluating OVR before and after");
         const std::vector<OrderEvaluation> ovr = evaluate_methods(mesh, {input_order, run.buffers}, evaluation);
         ovr_before = ovr[0].overall.ovr_mean;
         ovr_after = ovr[1].overall.ovr_mean;
@@ -124,7 +130,7 @@ void run_item(const PlannedItem& p, const Stamp& stamp, const BatchOptions& batc
     json& report = product.report;
     // Paths as the manifest writes them (relative to its folder), so that the report is the same
     // bytes whatever folder the batch starts in and however the manifest's path is spelled.
-    if (p.item.input_given && report["input"] == p.options.common.input) report["input"] = p.item.input_as_written;
+    if (p.item.input_given && report["input"] == options.common.input) report["input"] = p.item.input_as_written;
     for (auto& [kind, path] : report["outputs"].items())  // OUT.glb, OUT.animorder.bin, ...: all from the stem
         if (path.is_string()) path = output_as_written(p, path.get<std::string>());
     report["batch"] = {{"stamp", stamp.digest},
@@ -176,10 +182,11 @@ std::string as_written(const ManifestItem& item, std::string message) {
 }
 
 // --dry-run: which of the shard's items a run would redo, and why, as JSON on stdout; nothing is
-// written or removed.
+// written or removed. The items' rows are printed one at a time (a library's plan as one JSON
+// value took more memory than all its items).
 int print_plan(const std::vector<PlannedItem>& items, std::pair<size_t, size_t> shard, bool sharded,
                const BatchOptions& batch) {
-    json rows = json::array();
+    std::vector<std::pair<size_t, std::string>> why;  // per item of the shard: its index, why it runs ("": skip)
     size_t run = 0, skip = 0;
     for (size_t i = 0; i < items.size(); ++i) {
         if (i % shard.second != shard.first) continue;
@@ -188,25 +195,44 @@ int print_plan(const std::vector<PlannedItem>& items, std::pair<size_t, size_t> 
         if (batch.force) s = {Staleness::kChanged, "--force"};
         const bool current = s.kind == Staleness::kCurrent;
         (current ? skip : run) += 1;
-        rows.push_back({{"item", i + 1},
-                        {"name", p.item.name},
-                        {"output", p.item.output_as_written},
-                        {"action", current ? "skip" : "run"},
-                        {"why", current ? json("up to date") : json(s.why)}});
+        why.emplace_back(i, current ? std::string() : std::move(s.why));
     }
     json plan = {{"manifest", fs::path(batch.manifest).filename().string()},
                  {"shard", sharded ? json::array({shard.first, shard.second}) : json(nullptr)},
                  {"run", run},
                  {"skip", skip},
-                 {"items", rows}};
-    std::fputs(report_text(plan).c_str(), stdout);
+                 {"items", json::array()}};
+    // The text of the plan with its rows in place of the empty list, as report_text would write
+    // them (each row indented by its depth).
+    const std::string outline = report_text(plan);
+    const size_t list = outline.rfind("[]");
+    if (why.empty()) {
+        std::fputs(outline.c_str(), stdout);
+        return 0;
+    }
+    std::fputs(outline.substr(0, list + 1).c_str(), stdout);
+    for (size_t r = 0; r < why.size(); ++r) {
+        const PlannedItem& p = items[why[r].first];
+        const bool current = why[r].second.empty();
+        const json row = {{"item", why[r].first + 1},
+                          {"name", p.item.name},
+                          {"output", p.item.output_as_written},
+                          {"action", current ? "skip" : "run"},
+                          {"why", current ? "up to date" : why[r].second}};
+        std::string text = report_text(row);
+        text.pop_back();  // its line end
+        std::string indented = r ? ",\n    " : "\n    ";
+        for (const char c : text) indented += c == '\n' ? std::string("\n    ") : std::string(1, c);
+        std::fputs(indented.c_str(), stdout);
+    }
+    std::fputs(("\n  " + outline.substr(list + 1)).c_str(), stdout);
     return 0;
 }
 
 }  // namespace
 
 int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
-    const std::vector<ManifestItem> manifest = read_manifest(batch.manifest);
+    std::vector<ManifestItem> manifest = read_manifest(batch.manifest);
     std::pair<size_t, size_t> shard = {0, 1};
     if (batch.shard_given || !batch.shard.empty()) shard = parse_shard(batch.shard);
     check_merge_options(batch);
@@ -214,7 +240,12 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
     // Every item planned and every output of every item checked before any work: folders exist
     // and are writable, no output is any item's input or the manifest, no file is named twice.
     std::vector<PlannedItem> items;
-    for (size_t i = 0; i < manifest.size(); ++i) items.push_back(plan_item(manifest[i], i, batch, parse_item));
+    items.reserve(manifest.size());
+    PlanCache shared_plans;
+    for (size_t i = 0; i < manifest.size(); ++i)
+        items.push_back(plan_item(std::move(manifest[i]), i, batch, parse_item, &shared_plans));
+    std::vector<ManifestItem>().swap(manifest);  // each item's fields are its PlannedItem's now
+    shared_plans = PlanCache();
     Places places;
     if (!batch.allow_outside) check_outputs_inside(items, batch.manifest, places);
     std::string summary = batch.summary;
@@ -225,33 +256,42 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
         summary = (m.parent_path() / m.stem()).string() + ".summary";
     }
     check_output_stem(summary);
-    // Only what this process writes is checked for writing (a shard its own items' files, the
-    // merge the summary, a whole run everything); the files of the job's other processes are
-    // checked against every input and every other output only.
     const bool sharded = shard.second > 1 || batch.shard_given || !batch.shard.empty();
-    std::vector<std::string> written, others, inputs = {batch.manifest}, folders;
-    std::vector<std::string>& summary_files = batch.merge || !sharded ? written : others;
-    summary_files.insert(summary_files.end(), {summary + ".json", summary + ".md"});
-    for (size_t i = 0; i < items.size(); ++i) {
-        const PlannedItem& p = items[i];
-        std::vector<std::string>& files = !batch.merge && i % shard.second == shard.first ? written : others;
-        files.insert(files.end(), p.plan.outputs.begin(), p.plan.outputs.end());
-        files.push_back(p.error);
-        inputs.insert(inputs.end(), p.plan.inputs.begin(), p.plan.inputs.end());
-        folders.insert(folders.end(), p.plan.input_folders.begin(), p.plan.input_folders.end());
+    OutputsByPlace outputs_by_place{{}, std::move(places)};
+    {  // the lists of every path go once checked (a library's are large)
+        // Only what this process writes is checked for writing (a shard its own items' files, the
+        // merge the summary, a whole run everything); the files of the job's other processes are
+        // checked against every input and every other output only.
+        std::vector<const std::string*> written, others;  // the items' own strings, not copies
+        std::vector<std::string> inputs = {batch.manifest}, folders;
+        std::unordered_set<const SharedPlan*> planned;
+        const std::string summary_files[] = {summary + ".json", summary + ".md"};
+        for (const std::string& file : summary_files) (batch.merge || !sharded ? written : others).push_back(&file);
+        for (size_t i = 0; i < items.size(); ++i) {
+            const PlannedItem& p = items[i];
+            std::vector<const std::string*>& files = !batch.merge && i % shard.second == shard.first ? written : others;
+            for (const std::string& out : p.outputs) files.push_back(&out);
+            files.push_back(&p.error);
+            if (!planned.insert(p.shared.get()).second) continue;  // a shared plan's inputs are listed
+            inputs.insert(inputs.end(), p.shared->plan.inputs.begin(), p.shared->plan.inputs.end());
+            folders.insert(folders.end(), p.shared->plan.input_folders.begin(), p.shared->plan.input_folders.end());
+        }
+        const size_t written_here = written.size();
+        std::vector<const std::string*> outputs = std::move(written);
+        outputs.insert(outputs.end(), others.begin(), others.end());
+        std::vector<const std::string*>().swap(others);
+        // A dry run writes nothing, not even the probes that check a folder takes a new file.
+        check_output_paths(
+            outputs.size(), [&](size_t i) -> const std::string& { return *outputs[i]; }, inputs, folders,
+            batch.dry_run ? 0 : written_here);
+        if (!batch.merge && !batch.dry_run)
+            for (const std::string* output : outputs)
+                outputs_by_place.outputs.emplace(outputs_by_place.places.of(*output).string(), *output);
     }
-    std::vector<std::string> outputs = written;
-    outputs.insert(outputs.end(), others.begin(), others.end());
-    // A dry run writes nothing, not even the probes that check a folder takes a new file.
-    check_output_paths(outputs, inputs, folders, batch.dry_run ? 0 : written.size());
 
     if (batch.merge) return merge_shards(items, summary, batch);  // it stamps every item
 
     if (batch.dry_run) return print_plan(items, shard, sharded, batch);
-
-    OutputsByPlace outputs_by_place{{}, std::move(places)};
-    for (const std::string& output : outputs)
-        outputs_by_place.outputs.emplace(outputs_by_place.places.of(output).string(), output);
 
     // A shard stamps its own items only, each when its turn comes (so that an input edited while
     // earlier items run is read as it is then).
@@ -270,19 +310,19 @@ int run_batch(const BatchOptions& batch, const ItemParser& parse_item) {
         stamps[i] = stamp_of(p, batch);
         if (!batch.force && current_report(p, stamps[i]).is_object()) {
             ++skipped;
-            std::vector<std::string> files_of_item = p.plan.outputs;
+            std::vector<std::string> files_of_item = p.outputs;
             files_of_item.push_back(p.error);
             remove_stale_temporaries(files_of_item);
             std::error_code error;
             fs::remove(p.error, error);  // an earlier failure of this item is over: its result is current
-            note(p.options.common, label + ": up to date, skipped");
+            note(p.shared->options.common, label + ": up to date, skipped");
             continue;
         }
-        note(p.options.common, label + ": running");
+        note(p.shared->options.common, label + ": running");
         try {
             run_item(p, stamps[i], batch, outputs_by_place);
             ++done;
-            note(p.options.common, label + ": done");
+            note(p.shared->options.common, label + ": done");
         } catch (const std::exception& e) {
             ++failed;
             std::string message = as_written(p.item, e.what());

@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 namespace animorder::tool {
@@ -37,9 +38,9 @@ std::string item_label(const ManifestItem& item, size_t index) {
            ")";
 }
 
-PlannedItem plan_item(const ManifestItem& item, size_t index, const BatchOptions& batch, const ItemParser& parse) {
+PlannedItem plan_item(ManifestItem item, size_t index, const BatchOptions& batch, const ItemParser& parse,
+                      PlanCache* shared) {
     PlannedItem p;
-    p.item = item;
     const std::string label = item_label(item, index);
     // The item's own fields first, its options last (so an option missing its value says so).
     std::vector<std::string> args = {"-o", item.output};
@@ -57,22 +58,62 @@ PlannedItem plan_item(const ManifestItem& item, size_t index, const BatchOptions
                                      ": threads are the batch's (animorder batch --threads N)");
         args.push_back(o);
     }
+    // The arguments but the output, as the key of a shared plan (no argument holds a NUL); an
+    // output that reads as an option is parsed on its own.
+    std::string key;
+    const bool shareable = shared && !item.output.empty() && item.output[0] != '-';
+    if (shareable)
+        for (size_t a = 2; a < args.size(); ++a) key += args[a] + '\0';
+    p.report = stem_of(item.output) + ".animorder.report.json";
+    p.error = stem_of(item.output) + ".animorder.error.json";
     try {
-        p.options = parse(args);
-        if (p.options.common.input != item.input)
-            throw std::runtime_error("the options name a file (" + p.options.common.input +
-                                     "): give it as the item's \"input\" (resolved against the manifest's folder)");
-        p.options.common.clip_files_absolute = true;
-        if (batch.quiet) p.options.common.quiet = true;
-        p.options.methods.settings.clustering.threads = batch.threads;
-        p.options.report_path = stem_of(item.output) + ".animorder.report.json";
-        p.plan = plan_optimize(p.options);
+        const auto known = shareable ? shared->find(key) : PlanCache::iterator();
+        if (shareable && known != shared->end()) {
+            p.shared = known->second;
+        } else {
+            auto plan = std::make_shared<SharedPlan>();
+            OptimizeOptions& options = plan->options;
+            options = parse(args);
+            if (options.common.input != item.input)
+                throw std::runtime_error("the options name a file (" + options.common.input +
+                                         "): give it as the item's \"input\" (resolved against the manifest's folder)");
+            options.common.clip_files_absolute = true;
+            if (batch.quiet) options.common.quiet = true;
+            options.methods.settings.clustering.threads = batch.threads;
+            options.report_path = p.report;
+            plan->plan = plan_optimize(options);
+            options.output.clear(), options.report_path.clear();
+            plan->plan.gltf.clear(), plan->plan.sidecar.clear(), plan->plan.sidecar_json.clear();
+            plan->plan.outputs.clear();
+            p.shared = plan;
+            if (shareable) shared->emplace(key, p.shared);
+        }
+        // Its outputs, as plan_optimize names them from -o and -r (and the input's kind).
+        OptimizeOptions named;
+        named.common.input = item.input;
+        named.output = item.output;
+        named.report_path = p.report;
+        OptimizePlan outputs;
+        name_outputs(named, outputs);
+        p.outputs = std::move(outputs.outputs);
     } catch (const std::exception& e) {
         throw std::runtime_error(label + ": " + e.what());
     }
-    p.report = p.options.report_path;
-    p.error = stem_of(item.output) + ".animorder.error.json";
+    p.item = std::move(item);
     return p;
+}
+
+OptimizeOptions PlannedItem::run_options() const {
+    OptimizeOptions options = shared->options;
+    options.output = item.output;
+    options.report_path = report;
+    return options;
+}
+
+OptimizePlan PlannedItem::run_plan() const {
+    OptimizePlan plan = shared->plan;
+    name_outputs(run_options(), plan);
+    return plan;
 }
 
 // An output's path as the manifest writes it (the item's output stem as written).
@@ -116,7 +157,7 @@ void check_outputs_inside(const std::vector<PlannedItem>& items, const std::stri
     const fs::path home = places.folder(folder_of(manifest));
     for (size_t i = 0; i < items.size(); ++i) {
         const PlannedItem& p = items[i];
-        std::vector<std::string> files = p.plan.outputs;
+        std::vector<std::string> files = p.outputs;
         files.push_back(p.error);
         for (const std::string& file : files) {
             const fs::path place = places.of(file);

@@ -8,25 +8,46 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 namespace animorder::tool {
 
-struct PlannedItem {
-    ManifestItem item;
+// The options and plan of an item but its outputs (output, report_path and the plan's output
+// names empty), shared by the items whose arguments differ only in their outputs (a library's
+// items with one input and the same options): parsed and planned once.
+struct SharedPlan {
     OptimizeOptions options;
     OptimizePlan plan;
-    std::string report, error;  // OUT.animorder.report.json, OUT.animorder.error.json
+    mutable std::string settings_digest;  // the stamp's settings part, once taken (batch_stamp)
+};
+
+struct PlannedItem {
+    ManifestItem item;
+    std::shared_ptr<const SharedPlan> shared;
+    std::vector<std::string> outputs;  // every file the item's run writes, the report included
+    std::string report, error;         // OUT.animorder.report.json, OUT.animorder.error.json
+
+    // The options and the plan whole, with the item's outputs (to run it).
+    OptimizeOptions run_options() const;
+    OptimizePlan run_plan() const;
 };
 
 // An item as errors name it: its CSV line or its number, and its name.
 std::string item_label(const ManifestItem& item, size_t index);
 
+// Shared plans by the items' arguments but their outputs: items that differ only in their outputs
+// share one parse and one plan (the parser's work, the input's glTF read for its buffers).
+using PlanCache = std::unordered_map<std::string, std::shared_ptr<const SharedPlan>>;
+
 // The item's optimize options (its fields first, its options last; batch's own options refused:
-// outputs, clips and threads) and plan; an error names the item's line or number and name.
-PlannedItem plan_item(const ManifestItem& item, size_t index, const BatchOptions& batch, const ItemParser& parse);
+// outputs, clips and threads) and plan, from `shared` when an earlier item had the same
+// arguments but its output; an error names the item's line or number and name.
+PlannedItem plan_item(ManifestItem item, size_t index, const BatchOptions& batch, const ItemParser& parse,
+                      PlanCache* shared = nullptr);
 
 // The output without .glb or .gltf: the stem the item's other files are named from.
 std::string stem_of(const std::string& output);

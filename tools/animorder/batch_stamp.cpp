@@ -8,12 +8,16 @@
 #include <nettle/sha2.h>
 #include <nlohmann/json.hpp>
 
+#include <sys/stat.h>
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <ctime>
 #include <filesystem>
+#include <mutex>
 #include <string>
+#include <unordered_map>
 #include <unordered_set>
 #include <utility>
 #include <vector>
@@ -141,23 +145,86 @@ std::string side_file_path(const json& entry) {
     return out;
 }
 
-// A file's path from the item report's folder, as the report names the files the item read.
+// The digests of the files items read, each file read and hashed once in a run however many
+// items share it (a library's items often share a character, its buffers, a clip folder): kept
+// by the file's device and inode, size, modification and change times, and its name (which the
+// digest hashes too). A file changed in the kSettleSeconds before it was hashed is not kept (its
+// times could not tell a second change within the same tick of the file system's clock: 2 s on
+// FAT), so each item reads it again; nor is one that changed while it was read.
+class FileDigests {
+public:
+    std::string of(const fs::path& path) {
+        struct stat before {};
+        if (::stat(path.c_str(), &before) != 0 || !S_ISREG(before.st_mode)) return file_digest(path);
+        const std::string key = identity(before) + "/" + path.filename().string();
+        {
+            const std::lock_guard<std::mutex> lock(mutex_);
+            const auto known = known_.find(key);
+            if (known != known_.end()) return known->second;
+        }
+        timespec now{};
+        ::clock_gettime(CLOCK_REALTIME, &now);
+        std::string digest = file_digest(path);
+        struct stat after {};
+        const auto nanoseconds = [](const timespec& t) { return int64_t(t.tv_sec) * 1000000000 + t.tv_nsec; };
+        const int64_t changed = std::max(nanoseconds(before.st_mtim), nanoseconds(before.st_ctim));
+        if (::stat(path.c_str(), &after) == 0 && identity(after) == identity(before) &&
+            changed + kSettleSeconds * 1000000000 < nanoseconds(now)) {
+            const std::lock_guard<std::mutex> lock(mutex_);
+            known_.emplace(key, digest);
+        }
+        return digest;
+    }
+
+private:
+    static constexpr int64_t kSettleSeconds = 2;
+    static std::string identity(const struct stat& st) {
+        return std::to_string(st.st_dev) + ":" + std::to_string(st.st_ino) + ":" + std::to_string(st.st_size) + ":" +
+               std::to_string(st.st_mtim.tv_sec) + "." + std::to_string(st.st_mtim.tv_nsec) + ":" +
+               std::to_string(st.st_ctim.tv_sec) + "." + std::to_string(st.st_ctim.tv_nsec);
+    }
+    std::mutex mutex_;
+    std::unordered_map<std::string, std::string> known_;
+};
+
+// file_digest through the run's FileDigests.
+std::string shared_file_digest(const fs::path& path) {
+    static FileDigests digests;
+    return digests.of(path);
+}
+
+// A file's path from the item report's folder, as the report names the files the item read;
+// each (file, folder) worked out once in a run (relative() resolves both paths' links).
 std::string from_report_folder(const PlannedItem& p, const std::string& file) {
+    static std::mutex mutex;
+    static std::unordered_map<std::string, std::string> known;
+    const fs::path folder = folder_of(p.report);
+    const std::string key = file + '\0' + folder.string();  // no path holds a NUL
+    {
+        const std::lock_guard<std::mutex> lock(mutex);
+        const auto found = known.find(key);
+        if (found != known.end()) return found->second;
+    }
     std::error_code error;
     // Both absolute first: relative() leaves a relative path whose folders are all missing as
     // it is, and the result was empty (the absolute path was kept, tying the report to a place).
-    fs::path from_report = fs::relative(fs::absolute(file, error), fs::absolute(folder_of(p.report), error), error);
+    fs::path from_report = fs::relative(fs::absolute(file, error), fs::absolute(folder, error), error);
     if (error || from_report.empty()) from_report = fs::absolute(file, error);
-    return from_report.generic_string();
+    const std::lock_guard<std::mutex> lock(mutex);
+    return known.emplace(key, from_report.generic_string()).first->second;
 }
 
 // The parts of the item's stamp (StampParts) as its files are now.
 StampParts stamp_parts(const PlannedItem& p, const BatchOptions& batch) {
     StampParts parts;
-    Sha256 settings;
-    settings.add(optimize_settings_json(p.options, p.plan, false).dump());
-    settings.add("max_memory:" + std::to_string(p.options.common.max_memory));
-    parts.settings = settings.hex();
+    std::string& settings = p.shared->settings_digest;  // the same for every item of a shared plan
+    if (settings.empty()) {
+        Sha256 hash;
+        hash.add(optimize_settings_json(p.shared->options, p.shared->plan, false).dump());
+        hash.add("max_memory:" + std::to_string(p.shared->options.common.max_memory));
+        settings = hash.hex();
+    }
+    parts.settings = settings;
     Sha256 paths;
     paths.add("input:" + p.item.input_as_written);
     paths.add("output:" + p.item.output_as_written);
@@ -165,11 +232,8 @@ StampParts stamp_parts(const PlannedItem& p, const BatchOptions& batch) {
     parts.paths = paths.hex();
     parts.eval = std::to_string(batch.eval_views) + "/" + std::to_string(batch.eval_resolution) +
                  (batch.no_timings ? "/no-timings" : "");
-    for (const std::string& file : p.plan.inputs) {
-        Sha256 bytes;
-        bytes.add_file(file);
-        parts.inputs.emplace_back(from_report_folder(p, file), bytes.hex());
-    }
+    for (const std::string& file : p.shared->plan.inputs)
+        parts.inputs.emplace_back(from_report_folder(p, file), shared_file_digest(file));
     return parts;
 }
 
@@ -211,7 +275,7 @@ json stamp_parts_json(const StampParts& parts) {
 // appear there would need its folder made first.
 json side_files(const PlannedItem& p, const std::vector<std::string>& files_read) {
     std::unordered_set<std::string> known;
-    for (const std::string& input : p.plan.inputs) known.insert(file_identity(input));
+    for (const std::string& input : p.shared->plan.inputs) known.insert(file_identity(input));
     json list = json::array();
     std::unordered_set<std::string> listed;
     for (const std::string& file : files_read) {
@@ -349,13 +413,13 @@ Staleness staleness_of_report(const PlannedItem& p, const Stamp& stamp, json* re
     if (string_at(b, "stamp") != stamp.digest) return stamp_change(p, b, stamp.parts);
     const std::string implausible = implausible_figure(b);
     if (!implausible.empty()) return edited("was edited: " + implausible);
-    for (const std::string& out : p.plan.outputs)
+    for (const std::string& out : p.outputs)
         if (!fs::is_regular_file(out, error))
             return {S::kChanged, "its output " + output_as_written(p, out) + " is missing"};
     // Every output but the report as it was written (a truncated or emptied one is not up to date).
     const auto outputs = b.find("outputs");
     if (outputs == b.end() || !outputs->is_array()) return {S::kChanged, "its report was edited: it lists no outputs"};
-    for (const std::string& out : p.plan.outputs) {
+    for (const std::string& out : p.outputs) {
         if (out == p.report) continue;
         const std::string name = fs::path(out).filename().string();
         const auto entry =
@@ -368,7 +432,7 @@ Staleness staleness_of_report(const PlannedItem& p, const Stamp& stamp, json* re
         if (!side->is_array()) return {S::kChanged, "its report was edited: its side files are not a list"};
         for (const json& entry : *side) {
             const std::string file = side_file_path(entry);
-            if (file.empty() || string_at(entry, "sha256") != file_digest(folder_of(p.report) / file))
+            if (file.empty() || string_at(entry, "sha256") != shared_file_digest(folder_of(p.report) / file))
                 return {S::kChanged, "its input " + as_manifest_writes(p, file) + " changed since it ran"};
         }
     }

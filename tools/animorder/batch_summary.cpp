@@ -37,7 +37,7 @@ json summary_row(const PlannedItem& p, const Stamp& stamp, const std::string& fa
     json row = {{"name", p.item.name},
                 {"input", p.item.input_as_written.empty() ? "(bundled)" : p.item.input_as_written},
                 {"output", p.item.output_as_written},
-                {"method", method_name(p.plan.method)}};
+                {"method", method_name(p.shared->plan.method)}};
     json report;
     const Staleness s = failed_now.empty() ? staleness(p, stamp, &report) : Staleness{Staleness::kChanged, ""};
     if (s.kind == Staleness::kCurrent) {

@@ -74,6 +74,14 @@ nlohmann::ordered_json optimize_settings_json(const OptimizeOptions& options, co
     return settings;
 }
 
+void name_outputs(const OptimizeOptions& options, OptimizePlan& plan) {
+    plan.gltf.clear(), plan.sidecar.clear(), plan.sidecar_json.clear(), plan.outputs.clear();
+    output_paths(options, plan);
+    const std::string* named[] = {&plan.gltf, &plan.sidecar, &plan.sidecar_json, &options.report_path};
+    for (const std::string* p : named)
+        if (!p->empty()) plan.outputs.push_back(*p);
+}
+
 OptimizePlan plan_optimize(const OptimizeOptions& options) {
     OptimizePlan plan;
     Method method = parse_method(options.method);
@@ -90,10 +98,7 @@ OptimizePlan plan_optimize(const OptimizeOptions& options) {
     plan.method = method;
     plan.settings = method_settings(options.methods, options.common, method);
     validate_method_settings(plan.settings);
-    output_paths(options, plan);
-    const std::string* named[] = {&plan.gltf, &plan.sidecar, &plan.sidecar_json, &options.report_path};
-    for (const std::string* p : named)
-        if (!p->empty()) plan.outputs.push_back(*p);
+    name_outputs(options, plan);
     plan.inputs = input_files(options.common);
     plan.input_folders = input_folders(options.common);
     return plan;

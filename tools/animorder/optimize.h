@@ -31,6 +31,11 @@ struct OptimizePlan {
 // Validates the options (method, settings, output names) and names the outputs; touches no file.
 OptimizePlan plan_optimize(const OptimizeOptions& options);
 
+// The plan's outputs named anew from the options' output and report (plan_optimize's own last
+// step but the inputs), so that runs that differ only in those (a batch's items with one input
+// and the same options) share the rest of one plan.
+void name_outputs(const OptimizeOptions& options, OptimizePlan& plan);
+
 // The settings as the report writes them: with_threads adds how the run went, which never
 // changes an output (the threads used, --fragment-memory and --max-memory).
 nlohmann::ordered_json optimize_settings_json(const OptimizeOptions& options, const OptimizePlan& plan,

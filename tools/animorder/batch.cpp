@@ -202,15 +202,8 @@ int print_plan(const std::vector<PlannedItem>& items, std::pair<size_t, size_t> 
                  {"run", run},
                  {"skip", skip},
                  {"items", json::array()}};
-    // The text of the plan with its rows in place of the empty list, as report_text would write
-    // them (each row indented by its depth).
-    const std::string outline = report_text(plan);
-    const size_t list = outline.rfind("[]");
-    if (why.empty()) {
-        std::fputs(outline.c_str(), stdout);
-        return 0;
-    }
-    std::fputs(outline.substr(0, list + 1).c_str(), stdout);
+    const auto [head, tail] = report_text_around_list(plan, why.empty());
+    std::fputs(head.c_str(), stdout);
     for (size_t r = 0; r < why.size(); ++r) {
         const PlannedItem& p = items[why[r].first];
         const bool current = why[r].second.empty();
@@ -219,13 +212,9 @@ int print_plan(const std::vector<PlannedItem>& items, std::pair<size_t, size_t> 
                           {"output", p.item.output_as_written},
                           {"action", current ? "skip" : "run"},
                           {"why", current ? "up to date" : why[r].second}};
-        std::string text = report_text(row);
-        text.pop_back();  // its line end
-        std::string indented = r ? ",\n    " : "\n    ";
-        for (const char c : text) indented += c == '\n' ? std::string("\n    ") : std::string(1, c);
-        std::fputs(indented.c_str(), stdout);
+        std::fputs(list_element_text(row, r == 0).c_str(), stdout);
     }
-    std::fputs(("\n  " + outline.substr(list + 1)).c_str(), stdout);
+    std::fputs(tail.c_str(), stdout);
     return 0;
 }
 

@@ -65,9 +65,7 @@ void check_merge_options(const BatchOptions& batch) {
 }
 
 int merge_shards(const std::vector<PlannedItem>& items, const std::string& summary, const BatchOptions& batch) {
-    std::vector<Stamp> stamps(items.size());
-    for (size_t i = 0; i < items.size(); ++i) stamps[i] = stamp_of(items[i], batch);
-    return summarise(items, stamps, std::vector<std::string>(items.size()), summary, batch);
+    return summarise(items, {}, {}, summary, batch);  // each item stamped as its row is made
 }
 
 }  // namespace animorder::tool

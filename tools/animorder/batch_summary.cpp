@@ -14,6 +14,7 @@
 #include <exception>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace animorder::tool {
@@ -87,47 +88,57 @@ std::string cell(const json& v, int digits) {
     return v.dump();
 }
 
-std::string summary_markdown(const json& summary) {
+// The Markdown summary's title, counts and table header.
+std::string markdown_head(size_t items, size_t ok, size_t failed, size_t missing) {
     std::string md = "# animorder batch summary\n\n";
-    md += std::to_string(summary["items"].size()) + " items: " + summary["ok"].dump() + " ok, " +
-          summary["failed"].dump() + " failed, " + summary["missing"].dump() + " missing (animorder " +
-          summary["version"].get<std::string>() + ").\n\n";
+    md += std::to_string(items) + " items: " + std::to_string(ok) + " ok, " + std::to_string(failed) + " failed, " +
+          std::to_string(missing) + " missing (animorder " + ANIMORDER_VERSION + ").\n\n";
     md +=
         "| item | method | triangles | clips | OVR before | OVR after | ACMR before | ACMR after | index bytes added | "
         "time (s) | status |\n|---|---|---|---|---|---|---|---|---|---|---|\n";
-    for (const json& r : summary["items"]) {
-        std::string status = r["status"].get<std::string>();
-        if (!r["error"].is_null()) status += ": " + cell(r["error"], 0);
-        md += "| " + cell(r["name"], 0) + " | " + cell(r["method"], 0) + " | " + cell(r["triangles"], 0) + " | " +
-              cell(r["clips"], 0) + " | " + cell(r["ovr_before"], 3) + " | " + cell(r["ovr_after"], 3) + " | " +
-              cell(r["acmr_before"], 3) + " | " + cell(r["acmr_after"], 3) + " | " + cell(r["index_bytes_added"], 0) +
-              " | " + cell(r["time_s"], 1) + " | " + status + " |\n";
-    }
     return md;
 }
 
-// Builds and writes the summary; returns the exit code it implies. failed_now: per item, the
-// error of this run's attempt when it failed (empty otherwise).
+// A row of the Markdown table.
+std::string markdown_row(const json& r) {
+    std::string status = r["status"].get<std::string>();
+    if (!r["error"].is_null()) status += ": " + cell(r["error"], 0);
+    return "| " + cell(r["name"], 0) + " | " + cell(r["method"], 0) + " | " + cell(r["triangles"], 0) + " | " +
+           cell(r["clips"], 0) + " | " + cell(r["ovr_before"], 3) + " | " + cell(r["ovr_after"], 3) + " | " +
+           cell(r["acmr_before"], 3) + " | " + cell(r["acmr_after"], 3) + " | " + cell(r["index_bytes_added"], 0) +
+           " | " + cell(r["time_s"], 1) + " | " + status + " |\n";
+}
+
+// Builds and writes the summary; returns the exit code it implies. stamps: per item, or none (the
+// merge: each item is stamped as its row is made); failed_now: per item, the error of this run's
+// attempt when it failed (empty otherwise), or none. The rows are written into the two texts one
+// at a time (a library's summary as one JSON value took several times the memory of its text).
 int write_summary(const std::vector<PlannedItem>& items, const std::vector<Stamp>& stamps,
                   const std::vector<std::string>& failed_now, const std::string& stem, const std::string& manifest,
                   const BatchOptions& batch) {
-    json summary = {
-        {"tool", "animorder"}, {"version", ANIMORDER_VERSION}, {"manifest", fs::path(manifest).filename().string()}};
-    json rows = json::array();
+    std::string json_rows, md_rows;
     size_t ok = 0, failed = 0, missing = 0;
     for (size_t i = 0; i < items.size(); ++i) {
-        rows.push_back(summary_row(items[i], stamps[i], failed_now[i], batch.merge));
-        const std::string status = rows.back()["status"].get<std::string>();
+        const json row = summary_row(items[i], stamps.empty() ? stamp_of(items[i], batch) : stamps[i],
+                                     failed_now.empty() ? std::string() : failed_now[i], batch.merge);
+        const std::string status = row["status"].get<std::string>();
         (status == "ok" ? ok : status == "failed" ? failed : missing) += 1;
+        json_rows += list_element_text(row, i == 0);
+        md_rows += markdown_row(row);
     }
-    summary["ok"] = ok;
-    summary["failed"] = failed;
-    summary["missing"] = missing;
-    summary["items"] = rows;
+    const json summary = {{"tool", "animorder"},
+                          {"version", ANIMORDER_VERSION},
+                          {"manifest", fs::path(manifest).filename().string()},
+                          {"ok", ok},
+                          {"failed", failed},
+                          {"missing", missing},
+                          {"items", json::array()}};
+    const auto [head, tail] = report_text_around_list(summary, items.empty());
     remove_stale_temporaries({stem + ".json", stem + ".md"});
     OutputSet files;
-    files.add(stem + ".json", report_text(summary));
-    files.add(stem + ".md", summary_markdown(summary));
+    files.add(stem + ".json", head + json_rows + tail);
+    std::string().swap(json_rows);
+    files.add(stem + ".md", markdown_head(items.size(), ok, failed, missing) + md_rows);
     files.commit();
     if (!batch.quiet)
         std::fprintf(stderr, "animorder: batch: summary %s.json / .md: %zu ok, %zu failed, %zu missing\n", stem.c_str(),
@@ -136,6 +147,20 @@ int write_summary(const std::vector<PlannedItem>& items, const std::vector<Stamp
 }
 
 }  // namespace
+
+std::string list_element_text(const json& value, bool first) {
+    std::string text = report_text(value);
+    text.pop_back();  // its line end
+    std::string indented = first ? "\n    " : ",\n    ";
+    for (const char c : text) indented += c == '\n' ? std::string("\n    ") : std::string(1, c);
+    return indented;
+}
+
+std::pair<std::string, std::string> report_text_around_list(const json& outline, bool empty) {
+    const std::string text = report_text(outline);
+    const size_t list = text.rfind("[]");
+    return {text.substr(0, list + 1), (empty ? "" : "\n  ") + text.substr(list + 1)};
+}
 
 // write_summary, whose failure (a full disk, say) comes after the items' work: its own exit code,
 // not 1 (an error before any work), so that a farm does not take it for a bad manifest.

@@ -1367,6 +1367,22 @@ TEST_F(CliView, StalledClientsDelayNoOther) {
     EXPECT_LT(seconds, 3.0);
 }
 
+// More clients that never read than the server has workers (40 ask for a 32 MiB model and take
+// none of it): each is dropped after 5 s without taking a byte, so another client is answered
+// within seconds, not after the 60 s a response may take.
+TEST_F(CliView, ClientsThatNeverReadAreDroppedSoonEvenMoreThanTheWorkers) {
+    const unsigned port = start_view({"-q", "--seconds", "90", big_model("big.glb", size_t(32) << 20)});
+    ASSERT_NE(port, 0u) << test::slurp(path("view-err.txt"));
+    const std::vector<int> stalled = stall(port, 40, 0);
+    ASSERT_EQ(stalled.size(), 40u);
+    const auto start = std::chrono::steady_clock::now();
+    const std::string response = http_exchange(port, get_request(port, "/viewer/"), std::chrono::milliseconds(30000));
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    close_all(stalled);
+    EXPECT_EQ(status_of(response), 200) << response;
+    EXPECT_LT(seconds, 20.0);
+}
+
 // With clients stalled as above, view ends at its --seconds (it stayed until they went away),
 // and on SIGTERM (std::signal restarted the blocked send), within a few seconds either way.
 TEST_F(CliView, StalledClientsDelayNeitherTheEndNorASignal) {

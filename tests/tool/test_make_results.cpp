@@ -1070,7 +1070,10 @@ TEST(CommittedDocs, CarryNoHandTypedMeasurements) {
         {"beyond 1% of the view radius", "check's tolerance"},
         {"at most every 10 s", "the progress interval"},
         {"after 20 s of processor time plus 20 s per MiB", "the isolated loader's limit"},
-        {"has 10 s to send its request (at most 8 KiB, GET or HEAD) and 60 s to take", "view's deadlines (view.cpp's constants)"},
+        {"a pool of 32 threads", "view's pool (a constant of view.cpp)"},
+        {"has 10 s to send its request (at most 8 KiB, GET or HEAD) and 60 s to take the whole response (a client that "
+         "takes none of it for 5 s",
+         "view's deadlines (view.cpp's constants)"},
         {"an HTTP/1.1 request", "a protocol's version"},
     };
     const std::set<std::string> allowed = {"0.654", "1.377", "1.302", "1.211", "1.153", "1.065", "1.166", "1.088",

@@ -9,9 +9,10 @@
 // - Connections are served at once by a pool of kWorkers threads; when all are busy, new ones
 //   wait in the listen backlog (not refused) until a worker is free. A connection has kReadSeconds
 //   to send its request head (at most 8 KiB, http_request.h) and then kResponseSeconds to take
-//   the whole response; no single socket call waits longer than about a second, so a client that
-//   stalls (sends half a request, or never reads) holds one worker until its deadline, never the
-//   others, nor the end of `--seconds`, nor SIGINT/SIGTERM.
+//   the whole response, taking some of it at least every kStallSeconds; no single socket call
+//   waits longer than about a second, so a client that stalls (sends half a request, or never
+//   reads) holds one worker until its deadline, never the others, nor the end of `--seconds`,
+//   nor SIGINT/SIGTERM.
 // - `--seconds` and SIGINT/SIGTERM (handlers without SA_RESTART, the workers blocking both) end
 //   the server within about a second whatever the clients do: the workers' sockets are shut down,
 //   the workers joined, and the scratch folder removed.
@@ -60,10 +61,11 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-constexpr size_t kWorkers = 16;                          // connections served at once (a browser opens at most 6)
+constexpr size_t kWorkers = 32;                          // connections served at once (a browser opens at most 6)
 constexpr int kBacklog = 64;                             // connections that wait while every worker is busy
 constexpr int kReadSeconds = 10;                         // to send the request head, from the connection's accept
 constexpr int kResponseSeconds = 60;                     // to take the whole response, from the end of the request
+constexpr int kStallSeconds = 5;                         // the longest a client may take no byte of the response
 constexpr auto kSlice = std::chrono::milliseconds(250);  // the accept loop's longest wait
 
 volatile std::sig_atomic_t interrupted = 0;  // Ctrl-C / SIGTERM: stop serving, remove the scratch folder
@@ -115,14 +117,18 @@ struct Connection {
 bool try_again(int error) { return error == EAGAIN || error == EWOULDBLOCK || error == EINTR; }
 
 // `size` bytes sent whole; false when the client went away, the deadline passed or the server stops.
+// A client that takes no byte for kStallSeconds is dropped (a browser reads as the bytes come), so
+// that clients which never read free their workers long before their deadlines.
 bool send_all(const Connection& c, const char* data, size_t size) {
     size_t sent = 0;
+    Clock::time_point progress = Clock::now();
     while (sent < size) {
-        if (!c.may_go_on()) return false;
+        if (!c.may_go_on() || Clock::now() - progress > std::chrono::seconds(kStallSeconds)) return false;
         const ssize_t n = ::send(c.fd, data + sent, size - sent, MSG_NOSIGNAL);
         if (n < 0 && try_again(errno)) continue;
         if (n <= 0) return false;  // the browser went away: nothing to do
         sent += size_t(n);
+        progress = Clock::now();
     }
     return true;
 }

@@ -61,6 +61,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <set>
 #include <memory>
 #include <sstream>
 #include <unordered_set>
@@ -578,30 +579,44 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
 
     // A clip file made for another skeleton (Mixamo rigs share their joint names, not their bone
     // lengths) is retargeted as engines play such clips: joints bound by name, the clip's rotations
-    // (and scales) put on the character's own bone offsets, and the root joints' translations (the
-    // hips: a bone whose parent is no bone) scaled by the ratio of their rest offsets (the hip
-    // heights), so the character walks its own stride. A clip file is applied as it is when every
-    // node of its skeleton that the character has too, below one of the character's joints, has
-    // the character's rest translation within kSameSkeleton of the character's size (the diagonal
-    // of its joints' rest-pose bounding box: exporters round); otherwise it is retargeted, with a
-    // note naming the largest difference (Clip::retargeted), and refused only when its skeleton
-    // lacks one of the character's skinned joints. On ../shared/data a character's own clip files
-    // differ by 0 (identical rest skeletons), another character's by 3.9% to 24%.
+    // (and scales) put on the character's own bone offsets, and the translations of the skeleton's
+    // top (the hips: on the path from the scene's root to the first skinned joint, the first node
+    // the clip moves with a rest offset in both skeletons) and of the nodes above it (an engine's
+    // root motion) scaled by the ratio of the top's rest offsets (the hip heights), so the
+    // character walks its own stride. A clip file is applied as it is when every node of its skeleton that the
+    // character has too, below one of the character's joints, has the character's rest translation
+    // within kSameSkeleton of the character's size (the diagonal of its joints' rest-pose bounding
+    // box: exporters round); otherwise it is retargeted, with a note naming the largest difference
+    // (Clip::retargeted), and refused only when its skeleton lacks one of the character's skinned
+    // joints (a clip for the character's own skeleton may lack some: they stay at rest). On
+    // ../shared/data a character's own clip files differ by 0 (identical rest skeletons), another
+    // character's by 3.9% to 24%.
     constexpr double kSameSkeleton = 1e-3;
-    std::vector<bool> is_bone(flat.nodes.size(), false), below_bone(flat.nodes.size(), false),
-        root_joint(flat.nodes.size(), false);
+    std::vector<bool> is_bone(flat.nodes.size(), false), below_bone(flat.nodes.size(), false);
     for (const Part& part : parts)
         for (size_t n : part.bone_node) is_bone[n] = true;
     for (size_t n = 0; n < flat.nodes.size(); ++n)  // parents first
         if (flat.parent[n] >= 0) below_bone[n] = is_bone[size_t(flat.parent[n])] || below_bone[size_t(flat.parent[n])];
-    // A root joint, or one of assimp's pivot helper nodes of one ("J_$AssimpFbx$_Translation" for an
-    // FBX joint J), which carry its translation.
-    auto joint_name = [](const std::string& name) { return name.substr(0, name.find("_$AssimpFbx$")); };
-    for (size_t n = 0; n < flat.nodes.size(); ++n) {
-        if (below_bone[n]) continue;
-        const auto joint = flat.by_name.find(joint_name(flat.nodes[n]->mName.C_Str()));
-        root_joint[n] = joint != flat.by_name.end() && is_bone[joint->second] && !below_bone[joint->second];
-    }
+    // The first skinned joint below no other, and the path from the scene's root down to it.
+    std::vector<size_t> to_first_joint;
+    for (size_t n = 0; n < flat.nodes.size() && to_first_joint.empty(); ++n)
+        if (is_bone[n] && !below_bone[n])
+            for (long up = long(n); up >= 0; up = flat.parent[size_t(up)])
+                to_first_joint.insert(to_first_joint.begin(), size_t(up));
+    // A node's name as a message may quote it on one line (a file's names may hold control bytes).
+    auto printable = [](const std::string& name) {
+        std::string out;
+        for (const unsigned char c : name) {
+            if (c >= 0x20 && c != 0x7f) {
+                out += char(c);
+                continue;
+            }
+            char escaped[5];
+            std::snprintf(escaped, sizeof escaped, "\\x%02x", c);
+            out += escaped;
+        }
+        return out;
+    };
     double size = 0;
     {
         std::vector<aiMatrix4x4> rest(flat.nodes.size());
@@ -641,6 +656,7 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
                            .Length());
             if (!(d <= worst)) worst = d, worst_node = node, worst_char = found->second;
         }
+        if (!worst_node || worst <= kSameSkeleton * size) return retarget;
         size_t missing = 0;
         std::string first_missing;
         for (size_t n = 0; n < flat.nodes.size(); ++n)
@@ -648,28 +664,45 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
                 if (missing++ == 0) first_missing = flat.nodes[n]->mName.C_Str();
         if (missing)
             throw LoadError(source.file + ": made for another skeleton than " + path + "'s: it has no joint '" +
-                            first_missing + "' (" + std::to_string(missing) + " of the character's " +
+                            printable(first_missing) + "' (" + std::to_string(missing) + " of the character's " +
                             std::to_string(std::count(is_bone.begin(), is_bone.end(), true)) +
                             " skinned joints missing), so it cannot drive the character");
-        if (!worst_node || worst <= kSameSkeleton * size) return retarget;
-        retarget.scale.assign(flat.nodes.size(), 1.0);
-        std::string scaled;
-        for (size_t n = 0; n < flat.nodes.size(); ++n) {
-            if (below_bone[n]) retarget.scale[n] = NAN;
-            if (!root_joint[n]) continue;
+        // The skeleton's top and the ratio of its rest offsets: the first node on the way that the
+        // clip moves and that has an offset in both (1, and the first joint, when none has).
+        std::set<std::string> moved;
+        for (unsigned c = 0; c < source.animation->mNumChannels; ++c)
+            if (source.animation->mChannels[c]->mNumPositionKeys)
+                moved.insert(source.animation->mChannels[c]->mNodeName.C_Str());
+        size_t top = to_first_joint.empty() ? 0 : to_first_joint.back();
+        double ratio = 1;
+        for (const size_t n : to_first_joint) {
             const auto theirs = theirs_by_name.find(flat.nodes[n]->mName.C_Str());
-            if (theirs == theirs_by_name.end()) continue;
+            if (theirs == theirs_by_name.end() || !moved.count(flat.nodes[n]->mName.C_Str())) continue;
             const double mine_length = double(translation(flat.nodes[n]->mTransformation).Length()),
                          their_length = double(translation(theirs->second->mTransformation).Length());
             if (mine_length > 1e-6 * size && their_length > 1e-6 * size && std::isfinite(mine_length / their_length)) {
-                retarget.scale[n] = mine_length / their_length;
-                if (scaled.empty() && std::fabs(retarget.scale[n] - 1) > 1e-6) {
-                    char factor[120];
-                    std::snprintf(factor, sizeof factor, "; root translation of '%s' scaled by %.4g",
-                                  joint_name(flat.nodes[n]->mName.C_Str()).c_str(), retarget.scale[n]);
-                    scaled = factor;
-                }
+                top = n, ratio = mine_length / their_length;
+                break;
             }
+        }
+        // Below the top (or below a joint): the character's offsets; the top and the nodes above it
+        // on the way: scaled; elsewhere as the clip has them.
+        retarget.scale.assign(flat.nodes.size(), 1.0);
+        std::vector<bool> below_top(flat.nodes.size(), false);
+        for (size_t n = 0; n < flat.nodes.size(); ++n) {  // parents first
+            const long parent = flat.parent[n];
+            below_top[n] = parent >= 0 && (size_t(parent) == top || below_top[size_t(parent)]);
+            if (below_top[n] || below_bone[n]) retarget.scale[n] = NAN;
+        }
+        for (const size_t n : to_first_joint) {
+            retarget.scale[n] = ratio;
+            if (n == top) break;
+        }
+        std::string scaled;
+        if (!to_first_joint.empty() && std::fabs(ratio - 1) > 1e-6) {
+            char factor[64];
+            std::snprintf(factor, sizeof factor, "' scaled by %.4g", ratio);
+            scaled = "; root translation of '" + printable(flat.nodes[top]->mName.C_Str()) + factor;
         }
         // + 0: "0" for a zero of either sign.
         const aiVector3D t = translation(worst_node->mTransformation) + aiVector3D(0, 0, 0),
@@ -679,7 +712,7 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
                       "(%.4g, %.4g, %.4g) in the clip and (%.4g, %.4g, %.4g) in the character: %.1f%% of its size %.4g",
                       t.x, t.y, t.z, m.x, m.y, m.z, 100 * worst / size, size);
         note = "retargeted onto the character's bone offsets (largest difference: joint '" +
-               joint_name(worst_node->mName.C_Str()) + "' at " + numbers + ")" + scaled;
+               printable(worst_node->mName.C_Str()) + "' at " + numbers + ")" + scaled;
         return retarget;
     };
 

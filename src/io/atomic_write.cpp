@@ -77,7 +77,7 @@ int create_temporary(const fs::path& target, std::string& name) {
 bool rename_without_replacing(const std::string& from, const std::string& to, std::error_code& error) {
     error.clear();
     if (::renameat2(AT_FDCWD, from.c_str(), AT_FDCWD, to.c_str(), RENAME_NOREPLACE) == 0) return true;
-    if (errno == EINVAL || errno == ENOSYS) {
+    if (errno == EINVAL || errno == ENOSYS || errno == EPERM) {  // EPERM: a sandbox that forbids the call
         if (::rename(from.c_str(), to.c_str()) == 0) return true;
     }
     error = std::error_code(errno, std::generic_category());

@@ -543,11 +543,20 @@ TEST_F(AssimpHostile, AClipForAnotherRigMovesTheCharacterAsItsOwnClipDoes) {
             moved = std::max(moved, std::fabs(expected - m.keyframe(own.first_keyframe)[i]));
         }
     EXPECT_GT(moved, 0.4f) << "the motion moves the triangle";
-    const std::string lacking = write("lacking.x", x_rig(1.5, 2, "Frame Bone1 {\nFrameTransformMatrix { " +
-                                                                  std::string(kIdentity) + " }\n}\n"));
+    // Its hips named otherwise: Bone2 is 2 from them, not 1, and Bone1 is not there.
+    const std::string lacking = write(
+        "lacking.x", x_rig(1.5, 2, "Frame Hips {\nFrameTransformMatrix { 1.0,0.0,0.0,0.0,0.0,1.0,0.0,0.0,0.0,0.0,1.0,"
+                                   "0.0,0.0,1.5,0.0,1.0;; }\nFrame Bone2 {\nFrameTransformMatrix { 1.0,0.0,0.0,0.0,0.0,"
+                                   "1.0,0.0,0.0,0.0,0.0,1.0,0.0,0.0,2.0,0.0,1.0;; }\n}\n}\n"));
+    // One made for the character's own rig that lacks a joint loads: the joint stays at rest.
+    const AnimatedMesh own_lacking = load_character(
+        character, {write("own-lacking.x", x_rig(1, 1, "Frame Bone1 {\nFrameTransformMatrix { 1.0,0.0,0.0,0.0,0.0,1.0,"
+                                                      "0.0,0.0,0.0,0.0,1.0,0.0,0.0,1.0,0.0,1.0;; }\n}\n"))});
+    ASSERT_EQ(own_lacking.clips.size(), 2u);
+    EXPECT_EQ(own_lacking.clips[1].retargeted, "");
     const std::string what = load_error(character, {lacking});
     EXPECT_EQ(what, lacking + ": made for another skeleton than " + character +
-                        "'s: it has no joint 'Bone2' (1 of the character's 2 skinned joints missing), so it cannot "
+                        "'s: it has no joint 'Bone1' (1 of the character's 2 skinned joints missing), so it cannot "
                         "drive the character");
 }
 

@@ -1351,8 +1351,8 @@ TEST_F(CliView, ScratchFoldersOfGoneProcessesAreRemoved) {
 }
 
 // Clients that stall (three ask for a model bigger than the socket buffers and never read it, two
-// send half a request) do not delay another: its answer comes at once (it waited for the stalled
-// ones to go away, or 5 s for each half request).
+// send half a request) do not delay another: its answer comes at once (a server serving one
+// connection at a time made it wait for the stalled ones to go away, or 5 s for each half request).
 TEST_F(CliView, StalledClientsDelayNoOther) {
     const unsigned port = start_view({"-q", "--seconds", "60", big_model("big.glb", size_t(32) << 20)});
     ASSERT_NE(port, 0u) << test::slurp(path("view-err.txt"));

@@ -58,9 +58,11 @@ PlannedItem plan_item(ManifestItem item, size_t index, const BatchOptions& batch
                                      ": threads are the batch's (animorder batch --threads N)");
         args.push_back(o);
     }
-    // The arguments but the output, as the key of a shared plan (no argument holds a NUL); an
-    // output that reads as an option is parsed on its own.
-    std::string key;
+    // The item's input, then the arguments but the output, as the key of a shared plan (no
+    // argument holds a NUL): the input on its own, so that an item whose options name the file
+    // another item gives as its input gets a plan of its own (and its refusal). An output that
+    // reads as an option is parsed on its own.
+    std::string key = item.input + '\0' + '\0';
     const bool shareable = shared && !item.output.empty() && item.output[0] != '-';
     if (shareable)
         for (size_t a = 2; a < args.size(); ++a) key += args[a] + '\0';

@@ -333,7 +333,7 @@ std::string implausible_figure(const json& batch) {
         if (!batch.contains(key)) return std::string(key) + " is missing";
         if (!batch[key].is_number() || !std::isfinite(batch[key].get<double>())) return value(key) + ", not a number";
         const double acmr = batch[key].get<double>();
-        const bool plausible = triangles == 0 ? acmr == 0 : acmr >= (1 - 1e-9) / t && acmr <= 3;
+        const bool plausible = triangles == 0 ? acmr == 0 : acmr >= (1 - 1e-9) / t && acmr <= 3 * (1 + 1e-9);
         if (!plausible) return value(key) + ", not an ACMR (from 1/triangles to 3)";
     }
     for (const char* key : {"ovr_before", "ovr_after"}) {

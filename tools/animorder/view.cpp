@@ -71,7 +71,9 @@ constexpr auto kSlice = std::chrono::milliseconds(250);  // the accept loop's lo
 volatile std::sig_atomic_t interrupted = 0;  // Ctrl-C / SIGTERM: stop serving, remove the scratch folder
 void on_signal(int) { interrupted = 1; }
 
-// SIGINT and SIGTERM set `interrupted`; without SA_RESTART, so that a wait under way returns at once.
+// SIGINT, SIGTERM and SIGHUP (the terminal closed) set `interrupted`; without SA_RESTART, so that
+// a wait under way returns at once. (While the bundled character is optimised, before, their
+// default actions end the run; the next `view` removes the scratch folder it left.)
 void install_signal_handlers() {
     struct sigaction action {};
     action.sa_handler = on_signal;
@@ -79,6 +81,7 @@ void install_signal_handlers() {
     action.sa_flags = 0;
     sigaction(SIGINT, &action, nullptr);
     sigaction(SIGTERM, &action, nullptr);
+    sigaction(SIGHUP, &action, nullptr);
 }
 
 std::string content_type(const fs::path& path) {
@@ -387,16 +390,25 @@ void make_bundled(const fs::path& dir, bool quiet) {
 }
 
 // The scratch folders of earlier `view` runs whose process is gone (killed while optimising the
-// bundled character, before it could remove its folder): removed.
+// bundled character, before it could remove its folder): removed. Only folders (not links) of
+// this user named as `view` names them: nothing another user of the shared temporary folder
+// planted is followed or removed.
 void remove_stale_scratch_folders(const fs::path& temp) {
     const std::string prefix = "animorder-view-";
     std::error_code error;
     for (auto it = fs::directory_iterator(temp, error); !error && it != fs::directory_iterator(); it.increment(error)) {
         // "animorder-view-PID-RANDOM" (and "animorder-view-PID", as earlier versions named them).
         const std::string name = it->path().filename().string(),
-                          rest = name.substr(std::min(name.size(), prefix.size())), pid = rest.substr(0, rest.find('-'));
-        if (name.rfind(prefix, 0) != 0 || pid.empty() || pid.size() > 9 ||
-            !std::all_of(pid.begin(), pid.end(), [](char c) { return c >= '0' && c <= '9'; }) ||
+                          rest = name.substr(std::min(name.size(), prefix.size())),
+                          pid = rest.substr(0, rest.find('-')),
+                          random = rest.substr(std::min(rest.size(), pid.size() + 1));
+        auto digits = [](const std::string& text, const char* allowed) {
+            return text.find_first_not_of(allowed) == std::string::npos;
+        };
+        struct stat entry {};
+        if (name.rfind(prefix, 0) != 0 || pid.empty() || pid.size() > 9 || !digits(pid, "0123456789") ||
+            (rest.size() > pid.size() && (random.size() != 16 || !digits(random, "0123456789abcdef"))) ||
+            ::lstat(it->path().c_str(), &entry) != 0 || !S_ISDIR(entry.st_mode) || entry.st_uid != ::geteuid() ||
             process_may_run(std::stol(pid)))
             continue;
         std::error_code ignored;

@@ -1,5 +1,6 @@
 // The ANIMORDER_animated_triangle_orders extension read back, every reference and size checked
-// against the file before anything is read (docs/extension/README.md), and written into a file.
+// against the file before anything is read (docs/extension/README.md, the rules of
+// docs/extension/VALIDITY.md), and written into a file.
 #include "animorder/gltf_extension.h"
 
 #include "animorder/load.h"
@@ -13,10 +14,31 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
+#include <map>
 
 namespace animorder {
+
+std::string printable(const std::string& text) {
+    std::string out;
+    for (const char ch : text) {
+        const unsigned char c = static_cast<unsigned char>(ch);
+        if (c == '\\') {
+            out += "\\\\";
+        } else if (c < 0x20 || c == 0x7f) {
+            const char* const hex = "0123456789abcdef";
+            out += "\\x";
+            out += hex[c >> 4];
+            out += hex[c & 15];
+        } else {
+            out += ch;
+        }
+    }
+    return out;
+}
+
 namespace {
 
 using Object = tinygltf::Value::Object;
@@ -28,64 +50,215 @@ struct Problems {
     void add(const std::string& what) { list.push_back(what); }
 };
 
-// The bytes of accessor `index` as `count` tightly read elements of `element` bytes, or an error
-// (non-empty) naming what is wrong. Sparse accessors and accessors without a view are refused:
-// the extension's accessors are plain arrays.
-std::string accessor_bytes(const tinygltf::Model& model, int index, int type, const std::vector<int>& components,
-                           const std::string& what, std::vector<unsigned char>& out, int& component_type) {
-    const std::string name = what + " (accessor " + std::to_string(index) + ")";
-    if (index < 0 || size_t(index) >= model.accessors.size())
-        return what + ": accessor " + std::to_string(index) + " does not exist";
-    const tinygltf::Accessor& a = model.accessors[size_t(index)];
-    if (a.type != type)
-        return name + " has the wrong type (expected " + (type == TINYGLTF_TYPE_VEC3 ? "VEC3" : "SCALAR") + ")";
-    if (std::find(components.begin(), components.end(), a.componentType) == components.end())
-        return name + " has component type " + std::to_string(a.componentType) + ", not one the extension allows";
-    if (a.normalized) return name + " is normalized";
-    if (a.sparse.isSparse) return name + " is sparse";
-    if (a.bufferView < 0 || size_t(a.bufferView) >= model.bufferViews.size()) return name + " has no valid buffer view";
-    const tinygltf::BufferView& v = model.bufferViews[size_t(a.bufferView)];
-    if (v.buffer < 0 || size_t(v.buffer) >= model.buffers.size()) return name + "'s buffer view names no buffer";
-    const std::vector<unsigned char>& data = model.buffers[size_t(v.buffer)].data;
-    const size_t size = size_t(tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType)));
-    const size_t element = size * size_t(tinygltf::GetNumComponentsInType(uint32_t(a.type)));
-    const size_t stride = v.byteStride ? v.byteStride : element;
-    size_t view_end = 0, last = 0, end = 0;
-    if (stride < element || !io::checked_add(v.byteOffset, v.byteLength, view_end) || view_end > data.size())
-        return name + "'s buffer view lies outside its buffer";
-    if (a.count == 0) {
-        out.clear();
-        component_type = a.componentType;
-        return "";
+// One accessor as read the first time a clip or primitive named it: the problem (after the
+// accessor's name), or its elements, tightly packed; and the forms its uses make of them, each
+// made once.
+struct Decoded {
+    bool tried = false;
+    std::string error;
+    size_t count = 0;
+    std::vector<unsigned char> bytes;
+    bool has_values = false;  // indices and orders
+    SharedArray<uint32_t> values;
+    uint32_t largest = 0;
+    bool has_cells = false;  // tables
+    SharedArray<uint8_t> cells;
+    std::array<size_t, 256> first_of_value{};  // SIZE_MAX: the value is not in the table
+    bool has_floats = false;                   // centres
+    SharedArray<float> floats;
+    bool finite = true;
+    bool has_range = false;  // key times
+    double t0 = INFINITY, t1 = -INFINITY;
+};
+
+// Whether two orders of one primitive hold the same triangles, windings kept, for each
+// (orders, indices) pair of accessors: compared once however many primitives share the pair.
+struct PairVerdict {
+    bool indices_equal_fallback = false;
+    std::vector<bool> order_is_permutation;
+};
+
+// The triangles of `v` (3·count indices), each rotated so that its smallest corner comes first
+// (the winding kept), sorted: two orders hold the same triangles when these are equal.
+std::vector<std::array<uint32_t, 3>> sorted_triangles(const uint32_t* v, size_t count) {
+    std::vector<std::array<uint32_t, 3>> t(count);
+    for (size_t i = 0; i < count; ++i) {
+        const uint32_t a = v[3 * i], b = v[3 * i + 1], c = v[3 * i + 2];
+        t[i] = a <= b && a <= c ? std::array<uint32_t, 3>{a, b, c}
+               : b <= c         ? std::array<uint32_t, 3>{b, c, a}
+                                : std::array<uint32_t, 3>{c, a, b};
     }
-    if (!io::checked_mul(a.count - 1, stride, last) || !io::checked_add(last, element, end) ||
-        !io::checked_add(end, a.byteOffset, end) || end > v.byteLength)
-        return name + " has " + std::to_string(a.count) + " elements, more than its buffer view holds";
-    out.resize(a.count * element);
-    const unsigned char* base = data.data() + v.byteOffset + a.byteOffset;
-    for (size_t i = 0; i < a.count; ++i) std::memcpy(out.data() + i * element, base + i * stride, element);
-    component_type = a.componentType;
-    return "";
+    std::sort(t.begin(), t.end());
+    return t;
 }
 
-std::string read_indices(const tinygltf::Model& model, int index, const std::string& what, std::vector<uint32_t>& out,
-                         int& component_type) {
-    std::vector<unsigned char> bytes;
-    const std::string error =
-        accessor_bytes(model, index, TINYGLTF_TYPE_SCALAR,
-                       {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
-                        TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT},
-                       what, bytes, component_type);
-    if (!error.empty()) return error;
-    const size_t size = size_t(tinygltf::GetComponentSizeInBytes(uint32_t(component_type)));
-    out.resize(bytes.size() / size);
-    for (size_t i = 0; i < out.size(); ++i) {
-        uint32_t v = 0;
-        for (size_t b = 0; b < size; ++b) v |= uint32_t(bytes[i * size + b]) << (8 * b);
-        out[i] = v;
+// The accessors the extension names, each read and checked once, and the work all of it may
+// cost (VALIDITY.md, "Work"): the elements of every distinct accessor read plus the orders of
+// every distinct (orders, indices) pair compared, at most 8 × the bytes of the file's buffers
+// + 2^20. Past that, one problem says so and every later read fails (`over`).
+class Accessors {
+public:
+    Accessors(const tinygltf::Model& model, Problems& p) : model_(model), p_(p) {
+        for (const tinygltf::Buffer& b : model.buffers) budget_ += 8 * uint64_t(b.data.size());
     }
-    return "";
-}
+
+    bool over() const { return over_; }
+    uint64_t budget() const { return budget_; }
+
+    // Adds `error` unless the budget ran out (then the one problem that says so stands for it).
+    void report(const std::string& error) {
+        if (!over_) p_.add(error);
+    }
+
+    // Accessor `index` as `type` of one of `components`, not normalized: "" and `out` the decoded
+    // accessor, or the error (non-empty) naming what is wrong. Sparse accessors and accessors
+    // without a view are refused: the extension's accessors are plain arrays.
+    std::string get(int index, int type, const std::vector<int>& components, const std::string& what, Decoded*& out) {
+        out = nullptr;
+        const std::string name = what + " (accessor " + std::to_string(index) + ")";
+        if (index < 0 || size_t(index) >= model_.accessors.size())
+            return what + ": accessor " + std::to_string(index) + " does not exist";
+        const tinygltf::Accessor& a = model_.accessors[size_t(index)];
+        if (a.type != type)
+            return name + " has the wrong type (expected " + (type == TINYGLTF_TYPE_VEC3 ? "VEC3" : "SCALAR") + ")";
+        if (std::find(components.begin(), components.end(), a.componentType) == components.end())
+            return name + " has component type " + std::to_string(a.componentType) + ", not one the extension allows";
+        if (a.normalized) return name + " is normalized";
+        Decoded& d = decoded_[index];
+        if (!d.tried) {
+            d.tried = true;
+            d.error = decode(a, d);
+        }
+        if (!d.error.empty()) return name + d.error;
+        out = &d;
+        return "";
+    }
+
+    // The accessor's values as unsigned integers (indices, orders) and the largest of them.
+    static void make_values(Decoded& d, int component_type) {
+        if (d.has_values) return;
+        d.has_values = true;
+        const size_t size = size_t(tinygltf::GetComponentSizeInBytes(uint32_t(component_type)));
+        std::vector<uint32_t> values(d.count);
+        for (size_t i = 0; i < values.size(); ++i) {
+            uint32_t v = 0;
+            for (size_t b = 0; b < size; ++b) v |= uint32_t(d.bytes[i * size + b]) << (8 * b);
+            values[i] = v;
+            d.largest = std::max(d.largest, v);
+        }
+        d.values = SharedArray<uint32_t>(std::move(values));
+    }
+
+    // A table's cells, and where each value first occurs.
+    static void make_cells(Decoded& d) {
+        if (d.has_cells) return;
+        d.has_cells = true;
+        d.first_of_value.fill(SIZE_MAX);
+        for (size_t i = d.bytes.size(); i-- > 0;) d.first_of_value[d.bytes[i]] = i;
+        d.cells = SharedArray<uint8_t>(std::vector<uint8_t>(d.bytes.begin(), d.bytes.end()));
+    }
+
+    // Centres as floats, and whether every one is finite.
+    static void make_floats(Decoded& d) {
+        if (d.has_floats) return;
+        d.has_floats = true;
+        std::vector<float> floats(d.bytes.size() / 4);
+        if (!floats.empty()) std::memcpy(floats.data(), d.bytes.data(), floats.size() * 4);
+        for (const float f : floats) d.finite = d.finite && std::isfinite(f);
+        d.floats = SharedArray<float>(std::move(floats));
+    }
+
+    // The key times of sampler input `index` as the loader and the engines read them, the data
+    // (an accessor's declared min and max may disagree with it; they stand in only for keys this
+    // check cannot read: sparse ones): widens [t0, t1].
+    void widen_key_range(int index, double& t0, double& t1) {
+        if (index < 0 || size_t(index) >= model_.accessors.size()) return;
+        Decoded* d = nullptr;
+        if (get(index, TINYGLTF_TYPE_SCALAR, {TINYGLTF_COMPONENT_TYPE_FLOAT}, "", d).empty()) {
+            if (!d->has_range) {
+                d->has_range = true;
+                for (size_t k = 0; k + 4 <= d->bytes.size(); k += 4) {
+                    float t;
+                    std::memcpy(&t, d->bytes.data() + k, 4);
+                    d->t0 = std::min(d->t0, double(t)), d->t1 = std::max(d->t1, double(t));
+                }
+            }
+            t0 = std::min(t0, d->t0), t1 = std::max(t1, d->t1);
+            return;
+        }
+        const tinygltf::Accessor& in = model_.accessors[size_t(index)];
+        if (in.minValues.size() == 1 && in.maxValues.size() == 1)
+            t0 = std::min(t0, in.minValues[0]), t1 = std::max(t1, in.maxValues[0]);
+    }
+
+    // The permutation verdicts of orders accessor `orders` (order_count × n values) against
+    // indices accessor `indices` (n values, whole triangles), each pair compared once; null when
+    // the budget ran out.
+    const PairVerdict* pair(int orders, int indices, const Decoded& o, const Decoded& in, uint32_t order_count,
+                            uint32_t fallback) {
+        const auto key = std::make_pair(orders, indices);
+        const auto found = pairs_.find(key);
+        if (found != pairs_.end()) return &found->second;
+        if (!charge(o.count)) return nullptr;
+        PairVerdict& v = pairs_[key];
+        const size_t n = in.count;
+        const uint32_t* all = o.values.data();
+        v.indices_equal_fallback = std::equal(in.values.begin(), in.values.end(), all + size_t(fallback) * n);
+        const std::vector<std::array<uint32_t, 3>> base = sorted_triangles(in.values.data(), n / 3);
+        for (uint32_t b = 0; b < order_count; ++b)
+            v.order_is_permutation.push_back(sorted_triangles(all + size_t(b) * n, n / 3) == base);
+        return &v;
+    }
+
+private:
+    // Counts `elements` of work; false (with one problem said) once past the budget.
+    bool charge(uint64_t elements) {
+        if (over_) return false;
+        if (elements > budget_ - used_) {
+            over_ = true;
+            p_.add("the extension asks for more work than its file's size allows: over " + std::to_string(budget_) +
+                   " accessor elements read and compared (8 x the buffers' bytes + 2^20; accessors shared by "
+                   "many clips or primitives?)");
+            return false;
+        }
+        used_ += elements;
+        return true;
+    }
+
+    std::string decode(const tinygltf::Accessor& a, Decoded& d) {
+        if (a.sparse.isSparse) return " is sparse";
+        if (a.bufferView < 0 || size_t(a.bufferView) >= model_.bufferViews.size()) return " has no valid buffer view";
+        const tinygltf::BufferView& v = model_.bufferViews[size_t(a.bufferView)];
+        if (v.buffer < 0 || size_t(v.buffer) >= model_.buffers.size()) return "'s buffer view names no buffer";
+        const std::vector<unsigned char>& data = model_.buffers[size_t(v.buffer)].data;
+        const size_t size = size_t(tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType)));
+        const size_t element = size * size_t(tinygltf::GetNumComponentsInType(uint32_t(a.type)));
+        const size_t stride = v.byteStride ? v.byteStride : element;
+        if (stride < element || stride % size != 0)
+            return "'s buffer view has byteStride " + std::to_string(stride) + ", not a multiple of " +
+                   std::to_string(size) + " of at least its element size " + std::to_string(element);
+        size_t view_end = 0, last = 0, end = 0;
+        if (!io::checked_add(v.byteOffset, v.byteLength, view_end) || view_end > data.size())
+            return "'s buffer view lies outside its buffer";
+        if (a.count > 0 && (!io::checked_mul(a.count - 1, stride, last) || !io::checked_add(last, element, end) ||
+                            !io::checked_add(end, a.byteOffset, end) || end > v.byteLength))
+            return " has " + std::to_string(a.count) + " elements, more than its buffer view holds";
+        if (!charge(uint64_t(a.count) * uint64_t(tinygltf::GetNumComponentsInType(uint32_t(a.type)))))
+            return " was not read (the work cap)";
+        d.count = a.count;
+        d.bytes.resize(a.count * element);
+        const unsigned char* base = data.data() + v.byteOffset + a.byteOffset;
+        for (size_t i = 0; i < a.count; ++i) std::memcpy(d.bytes.data() + i * element, base + i * stride, element);
+        return "";
+    }
+
+    const tinygltf::Model& model_;
+    Problems& p_;
+    uint64_t budget_ = uint64_t(1) << 20, used_ = 0;
+    bool over_ = false;
+    std::map<int, Decoded> decoded_;
+    std::map<std::pair<int, int>, PairVerdict> pairs_;
+};
 
 // An integer member (JSON numbers that are whole), or false.
 bool integer(const Object& o, const char* key, int64_t& out) {
@@ -128,12 +301,13 @@ bool bounded(const Object& o, const char* key, int64_t low, int64_t high, const 
 }
 
 void read_clip(const tinygltf::Model& model, const tinygltf::Value& value, size_t c, uint32_t buffer_count, Problems& p,
-               std::vector<ExtensionClip>& clips) {
+               Accessors& accessors, std::vector<ExtensionClip>& clips) {
     const std::string where = "clips[" + std::to_string(c) + "]";
     if (!value.IsObject()) return p.add(where + " is not an object");
     const Object& o = value.Get<Object>();
     ExtensionClip clip;
-    if (o.count("name") && o.at("name").IsString()) clip.name = o.at("name").Get<std::string>();
+    if (o.count("name") && !o.at("name").IsString()) return p.add(where + ".name is not a string");
+    if (o.count("name")) clip.name = o.at("name").Get<std::string>();
     int64_t v = 0;
     if (o.count("animation")) {
         if (!bounded(o, "animation", 0, int64_t(model.animations.size()) - 1, where, p, v)) return;
@@ -144,16 +318,17 @@ void read_clip(const tinygltf::Model& model, const tinygltf::Value& value, size_
         const std::string& own = model.animations[size_t(v)].name;
         const std::string expected = own.empty() ? "animation" + std::to_string(v) : own;
         if (o.count("name") && clip.name != expected)
-            return p.add(where + ".name '" + clip.name + "' is not the name of animation " + std::to_string(v) + " ('" +
-                         expected + "')");
+            return p.add(where + ".name '" + printable(clip.name) + "' is not the name of animation " +
+                         std::to_string(v) + " ('" + printable(expected) + "')");
     }
     if (o.count("startTime") && !number(o, "startTime", clip.start_time))
         return p.add(where + ".startTime is not a finite number");
     // Positive as the runtimes keep it too (a float: 1e-300 is 0 there).
     if (!number(o, "sampleRate", clip.sample_rate) || !(clip.sample_rate > 0) || !(float(clip.sample_rate) > 0) ||
         !std::isfinite(float(clip.sample_rate)))
-        return p.add(where + ".sampleRate is missing or not a positive number a 32-bit float holds (from about "
-                             "1.2e-38 to 3.4e38)");
+        return p.add(where +
+                     ".sampleRate is missing or not a positive number a 32-bit float holds (from about "
+                     "1.2e-38 to 3.4e38)");
     bool ok = bounded(o, "keyframes", 1, 100000, where, p, v);
     clip.keyframes = uint32_t(v);
     ok = bounded(o, "thetaSteps", 2, 100000, where, p, v) && ok;
@@ -167,54 +342,40 @@ void read_clip(const tinygltf::Model& model, const tinygltf::Value& value, size_
     ok = bounded(o, "centers", 0, INT32_MAX, where, p, v) && ok;
     clip.centers_accessor = int(v);
     if (!ok) return;
-    std::vector<unsigned char> bytes;
-    int component = 0;
-    std::string error = accessor_bytes(model, clip.table_accessor, TINYGLTF_TYPE_SCALAR,
-                                       {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE}, where + ".table", bytes, component);
-    if (!error.empty()) return p.add(error);
+    Decoded* table = nullptr;
+    std::string error = accessors.get(clip.table_accessor, TINYGLTF_TYPE_SCALAR,
+                                      {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE}, where + ".table", table);
+    if (!error.empty()) return accessors.report(error);
     const uint64_t cells = uint64_t(clip.keyframes) * clip.theta_steps * clip.phi_steps;
-    if (bytes.size() != cells)
-        return p.add(where + ".table has " + std::to_string(bytes.size()) +
+    if (table->count != cells)
+        return p.add(where + ".table has " + std::to_string(table->count) +
                      " cells; keyframes x thetaSteps x phiSteps = " + std::to_string(cells));
-    clip.cells.assign(bytes.begin(), bytes.end());
-    for (size_t i = 0; i < clip.cells.size(); ++i)
-        if (uint64_t(clip.buffer_base) + clip.cells[i] >= buffer_count)
-            return p.add(where + ".table cell " + std::to_string(i) + " names order " +
-                         std::to_string(clip.buffer_base + clip.cells[i]) + ", not below bufferCount " +
-                         std::to_string(buffer_count));
-    error = accessor_bytes(model, clip.centers_accessor, TINYGLTF_TYPE_VEC3, {TINYGLTF_COMPONENT_TYPE_FLOAT},
-                           where + ".centers", bytes, component);
-    if (!error.empty()) return p.add(error);
-    if (bytes.size() != size_t(clip.keyframes) * 12)
-        return p.add(where + ".centers has " + std::to_string(bytes.size() / 12) +
+    Accessors::make_cells(*table);
+    clip.cells = table->cells;
+    // The first cell naming an order past bufferCount: the first of any value that large.
+    size_t first = SIZE_MAX;
+    for (size_t value = buffer_count - clip.buffer_base; value < 256; ++value)
+        first = std::min(first, table->first_of_value[value]);
+    if (first != SIZE_MAX)
+        return p.add(where + ".table cell " + std::to_string(first) + " names order " +
+                     std::to_string(clip.buffer_base + clip.cells[first]) + ", not below bufferCount " +
+                     std::to_string(buffer_count));
+    Decoded* centers = nullptr;
+    error = accessors.get(clip.centers_accessor, TINYGLTF_TYPE_VEC3, {TINYGLTF_COMPONENT_TYPE_FLOAT},
+                          where + ".centers", centers);
+    if (!error.empty()) return accessors.report(error);
+    if (centers->count != clip.keyframes)
+        return p.add(where + ".centers has " + std::to_string(centers->count) +
                      " elements, not keyframes = " + std::to_string(clip.keyframes));
-    clip.centers.resize(bytes.size() / 4);
-    std::memcpy(clip.centers.data(), bytes.data(), bytes.size());
-    for (float f : clip.centers)
-        if (!std::isfinite(f)) return p.add(where + ".centers holds a value that is not finite");
-    // The table covers the animation's time range: keyframe f at startTime + f / sampleRate. The
-    // key times as the loader and the engines read them, the data (an accessor's declared min and
-    // max may disagree with it; they stand in only for keys this check cannot read: sparse ones).
+    Accessors::make_floats(*centers);
+    clip.centers = centers->floats;
+    if (!centers->finite) return p.add(where + ".centers holds a value that is not finite");
+    // The table covers the animation's time range: keyframe f at startTime + f / sampleRate.
     if (clip.animation >= 0) {
         const tinygltf::Animation& anim = model.animations[size_t(clip.animation)];
         double t0 = INFINITY, t1 = -INFINITY;
-        for (const tinygltf::AnimationSampler& s : anim.samplers) {
-            if (s.input < 0 || size_t(s.input) >= model.accessors.size()) continue;
-            const tinygltf::Accessor& in = model.accessors[size_t(s.input)];
-            std::vector<unsigned char> keys;
-            int key_type = 0;
-            if (accessor_bytes(model, s.input, TINYGLTF_TYPE_SCALAR, {TINYGLTF_COMPONENT_TYPE_FLOAT}, "", keys,
-                               key_type)
-                    .empty()) {
-                for (size_t k = 0; k + 4 <= keys.size(); k += 4) {
-                    float t;
-                    std::memcpy(&t, keys.data() + k, 4);
-                    t0 = std::min(t0, double(t)), t1 = std::max(t1, double(t));
-                }
-            } else if (in.minValues.size() == 1 && in.maxValues.size() == 1) {
-                t0 = std::min(t0, in.minValues[0]), t1 = std::max(t1, in.maxValues[0]);
-            }
-        }
+        for (const tinygltf::AnimationSampler& s : anim.samplers) accessors.widen_key_range(s.input, t0, t1);
+        if (accessors.over()) return;
         if (t0 <= t1) {
             const double step = 1.0 / clip.sample_rate;
             if (std::fabs(clip.start_time - t0) > 0.5 * step)
@@ -230,7 +391,8 @@ void read_clip(const tinygltf::Model& model, const tinygltf::Value& value, size_
 }
 
 void read_primitive(const tinygltf::Model& model, size_t m, size_t pi, const Object& o,
-                    const OrdersExtensionCheck& root, Problems& p, std::vector<ExtensionPrimitive>& out) {
+                    const OrdersExtensionCheck& root, Problems& p, Accessors& accessors,
+                    std::vector<ExtensionPrimitive>& out) {
     const std::string where = "meshes[" + std::to_string(m) + "].primitives[" + std::to_string(pi) + "]";
     const tinygltf::Primitive& prim = model.meshes[m].primitives[pi];
     ExtensionPrimitive e;
@@ -245,28 +407,49 @@ void read_primitive(const tinygltf::Model& model, size_t m, size_t pi, const Obj
         return p.add(where + ".orderCount " + std::to_string(e.order_count) + " differs from bufferCount " +
                      std::to_string(root.buffer_count));
     if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != -1) return p.add(where + " is not a TRIANGLES primitive");
-    int component = 0;
-    std::string error = read_indices(model, prim.indices, where + ".indices", e.indices, component);
-    if (!error.empty()) return p.add(error);
-    error = read_indices(model, e.orders_accessor, where + ".orders", e.orders, e.component_type);
-    if (!error.empty()) return p.add(error);
+    const std::vector<int> unsigned_types = {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+                                             TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
+                                             TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT};
+    Decoded *indices = nullptr, *orders = nullptr;
+    std::string error = accessors.get(prim.indices, TINYGLTF_TYPE_SCALAR, unsigned_types, where + ".indices", indices);
+    if (!error.empty()) return accessors.report(error);
+    error = accessors.get(e.orders_accessor, TINYGLTF_TYPE_SCALAR, unsigned_types, where + ".orders", orders);
+    if (!error.empty()) return accessors.report(error);
+    e.component_type = model.accessors[size_t(e.orders_accessor)].componentType;
     if (e.component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE) return p.add(where + ".orders is UNSIGNED_BYTE");
-    const size_t n = e.indices.size();
+    const size_t n = indices->count;
     if (n % 3 != 0) return p.add(where + ".indices holds " + std::to_string(n) + " indices, not whole triangles");
-    if (e.orders.size() != n * e.order_count)
-        return p.add(where + ".orders has " + std::to_string(e.orders.size()) +
+    if (orders->count != n * e.order_count)
+        return p.add(where + ".orders has " + std::to_string(orders->count) +
                      " elements; orderCount x indices = " + std::to_string(n * e.order_count));
-    e.indices_equal_fallback =
-        std::equal(e.indices.begin(), e.indices.end(), e.orders.begin() + ptrdiff_t(root.fallback * n));
+    Accessors::make_values(*indices, model.accessors[size_t(prim.indices)].componentType);
+    Accessors::make_values(*orders, e.component_type);
+    e.indices = indices->values;
+    e.orders = orders->values;
+    // Every order names vertices of the primitive (an unsigned short never 65535, WebGL 2's
+    // primitive restart).
+    const auto position = prim.attributes.find("POSITION");
+    if (position == prim.attributes.end() || position->second < 0 || size_t(position->second) >= model.accessors.size())
+        return p.add(where + " has no POSITION accessor");
+    const size_t vertices = model.accessors[size_t(position->second)].count;
+    if (!orders->values.empty() && orders->largest >= vertices)
+        return p.add(where + ".orders names vertex " + std::to_string(orders->largest) + " of " +
+                     std::to_string(vertices));
+    if (e.component_type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT && orders->largest == 65535)
+        return p.add(where + ".orders names vertex 65535 (primitive restart)");
+    const PairVerdict* verdict =
+        accessors.pair(e.orders_accessor, prim.indices, *orders, *indices, e.order_count, root.fallback);
+    if (!verdict) return;
+    e.indices_equal_fallback = verdict->indices_equal_fallback;
+    e.order_is_permutation = verdict->order_is_permutation;
     if (!e.indices_equal_fallback)
         p.add(where + ".indices differs from order " + std::to_string(root.fallback) + " (fallback)");
-    for (uint32_t b = 0; b < e.order_count; ++b) {
-        const bool permutation =
-            !triangle_permutation(e.indices.data(), e.orders.data() + b * n, n / 3).empty() || n == 0;
-        e.order_is_permutation.push_back(permutation);
-        if (!permutation)
-            p.add(where + " order " + std::to_string(b) +
-                  " is not a permutation of the primitive's triangles with their winding (stale orders?)");
+    const auto bad = std::find(e.order_is_permutation.begin(), e.order_is_permutation.end(), false);
+    if (bad != e.order_is_permutation.end()) {
+        const size_t more = size_t(std::count(bad + 1, e.order_is_permutation.end(), false));
+        p.add(where + " order " + std::to_string(bad - e.order_is_permutation.begin()) +
+              " is not a permutation of the primitive's triangles with their winding (stale orders?)" +
+              (more ? " (and " + std::to_string(more) + " more orders)" : ""));
     }
     out.push_back(std::move(e));
 }
@@ -315,6 +498,18 @@ void check_json_as_written(const std::string& path, Problems& p) {
                     p.add(std::string(list) + "[" + std::to_string(i) + "].byteOffset " + item["byteOffset"].dump() +
                           " is not a non-negative integer");
             }
+    // A stride tinygltf reads as absent (a negative one) or as tight (0): glTF's from 4 to 252, a
+    // multiple of 4, or none.
+    if (doc.contains("bufferViews") && doc["bufferViews"].is_array())
+        for (size_t i = 0; i < doc["bufferViews"].size(); ++i) {
+            const nlohmann::json& item = doc["bufferViews"][i];
+            if (!item.is_object() || !item.contains("byteStride")) continue;
+            const nlohmann::json& stride = item["byteStride"];
+            if (!stride.is_number_unsigned() || stride.get<uint64_t>() < 4 || stride.get<uint64_t>() > 252 ||
+                stride.get<uint64_t>() % 4 != 0)
+                p.add("bufferViews[" + std::to_string(i) + "].byteStride " + stride.dump() +
+                      " is not an integer from 4 to 252, a multiple of 4");
+        }
     if (!doc.contains("meshes") || !doc["meshes"].is_array()) return;
     for (size_t m = 0; m < doc["meshes"].size(); ++m) {
         const nlohmann::json& mesh = doc["meshes"][m];
@@ -358,14 +553,15 @@ OrdersExtensionCheck check_orders_extension(const std::string& path) {
     r.buffer_count = uint32_t(v);
     if (!bounded(o, "fallback", 0, int64_t(r.buffer_count) - 1, "root", p, v)) return r;
     r.fallback = uint32_t(v);
+    Accessors accessors(model, p);
     const auto clips = o.find("clips");
     if (clips == o.end() || !clips->second.IsArray() || clips->second.ArrayLen() == 0)
         p.add("root.clips is missing or empty");
     else
-        for (size_t c = 0; c < clips->second.ArrayLen(); ++c)
-            read_clip(model, clips->second.Get(int(c)), c, r.buffer_count, p, r.clips);
-    for (size_t m = 0; m < model.meshes.size(); ++m)
-        for (size_t pi = 0; pi < model.meshes[m].primitives.size(); ++pi) {
+        for (size_t c = 0; c < clips->second.ArrayLen() && !accessors.over(); ++c)
+            read_clip(model, clips->second.Get(int(c)), c, r.buffer_count, p, accessors, r.clips);
+    for (size_t m = 0; m < model.meshes.size() && !accessors.over(); ++m)
+        for (size_t pi = 0; pi < model.meshes[m].primitives.size() && !accessors.over(); ++pi) {
             const tinygltf::Primitive& prim = model.meshes[m].primitives[pi];
             const auto e = prim.extensions.find(kOrdersExtensionName);
             if (e == prim.extensions.end()) {  // drawn in its file order: said, not an error
@@ -387,9 +583,20 @@ OrdersExtensionCheck check_orders_extension(const std::string& path) {
                       "] extension is not an object");
                 continue;
             }
-            read_primitive(model, m, pi, e->second.Get<Object>(), r, p, r.primitives);
+            read_primitive(model, m, pi, e->second.Get<Object>(), r, p, accessors, r.primitives);
         }
     if (r.primitives.empty() && r.errors.empty()) p.add("no primitive carries the orders");
+    r.work_budget = accessors.budget();
+    const auto count = [&model](int a) {
+        return a >= 0 && size_t(a) < model.accessors.size() ? model.accessors[size_t(a)].count : 0;
+    };
+    for (const tinygltf::Node& node : model.nodes)
+        if (node.mesh >= 0 && size_t(node.mesh) < model.meshes.size())
+            for (const tinygltf::Primitive& prim : model.meshes[size_t(node.mesh)].primitives) {
+                const auto position = prim.attributes.find("POSITION");
+                r.posed_elements +=
+                    count(prim.indices) + (position == prim.attributes.end() ? 0 : count(position->second));
+            }
     return r;
 }
 

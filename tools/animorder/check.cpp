@@ -23,8 +23,14 @@ namespace {
 // as optimize wrote them): a tool that moved the whole scene (glTF-Transform's `center` adds a
 // parent node) leaves the orders valid but every table lookup computes its view direction from
 // the wrong point. Off by more than 1% of the view radius is an error (quantised positions move
-// them far less). A file that cannot be posed here is reported unchecked, not as an error.
+// them far less). A file that cannot be posed here, or only at a cost far above its size (shared
+// accessors), is reported unchecked, not as an error.
 nlohmann::json check_centres(const std::string& file, OrdersExtensionCheck& r) {
+    if (r.posed_elements > r.work_budget)
+        return {{"checked", false},
+                {"why", "posing the mesh would read " + std::to_string(r.posed_elements) +
+                            " vertices and indices, more than the file's size allows (" +
+                            std::to_string(r.work_budget) + "): its nodes or primitives share accessors"}};
     AnimatedMesh mesh;
     try {
         mesh = load_character(file);
@@ -54,7 +60,7 @@ nlohmann::json check_centres(const std::string& file, OrdersExtensionCheck& r) {
         if (off > 0.01) {
             char text[64];
             std::snprintf(text, sizeof text, "%.1f%%", 100 * off);
-            r.errors.push_back("clip '" + c.name + "': its centers are " + text +
+            r.errors.push_back("clip '" + printable(c.name) + "': its centers are " + text +
                                " of the view radius away from the mesh's frame centres (the scene moved since "
                                "the orders were made?): every lookup would use the wrong view direction");
         }

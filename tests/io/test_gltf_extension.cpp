@@ -12,6 +12,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <array>
 #include <cstring>
 #include <fstream>
 #include <functional>
@@ -254,4 +256,151 @@ TEST_F(GltfExtension, TheExamplePassesTheKhronosValidator) {
     const fs::path example = fs::path(ANIMORDER_SOURCE_DIR) / "docs" / "extension" / "example.gltf";
     ASSERT_TRUE(test::validate_gltf(example, report, dir_)) << report;
     EXPECT_EQ(nlohmann::json::parse(report)["errors"], 0) << report;
+}
+
+// The shared corpus of hostile files (tests/extension-corpus/, made by make.mjs): every reader
+// gives each file its manifest's verdict (the JS runtime and the glTF-Transform extension in their
+// own tests). Invalid: some error holds the manifest's phrase; every error is one line of
+// printable text (a clip name's newline or ESC escaped).
+TEST_F(GltfExtension, EveryCorpusFileGetsItsManifestVerdict) {
+    const fs::path corpus = fs::path(ANIMORDER_SOURCE_DIR) / "tests" / "extension-corpus";
+    const json manifest = json::parse(test::slurp(corpus / "manifest.json"));
+    ASSERT_GE(manifest.size(), 40u);
+    for (const json& entry : manifest) {
+        const std::string file = entry["file"].get<std::string>();
+        SCOPED_TRACE(file);
+        std::vector<std::string> errors;
+        try {
+            errors = check_orders_extension((corpus / file).string()).errors;
+        } catch (const LoadError& e) {  // tinygltf itself refused the file
+            errors = {e.what()};
+        }
+        for (const std::string& e : errors)
+            for (const char c : e) EXPECT_FALSE(static_cast<unsigned char>(c) < 0x20 || c == 0x7f) << e;
+        if (entry["valid"].get<bool>()) {
+            EXPECT_TRUE(errors.empty()) << errors.front();
+            continue;
+        }
+        ASSERT_FALSE(errors.empty());
+        const std::string phrase = entry["phrase"].get<std::string>();
+        EXPECT_TRUE(std::any_of(errors.begin(), errors.end(),
+                                [&](const std::string& e) { return e.find(phrase) != std::string::npos; }))
+            << "'" << phrase << "' not in: " << errors.front();
+    }
+}
+
+namespace {
+
+// A strip of `triangles` triangles (t, t+1, t+2, windings alternating) with `orders` orders, order
+// b the triangles rotated b places, in `bin` (appended); as tests/extension-corpus/amplify.mjs.
+// Returns the byte offsets of positions, indices, orders and the end.
+std::array<size_t, 4> put_strip(std::string& bin, size_t triangles, size_t orders) {
+    const auto put = [&bin](const void* p, size_t n) {
+        bin.append(static_cast<const char*>(p), n);
+        bin.append((4 - n % 4) % 4, '\0');
+    };
+    std::array<size_t, 4> at{};
+    std::vector<float> positions;
+    for (size_t v = 0; v < triangles + 2; ++v) positions.insert(positions.end(), {float(v / 2), float(v % 2), 0.f});
+    const auto triangle = [](size_t t) {
+        return t % 2 == 0 ? std::vector<uint16_t>{uint16_t(t), uint16_t(t + 1), uint16_t(t + 2)}
+                          : std::vector<uint16_t>{uint16_t(t + 1), uint16_t(t), uint16_t(t + 2)};
+    };
+    std::vector<uint16_t> indices, all;
+    for (size_t t = 0; t < triangles; ++t) {
+        const auto c = triangle(t);
+        indices.insert(indices.end(), c.begin(), c.end());
+    }
+    for (size_t b = 0; b < orders; ++b)
+        for (size_t t = 0; t < triangles; ++t) {
+            const auto c = triangle((t + b) % triangles);
+            all.insert(all.end(), c.begin(), c.end());
+        }
+    at[0] = bin.size();
+    put(positions.data(), positions.size() * 4);
+    at[1] = bin.size();
+    put(indices.data(), indices.size() * 2);
+    at[2] = bin.size();
+    put(all.data(), all.size() * 2);
+    at[3] = bin.size();
+    return at;
+}
+
+// `primitives` primitives sharing one POSITION, one orders and (unless `distinct_indices`) one
+// indices accessor, and `clips` clips sharing one table of `cells` cells and one centres
+// accessor: a small file that names its accessors thousands of times.
+json shared_file(size_t primitives, size_t clips, size_t cells, bool distinct_indices, std::string& bin) {
+    const size_t triangles = 500, orders = 8;
+    const std::array<size_t, 4> at = put_strip(bin, triangles, orders);
+    const size_t table = bin.size();
+    for (size_t i = 0; i < cells; ++i) bin.push_back(char(i % orders));
+    bin.append((4 - cells % 4) % 4, '\0');
+    const size_t centre = bin.size();
+    const float c[3] = {0.5f, 0.5f, 0};
+    bin.append(reinterpret_cast<const char*>(c), 12);
+    const auto view = [](size_t offset, size_t length) {
+        return json{{"buffer", 0}, {"byteOffset", offset}, {"byteLength", length}};
+    };
+    json g = {{"asset", {{"version", "2.0"}}},
+              {"extensionsUsed", {kExt}},
+              {"scene", 0},
+              {"scenes", {{{"nodes", {0}}}}},
+              {"nodes", {{{"mesh", 0}}}},
+              {"buffers", {{{"uri", "shared.bin"}, {"byteLength", bin.size()}}}},
+              {"bufferViews",
+               {view(at[0], at[1] - at[0]), view(at[1], at[2] - at[1]), view(at[2], at[3] - at[2]), view(table, cells),
+                view(centre, 12)}},
+              {"accessors",
+               {{{"bufferView", 0}, {"componentType", 5126}, {"count", triangles + 2}, {"type", "VEC3"}},
+                {{"bufferView", 1}, {"componentType", 5123}, {"count", 3 * triangles}, {"type", "SCALAR"}},
+                {{"bufferView", 2}, {"componentType", 5123}, {"count", 3 * triangles * orders}, {"type", "SCALAR"}},
+                {{"bufferView", 3}, {"componentType", 5121}, {"count", cells}, {"type", "SCALAR"}},
+                {{"bufferView", 4}, {"componentType", 5126}, {"count", 1}, {"type", "VEC3"}}}}};
+    json prims = json::array();
+    for (size_t p = 0; p < primitives; ++p) {
+        size_t indices = 1;
+        if (distinct_indices && p > 0) {
+            indices = g["accessors"].size();
+            g["accessors"].push_back(g["accessors"][1]);
+        }
+        prims.push_back({{"attributes", {{"POSITION", 0}}},
+                         {"indices", indices},
+                         {"extensions", {{kExt, {{"orders", 2}, {"orderCount", orders}}}}}});
+    }
+    g["meshes"] = {{{"primitives", prims}}};
+    const json clip = {{"name", "posed"}, {"sampleRate", 30},      {"keyframes", 1}, {"bufferBase", 0},
+                       {"thetaSteps", 2}, {"phiSteps", cells / 2}, {"table", 3},     {"centers", 4}};
+    g["extensions"][kExt] = {{"bufferCount", orders}, {"fallback", 0}, {"clips", json::array()}};
+    for (size_t k = 0; k < clips; ++k) g["extensions"][kExt]["clips"].push_back(clip);
+    return g;
+}
+
+}  // namespace
+
+// Accessors that many clips and primitives share are read once and held once (each clip's cells
+// and each primitive's orders the same storage); distinct (orders, indices) pairs over the same
+// bytes, which would compare the orders once per primitive, are refused past the work cap.
+TEST_F(GltfExtension, SharedAccessorsAreReadOnceAndTheWorkIsCapped) {
+    std::string bin;
+    const json shared = shared_file(2000, 1000, 200000, false, bin);
+    std::ofstream(path("shared.bin"), std::ios::binary) << bin;
+    std::ofstream(path("shared.gltf")) << shared.dump();
+    const OrdersExtensionCheck r = check_orders_extension(path("shared.gltf").string());
+    ASSERT_TRUE(r.errors.empty()) << r.errors.front();
+    ASSERT_EQ(r.clips.size(), 1000u);
+    ASSERT_EQ(r.primitives.size(), 2000u);
+    EXPECT_EQ(r.clips[0].cells.data(), r.clips[999].cells.data());
+    EXPECT_EQ(r.primitives[0].orders.data(), r.primitives[1999].orders.data());
+    EXPECT_EQ(r.primitives[0].indices.data(), r.primitives[1999].indices.data());
+    EXPECT_EQ(r.primitives[1999].order_is_permutation, std::vector<bool>(8, true));
+    // Posing 2000 copies of the strip costs more than the file holds: check leaves it unposed.
+    EXPECT_GT(r.posed_elements, r.work_budget);
+
+    bin.clear();
+    const json distinct = shared_file(2000, 1, 200, true, bin);
+    std::ofstream(path("shared.bin"), std::ios::binary) << bin;
+    std::ofstream(path("shared.gltf")) << distinct.dump();
+    const OrdersExtensionCheck d = check_orders_extension(path("shared.gltf").string());
+    ASSERT_EQ(d.errors.size(), 1u);
+    EXPECT_NE(d.errors[0].find("more work than its file's size allows"), std::string::npos) << d.errors[0];
 }

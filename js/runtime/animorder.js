@@ -162,9 +162,9 @@ export class AnimorderRuntime {
             const root = json && json.extensions && json.extensions[EXTENSION_NAME];
             if (!root) return null;
             const reader = new AccessorReader(json, bin);
-            const runtime = AnimorderRuntime.fromExtension(root, (index) => reader.read(index));
-            checkPrimitives(json, runtime.bufferCount, reader);
-            return runtime;
+            const problems = extensionProblems(json, reader);
+            if (problems.length) fail(`${EXTENSION_NAME}: ${problems[0]}`);
+            return AnimorderRuntime.fromExtension(root, (index) => reader.read(index));
         });
     }
 
@@ -222,29 +222,15 @@ export function ordersProblem(orders, valueAt, orderCount, indexCount, vertexCou
     return null;
 }
 
-// What the extension asks of each primitive that carries orders (the checks of `animorder check`
-// an engine needs before binding them): triangles with indices and positions, orderCount =
-// bufferCount, an orders accessor inside its buffer view and buffer (`reader`) that fits
-// (ordersProblem).
-function checkPrimitives(json, bufferCount, reader) {
-    const accessors = json.accessors || [];
-    (json.meshes || []).forEach((mesh, m) => (mesh && mesh.primitives || []).forEach((primitive, p) => {
-        const ext = primitive && primitive.extensions && primitive.extensions[EXTENSION_NAME];
-        if (!ext) return;
-        const where = `mesh ${m} primitive ${p}`;
-        if (primitive.mode !== undefined && primitive.mode !== 4) fail(`${where}: orders on a primitive that is not triangles`);
-        const indices = accessors[primitive.indices];
-        if (!Number.isInteger(primitive.indices) || !indices || !isCount(indices.count)) fail(`${where}: orders on a primitive without indices`);
-        if (ext.orderCount !== bufferCount) fail(`${where}: orderCount ${ext.orderCount} != bufferCount ${bufferCount}`);
-        const position = primitive.attributes ? accessors[primitive.attributes.POSITION] : undefined;
-        if (!position || !isCount(position.count)) fail(`${where}: orders on a primitive without positions`);
-        const at = reader.locate(ext.orders);  // sparse or view-less accessors refused there
-        const wide = at.accessor.componentType === 5125;
-        const valueAt = (e) => wide ? at.data.getUint32(at.start + e * at.stride, true) : at.data.getUint16(at.start + e * at.stride, true);
-        const problem = ordersProblem({ itemSize: at.itemSize, componentType: at.accessor.componentType, count: at.count,
-            normalized: at.accessor.normalized === true, sparse: false }, valueAt, ext.orderCount, indices.count, position.count);
-        if (problem) fail(`${where}: ${problem}`);
-    }));
+// The largest value of a table, found once per table (clips may share one: a thousand clips of one
+// table must not cost a thousand passes over it).
+const largestCells = new WeakMap();
+function largestCell(cells) {
+    if (typeof cells === 'object' && largestCells.has(cells)) return largestCells.get(cells);
+    let m = 0;
+    for (let k = 0; k < cells.length; ++k) if (cells[k] > m) m = cells[k];
+    if (typeof cells === 'object') largestCells.set(cells, m);
+    return m;
 }
 
 function checkClip(c, index, bufferCount) {
@@ -258,8 +244,8 @@ function checkClip(c, index, bufferCount) {
     const cellCount = c.keyframes * c.thetaSteps * c.phiSteps;
     if (!c.cells || c.cells.length !== cellCount) fail(`${where}: the table has ${c.cells ? c.cells.length : 0} cells, not ${cellCount}`);
     if (!c.centres || c.centres.length !== c.keyframes * 3) fail(`${where}: ${c.keyframes} keyframes need ${c.keyframes} centres`);
-    for (let k = 0; k < cellCount; ++k)
-        if (c.bufferBase + c.cells[k] >= bufferCount) fail(`${where}: a cell names buffer ${c.bufferBase + c.cells[k]} >= ${bufferCount}`);
+    const largest = largestCell(c.cells);
+    if (c.bufferBase + largest >= bufferCount) fail(`${where}: a cell names buffer ${c.bufferBase + largest} >= ${bufferCount}`);
     const startTime = c.startTime ?? 0;
     if (!Number.isFinite(startTime)) fail(`${where}: startTime must be a number`);
     return {
@@ -401,5 +387,332 @@ export class AccessorReader {
         for (let e = 0; e < count; ++e)
             for (let k = 0; k < itemSize; ++k) array[e * itemSize + k] = get(start + e * stride + k * Type.BYTES_PER_ELEMENT);
         return { array, itemSize, count, componentType: accessor.componentType, normalized: accessor.normalized === true };
+    }
+}
+
+// ---- the rules of docs/extension/VALIDITY.md, as `animorder check` applies them ----
+
+const INT32_MAX = 2147483647;
+const COMPONENT_SIZE = { 5120: 1, 5121: 1, 5122: 2, 5123: 2, 5125: 4, 5126: 4 };
+
+// `text` with every control character (below 0x20, and 0x7f) written as \xNN and backslashes
+// doubled: a name from a file quoted in a one-line message.
+export function printable(text) {
+    return String(text).replace(/[\x00-\x1f\x7f\\]/g, (c) => c === '\\' ? '\\\\' : '\\x' + c.charCodeAt(0).toString(16).padStart(2, '0'));
+}
+
+// A whole JSON number, as `animorder check` reads one (strings, fractions and NaN are not).
+function integer(value) {
+    return typeof value === 'number' && Number.isInteger(value) && Math.abs(value) < 9e15;
+}
+
+// The problems of a glTF's ANIMORDER_animated_triangle_orders extension (an array of one-line
+// messages, empty when its orders are usable; null when the file does not use it): the rules of
+// docs/extension/VALIDITY.md, in `animorder check`'s words, and at most its work (each accessor
+// read once however many clips or primitives name it, each (orders, indices) pair compared once,
+// all of it at most 8 × the bytes of the file's buffers + 2^20). `reader` is an AccessorReader of
+// the file: its bufferBytes give the bytes, and the accessors read here are left in its cache for
+// read().
+export function extensionProblems(json, reader) {
+    const root = json && json.extensions && json.extensions[EXTENSION_NAME];
+    if (root === undefined) return null;
+    return new ExtensionCheck(json, reader).run(root);
+}
+
+class ExtensionCheck {
+    constructor(json, reader) {
+        this.json = json;
+        this.reader = reader;
+        this.problems = [];
+        this.budget = 2 ** 20;
+        for (const b of json.buffers || []) if (b && isCount(b.byteLength)) this.budget += 8 * b.byteLength;
+        this.used = 0;
+        this.over = false;
+        this.decoded = new Map();  // accessor → { error } or { count, array, largest, ... }
+        this.pairs = new Map();    // "orders,indices" → { equal, permutation: [bool] }
+    }
+
+    add(problem) {
+        this.problems.push(problem);
+    }
+
+    // Adds `error` unless the budget ran out (then the one problem that says so stands for it).
+    report(error) {
+        if (!this.over) this.add(error);
+    }
+
+    // Counts `elements` of work; false (with one problem said) once past the budget.
+    charge(elements) {
+        if (this.over) return false;
+        if (elements > this.budget - this.used) {
+            this.over = true;
+            this.add(`the extension asks for more work than its file's size allows: over ${this.budget} accessor elements ` +
+                'read and compared (8 x the buffers\' bytes + 2^20; accessors shared by many clips or primitives?)');
+            return false;
+        }
+        this.used += elements;
+        return true;
+    }
+
+    // A required integer in [low, high] of object `o`, or undefined (a problem added).
+    bounded(o, key, low, high, where) {
+        const value = o[key];
+        if (!Object.hasOwn(o, key) || !integer(value)) {
+            this.add(`${where}.${key} is missing or not an integer`);
+            return undefined;
+        }
+        if (value < low || value > high) {
+            this.add(`${where}.${key} = ${value} is out of range [${low}, ${high}]`);
+            return undefined;
+        }
+        return value;
+    }
+
+    // Accessor `index` as `type` of one of `components`, not normalized: { decoded } or { error }.
+    get(index, type, components, what) {
+        const name = `${what} (accessor ${index})`;
+        const accessors = this.json.accessors || [];
+        const a = integer(index) && index >= 0 && index < accessors.length ? accessors[index] : undefined;
+        if (!a || typeof a !== 'object') return { error: `${what}: accessor ${index} does not exist` };
+        if (a.type !== type) return { error: `${name} has the wrong type (expected ${type})` };
+        if (!components.includes(a.componentType))
+            return { error: `${name} has component type ${a.componentType}, not one the extension allows` };
+        if (a.normalized === true) return { error: `${name} is normalized` };
+        if (!this.decoded.has(index)) this.decoded.set(index, this.decode(index, a));
+        const d = this.decoded.get(index);
+        return d.error !== undefined ? { error: name + d.error } : { decoded: d };
+    }
+
+    decode(index, a) {
+        if (a.sparse !== undefined) return { error: ' is sparse' };
+        const views = this.json.bufferViews || [];
+        const v = integer(a.bufferView) && a.bufferView >= 0 ? views[a.bufferView] : undefined;
+        if (!v || typeof v !== 'object') return { error: ' has no valid buffer view' };
+        const buffers = this.json.buffers || [];
+        if (!integer(v.buffer) || v.buffer < 0 || !buffers[v.buffer]) return { error: '\'s buffer view names no buffer' };
+        const data = this.reader.bufferBytes(v.buffer);
+        const Type = TYPES[a.componentType], itemSize = COMPONENTS[a.type];
+        const size = COMPONENT_SIZE[a.componentType], element = size * itemSize;
+        const stride = v.byteStride || element;
+        if (stride < element || stride % size !== 0)
+            return { error: `'s buffer view has byteStride ${stride}, not a multiple of ${size} of at least its element size ${element}` };
+        const viewOffset = v.byteOffset ?? 0, offset = a.byteOffset ?? 0;
+        if (!isCount(viewOffset) || !isCount(v.byteLength) || viewOffset + v.byteLength > data.length)
+            return { error: '\'s buffer view lies outside its buffer' };
+        const count = a.count;
+        if (!isCount(count) || !isCount(offset) || (count > 0 && (count - 1) * stride + element + offset > v.byteLength))
+            return { error: ` has ${count} elements, more than its buffer view holds` };
+        if (!this.charge(count * itemSize)) return { error: ' was not read (the work cap)' };
+        const view = new DataView(data.buffer, data.byteOffset, data.byteLength);
+        const get = {
+            5120: (o) => view.getInt8(o), 5121: (o) => view.getUint8(o), 5122: (o) => view.getInt16(o, true),
+            5123: (o) => view.getUint16(o, true), 5125: (o) => view.getUint32(o, true), 5126: (o) => view.getFloat32(o, true),
+        }[a.componentType];
+        const array = new Type(count * itemSize), start = viewOffset + offset;
+        for (let e = 0; e < count; ++e)
+            for (let k = 0; k < itemSize; ++k) array[e * itemSize + k] = get(start + e * stride + k * size);
+        // Left for the reader's read(): the runtime's tables and centres are these arrays.
+        this.reader.read_.set(index, { array, itemSize, count, componentType: a.componentType, normalized: false });
+        return { count, array };
+    }
+
+    // The largest value of a decoded accessor, found once.
+    static largest(d) {
+        if (d.largest === undefined) {
+            let m = 0;
+            for (const v of d.array) if (v > m) m = v;
+            d.largest = m;
+        }
+        return d.largest;
+    }
+
+    run(root) {
+        const json = this.json;
+        // What tinygltf hides from `check`, checked on the JSON: offsets and strides.
+        for (const list of ['accessors', 'bufferViews'])
+            (Array.isArray(json[list]) ? json[list] : []).forEach((item, i) => {
+                if (item && typeof item === 'object' && Object.hasOwn(item, 'byteOffset') &&
+                    !(integer(item.byteOffset) && item.byteOffset >= 0))
+                    this.add(`${list}[${i}].byteOffset ${JSON.stringify(item.byteOffset)} is not a non-negative integer`);
+            });
+        (Array.isArray(json.bufferViews) ? json.bufferViews : []).forEach((item, i) => {
+            if (!item || typeof item !== 'object' || !Object.hasOwn(item, 'byteStride')) return;
+            const s = item.byteStride;
+            if (!(integer(s) && s >= 4 && s <= 252 && s % 4 === 0))
+                this.add(`bufferViews[${i}].byteStride ${JSON.stringify(s)} is not an integer from 4 to 252, a multiple of 4`);
+        });
+        if (root !== null && typeof root === 'object' && Array.isArray(root.clips))
+            root.clips.forEach((c, i) => { if (c === null || typeof c !== 'object' || Array.isArray(c)) this.add(`clips[${i}] is not an object`); });
+        if (!(json.extensionsUsed || []).includes(EXTENSION_NAME)) this.add(`${EXTENSION_NAME} is not listed in extensionsUsed`);
+        if ((json.extensionsRequired || []).includes(EXTENSION_NAME))
+            this.add(`${EXTENSION_NAME} must not be listed in extensionsRequired`);
+        if (root === null || typeof root !== 'object' || Array.isArray(root)) {
+            this.add('the root extension object is not an object');
+            return this.problems;
+        }
+        if (Object.hasOwn(root, 'method') && typeof root.method !== 'string') this.add('root.method is not a string');
+        const bufferCount = this.bounded(root, 'bufferCount', 1, 65536, 'root');
+        if (bufferCount === undefined) return this.problems;
+        const fallback = this.bounded(root, 'fallback', 0, bufferCount - 1, 'root');
+        if (fallback === undefined) return this.problems;
+        if (!Array.isArray(root.clips) || root.clips.length === 0) this.add('root.clips is missing or empty');
+        else
+            for (let c = 0; c < root.clips.length && !this.over; ++c)
+                if (root.clips[c] !== null && typeof root.clips[c] === 'object' && !Array.isArray(root.clips[c]))
+                    this.clip(root.clips[c], c, bufferCount);
+        let carried = 0;
+        (json.meshes || []).forEach((mesh, m) => ((mesh && mesh.primitives) || []).forEach((primitive, p) => {
+            const ext = primitive && primitive.extensions && primitive.extensions[EXTENSION_NAME];
+            if (ext === undefined || this.over) return;
+            if (ext === null || typeof ext !== 'object' || Array.isArray(ext)) {
+                this.add(`meshes[${m}].primitives[${p}] extension is not an object`);
+                return;
+            }
+            carried += this.primitive(primitive, ext, m, p, bufferCount, fallback);
+        }));
+        if (carried === 0 && this.problems.length === 0) this.add('no primitive carries the orders');
+        return this.problems;
+    }
+
+    clip(o, c, bufferCount) {
+        const where = `clips[${c}]`, animations = this.json.animations || [];
+        if (Object.hasOwn(o, 'name') && typeof o.name !== 'string') return this.add(`${where}.name is not a string`);
+        let animation = -1;
+        if (Object.hasOwn(o, 'animation')) {
+            animation = this.bounded(o, 'animation', 0, animations.length - 1, where);
+            if (animation === undefined) return;
+            // The clip's name is its animation's (an unnamed one's "animationN").
+            const own = animations[animation] && typeof animations[animation].name === 'string' ? animations[animation].name : '';
+            const expected = own === '' ? `animation${animation}` : own;
+            if (Object.hasOwn(o, 'name') && o.name !== expected)
+                return this.add(`${where}.name '${printable(o.name)}' is not the name of animation ${animation} ('${printable(expected)}')`);
+        }
+        const startTime = Object.hasOwn(o, 'startTime') ? o.startTime : 0;
+        if (typeof startTime !== 'number' || !Number.isFinite(startTime)) return this.add(`${where}.startTime is not a finite number`);
+        const rate = o.sampleRate;
+        if (typeof rate !== 'number' || !Number.isFinite(rate) || !(rate > 0) || !(f32(rate) > 0) || !Number.isFinite(f32(rate)))
+            return this.add(`${where}.sampleRate is missing or not a positive number a 32-bit float holds (from about ` +
+                '1.2e-38 to 3.4e38)');
+        const keyframes = this.bounded(o, 'keyframes', 1, 100000, where);
+        const thetaSteps = this.bounded(o, 'thetaSteps', 2, 100000, where);
+        const phiSteps = this.bounded(o, 'phiSteps', 1, 100000, where);
+        const bufferBase = this.bounded(o, 'bufferBase', 0, bufferCount - 1, where);
+        const table = this.bounded(o, 'table', 0, INT32_MAX, where);
+        const centers = this.bounded(o, 'centers', 0, INT32_MAX, where);
+        if ([keyframes, thetaSteps, phiSteps, bufferBase, table, centers].includes(undefined)) return;
+        const t = this.get(table, 'SCALAR', [5121], `${where}.table`);
+        if (t.error) return this.report(t.error);
+        const cells = keyframes * thetaSteps * phiSteps;
+        if (t.decoded.count !== cells)
+            return this.add(`${where}.table has ${t.decoded.count} cells; keyframes x thetaSteps x phiSteps = ${cells}`);
+        if (bufferBase + ExtensionCheck.largest(t.decoded) >= bufferCount) {
+            const first = t.decoded.array.findIndex((v) => bufferBase + v >= bufferCount);
+            return this.add(`${where}.table cell ${first} names order ${bufferBase + t.decoded.array[first]}, not below bufferCount ${bufferCount}`);
+        }
+        const m = this.get(centers, 'VEC3', [5126], `${where}.centers`);
+        if (m.error) return this.report(m.error);
+        if (m.decoded.count !== keyframes)
+            return this.add(`${where}.centers has ${m.decoded.count} elements, not keyframes = ${keyframes}`);
+        if (m.decoded.finite === undefined) m.decoded.finite = m.decoded.array.every(Number.isFinite);
+        if (!m.decoded.finite) return this.add(`${where}.centers holds a value that is not finite`);
+        // The table covers the animation's time range: keyframe f at startTime + f / sampleRate.
+        if (animation >= 0) {
+            let t0 = Infinity, t1 = -Infinity;
+            for (const s of (animations[animation].samplers || [])) {
+                const input = s && s.input;
+                const accessor = integer(input) && input >= 0 ? (this.json.accessors || [])[input] : undefined;
+                if (!accessor) continue;
+                const keys = this.get(input, 'SCALAR', [5126], '');
+                if (!keys.error) {
+                    if (keys.decoded.t0 === undefined) {
+                        let lo = Infinity, hi = -Infinity;
+                        for (const k of keys.decoded.array) lo = Math.min(lo, k), hi = Math.max(hi, k);
+                        keys.decoded.t0 = lo, keys.decoded.t1 = hi;
+                    }
+                    t0 = Math.min(t0, keys.decoded.t0), t1 = Math.max(t1, keys.decoded.t1);
+                } else if (Array.isArray(accessor.min) && Array.isArray(accessor.max) && accessor.min.length === 1 &&
+                           accessor.max.length === 1) {
+                    t0 = Math.min(t0, accessor.min[0]), t1 = Math.max(t1, accessor.max[0]);
+                }
+            }
+            if (this.over) return;
+            if (t0 <= t1) {
+                const step = 1 / rate;
+                if (Math.abs(startTime - t0) > 0.5 * step)
+                    this.add(`${where}.startTime ${startTime.toFixed(6)} is not animation ${animation}'s first key time ${t0.toFixed(6)}`);
+                else if (startTime + (keyframes - 1) * step < t1 - step - 1e-6)
+                    this.add(`${where} has ${keyframes} keyframes; animation ${animation} lasts to ${t1.toFixed(6)} s and needs ` +
+                        `${Math.floor((t1 - startTime) * rate + 1e-9) + 1}`);
+            }
+        }
+    }
+
+    // 1 when the primitive's orders were read (whatever they hold), else 0.
+    primitive(primitive, o, m, p, bufferCount, fallback) {
+        const where = `meshes[${m}].primitives[${p}]`;
+        const orders = this.bounded(o, 'orders', 0, INT32_MAX, where);
+        const orderCount = this.bounded(o, 'orderCount', 1, INT32_MAX, where);
+        if (orders === undefined || orderCount === undefined) return 0;
+        if (orderCount !== bufferCount) return this.add(`${where}.orderCount ${orderCount} differs from bufferCount ${bufferCount}`), 0;
+        if (primitive.mode !== undefined && primitive.mode !== 4) return this.add(`${where} is not a TRIANGLES primitive`), 0;
+        const indexIndex = Object.hasOwn(primitive, 'indices') ? primitive.indices : -1;
+        const ind = this.get(indexIndex, 'SCALAR', [5121, 5123, 5125], `${where}.indices`);
+        if (ind.error) return this.report(ind.error), 0;
+        const ord = this.get(orders, 'SCALAR', [5121, 5123, 5125], `${where}.orders`);
+        if (ord.error) return this.report(ord.error), 0;
+        const type = this.json.accessors[orders].componentType;
+        if (type === 5121) return this.add(`${where}.orders is UNSIGNED_BYTE`), 0;
+        const n = ind.decoded.count;
+        if (n % 3 !== 0) return this.add(`${where}.indices holds ${n} indices, not whole triangles`), 0;
+        if (ord.decoded.count !== n * orderCount)
+            return this.add(`${where}.orders has ${ord.decoded.count} elements; orderCount x indices = ${n * orderCount}`), 0;
+        // Every order names vertices of the primitive (an unsigned short never 65535, WebGL 2's
+        // primitive restart).
+        const position = primitive.attributes ? primitive.attributes.POSITION : undefined;
+        const positions = integer(position) && position >= 0 ? (this.json.accessors || [])[position] : undefined;
+        if (!positions) return this.add(`${where} has no POSITION accessor`), 0;
+        const largest = ExtensionCheck.largest(ord.decoded);
+        if (ord.decoded.count > 0 && largest >= positions.count) return this.add(`${where}.orders names vertex ${largest} of ${positions.count}`), 0;
+        if (type === 5123 && largest === 65535) return this.add(`${where}.orders names vertex 65535 (primitive restart)`), 0;
+        const verdict = this.pair(orders, indexIndex, ord.decoded, ind.decoded, orderCount, fallback);
+        if (!verdict) return 0;
+        if (!verdict.equal) this.add(`${where}.indices differs from order ${fallback} (fallback)`);
+        const bad = verdict.permutation.indexOf(false);
+        if (bad >= 0) {
+            const more = verdict.permutation.filter((x) => !x).length - 1;
+            this.add(`${where} order ${bad} is not a permutation of the primitive's triangles with their winding (stale orders?)` +
+                (more ? ` (and ${more} more orders)` : ''));
+        }
+        return 1;
+    }
+
+    // The permutation verdicts of an (orders, indices) pair of accessors, compared once.
+    pair(orders, indices, o, ind, orderCount, fallback) {
+        const key = `${orders},${indices}`;
+        if (this.pairs.has(key)) return this.pairs.get(key);
+        if (!this.charge(o.count)) return null;
+        const n = ind.count, all = o.array, base = ind.array;
+        let equal = true;
+        for (let i = 0; i < n && equal; ++i) equal = base[i] === all[fallback * n + i];
+        const rotated = (v, i) => {
+            const a = v[i], b = v[i + 1], c = v[i + 2];
+            return a <= b && a <= c ? `${a},${b},${c}` : b <= c ? `${b},${c},${a}` : `${c},${a},${b}`;
+        };
+        const counts = new Map();
+        for (let i = 0; i < n; i += 3) { const k = rotated(base, i); counts.set(k, (counts.get(k) || 0) + 1); }
+        const permutation = [];
+        for (let b = 0; b < orderCount; ++b) {
+            const left = new Map(counts);
+            let ok = true;
+            for (let i = b * n; i < (b + 1) * n && ok; i += 3) {
+                const k = rotated(all, i), c = left.get(k);
+                if (!c) ok = false;
+                else left.set(k, c - 1);
+            }
+            permutation.push(ok);
+        }
+        const verdict = { equal, permutation };
+        this.pairs.set(key, verdict);
+        return verdict;
     }
 }

@@ -74,17 +74,17 @@ const table = (g) => g.accessors[ext(g).clips[0].table];
 assert.throws(broken((g) => { g.accessors[2].bufferView = 99; }), AnimorderError);
 assert.throws(broken((g) => { g.accessors[2].byteOffset = 1000; }), AnimorderError);
 assert.throws(broken((g) => { g.bufferViews[2].byteOffset = 4096; }), AnimorderError);  // the view past the buffer
-assert.throws(broken((g) => { g.bufferViews[2].byteStride = 4; }), /reaches past/);     // 12 values 4 bytes apart
+assert.throws(broken((g) => { g.bufferViews[2].byteStride = 4; }), /more than its buffer view holds/);  // 12 values 4 bytes apart
 assert.throws(broken((g) => { g.accessors[2].normalized = true; }), AnimorderError);
 assert.throws(broken((g) => { g.accessors[0].count = 3; }), /names vertex 3 of 3/);     // the orders name vertex 3
 assert.throws(broken((g) => { g.bufferViews[2].buffer = '0'; }), AnimorderError);
 // Fields of the wrong type, which numeric conversion would let through ("30" → 30), and the
 // required fallback.
-assert.throws(broken((g) => { ext(g).clips[0].sampleRate = '30'; }), /sample rate/);
-assert.throws(broken((g) => { ext(g).clips[0].sampleRate = [30]; }), /sample rate/);
-assert.throws(broken((g) => { ext(g).clips[0].sampleRate = true; }), /sample rate/);
+assert.throws(broken((g) => { ext(g).clips[0].sampleRate = '30'; }), /sampleRate is missing or not a positive number/);
+assert.throws(broken((g) => { ext(g).clips[0].sampleRate = [30]; }), /sampleRate is missing or not a positive number/);
+assert.throws(broken((g) => { ext(g).clips[0].sampleRate = true; }), /sampleRate is missing or not a positive number/);
 assert.throws(broken((g) => { delete ext(g).fallback; }), /fallback/);
-assert.throws(broken((g) => { table(g).normalized = true; }), /not normalized/);
+assert.throws(broken((g) => { table(g).normalized = true; }), /is normalized/);
 // Accessors: never read outside their view, never `count` zeros without one (4 GB for a big count).
 assert.throws(broken((g) => { table(g).byteOffset = -1; }), AnimorderError);
 assert.throws(broken((g) => { delete g.bufferViews[table(g).bufferView].byteLength; }), AnimorderError);

@@ -154,6 +154,15 @@ TEST_F(JsTest, RuntimeHandWorkedOnTheSpecExample) {
     expect_script_passes("js/test/hand-worked.mjs", "hand-worked: all checks passed");
 }
 
+// The JS runtime on the shared corpus of hostile files (tests/extension-corpus/): the verdict of
+// each as its manifest and `animorder check` give it, and the amplification files of amplify.mjs
+// read once or refused by the work cap (js/test/corpus.mjs).
+TEST_F(JsTest, RuntimeGivesTheCorpusVerdictsOfCheck) {
+    std::string why;
+    ANIMORDER_REQUIRE_OR_SKIP("node", have_node(why), why);
+    expect_script_passes("js/test/corpus.mjs", "corpus: all checks passed");
+}
+
 // The three.js plugin in node with three.js's GLTFLoader on the extension's example, broken as a
 // hostile file is (js/test/three-plugin.mjs): it refuses what the runtime refuses, with one clear
 // line, and never draws a primitive without orders from another's.

@@ -13,7 +13,7 @@
 // it, with a warning: a pipeline never carries, nor rewrites `indices` from, orders that an
 // engine would refuse.
 import { Extension, ExtensionProperty, PropertyType, RefList } from '@gltf-transform/core';
-import { AnimorderRuntime, ordersProblem } from '../runtime/animorder.js';
+import { AccessorReader, extensionProblems } from '../runtime/animorder.js';
 
 export const NAME = 'ANIMORDER_animated_triangle_orders';
 const ORDERS_USAGE = 'ANIMORDER_ORDERS';
@@ -173,38 +173,19 @@ export function staleReason(primitive, orders, bufferCount, fallback) {
   return null;
 }
 
-// Why the root object and its clips do not check out, or null: the runtime's rules (bufferCount,
-// fallback, each clip's dimensions, sample rate, table and centres accessors and every cell),
-// on the accessors as glTF-Transform read them; sparse ones refused as the runtime does.
-function rootProblem(rootDef, json, context) {
-  try {
-    AnimorderRuntime.fromExtension(rootDef, (index) => {
-      const def = Number.isInteger(index) ? (json.accessors || [])[index] : undefined;
-      const accessor = def && context.accessors[index];
-      if (!accessor) throw new Error(`accessor ${index} does not exist`);
-      if (def.sparse) throw new Error(`accessor ${index} is sparse`);
-      return { array: accessor.getArray(), itemSize: accessor.getElementSize(), count: accessor.getCount(),
-        componentType: accessor.getComponentType(), normalized: accessor.getNormalized() };
-    });
-    return null;
-  } catch (error) {
-    return (error && error.message ? error.message : String(error)).replace(`${NAME}: `, '');
-  }
-}
-
-// Why a primitive's orders do not check out when read, or null: `animorder check`'s rules (the
-// runtime's ordersProblem for the accessor and its values).
-function primitiveProblem(def, primDef, json, context, primitive, bufferCount) {
-  if (primDef.mode !== undefined && primDef.mode !== 4) return 'not a TRIANGLES primitive';
-  if (def.orderCount !== bufferCount) return `orderCount ${def.orderCount} != bufferCount ${bufferCount}`;
-  const accessorDef = Number.isInteger(def.orders) ? (json.accessors || [])[def.orders] : undefined;
-  const orders = accessorDef && context.accessors[def.orders];
-  const indices = primitive.getIndices(), position = primitive.getAttribute('POSITION');
-  if (!orders || !indices || !position) return 'no orders accessor, indices or positions';
-  const values = orders.getArray();
-  const shape = { itemSize: orders.getElementSize(), componentType: orders.getComponentType(), count: orders.getCount(),
-    normalized: orders.getNormalized(), sparse: Boolean(accessorDef.sparse) };
-  return ordersProblem(shape, (e) => values[e], def.orderCount, indices.getCount(), position.getCount());
+// Why the file's extension does not check out, or null: the first problem of the runtime's
+// extensionProblems (the rules of docs/extension/VALIDITY.md, in `animorder check`'s words, at
+// most its work), on the file's JSON and the buffers glTF-Transform read (a data URI's bytes under
+// the name it gave the buffer, a GLB's binary chunk under '@glb.bin').
+function extensionProblem(context) {
+  const json = context.jsonDoc.json, resources = context.jsonDoc.resources || {};
+  const reader = new AccessorReader(json, null);
+  (json.buffers || []).forEach((buffer, b) => {
+    const bytes = buffer && (buffer.uri === undefined ? resources['@glb.bin'] : resources[buffer.uri]);
+    if (bytes) reader.buffers[b] = bytes instanceof Uint8Array ? bytes : new Uint8Array(bytes);
+  });
+  const problems = extensionProblems(json, reader);
+  return problems && problems.length ? problems[0] : null;
 }
 
 export class AnimorderTriangleOrders extends Extension {
@@ -216,51 +197,88 @@ export class AnimorderTriangleOrders extends Extension {
   createClip() { return new OrdersClip(this.document.getGraph()); }
   createPrimitiveOrders() { return new PrimitiveOrders(this.document.getGraph()); }
 
+  // A file whose extension does not check out is read without it, with a warning; nothing here
+  // throws out of io.read.
   read(context) {
     const json = context.jsonDoc.json;
-    const rootDef = json.extensions && json.extensions[NAME];
     const logger = this.document.getLogger();
-    const refused = rootDef ? rootProblem(rootDef, json, context) : null;
-    if (refused) logger.warn(`${NAME}: the file's extension does not check out (${refused}); reading the file without it.`);
-    if (rootDef && !refused) {
-      const root = this.createOrders()
-        .setMethod(rootDef.method || '')
-        .setBufferCount(rootDef.bufferCount)
-        .setFallback(rootDef.fallback);
-      for (const c of rootDef.clips || []) {
-        const clip = this.createClip()
-          .setStartTime(c.startTime || 0).setSampleRate(c.sampleRate).setKeyframes(c.keyframes)
-          .setBufferBase(c.bufferBase).setThetaSteps(c.thetaSteps).setPhiSteps(c.phiSteps)
-          .setTable(context.accessors[c.table]).setCenters(context.accessors[c.centers]);
-        clip.setName(c.name || '');
-        if (c.animation !== undefined && context.animations[c.animation]) clip.setAnimation(context.animations[c.animation]);
-        root.addClip(clip);
-      }
-      this.document.getRoot().setExtension(NAME, root);
+    if (!json.extensions || json.extensions[NAME] === undefined) return this;
+    let refused;
+    try {
+      refused = extensionProblem(context);
+    } catch (error) {
+      refused = error && error.message ? error.message : String(error);
     }
+    if (refused) {
+      logger.warn(`${NAME}: the file's extension does not check out (${refused.replace(`${NAME}: `, '')}); reading the file without it.`);
+      return this;
+    }
+    const made = [];
+    try {
+      this.readChecked(context, made);
+    } catch (error) {
+      for (const property of made) if (!property.isDisposed()) property.dispose();
+      this.document.getRoot().setExtension(NAME, null);
+      logger.warn(`${NAME}: the file's extension could not be read (${error && error.message}); reading the file without it.`);
+    }
+    return this;
+  }
+
+  // The extension's properties of a file whose extension checks out (`made` collects them).
+  readChecked(context, made) {
+    const json = context.jsonDoc.json;
+    const rootDef = json.extensions[NAME];
+    const root = this.createOrders()
+      .setMethod(rootDef.method || '')
+      .setBufferCount(rootDef.bufferCount)
+      .setFallback(rootDef.fallback);
+    made.push(root);
+    for (const c of rootDef.clips) {
+      const clip = this.createClip()
+        .setStartTime(c.startTime || 0).setSampleRate(c.sampleRate).setKeyframes(c.keyframes)
+        .setBufferBase(c.bufferBase).setThetaSteps(c.thetaSteps).setPhiSteps(c.phiSteps)
+        .setTable(context.accessors[c.table]).setCenters(context.accessors[c.centers]);
+      made.push(clip);
+      clip.setName(c.name || '');
+      if (c.animation !== undefined) clip.setAnimation(context.animations[c.animation]);
+      root.addClip(clip);
+    }
+    this.document.getRoot().setExtension(NAME, root);
+    // Each order's triangles by their corners' attributes, to re-derive the orders after a
+    // transform that renumbers vertices or re-sequences triangles (not written to the file): made
+    // once per (orders, indices, attributes) and shared, at most 8 × the buffers' bytes + 2^20
+    // corners in all (past that a primitive keeps its orders but cannot have them re-derived).
+    const keysOf = new Map();
+    let budget = 2 ** 20;
+    for (const b of json.buffers || []) if (b && Number.isInteger(b.byteLength)) budget += 8 * b.byteLength;
     (json.meshes || []).forEach((meshDef, m) => {
       (meshDef.primitives || []).forEach((primDef, p) => {
         const def = primDef.extensions && primDef.extensions[NAME];
-        if (!def || !rootDef || refused) return;
+        if (!def) return;
         const primitive = context.meshes[m].listPrimitives()[p];
-        const problem = primitiveProblem(def, primDef, json, context, primitive, rootDef.bufferCount);
-        if (problem) {
-          logger.warn(`${NAME}: dropping the orders of mesh ${m} primitive ${p}: ${problem}.`);
-          return;
-        }
         const orders = this.createPrimitiveOrders().setOrders(context.accessors[def.orders]).setOrderCount(def.orderCount);
+        made.push(orders);
         primitive.setExtension(NAME, orders);
-        // Each order's triangles by their corners' attributes, to re-derive the orders after a
-        // transform that renumbers vertices or re-sequences triangles (not written to the file).
-        const all = orders.getOrders() && orders.getOrders().getArray();
-        const n = primitive.getIndices() ? primitive.getIndices().getCount() : 0;
-        if (all && n > 0 && all.length === n * def.orderCount) {
-          orders.cornerKeys = [];
-          for (let b = 0; b < def.orderCount; ++b) orders.cornerKeys.push(cornerKeys(primitive, all, b * n, (b + 1) * n));
+        const attributes = Object.keys(primDef.attributes || {}).sort().map((k) => `${k}=${primDef.attributes[k]}`);
+        const key = `${def.orders};${primDef.indices};${attributes.join(',')}`;
+        if (!keysOf.has(key)) {
+          const all = orders.getOrders().getArray();
+          const n = primitive.getIndices().getCount();
+          let keys;
+          if (n > 0 && all.length === n * def.orderCount && all.length <= budget) {
+            budget -= all.length;
+            try {  // attributes glTF-Transform has not filled in yet (sparse ones) leave no keys
+              keys = [];
+              for (let b = 0; b < def.orderCount; ++b) keys.push(cornerKeys(primitive, all, b * n, (b + 1) * n));
+            } catch {
+              keys = undefined;
+            }
+          }
+          keysOf.set(key, keys);
         }
+        if (keysOf.get(key)) orders.cornerKeys = keysOf.get(key);
       });
     });
-    return this;
   }
 
   // Stale orders are dropped here, before any accessor is written.
@@ -268,11 +286,19 @@ export class AnimorderTriangleOrders extends Extension {
     const logger = this.document.getLogger();
     const root = this.document.getRoot().getExtension(NAME);
     let kept = 0;
+    // staleReason once per (orders, indices, mode, orderCount): primitives sharing accessors share it.
+    const ids = new Map(), reasons = new Map();
+    const id = (object) => { if (!ids.has(object)) ids.set(object, ids.size); return ids.get(object); };
+    const stale = (primitive, orders) => {
+      const key = `${id(orders.getOrders())},${id(primitive.getIndices())},${primitive.getMode()},${orders.getOrderCount()}`;
+      if (!reasons.has(key)) reasons.set(key, staleReason(primitive, orders, root.getBufferCount(), root.getFallback()));
+      return reasons.get(key);
+    };
     for (const mesh of this.document.getRoot().listMeshes())
       for (const primitive of mesh.listPrimitives()) {
         const orders = primitive.getExtension(NAME);
         if (!orders) continue;
-        const why = root ? staleReason(primitive, orders, root.getBufferCount(), root.getFallback()) : 'no root object';
+        const why = root ? stale(primitive, orders) : 'no root object';
         if (why === null) { ++kept; continue; }
         const derived = root ? rederive(primitive, orders, root.getBufferCount()) : null;
         if (derived) {
@@ -316,9 +342,11 @@ export class AnimorderTriangleOrders extends Extension {
       orphan.dispose();
       if (accessor && accessor.listParents().every((p) => p.propertyType === PropertyType.ROOT)) accessor.dispose();
     }
-    // The extension's accessors stay dense: a reader refuses a sparse one (sparse() makes a
-    // mostly-zero table sparse).
+    // The extension's accessors, and the indices of primitives with orders, stay dense: a reader
+    // refuses a sparse one (sparse() makes a mostly-zero table sparse).
     const ours = [];
+    for (const mesh of this.document.getRoot().listMeshes())
+      for (const primitive of mesh.listPrimitives()) if (primitive.getExtension(NAME)) ours.push(primitive.getIndices());
     for (const p of this.properties) {
       if (p.isDisposed()) continue;
       if (p instanceof PrimitiveOrders) ours.push(p.getOrders());

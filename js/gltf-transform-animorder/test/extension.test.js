@@ -166,10 +166,10 @@ test('an extension that does not check out is read without it, never carried or 
 test('orders that do not fit their primitive are dropped when read, never re-derived', async () => {
   const broken = {
     'a strip': [(j) => { j.meshes[0].primitives[0].mode = 5; }, /not a TRIANGLES primitive/],
-    'VEC2 orders': [(j) => { Object.assign(j.accessors[2], { type: 'VEC2', count: 6 }); }, /orders must be 2×6/],
-    'normalized orders': [(j) => { j.accessors[2].normalized = true; }, /orders must be 2×6/],
+    'VEC2 orders': [(j) => { Object.assign(j.accessors[2], { type: 'VEC2', count: 6 }); }, /orders \(accessor 2\) has the wrong type/],
+    'normalized orders': [(j) => { j.accessors[2].normalized = true; }, /orders \(accessor 2\) is normalized/],
     'orders naming vertex 4': [(j) => { j.accessors[0].count = 3; j.bufferViews[0].byteLength = 36; }, /vertex 3 of 3/],
-    'orderCount 3': [(j) => { primitiveExt(j).orderCount = 3; }, /orderCount 3 != bufferCount 2/],
+    'orderCount 3': [(j) => { primitiveExt(j).orderCount = 3; }, /orderCount 3 differs from bufferCount 2/],
   };
   for (const [name, [mutate, why]] of Object.entries(broken)) {
     const { io, document, logger } = await loadMutated(mutate);
@@ -225,4 +225,57 @@ test('join() drops the orders of the primitives it merges, with a warning', asyn
   const { json } = await roundTrip(io, document);
   assert.match(logger.warnings.join('\n'), /dropping the orders of 2 primitive\(s\) that a transform removed or merged/);
   assert.ok(primitiveExt(json), 'the animated node keeps its orders');
+});
+
+// The shared corpus of hostile files (tests/extension-corpus/, docs/extension/VALIDITY.md): read
+// with the extension registered, each keeps the extension exactly when its manifest says valid,
+// else loses it with a warning holding the manifest's phrase (as `animorder check` and the runtime
+// word it); io.read never throws for the extension's sake (glTF-Transform's own accessor reading
+// throws on a negative or odd byteStride before any extension runs: the file is refused all the
+// same, and the test checks the throw is not ours).
+const corpus = new URL('../../../tests/extension-corpus/', import.meta.url);
+
+async function readCorpus(json) {
+  const logger = new Recorder();
+  const io = new NodeIO().setLogger(logger).registerExtensions([AnimorderTriangleOrders]);
+  const document = await io.readJSON({ json, resources: {} });
+  return { kept: document.getRoot().getExtension(NAME) !== null, warnings: logger.warnings.join('\n') };
+}
+
+test('every file of the shared corpus gets its manifest verdict, never a throw', async () => {
+  const manifest = JSON.parse(readFileSync(new URL('manifest.json', corpus), 'utf8'));
+  assert.ok(manifest.length >= 40);
+  for (const entry of manifest) {
+    let read;
+    try {
+      read = await readCorpus(JSON.parse(readFileSync(new URL(entry.file, corpus), 'utf8')));
+    } catch (error) {
+      assert.ok(!entry.valid && /byteStride/.test(entry.phrase), `${entry.file}: ${error.stack}`);
+      assert.doesNotMatch(error.stack, /gltf-transform-animorder\/index\.js/, entry.file);
+      continue;
+    }
+    const { kept, warnings } = read;
+    if (entry.valid) {
+      assert.ok(kept, `${entry.file}: ${warnings}`);
+      assert.equal(warnings, '', entry.file);
+    } else {
+      assert.ok(!kept, `${entry.file} was kept`);
+      if (entry.phrase.includes('extensionsUsed')) continue;  // glTF-Transform never runs an unlisted extension
+      assert.match(warnings, /does not check out/, entry.file);
+      assert.ok(warnings.includes(entry.phrase), `${entry.file}: '${entry.phrase}' not in: ${warnings}`);
+      assert.doesNotMatch(warnings, /[\x00-\x09\x0b-\x1f\x7f]/, entry.file);
+    }
+  }
+});
+
+test('accessors shared by 1000 clips or 2000 primitives are read once; distinct pairs hit the cap', async () => {
+  const { sharedTable, sharedOrders, distinctIndices } = await import('../../../tests/extension-corpus/amplify.mjs');
+  for (const [name, make, valid] of [['shared table', sharedTable, true], ['shared orders', sharedOrders, true],
+    ['distinct indices', distinctIndices, false]]) {
+    const started = Date.now();
+    const { kept, warnings } = await readCorpus(make());
+    assert.equal(kept, valid, `${name}: ${warnings}`);
+    if (!valid) assert.match(warnings, /more work than its file's size allows/, name);
+    assert.ok(Date.now() - started < 20000, `${name} took ${(Date.now() - started) / 1000} s`);
+  }
 });

@@ -12,7 +12,7 @@
 //   const orders = gltf.userData.animorder;              // AnimorderCharacter, or null
 //   ... each frame: mixer.update(dt); orders?.update(camera, mixer); renderer.render(scene, camera);
 import { BufferAttribute, BufferGeometry, Vector3 } from 'three';
-import { AccessorReader, AnimorderError, AnimorderRuntime, EXTENSION_NAME, ordersProblem } from '../runtime/animorder.js';
+import { AccessorReader, AnimorderError, AnimorderRuntime, EXTENSION_NAME, extensionProblems, ordersProblem } from '../runtime/animorder.js';
 
 export { AnimorderRuntime, EXTENSION_NAME };
 
@@ -53,6 +53,16 @@ export class AnimorderGLTFPlugin {
 
     async read(gltf, root) {
         const json = this.parser.json;
+        // The file checked as `animorder check` and the runtime check it (extensionProblems: the
+        // rules of docs/extension/VALIDITY.md, each accessor read once, the work capped), on the
+        // buffers GLTFLoader loaded.
+        this.reader = this.reader || new AccessorReader(json, null);
+        const used = new Set((json.bufferViews || []).map((view) => view && view.buffer));
+        for (const b of used)
+            if (Number.isInteger(b) && (json.buffers || [])[b] && !this.reader.buffers[b])
+                this.reader.buffers[b] = new Uint8Array(await this.parser.getDependency('buffer', b));
+        const problems = extensionProblems(json, this.reader);
+        if (problems && problems.length) throw new AnimorderError(problems[0]);
         const needed = new Map();
         for (const clip of root.clips || [])
             for (const index of [clip.table, clip.centers])

@@ -541,6 +541,18 @@ class ExtensionCheck {
             if (!(integer(s) && s >= 4 && s <= 252 && s % 4 === 0))
                 this.add(`bufferViews[${i}].byteStride ${JSON.stringify(s)} is not an integer from 4 to 252, a multiple of 4`);
         });
+        // Integers past 32 bits, which tinygltf would wrap for `check`: quoted as written.
+        const wide = (value, where) => {
+            if (Array.isArray(value)) value.forEach((v, i) => wide(v, `${where}[${i}]`));
+            else if (value !== null && typeof value === 'object') for (const k of Object.keys(value)) wide(value[k], `${where}.${k}`);
+            else if (Number.isInteger(value) && (value > INT32_MAX || value < -INT32_MAX - 1))
+                this.add(`${where} = ${value} is out of range (an integer here is below 2^31)`);
+        };
+        wide(root, EXTENSION_NAME);
+        (json.meshes || []).forEach((mesh, m) => ((mesh && mesh.primitives) || []).forEach((primitive, q) => {
+            const ext = primitive && primitive.extensions && primitive.extensions[EXTENSION_NAME];
+            if (ext !== undefined) wide(ext, `mesh ${m} primitive ${q}`);
+        }));
         if (root !== null && typeof root === 'object' && Array.isArray(root.clips))
             root.clips.forEach((c, i) => { if (c === null || typeof c !== 'object' || Array.isArray(c)) this.add(`clips[${i}] is not an object`); });
         if (!(json.extensionsUsed || []).includes(EXTENSION_NAME)) this.add(`${EXTENSION_NAME} is not listed in extensionsUsed`);

@@ -142,4 +142,50 @@ for (const attributes of [{ TRANSLATION: 6 }, { TRANSLATION: 6, _ID: 6 }]) {
     assert.equal(base.character.addOrderFrom(original, original.parser), 2);
     assert.deepEqual([...base.character.meshes[0].mesh.geometry.index.array.slice(12)], indices);
 }
+// The shared corpus of hostile files (tests/extension-corpus/, docs/extension/VALIDITY.md): the
+// plugin's verdict on each is the manifest's, as `animorder check` and the runtime give it: the
+// orders bound when the file is valid, else refused with a one-line error holding the manifest's
+// phrase (or the file refused by GLTFLoader itself before the plugin sees it).
+{
+    const corpus = new URL('../../tests/extension-corpus/', import.meta.url);
+    const manifest = JSON.parse(readFileSync(new URL('manifest.json', corpus)));
+    // three.js's FileLoader (the corpus's data: URI buffers) reports progress with the browser's
+    // ProgressEvent, which node lacks.
+    globalThis.ProgressEvent ??= class extends Event {
+        constructor(type, init = {}) {
+            super(type);
+            Object.assign(this, init);
+        }
+    };
+    let beforeThePlugin = 0;
+    for (const entry of manifest) {
+        const text = readFileSync(new URL(entry.file, corpus), 'utf8');
+        const warn = console.warn;
+        console.warn = () => {};
+        let gltf = null, thrown = null;
+        try {
+            gltf = await new GLTFLoader().register((parser) => new AnimorderGLTFPlugin(parser)).parseAsync(text, '');
+        } catch (e) {
+            thrown = e;
+        } finally {
+            console.warn = warn;
+        }
+        if (entry.valid) {
+            assert.equal(thrown, null, `${entry.file}: ${thrown}`);
+            assert.ok(gltf.userData.animorder, `${entry.file}: ${gltf.userData.animorderError}`);
+            continue;
+        }
+        if (thrown) {
+            beforeThePlugin++;
+            continue;
+        }
+        const error = gltf.userData.animorderError;
+        assert.equal(gltf.userData.animorder ?? null, null, `${entry.file} was accepted`);
+        assert.ok(error && error.includes(entry.phrase), `${entry.file}: '${entry.phrase}' not in: ${error}`);
+        assert.doesNotMatch(error, /[\x00-\x1f\x7f]/, entry.file);
+    }
+    assert.ok(beforeThePlugin < manifest.length / 4, `GLTFLoader itself refused ${beforeThePlugin} files`);
+    console.log(`three plugin: corpus of ${manifest.length} files, every verdict as the manifest's ` +
+                `(${beforeThePlugin} refused by GLTFLoader before the plugin)`);
+}
 console.log('three plugin: all checks passed');

@@ -1124,6 +1124,22 @@ TEST_F(Batch, OutputsOutsideTheManifestsFolderNeedAllowOutside) {
     EXPECT_TRUE(fs::exists(path("lib/out/y.animorder.bin")));
 }
 
+// The merge's line about a refused report stays one line on a terminal whatever the item's name
+// holds: its control bytes (ESC, which could drive the terminal) written as \xNN.
+TEST_F(Batch, TheMergesLineAboutARefusedReportEscapesTheItemsName) {
+    write("m.json", R"({"items": [{"name": "e\u001b[2Jvil", "method": "original", "output": "out/a"}]})");
+    const std::string options = "batch -q --eval-views 1 --eval-resolution 32 ";
+    ASSERT_EQ(run(options + manifest()).exit_code, 0);
+    nlohmann::json report = nlohmann::json::parse(test::slurp_existing(path("out/a.animorder.report.json")));
+    report["batch"]["ovr_after"] = 1e308;
+    write("out/a.animorder.report.json", report.dump(2));
+    const test::Outcome merged = run(options + "--merge " + manifest());
+    EXPECT_EQ(merged.exit_code, 4) << merged.err;
+    EXPECT_EQ(merged.err.find('\x1b'), std::string::npos) << merged.err;
+    EXPECT_NE(merged.err.find("e\\x1b[2Jvil: "), std::string::npos) << merged.err;
+    EXPECT_EQ(test::line_count(merged.err), 1u) << merged.err;
+}
+
 // A report that carries its item's stamp but a figure no run gives (an OVR of 1e308 or below 1, an
 // ACMR outside 1/triangles..3, a negative count or time, a number JSON cannot hold) is not a
 // result: the merge counts the item as missing and says so in one line naming the report and the

@@ -51,9 +51,17 @@ json summary_row(const PlannedItem& p, const Stamp& stamp, const std::string& fa
         return row;
     }
     if (merge && s.kind == Staleness::kEditedReport) {
-        std::string line = p.item.name + ": " + s.why;
-        for (char& c : line)
-            if (c == '\n' || c == '\r') c = ' ';
+        // One line on a terminal: every control byte of a name (a line end, ESC) written as \xNN.
+        std::string line;
+        for (const char c : p.item.name + ": " + s.why) {
+            if ((unsigned char)c >= 0x20 && c != 0x7f) {
+                line += c;
+                continue;
+            }
+            char escaped[5];
+            std::snprintf(escaped, sizeof escaped, "\\x%02x", (unsigned char)c);
+            line += escaped;
+        }
         std::fprintf(stderr, "animorder: batch: %s; counted as missing\n", line.c_str());
     }
     const json failure = read_json_file(p.error);

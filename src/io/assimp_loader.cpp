@@ -31,6 +31,7 @@
 #include "animorder/assimp_loader.h"
 
 #include "animorder/animated_mesh.h"
+#include "animorder/gltf_extension.h"  // printable: names quoted on one line
 #include "animorder/invalid_input.h"
 #include "animorder/load.h"
 #include "animorder/skinning.h"
@@ -603,20 +604,6 @@ AnimatedMesh load_assimp_here(const std::string& path, const std::vector<std::st
         if (is_bone[n] && !below_bone[n])
             for (long up = long(n); up >= 0; up = flat.parent[size_t(up)])
                 to_first_joint.insert(to_first_joint.begin(), size_t(up));
-    // A node's name as a message may quote it on one line (a file's names may hold control bytes).
-    auto printable = [](const std::string& name) {
-        std::string out;
-        for (const unsigned char c : name) {
-            if (c >= 0x20 && c != 0x7f) {
-                out += char(c);
-                continue;
-            }
-            char escaped[5];
-            std::snprintf(escaped, sizeof escaped, "\\x%02x", c);
-            out += escaped;
-        }
-        return out;
-    };
     double size = 0;
     {
         std::vector<aiMatrix4x4> rest(flat.nodes.size());

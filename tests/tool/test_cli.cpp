@@ -27,7 +27,6 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <functional>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -1230,6 +1229,11 @@ protected:
         fs::resize_file(path(name), bytes);
         return path(name).string();
     }
+    // `view` for `seconds` on a 32 MiB model, `readers` clients that ask for it and never read it
+    // and `halves` that send half a request, then another client's GET /viewer/ (waiting at most
+    // `wait`): its status (0 when the server did not start) and how long it waited, in seconds.
+    std::pair<int, double> answer_beside_stalled_clients(const char* seconds, int readers, int halves,
+                                                         std::chrono::milliseconds wait);
 
     pid_t server_ = -1;
 };
@@ -1351,34 +1355,26 @@ TEST_F(CliView, ScratchFoldersOfGoneProcessesAreRemoved) {
     EXPECT_TRUE(fs::exists(alive)) << "a running process's scratch folder was removed";
 }
 
-namespace {
-// `readers` clients that ask for a 32 MiB model and never read it and `halves` that send half a
-// request, then another client's GET /viewer/ (waiting at most `wait`): its status and how long it
-// waited, in seconds.
-std::pair<int, double> answer_beside_stalled_clients(const std::function<unsigned()>& start_view, int readers,
-                                                     int halves, std::chrono::milliseconds wait) {
-    const unsigned port = start_view();
+std::pair<int, double> CliView::answer_beside_stalled_clients(const char* seconds, int readers, int halves,
+                                                              std::chrono::milliseconds wait) {
+    const unsigned port = start_view({"-q", "--seconds", seconds, big_model("big.glb", size_t(32) << 20)});
     if (port == 0) return {0, 0.0};
     const std::vector<int> stalled = stall(port, readers, halves);
     EXPECT_EQ(stalled.size(), size_t(readers + halves));
     const auto start = std::chrono::steady_clock::now();
     const std::string response = http_exchange(port, get_request(port, "/viewer/"), wait);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     close_all(stalled);
     EXPECT_NE(response.find("<html>"), std::string::npos) << response;
-    return {status_of(response), seconds};
+    return {status_of(response), waited};
 }
-}  // namespace
 
 // Clients that stall (three ask for a model bigger than the socket buffers and never read it, two
 // send half a request) do not delay another: its answer comes at once (a server serving one
 // connection at a time made it wait for the stalled ones to go away, or 5 s for each half request).
 TEST_F(CliView, StalledClientsDelayNoOther) {
-    const auto [status, seconds] = answer_beside_stalled_clients(
-        [&] {
-            return start_view({"-q", "--seconds", "60", big_model("big.glb", size_t(32) << 20)});
-        },
-        3, 2, std::chrono::milliseconds(3000));
+    const auto [status, seconds] =
+        answer_beside_stalled_clients("60", 3, 2, std::chrono::milliseconds(3000));
     EXPECT_EQ(status, 200) << test::slurp(path("view-err.txt"));
     EXPECT_LT(seconds, 3.0);
 }
@@ -1387,11 +1383,8 @@ TEST_F(CliView, StalledClientsDelayNoOther) {
 // none of it): each is dropped after 5 s without taking a byte, so another client is answered
 // within seconds, not after the 60 s a response may take.
 TEST_F(CliView, ClientsThatNeverReadAreDroppedSoonEvenMoreThanTheWorkers) {
-    const auto [status, seconds] = answer_beside_stalled_clients(
-        [&] {
-            return start_view({"-q", "--seconds", "90", big_model("big.glb", size_t(32) << 20)});
-        },
-        40, 0, std::chrono::milliseconds(30000));
+    const auto [status, seconds] =
+        answer_beside_stalled_clients("90", 40, 0, std::chrono::milliseconds(30000));
     EXPECT_EQ(status, 200) << test::slurp(path("view-err.txt"));
     EXPECT_LT(seconds, 20.0);
 }

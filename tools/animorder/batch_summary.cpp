@@ -5,6 +5,7 @@
 #include "report.h"
 
 #include "animorder/atomic_write.h"
+#include "animorder/gltf_extension.h"  // printable
 #include "animorder/methods.h"
 
 #include <nlohmann/json.hpp>
@@ -52,16 +53,7 @@ json summary_row(const PlannedItem& p, const Stamp& stamp, const std::string& fa
     }
     if (merge && s.kind == Staleness::kEditedReport) {
         // One line on a terminal: every control byte of a name (a line end, ESC) written as \xNN.
-        std::string line;
-        for (const char c : p.item.name + ": " + s.why) {
-            if ((unsigned char)c >= 0x20 && c != 0x7f) {
-                line += c;
-                continue;
-            }
-            char escaped[5];
-            std::snprintf(escaped, sizeof escaped, "\\x%02x", (unsigned char)c);
-            line += escaped;
-        }
+        const std::string line = printable(p.item.name + ": " + s.why);
         std::fprintf(stderr, "animorder: batch: %s; counted as missing\n", line.c_str());
     }
     const json failure = read_json_file(p.error);

@@ -92,6 +92,12 @@ struct ClusteringResult {
     double seconds_rasterization = 0;  // rasterising every node once (kept for all iterations)
     size_t kept_nodes = 0;             // nodes whose fragments fit the cache budget (the first ones)
     size_t kept_bytes = 0;             // their compact fragments (KeptNode)
+    // `measured` only (held_out_choice.h): the held-out nodes its buffers were checked on, and per
+    // cluster 1 where the integrated-distance order was kept (triangle_orders then hold it, and
+    // patch_orders the measured one it replaced); empty for other methods.
+    size_t held_out_nodes = 0;
+    std::vector<uint8_t> held_out_distance;
+    double seconds_held_out = 0;
 };
 
 // Han & Sander 2017, Algorithm 1, over the nodes keyframes × icosphere viewpoints.

@@ -38,6 +38,10 @@ std::vector<uint32_t> joined_vertices(const AnimatedMesh& mesh);
 MeshPatches build_welded_patches(const AnimatedMesh& mesh, double lambda, size_t max_triangles = 0,
                                  unsigned cache_size = kDefaultCacheSize);
 
+// Patches made into pieces along their cache order, as build_welded_patches' max_triangles says
+// (max_triangles > 0; throws InvalidInput for 0).
+MeshPatches patch_pieces(MeshPatches patches, size_t max_triangles);
+
 // Nehab, Barczak & Sander 2006's planar clusters as the units instead of λ patches (the measured
 // method's alternative units): each primitive's triangles clustered by normal (cluster_by_normals,
 // positions of `keyframe`) into as many clusters as `like` has patches there, each Tipsified on

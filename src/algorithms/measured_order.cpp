@@ -26,19 +26,22 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <limits>
 #include <numeric>
 #include <string>
 
 namespace animorder {
 namespace {
 
-// Open-addressing table: key (min unit << 32 | max unit) → pixels with min in front minus pixels
-// with max in front (signed: nodes are also removed; only the net makes an arc). Linear probing,
-// grown at half load.
-struct PairTable {
+// Open-addressing table of Slot {key, net}: key → pixels with the key's lower unit in front minus
+// pixels with its higher one in front (signed: nodes are also removed; only the net makes an arc).
+// Linear probing, grown at three-quarter load.
+template <typename Key, typename Net>
+struct OpenTable {
+    static constexpr Key kEmpty = std::numeric_limits<Key>::max();
     struct Slot {
-        uint64_t key = UINT64_MAX;
-        int64_t net = 0;
+        Key key = kEmpty;
+        Net net = 0;
     };
     std::vector<Slot> slots = std::vector<Slot>(1024);
     size_t used = 0;
@@ -49,25 +52,70 @@ struct PairTable {
         key ^= key >> 33;
         return size_t(key);
     }
-    Slot& find(uint64_t key) {
+    Slot& find(Key key) {
         const size_t mask = slots.size() - 1;
         for (size_t i = hash(key) & mask;; i = (i + 1) & mask)
-            if (slots[i].key == key || slots[i].key == UINT64_MAX) return slots[i];
+            if (slots[i].key == key || slots[i].key == kEmpty) return slots[i];
     }
-    void add(uint64_t key, int64_t net) {
-        if (2 * (used + 1) > slots.size()) grow();
+    // The slot of key, made when new.
+    Slot& at(Key key) {
+        if (4 * (used + 1) > 3 * slots.size()) grow();
         Slot& s = find(key);
-        if (s.key == UINT64_MAX) {
+        if (s.key == kEmpty) {
             s.key = key;
             ++used;
         }
-        s.net += net;
+        return s;
     }
     void grow() {
         std::vector<Slot> old(slots.size() * 2);
         old.swap(slots);
         for (const Slot& s : old)
-            if (s.key != UINT64_MAX) find(s.key) = s;
+            if (s.key != kEmpty) find(s.key) = s;
+    }
+};
+
+// The pairs' net counts, in 8-byte slots (16-bit unit ids, 32-bit nets) while every unit id fits
+// in 16 bits and every net in 32 (half the memory of the wide slots, and twice the slots a cache
+// line holds), else — from the first count that does not fit, all moved over — in 16-byte ones.
+struct PairTable {
+    OpenTable<uint32_t, int32_t> narrow;
+    OpenTable<uint64_t, int64_t> wide;
+    bool is_wide = false;
+
+    explicit PairTable(size_t units) : is_wide(units > 0x10000) {
+        if (is_wide) narrow.slots.clear(); else wide.slots.clear();
+    }
+    void add(uint32_t lo, uint32_t hi, int64_t net) {
+        if (!is_wide) {
+            auto& s = narrow.at(lo << 16 | hi);
+            const int64_t sum = int64_t(s.net) + net;
+            if (sum >= std::numeric_limits<int32_t>::min() && sum <= std::numeric_limits<int32_t>::max()) {
+                s.net = int32_t(sum);
+                return;
+            }
+            widen();
+        }
+        wide.at(uint64_t(lo) << 32 | hi).net += net;
+    }
+    void widen() {
+        wide.slots.assign(std::max<size_t>(1024, narrow.slots.size()), {});
+        for (const auto& s : narrow.slots)
+            if (s.key != narrow.kEmpty) wide.at(uint64_t(s.key >> 16) << 32 | (s.key & 0xffff)).net = s.net;
+        narrow.slots = {};
+        narrow.used = 0;
+        is_wide = true;
+    }
+    // f(lo, hi, net) for every pair met (net may be 0), in the table's own order.
+    template <typename F>
+    void for_each(F&& f) const {
+        if (is_wide) {
+            for (const auto& s : wide.slots)
+                if (s.key != wide.kEmpty) f(uint32_t(s.key >> 32), uint32_t(s.key), int64_t(s.net));
+        } else {
+            for (const auto& s : narrow.slots)
+                if (s.key != narrow.kEmpty) f(s.key >> 16, s.key & 0xffff, int64_t(s.net));
+        }
     }
 };
 
@@ -77,7 +125,7 @@ struct PairCounts {
     size_t units = 0;
     std::vector<int64_t> dense;  // [hi · (hi − 1) / 2 + lo], when units <= kDenseMeasuredUnits
     PairTable sparse;
-    explicit PairCounts(size_t unit_count) : units(unit_count) {
+    explicit PairCounts(size_t unit_count) : units(unit_count), sparse(unit_count) {
         if (units <= kDenseMeasuredUnits) dense.assign(units * (units - (units > 0)) / 2, 0);
     }
     static size_t slot(uint32_t lo, uint32_t hi) { return size_t(hi) * (hi - 1) / 2 + lo; }
@@ -87,12 +135,11 @@ struct PairCounts {
         if (units <= kDenseMeasuredUnits)
             dense[slot(lo, hi)] += net;
         else
-            sparse.add(uint64_t(lo) << 32 | hi, net);
+            sparse.add(lo, hi, net);
     }
     void merge(const PairCounts& other) {
         for (size_t i = 0; i < dense.size(); ++i) dense[i] += other.dense[i];
-        for (const PairTable::Slot& s : other.sparse.slots)
-            if (s.key != UINT64_MAX) sparse.add(s.key, s.net);
+        other.sparse.for_each([&](uint32_t lo, uint32_t hi, int64_t net) { sparse.add(lo, hi, net); });
     }
 };
 
@@ -136,10 +183,16 @@ void accumulate_node(PairCounts& table, const NodeFragments& node, const uint32_
 }
 
 // One entry of a unit's signed adjacency in sift_order: s > 0 when the unit should come first.
+// Weight: int32_t (8-byte entries) when every arc's weight fits, else int64_t.
+template <typename Weight>
 struct Neighbour {
     uint32_t unit;
-    int64_t s;
+    Weight s;
 };
+
+template <typename Weight>
+void sift_with(uint32_t* order, size_t unit_count, const Arc* arcs, size_t arc_count, const uint32_t* group,
+               size_t max_passes, const std::vector<size_t>& start);
 
 }  // namespace
 
@@ -170,6 +223,11 @@ MeasuredPairCounts& MeasuredPairCounts::operator=(MeasuredPairCounts&&) noexcept
 template <typename Node, typename Accumulate>
 void MeasuredPairCounts::State::add_nodes(const Node* const* nodes, size_t node_count, unsigned threads,
                                           Accumulate&& accumulate) {
+    if (worker_threads(threads) == 1) {  // straight into the counts: no table per worker to merge
+        Scratch s;
+        for (size_t n = 0; n < node_count; ++n) accumulate(counts, *nodes[n], s);
+        return;
+    }
     const size_t units = counts.units;
     tbb::enumerable_thread_specific<PairCounts> tables([units] { return PairCounts(units); });
     tbb::enumerable_thread_specific<Scratch> scratch;
@@ -221,19 +279,24 @@ std::vector<Arc> MeasuredPairCounts::arcs() const {
     } else {
         // In key order, whatever the table's layout: bucketed by the lower unit, then each
         // bucket (a unit's few hundred pairs at most) sorted by the higher one.
+        struct Pair {
+            uint32_t hi;
+            int64_t net;
+        };
         std::vector<size_t> first(c.units + 1, 0);
-        for (const PairTable::Slot& s : c.sparse.slots)
-            if (s.key != UINT64_MAX && s.net != 0) ++first[(s.key >> 32) + 1];
+        c.sparse.for_each([&](uint32_t lo, uint32_t, int64_t n) { first[lo + 1] += n != 0; });
         std::partial_sum(first.begin(), first.end(), first.begin());
-        std::vector<PairTable::Slot> all(first[c.units]);
+        std::vector<Pair> all(first[c.units]);
         std::vector<size_t> fill(first.begin(), first.end() - 1);
-        for (const PairTable::Slot& s : c.sparse.slots)
-            if (s.key != UINT64_MAX && s.net != 0) all[fill[s.key >> 32]++] = s;
-        for (size_t lo = 0; lo < c.units; ++lo)
-            std::sort(all.begin() + long(first[lo]), all.begin() + long(first[lo + 1]),
-                      [](const PairTable::Slot& a, const PairTable::Slot& b) { return a.key < b.key; });
+        c.sparse.for_each([&](uint32_t lo, uint32_t hi, int64_t n) {
+            if (n != 0) all[fill[lo]++] = {hi, n};
+        });
         arcs.reserve(all.size());
-        for (const PairTable::Slot& s : all) net(uint32_t(s.key >> 32), uint32_t(s.key), s.net);
+        for (uint32_t lo = 0; lo < c.units; ++lo) {
+            const auto begin = all.begin() + long(first[lo]), end = all.begin() + long(first[lo + 1]);
+            std::sort(begin, end, [](const Pair& a, const Pair& b) { return a.hi < b.hi; });
+            for (auto p = begin; p != end; ++p) net(lo, p->hi, p->net);
+        }
     }
     return arcs;
 }
@@ -250,16 +313,33 @@ uint64_t sift_order(uint32_t* order, size_t unit_count, const Arc* arcs, size_t 
                     size_t max_passes) {
     // Signed adjacency: s(u, v) > 0 when u should come first (the arc u→v's weight).
     std::vector<size_t> start(unit_count + 1, 0);
+    bool narrow = true;
     for (size_t i = 0; i < arc_count; ++i) {
         const Arc& a = arcs[i];
         if (a.from >= unit_count || a.to >= unit_count)
             throw InvalidInput("sifting: arc " + std::to_string(i) + " names a unit outside 0.." +
                                std::to_string(unit_count));
         if (a.from == a.to || (group && group[a.from] != group[a.to])) continue;
+        narrow = narrow && a.weight <= uint64_t(std::numeric_limits<int32_t>::max());
         ++start[a.from + 1];
         ++start[a.to + 1];
     }
     std::partial_sum(start.begin(), start.end(), start.begin());
+    if (narrow)
+        sift_with<int32_t>(order, unit_count, arcs, arc_count, group, max_passes, start);
+    else
+        sift_with<int64_t>(order, unit_count, arcs, arc_count, group, max_passes, start);
+    return count_feedback_arcs(order, unit_count, arcs, arc_count).weight;
+}
+
+namespace {
+
+// sift_order's search, with `start` each unit's offset into the adjacency (both ends of every arc
+// kept).
+template <typename Weight>
+void sift_with(uint32_t* order, size_t unit_count, const Arc* arcs, size_t arc_count, const uint32_t* group,
+               size_t max_passes, const std::vector<size_t>& start) {
+    using Neighbour = animorder::Neighbour<Weight>;
     std::vector<uint32_t> position(unit_count);
     for (size_t i = 0; i < unit_count; ++i) position[order[i]] = uint32_t(i);
     // Each unit's neighbours, sorted by their current position when the unit is visited. Moving
@@ -274,8 +354,8 @@ uint64_t sift_order(uint32_t* order, size_t unit_count, const Arc* arcs, size_t 
         for (size_t i = 0; i < arc_count; ++i) {
             const Arc& a = arcs[i];
             if (a.from == a.to || (group && group[a.from] != group[a.to])) continue;
-            of_unit[fill[a.from]++] = {a.to, int64_t(a.weight)};
-            of_unit[fill[a.to]++] = {a.from, -int64_t(a.weight)};
+            of_unit[fill[a.from]++] = {a.to, Weight(a.weight)};
+            of_unit[fill[a.to]++] = {a.from, Weight(-int64_t(a.weight))};
         }
         fill.assign(start.begin(), start.end() - 1);
         for (size_t x = 0; x < unit_count; ++x) {
@@ -344,8 +424,9 @@ uint64_t sift_order(uint32_t* order, size_t unit_count, const Arc* arcs, size_t 
         }
         if (!moved) break;
     }
-    return count_feedback_arcs(order, unit_count, arcs, arc_count).weight;
 }
+
+}  // namespace
 
 std::vector<uint32_t> measured_unit_order(size_t unit_count, const Arc* arcs, size_t arc_count, const uint32_t* group,
                                           const uint32_t* previous, MeasuredOrderStats* stats, bool try_greedy) {

@@ -25,6 +25,12 @@ namespace {
 // are sums, the same however the nodes are chunked.
 constexpr uint64_t kTransientFragmentBytes = uint64_t(64) << 20;
 
+bool all_kept(const NodeCache& cache, const std::vector<uint32_t>& which) {
+    for (const uint32_t n : which)
+        if (!cache.kept(n)) return false;
+    return true;
+}
+
 void add_to_graph(const NodeCache& cache, const std::vector<uint32_t>& which, int sign, unsigned threads,
                   MeasuredPairCounts& graph) {
     std::vector<const KeptNode*> kept;
@@ -84,17 +90,32 @@ std::vector<size_t> measured_update_orders(const MeasuredNodes& nodes, const Clu
     }
     size_t moved = 0;
     std::vector<uint8_t> changed(nodes.k, 0);
+    bool kept = true;
     for (size_t c = 0; c < nodes.k; ++c) {
         moved += arriving[c].size();
         changed[c] = !leaving[c].empty() || !arriving[c].empty();
-        add_to_graph(nodes.cache, leaving[c], -1, settings.threads, state.graphs[c]);
-        add_to_graph(nodes.cache, arriving[c], +1, settings.threads, state.graphs[c]);
+        kept = kept && all_kept(nodes.cache, leaving[c]) && all_kept(nodes.cache, arriving[c]);
     }
+    // With at least as many clusters as workers, and every node kept (nothing to rasterise
+    // again), each cluster's graph is counted by one worker straight into its table: no table per
+    // worker, no merge (the peak memory of the counts is the clusters' tables alone). Integer
+    // sums: the same counts either way.
+    tbb::task_arena arena(worker_threads(settings.threads));
+    const bool by_cluster = kept && nodes.k >= size_t(arena.max_concurrency());
+    const auto count = [&](size_t c, unsigned threads) {
+        add_to_graph(nodes.cache, leaving[c], -1, threads, state.graphs[c]);
+        add_to_graph(nodes.cache, arriving[c], +1, threads, state.graphs[c]);
+    };
+    if (by_cluster)
+        arena.execute([&] {
+            tbb::parallel_for(size_t(0), nodes.k, [&](size_t c) { count(c, 1); }, tbb::simple_partitioner());
+        });
+    else
+        for (size_t c = 0; c < nodes.k; ++c) count(c, settings.threads);
     const double graph_seconds = seconds_since(graph_start);
     const Clock::time_point order_start = Clock::now();
     // The clusters' searches are independent: run side by side, each the same whatever the thread.
     std::vector<std::string> lines(nodes.k);
-    tbb::task_arena arena(worker_threads(settings.threads));
     arena.execute([&] {
         tbb::parallel_for(size_t(0), nodes.k, [&](size_t c) {
             if (sizes[c] == 0) return;

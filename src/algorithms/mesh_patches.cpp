@@ -77,6 +77,11 @@ MeshPatches build_welded_patches(const AnimatedMesh& mesh, double lambda, size_t
     for (size_t i = 0; i < welded.size(); ++i) welded[i] = first[mesh.indices[i]];
     MeshPatches patches = patches_over(mesh, welded.data(), lambda, cache_size);
     if (max_triangles == 0) return patches;
+    return patch_pieces(std::move(patches), max_triangles);
+}
+
+MeshPatches patch_pieces(MeshPatches patches, size_t max_triangles) {
+    if (max_triangles == 0) throw InvalidInput("patch pieces: at most 0 triangles a piece");
     // Pieces along the cache order: a patch of max_triangles or more cut into the fewest pieces
     // of at most max_triangles, sized as equally as can be; smaller patches of one primitive
     // that follow each other packed together while the pack stays within max_triangles.

@@ -16,7 +16,9 @@
 #include "animorder/blend_orders.h"
 #include "animorder/clustering.h"
 #include "animorder/evaluation.h"
+#include "animorder/held_out_choice.h"
 #include "animorder/invalid_input.h"
+#include "animorder/kept_fragments.h"
 #include "animorder/mesh_patches.h"
 #include "animorder/measured_order.h"
 #include "animorder/meshopt_order.h"
@@ -253,6 +255,10 @@ AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double
     AnimatedMethodResult result;
     const auto start = std::chrono::steady_clock::now();
     result.patches = build_mesh_patches(mesh, lambda, cache_size);
+    // measured: the λ patches, whose distance order each cluster may keep (held_out_choice.h).
+    const bool measured = settings.order == OrderSource::Measured;
+    MeshPatches lambda_patches;
+    if (measured) lambda_patches = result.patches;
     if (planar_units) {
         result.patches = build_planar_units(mesh, result.patches, 0, cache_size);
     } else if (settings.order == OrderSource::Measured) {
@@ -271,6 +277,17 @@ AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double
                              " pieces of at most " + std::to_string(most) +
                              " triangles of the surface's patches, not the " +
                              std::to_string(result.patches.patch_count()) + " patches of the vertex buffer");
+            result.patches = std::move(pieces);
+        } else if (result.patches.patch_count() > kMaxListedUnits) {
+            // Beyond kMaxListedUnits a node's lists are kept per triangle, and the graph, the
+            // counting and the search grow with the square of the units a pixel sees: runs of
+            // the patches (at λ = 3, single triangles) packed along the cache order instead.
+            const size_t most = (result.patches.patch_count() + kMaxListedUnits - 1) / kMaxListedUnits;
+            MeshPatches pieces = patch_pieces(result.patches, most);
+            if (settings.log)
+                settings.log("units: " + std::to_string(result.patches.patch_count()) + " patches, more than " +
+                             std::to_string(kMaxListedUnits) + ": " + std::to_string(pieces.patch_count()) +
+                             " pieces of at most " + std::to_string(most) + " triangles");
             result.patches = std::move(pieces);
         }
     }
@@ -308,6 +325,28 @@ AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double
                 };
         }
         result.runs.push_back(cluster_nodes(mesh, result.patches, framing, keyframes, run_settings));
+        if (measured && !framing.shows_nothing()) {
+            ClusteringResult& run = result.runs.back();
+            const auto held_start = std::chrono::steady_clock::now();
+            const HeldOutChoice choice = choose_on_held_out_views(mesh, lambda_patches, framing, settings.resolution,
+                                                                  settings.threads, run);
+            run.held_out_nodes = choice.nodes;
+            run.held_out_distance = choice.distance;
+            run.seconds_held_out =
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - held_start).count();
+            if (run_settings.log) {
+                size_t kept = 0;
+                for (const uint8_t d : choice.distance) kept += d;
+                const auto ovr = [&](uint64_t passed) {
+                    return choice.visible ? std::to_string(double(passed) / double(choice.visible)) : std::string("-");
+                };
+                run_settings.log("held-out views: " + std::to_string(choice.nodes) + " nodes; the distance order kept in " +
+                                 std::to_string(kept) + " of " + std::to_string(choice.distance.size()) +
+                                 " clusters (OVR there " + ovr(choice.measured_passed) + " measured, " +
+                                 ovr(choice.chosen_passed) + " kept); " + std::to_string(choice.reassigned) +
+                                 " clustering nodes reassigned");
+            }
+        }
         // Blended primitives: back to front for each cluster, in the measured blend order of its
         // nodes (blend_orders.h; the nodes' transparent pass rasterised once); with blend_clusters,
         // by their own k clusters of the same nodes, the buffers then being the (opaque, blend)

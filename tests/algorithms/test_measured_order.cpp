@@ -2,6 +2,7 @@
 // hand-built scenes whose answer is known, the order it gives, and the local search against
 // brute force on small random graphs (every permutation of up to 8 units) and on graphs worked by hand.
 #include "animorder/invalid_input.h"
+#include "animorder/kept_fragments.h"
 #include "animorder/measured_order.h"
 #include "animorder/nehab06.h"
 #include "animorder/overdraw.h"
@@ -117,7 +118,8 @@ TEST(MeasuredGraph, SameWhateverTheThreadCountAndDropsArcsBetweenGroups) {
 // A second implementation of the graph's definition (a map of pair counts), against the library
 // on random pixels, with few units (the dense matrix) and many (the hash table).
 TEST(MeasuredGraph, MatchesASecondImplementationDenseAndSparse) {
-    for (const size_t units : {size_t(20), size_t(1700)}) {
+    // 20: the dense triangle; 1700: 8-byte table slots; 70000: more than 16-bit unit ids, 16-byte slots.
+    for (const size_t units : {size_t(20), size_t(1700), size_t(70000)}) {
         std::mt19937 rng{uint32_t(units)};
         const size_t triangles = 2 * units;
         std::vector<uint32_t> unit(triangles);
@@ -184,6 +186,46 @@ TEST(MeasuredGraph, RemovingNodesGivesTheGraphOfTheRest) {
         EXPECT_EQ(got[2].to, 3u);
         EXPECT_EQ(got[2].weight, 1u);
     }
+}
+
+// A pair's net count beyond 32 bits (the compact table's limit) moves the table to 64-bit counts
+// with nothing lost, and removing nodes after that still gives the rest's graph: 40,000 nodes of
+// 65,535 pixels where unit 5 covers unit 7 (2,621,400,000 pixels, above 2^31 − 1), then all but
+// one removed.
+TEST(MeasuredGraph, NetCountsBeyond32BitsAreKeptExactly) {
+    const size_t units = 1100;
+    std::vector<uint32_t> unit(units), starts(units + 1);
+    std::iota(unit.begin(), unit.end(), 0u);
+    std::iota(starts.begin(), starts.end(), 0u);
+    const UnitPartition partition = make_unit_partition(starts.data(), units, unit.data(), units);
+    KeepScratch scratch;
+    const auto kept = [&](const std::vector<std::vector<uint32_t>>& list) {
+        const NodeFragments n = pixels(list);
+        return keep_fragments(n.visible, n.single, n.starts.data(), n.starts.size() - 1, n.fragments.data(),
+                              partition, scratch);
+    };
+    const KeptNode big = kept(std::vector<std::vector<uint32_t>>(65535, {5, 7}));
+    const KeptNode small = kept({{9, 3}, {9, 3}, {2, 4}});
+    const std::vector<const KeptNode*> many(40000, &big);
+    const KeptNode* const other = &small;
+    MeasuredPairCounts counts(units, unit.data(), units, nullptr);
+    counts.add(&other, 1, +1, 1);
+    counts.add(many.data(), many.size(), +1, 2);
+    const auto weight = [](const std::vector<Arc>& arcs, uint32_t from, uint32_t to) {
+        for (const Arc& a : arcs)
+            if (a.from == from && a.to == to) return a.weight;
+        return uint64_t(0);
+    };
+    std::vector<Arc> arcs = counts.arcs();
+    ASSERT_EQ(arcs.size(), 3u);
+    EXPECT_EQ(weight(arcs, 5, 7), uint64_t(40000) * 65535);
+    EXPECT_EQ(weight(arcs, 9, 3), 2u);
+    EXPECT_EQ(weight(arcs, 2, 4), 1u);
+    counts.add(many.data(), many.size() - 1, -1, 1);
+    arcs = counts.arcs();
+    ASSERT_EQ(arcs.size(), 3u);
+    EXPECT_EQ(weight(arcs, 5, 7), 65535u);
+    EXPECT_EQ(weight(arcs, 9, 3), 2u);
 }
 
 TEST(MeasuredGraph, RejectsTrianglesAndUnitsOutOfRange) {
@@ -484,7 +526,8 @@ TEST(Sifting, MovesTheSameUnitsAsThePlainStatementOnLargerGraphs) {
         for (uint32_t a = 0; a < n; ++a)
             for (uint32_t b = a + 1; b < n; ++b) {
                 if (rng() % 4 != 0) continue;  // sparse, as measured graphs are
-                const uint64_t w = 1 + rng() % 1000;
+                // Odd trials: weights beyond 32 bits (sift_order's 64-bit adjacency).
+                const uint64_t w = (1 + rng() % 1000) << (trial % 2 ? 33 : 0);
                 arcs.push_back(rng() % 2 ? Arc{a, b, w} : Arc{b, a, w});
             }
         std::vector<uint32_t> group(n, 0);

@@ -3,6 +3,8 @@
 #include "animorder/animated_mesh.h"
 #include "animorder/evaluation.h"
 #include "animorder/invalid_input.h"
+#include "animorder/kept_fragments.h"
+#include "animorder/mesh_patches.h"
 #include "animorder/meshopt_order.h"
 #include "animorder/methods.h"
 #include "animorder/procedural_character.h"
@@ -112,6 +114,27 @@ TEST(Methods, EveryClusteredMethodMisSortsNoMoreBlendedPairsThanSingle) {
 // the surface patches in pieces of kMeasuredSurfaceUnitTriangles as its units, at λ = 0.85 and 3;
 // single keeps the λ patches (its outputs do not change), and on a smooth mesh measured keeps
 // them too.
+// More λ patches than a kept node lists (kMaxListedUnits): measured's units are runs of them,
+// as few patches a run as bring the units within the limit (a 20k-triangle knot at λ = 3: pairs).
+TEST(Methods, MeasuredPacksPatchesBeyondTheListedUnits) {
+    const AnimatedMesh knot = make_torus_knot(20000);
+    MethodSettings settings;
+    settings.lambda = 3;
+    settings.clustering.clusters = 2;
+    settings.clustering.views = 12;
+    settings.clustering.resolution = 48;
+    settings.clustering.max_iterations = 2;
+    const MeshPatches patches = build_mesh_patches(knot, 3);
+    ASSERT_GT(patches.patch_count(), kMaxListedUnits);
+    ASSERT_LE(patches.patch_count(), 2 * kMaxListedUnits);
+    const MeshPatches pairs = patch_pieces(patches, 2);
+    EXPECT_LE(pairs.patch_count(), kMaxListedUnits);
+    const MethodResult measured = run_method(knot, Method::Measured, settings);
+    EXPECT_EQ(measured.patch_count, pairs.patch_count());
+    for (const auto& order : measured.buffers.orders) EXPECT_TRUE(test::is_permutation_of_iota(order));
+    EXPECT_EQ(run_method(knot, Method::Single, settings).patch_count, patches.patch_count());
+}
+
 TEST(Methods, MeasuredTakesSurfacePiecesAsUnitsWhereThePatchesAreSingleTriangles) {
     const AnimatedMesh smooth = make_procedural_character();
     const AnimatedMesh flat = test::flat_shaded(smooth);

@@ -6,6 +6,7 @@
 #include <array>
 #include <nlohmann/json.hpp>
 #include "http_request.h"
+#include "peak_memory.h"
 #include "support/files.h"
 #include "support/gltf_builder.h"
 #include "support/require.h"
@@ -31,6 +32,7 @@
 #include <string>
 #include <thread>
 #include <utility>
+#include <optional>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -292,6 +294,17 @@ TEST_F(Cli, MeasuredOptimizesJointAndEvaluates) {
     const nlohmann::json j = nlohmann::json::parse(test::slurp(path("r.json")));
     EXPECT_EQ(j["methods"][0]["name"], "measured");
     EXPECT_EQ(j["methods"][0]["buffers"], 6);  // 3 per clip, 2 clips
+    // The process's peak while the method ran: at least the loaded character's keyframes.
+    ASSERT_TRUE(j["methods"][0]["peak_rss_bytes"].is_number()) << j["methods"][0].dump();
+    EXPECT_GT(j["methods"][0]["peak_rss_bytes"].get<double>(), 20e6);
+    // Each clip's run checked its buffers on held-out views (ceil(600 / keyframes) views at each of
+    // the clip's keyframes: at least 600 nodes on clips of 4 to 50 keyframes, as the bundled ones).
+    for (const auto& r : j["methods"][0]["runs"]) {
+        ASSERT_TRUE(r.contains("held_out")) << r.dump();
+        EXPECT_GE(r["held_out"]["nodes"].get<size_t>(), 600u);
+        EXPECT_LE(r["held_out"]["distance_orders_kept"].get<size_t>(), 3u);
+    }
+    EXPECT_TRUE(j["methods"][0]["stages_s"].contains("held_out"));
     ASSERT_EQ(run("optimize --method measured --joint" + fast + " --report " + path("j.json").string()).exit_code, 0);
     const nlohmann::json joint = nlohmann::json::parse(test::slurp(path("j.json")));
     EXPECT_EQ(joint["methods"][0]["name"], "measured-joint");
@@ -1642,4 +1655,24 @@ TEST_F(Cli, CheckRefusesCentresTheSceneMovedAwayFrom) {
     EXPECT_EQ(report["ok"], false);
     EXPECT_NEAR(report["centers"]["largest_offset"].get<double>(), std::hypot(0.5, 0.25), 1e-4);
     EXPECT_NE(o.err.find("clip 'walk': its centers are"), std::string::npos) << o.err;
+}
+
+// The tool's measure of a method's memory (peak_memory.h): memory touched after the reset raises
+// the mark by as much; a new reset after it is freed starts from far below.
+TEST(PeakResident, CountsWhatTheProcessTouchesAfterTheReset) {
+    constexpr size_t kBytes = size_t(256) << 20;
+    const animorder::tool::PeakResident mark;
+    const std::optional<uint64_t> base = mark.peak();
+    ASSERT_TRUE(base.has_value()) << "Linux's /proc/self/clear_refs and VmHWM are needed";
+    {
+        std::vector<unsigned char> touched(kBytes);
+        for (size_t i = 0; i < kBytes; i += 4096) touched[i] = static_cast<unsigned char>(i >> 12);
+        EXPECT_NE(touched[kBytes - 4096], 0);
+    }
+    const std::optional<uint64_t> after = mark.peak();
+    ASSERT_TRUE(after.has_value());
+    EXPECT_GE(*after, *base + kBytes - (kBytes >> 4));
+    const animorder::tool::PeakResident fresh;
+    ASSERT_TRUE(fresh.peak().has_value());
+    EXPECT_LT(*fresh.peak() + kBytes / 2, *after);
 }

@@ -55,15 +55,17 @@ namespace fs = std::filesystem;
 using json = nlohmann::ordered_json;
 using Clock = std::chrono::steady_clock;
 
-// Wall times out (--no-timings): every key of seconds set to null, wherever it is, and the thread
-// count they ran with (settings.threads), which changes nothing else.
+// Wall times out (--no-timings): every key of seconds set to null, wherever it is, the thread
+// count they ran with (settings.threads), which changes nothing else, and the peak resident
+// bytes (a measure of the machine's run, like the times).
 void drop_timings(json& value) {
     if (value.is_array())
         for (json& v : value) drop_timings(v);
     if (!value.is_object()) return;
     for (auto it = value.begin(); it != value.end(); ++it) {
         const std::string& k = it.key();
-        if (k == "time_s" || k == "timings_s" || k == "stages_s" || k == "threads" || k.rfind("seconds", 0) == 0)
+        if (k == "time_s" || k == "timings_s" || k == "stages_s" || k == "threads" || k == "peak_rss_bytes" ||
+            k.rfind("seconds", 0) == 0)
             it.value() = nullptr;
         else
             drop_timings(it.value());

@@ -3,6 +3,7 @@
 // JSON report and a CSV.
 #include "commands.h"
 #include "input.h"
+#include "peak_memory.h"
 #include "report.h"
 
 #include "animorder/atomic_write.h"
@@ -35,6 +36,7 @@ std::vector<std::string> split_list(const std::string& text) {
 struct Row {
     MethodResult result;
     MethodSettings settings;
+    std::optional<uint64_t> peak_resident;  // the process's peak while the method ran (peak_memory.h)
 };
 
 // Every combination of the swept settings, for the methods that use them.
@@ -216,8 +218,10 @@ int run_evaluate(const EvaluateOptions& options) {
         if (method_uses_clusters(n) && views.size() > 1) label += " views=" + std::to_string(m.clustering.views);
         note(options.common, "running " + label);
         // Each row's settings were validated with the plan (before loading): not checked again.
+        const PeakResident memory;
         rows.push_back(
-            {about_input(options.common, [&, n = n, m = m] { return run_validated_method(mesh, n, m); }), m});
+            {about_input(options.common, [&, n = n, m = m] { return run_validated_method(mesh, n, m); }), m, {}});
+        rows.back().peak_resident = memory.peak();
     }
     const double methods_s = seconds_since(start);
 
@@ -278,7 +282,7 @@ int run_evaluate(const EvaluateOptions& options) {
         const MethodSettings& s = rows[m].settings;
         const OrderEvaluation& r = results[m];
         const char* name = method_name(run.method);
-        json entry = method_entry(mesh, run, s);
+        json entry = method_entry(mesh, run, s, rows[m].peak_resident);
         const bool per_node = !method_has_buffers(run.method);
         entry["buffers"] = per_node ? nodes : run.buffers.orders.size();
         entry["ovr_mean"] = r.overall.ovr_mean;

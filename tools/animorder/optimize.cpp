@@ -5,6 +5,7 @@
 
 #include "commands.h"
 #include "input.h"
+#include "peak_memory.h"
 #include "report.h"
 
 #include "animorder/atomic_write.h"
@@ -133,7 +134,9 @@ OptimizeProduct produce_optimize(const OptimizeOptions& options, const OptimizeP
                              std::to_string(mesh.keyframe_count()) + " keyframes (" + input_name + ")");
 
     // plan_optimize validated the settings (before loading): they are not checked again.
+    const PeakResident memory;
     product.run = about_input(options.common, [&] { return run_validated_method(mesh, method, settings); });
+    const std::optional<uint64_t> peak = memory.peak();
     const MethodResult& run = product.run;
     product.before = analyze_mesh_vertex_cache(mesh, mesh.indices, settings.cache_size);
     const VertexCacheStats& before = product.before;
@@ -159,7 +162,7 @@ OptimizeProduct produce_optimize(const OptimizeOptions& options, const OptimizeP
     report = report_header(mesh, input_name);
     report["settings"] = optimize_settings_json(options, plan);
     report["input_order"] = cache_stats_json(before);
-    report["methods"] = nlohmann::ordered_json::array({method_entry(mesh, run, settings)});
+    report["methods"] = nlohmann::ordered_json::array({method_entry(mesh, run, settings, peak)});
     report["outputs"] = written;
     report["timings_s"] = {{"load", load_s}, {"method", run.seconds}, {"total", seconds_since(start)}};
     return product;

@@ -33,10 +33,13 @@ namespace {
 
 nlohmann::ordered_json clustering_details(const AnimatedMesh& mesh, const MethodResult& r, const MethodSettings& m) {
     using json = nlohmann::ordered_json;
-    double assignment = 0, update = 0, rasterization = 0;
+    double assignment = 0, update = 0, rasterization = 0, held_out = 0;
+    bool checked = false;
     json runs = json::array();
     for (size_t i = 0; i < r.runs.size(); ++i) {
         rasterization += r.runs[i].seconds_rasterization;
+        held_out += r.runs[i].seconds_held_out;
+        checked = checked || !r.runs[i].held_out_distance.empty();
         json iterations = json::array();
         for (size_t it = 0; it < r.runs[i].iterations.size(); ++it) {
             const ClusteringIteration& x = r.runs[i].iterations[it];
@@ -59,8 +62,15 @@ nlohmann::ordered_json clustering_details(const AnimatedMesh& mesh, const Method
                         {"kept_nodes", r.runs[i].kept_nodes},
                         {"kept_bytes", r.runs[i].kept_bytes},
                         {"iterations", iterations}});
+        if (!r.runs[i].held_out_distance.empty()) {
+            size_t kept = 0;
+            for (const uint8_t d : r.runs[i].held_out_distance) kept += d;
+            runs.back()["held_out"] = {{"nodes", r.runs[i].held_out_nodes},
+                                       {"distance_orders_kept", kept},
+                                       {"seconds", r.runs[i].seconds_held_out}};
+        }
     }
-    return {{"clusters", m.clustering.clusters},
+    json details = {{"clusters", m.clustering.clusters},
             {"views", m.clustering.views},
             {"resolution", m.clustering.resolution},
             {"seed", m.clustering.seed},
@@ -73,11 +83,14 @@ nlohmann::ordered_json clustering_details(const AnimatedMesh& mesh, const Method
               {"rasterization", rasterization},
               {"assignment", assignment},
               {"update", update}}}};
+    if (checked) details["stages_s"]["held_out"] = held_out;
+    return details;
 }
 
 }  // namespace
 
-nlohmann::ordered_json method_entry(const AnimatedMesh& mesh, const MethodResult& r, const MethodSettings& m) {
+nlohmann::ordered_json method_entry(const AnimatedMesh& mesh, const MethodResult& r, const MethodSettings& m,
+                                    std::optional<uint64_t> peak_resident) {
     using json = nlohmann::ordered_json;
     const bool clustered = method_uses_clusters(r.method);
     json entry = {{"name", method_name(r.method)},
@@ -89,7 +102,8 @@ nlohmann::ordered_json method_entry(const AnimatedMesh& mesh, const MethodResult
                   {"atvr", r.atvr_mean},
                   {"ovr_mean", nullptr},
                   {"ovr_pooled", nullptr},
-                  {"time_s", r.seconds}};
+                  {"time_s", r.seconds},
+                  {"peak_rss_bytes", peak_resident ? json(*peak_resident) : json(nullptr)}};
     json details;
     if (clustered)
         details = clustering_details(mesh, r, m);

@@ -12,6 +12,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cstdint>
+#include <optional>
 #include <string>
 
 namespace animorder::tool {
@@ -20,10 +22,11 @@ nlohmann::ordered_json report_header(const AnimatedMesh& mesh, const std::string
 nlohmann::ordered_json cache_stats_json(const VertexCacheStats& stats);
 
 // A method's entry of "methods": name, the settings it used (null where it uses none), buffers,
-// ACMR/ATVR, OVR (null until evaluate fills it), time, and what the method reports of itself
+// ACMR/ATVR, OVR (null until evaluate fills it), time, the process's peak resident bytes while the
+// method ran (peak_memory.h; null where not known), and what the method reports of itself
 // (patches; single/joint: runs, iterations, stages).
 nlohmann::ordered_json method_entry(const AnimatedMesh& mesh, const MethodResult& result,
-                                    const MethodSettings& settings);
+                                    const MethodSettings& settings, std::optional<uint64_t> peak_resident);
 
 // Serialised with two-space indentation and a final newline.
 std::string report_text(const nlohmann::ordered_json& report);

@@ -197,6 +197,7 @@ Report load_report(const fs::path& path, const std::string& name) {
         method.ovr_mean = r.required_number(m, "ovr_mean", where);
         method.ovr_pooled = r.required_number(m, "ovr_pooled", where);
         method.time_s = r.nullable_number(m, "time_s", where);
+        method.peak_rss_bytes = r.nullable_number(m, "peak_rss_bytes", where);
         if (const json* per_clip = r.optional_array(m, "per_clip", where)) {
             for (size_t c = 0; c < per_clip->size(); ++c) {
                 const std::string w = where + ".per_clip[" + std::to_string(c) + "]";

@@ -39,6 +39,7 @@ struct Method {
     long long clusters = -1, views = -1;
     long long buffers = 0;
     double acmr = kNaN, atvr = kNaN, ovr_mean = kNaN, ovr_pooled = kNaN, time_s = kNaN;
+    double peak_rss_bytes = kNaN;  // the process's peak while the method ran (absent in older reports)
     std::vector<ClipResult> per_clip;
     std::map<std::string, size_t> iterations;  // k-means iterations per run ("all" for joint)
     BlendResult blend;

@@ -26,6 +26,9 @@ namespace fs = std::filesystem;
 constexpr double kIdleOvrGoal085 = 1.06, kIdleAcmrGoal085 = 0.95, kIdleOvrGoal3 = 1.012;
 constexpr double kClipsOvrGoal = 1.08, kClipsJointOvrGoal = 1.09;
 constexpr double kTimeRatioGoal = 2.0, kAcmrTolerance = 0.02;
+// Issue 46's goals for making `measured` the default, per character × λ row: preprocessing time
+// and peak memory against `single`'s in the same run.
+constexpr double kDefaultTimeGoal = 2.0, kDefaultMemoryGoal = 1.5;
 
 // The row of `name` at λ and k (λ NaN: the row without λ; k < 0: any k, 5 preferred).
 const Method* row(const Report& r, const std::string& name, double lambda, long long k = -1) {
@@ -41,6 +44,11 @@ std::string ratio_text(double a, double b) {
 }
 
 std::string verdict(bool met) { return met ? "met" : "**not met**"; }
+
+// The process's peak resident memory while the method ran, in MB (evaluate's peak_rss_bytes).
+std::string megabytes_text(const Method& m) {
+    return std::isfinite(m.peak_rss_bytes) ? format_fixed(m.peak_rss_bytes / 1048576.0, 0) : kDash;
+}
 
 // Bytes of the index buffers of a method row: buffers × 3 indices × triangles, 16-bit indices when
 // every vertex index fits below 65,535 (the primitive-restart value), 32-bit otherwise.
@@ -92,17 +100,18 @@ void idle_part(const Inputs& in, std::string& b) {
             }
             rows.push_back({x->name, lambda_text(lambda), "k=" + std::to_string(x->clusters), goal, stages_text(*x),
                             f3(x->acmr), f3(x->ovr_mean), f3(x->ovr_pooled), f1(x->time_s),
-                            x == m && s ? ratio_text(x->time_s, s->time_s) : kDash});
+                            x == m && s ? ratio_text(x->time_s, s->time_s) : kDash, megabytes_text(*x),
+                            x == m && s ? ratio_text(x->peak_rss_bytes, s->peak_rss_bytes) : kDash});
         }
     }
     if (const Report* idle = in.get("ganfaul-idle.json"))
         if (const Method* o = row(*idle, "oracle", 0.85))
             rows.push_back({"oracle (per node, ganfaul-idle.json)", "0.85", kDash, kDash, kDash, f3(o->acmr),
-                            f3(o->ovr_mean), f3(o->ovr_pooled), f1(o->time_s), kDash});
-    b +=
-        table({"method", "λ", "k", "goal", "stages s", "ACMR", "OVR", "OVR pooled", "preprocessing s", "time / single"},
-              rows, 5) +
-        "\n";
+                            f3(o->ovr_mean), f3(o->ovr_pooled), f1(o->time_s), kDash, kDash, kDash});
+    b += table({"method", "λ", "k", "goal", "stages s", "ACMR", "OVR", "OVR pooled", "preprocessing s",
+                "time / single", "peak MB", "memory / single"},
+               rows, 5) +
+         "\n";
 }
 
 void sweep_part(const Inputs& in, Charts& charts, std::string& b) {
@@ -230,9 +239,10 @@ void characters_part(const Inputs& in, std::string& b) {
          format_fixed(kAcmrTolerance, 2) +
          ". The goal column marks each row that misses it: **worse** where measured's OVR is above single's, "
          "**ACMR higher** where measured's ACMR exceeds single's by more than the tolerance; \"ACMR lower\" marks "
-         "an ACMR more than the tolerance below single's (outside the goal's letter, but a gain).\n\n";
+         "an ACMR more than the tolerance below single's (outside the goal's letter, but a gain). \"Time ×\" and "
+         "\"memory ×\" are measured's preprocessing time and peak memory over single's.\n\n";
     std::vector<std::vector<std::string>> rows;
-    size_t total = 0, ovr_met = 0, acmr_higher = 0, acmr_lower = 0, met = 0;
+    size_t total = 0, ovr_met = 0, acmr_higher = 0, acmr_lower = 0, met = 0, default_met = 0, memory_known = 0;
     for (const std::string& file : in.measured_characters) {
         const Report& r = *in.get(file);
         const std::string character = fs::path(file).stem().string();
@@ -252,9 +262,24 @@ void characters_part(const Inputs& in, std::string& b) {
             met += d_ovr <= 0 && d_acmr <= kAcmrTolerance;
             std::string mark;
             for (const std::string& x : marks) mark += (mark.empty() ? "" : ", ") + x;
-            rows.push_back({character, lambda_text(lambda), mark.empty() ? "met" : mark, count(r.triangles),
-                            keyframes_total(r), f3(s->ovr_mean), f3(m->ovr_mean), format_fixed(d_ovr, 3), f3(s->acmr),
-                            f3(m->acmr), format_fixed(d_acmr, 3), f1(s->time_s), f1(m->time_s)});
+            // Issue 46: OVR at or below single's, time and peak memory within the goals' ratios.
+            const double time_ratio = m->time_s / s->time_s, memory_ratio = m->peak_rss_bytes / s->peak_rss_bytes;
+            std::vector<std::string> misses;
+            if (d_ovr > 0) misses.push_back("**OVR**");
+            if (!(time_ratio <= kDefaultTimeGoal)) misses.push_back("**time**");
+            if (!std::isfinite(memory_ratio))
+                misses.push_back("memory not measured");
+            else if (memory_ratio > kDefaultMemoryGoal)
+                misses.push_back("**memory**");
+            memory_known += std::isfinite(memory_ratio);
+            default_met += misses.empty();
+            std::string default_mark;
+            for (const std::string& x : misses) default_mark += (default_mark.empty() ? "" : ", ") + x;
+            rows.push_back({character, lambda_text(lambda), mark.empty() ? "met" : mark,
+                            default_mark.empty() ? "met" : default_mark, count(r.triangles), keyframes_total(r),
+                            f3(s->ovr_mean), f3(m->ovr_mean), format_fixed(d_ovr, 3), f3(s->acmr), f3(m->acmr),
+                            format_fixed(d_acmr, 3), f1(s->time_s), f1(m->time_s), ratio_text(m->time_s, s->time_s),
+                            ratio_text(m->peak_rss_bytes, s->peak_rss_bytes)});
         }
     }
     // The characters of "Every skinned character" (characters/*.json) that have no measured report.
@@ -263,9 +288,9 @@ void characters_part(const Inputs& in, std::string& b) {
         const std::string character = fs::path(file).stem().string();
         if (!in.get("measured/" + character + ".json")) missing += (missing.empty() ? "" : ", ") + character;
     }
-    b += table({"character", "λ", "goal", "triangles", "keyframes", "single OVR", "measured OVR", "Δ OVR",
-                "single ACMR", "measured ACMR", "Δ ACMR", "single s", "measured s"},
-               rows, 3) +
+    b += table({"character", "λ", "goal", "default goals", "triangles", "keyframes", "single OVR", "measured OVR",
+                "Δ OVR", "single ACMR", "measured ACMR", "Δ ACMR", "single s", "measured s", "time ×", "memory ×"},
+               rows, 4) +
          "\n" + std::to_string(total) + " character × λ rows from " + std::to_string(in.measured_characters.size()) +
          " characters: measured's OVR ≤ single's in " + std::to_string(ovr_met) + "; ACMR more than " +
          format_fixed(kAcmrTolerance, 2) + " above single's in " + std::to_string(acmr_higher) + ", more than " +
@@ -273,7 +298,12 @@ void characters_part(const Inputs& in, std::string& b) {
          "; both OVR and ACMR goals met "
          "(ACMR not higher by more than the tolerance) in " +
          std::to_string(met) + "." + (missing.empty() ? std::string() : " No measured report for " + missing + ".") +
-         "\n\n";
+         " Issue 46's goals for the default (\"default goals\": OVR ≤ single's, preprocessing time ≤ " +
+         format_fixed(kDefaultTimeGoal, 0) + "× and peak memory ≤ " + format_fixed(kDefaultMemoryGoal, 1) +
+         "× single's in the same run; memory is the process's peak resident size while the method ran, "
+         "`peak_rss_bytes`) met in " +
+         std::to_string(default_met) + " of " + std::to_string(total) + " rows; memory measured in " +
+         std::to_string(memory_known) + ".\n\n";
 }
 
 }  // namespace

@@ -1,0 +1,136 @@
+// Measured orders checked on held-out views (held_out_choice.h).
+//
+// This follows: Han & Sander, "Triangle Reordering for Efficient Rendering in Complex Scenes",
+// JCGT 2017, Algorithm 1 lines 20–24 (the integrated-distance update, the candidate every cluster
+// can fall back to), and the usual hold-out check of a model fitted to samples: an order measured
+// at the clustering views is kept where it also serves views it never saw at least as well.
+#include "animorder/held_out_choice.h"
+
+#include "animorder/invalid_input.h"
+#include "animorder/overdraw.h"
+
+#include <algorithm>
+#include <string>
+
+namespace animorder {
+
+size_t held_out_views_per_keyframe(size_t keyframes) {
+    if (keyframes == 0) return 0;
+    return std::clamp<size_t>((600 + keyframes - 1) / keyframes, 12, 162);
+}
+
+HeldOutChoice choose_on_held_out_views(const AnimatedMesh& mesh, const MeshPatches& patches, const Framing& framing,
+                                       unsigned resolution, unsigned threads, ClusteringResult& run) {
+    const size_t k = run.triangle_orders.size(), keyframes = run.keyframes.size();
+    const size_t views = run.directions.size() / 3;
+    HeldOutChoice choice;
+    choice.distance.assign(k, 0);
+    if (k < 1 || keyframes == 0 || views == 0) return choice;
+    if (run.assignment.size() != keyframes * views)
+        throw InvalidInput("held-out choice: the run assigns " + std::to_string(run.assignment.size()) +
+                           " nodes, not " + std::to_string(keyframes) + " × " + std::to_string(views));
+    for (const uint32_t c : run.assignment)
+        if (c >= k) throw InvalidInput("held-out choice: a node of cluster " + std::to_string(c) + " of " + std::to_string(k));
+
+    // Each cluster's distance order over the patches (the centroids of the run's keyframes, framed).
+    const std::vector<float> centroids = patch_centroids(mesh, patches, framing, run.keyframes);
+    std::vector<std::vector<uint32_t>> rows(k);
+    std::vector<std::vector<float>> eyes(k);
+    for (size_t n = 0; n < run.assignment.size(); ++n) {
+        const uint32_t c = run.assignment[n];
+        rows[c].push_back(uint32_t(n / views));
+        for (int a = 0; a < 3; ++a) eyes[c].push_back(3.0f * framing.radius * run.directions[3 * (n % views) + a]);
+    }
+    std::vector<std::vector<uint32_t>> distance(k);
+    for (size_t c = 0; c < k; ++c) {
+        if (rows[c].empty()) continue;  // no node draws it: nothing to choose
+        distance[c] = patch_order_to_triangle_order(
+            patches, integrated_distance_order(centroids.data(), keyframes, patches.patch_count(), rows[c].data(),
+                                               eyes[c].data(), rows[c].size(), DistanceVariant::Jcgt, nullptr,
+                                               patches.patch_primitive.data()));
+    }
+
+    // The held-out nodes and the cluster whose buffer each is drawn with.
+    const size_t held_views = held_out_views_per_keyframe(keyframes);
+    const std::vector<float> directions = random_sphere_directions(held_views, kHeldOutSeed);
+    std::vector<OverdrawNode> nodes(keyframes * held_views);
+    std::vector<uint32_t> cluster(nodes.size());
+    for (size_t i = 0; i < keyframes; ++i)
+        for (size_t v = 0; v < held_views; ++v) {
+            OverdrawNode& node = nodes[i * held_views + v];
+            node.keyframe = run.keyframes[i];
+            std::copy(&directions[3 * v], &directions[3 * v] + 3, node.direction);
+            size_t nearest = 0;
+            float best = -2.0f;
+            for (size_t u = 0; u < views; ++u) {
+                const float* d = &run.directions[3 * u];
+                const float dot = d[0] * node.direction[0] + d[1] * node.direction[1] + d[2] * node.direction[2];
+                if (dot > best) best = dot, nearest = u;
+            }
+            cluster[i * held_views + v] = run.assignment[i * views + nearest];
+        }
+
+    // Every node scored with the k measured buffers and the k distance ones (a cluster without
+    // nodes scores its measured buffer twice: never chosen).
+    std::vector<const uint32_t*> orders;
+    for (size_t c = 0; c < k; ++c) orders.push_back(run.triangle_orders[c].data());
+    for (size_t c = 0; c < k; ++c) orders.push_back(distance[c].empty() ? run.triangle_orders[c].data() : distance[c].data());
+    const std::vector<uint32_t> ranks = make_rank_table(orders, mesh.triangle_count());
+    const std::vector<uint8_t> modes = opaque_pass_modes(mesh);
+    ScoreSettings score;
+    score.resolution = resolution;
+    score.threads = threads;
+    score.triangle_modes = modes.empty() ? nullptr : modes.data();
+    std::vector<uint64_t> visible(nodes.size()), passed(nodes.size() * 2 * k);
+    score_nodes(visible.data(), passed.data(), mesh.keyframe_positions.data(), mesh.vertex_count, framing,
+                mesh.indices.data(), mesh.indices.size(), nodes.data(), nodes.size(), ranks.data(), 2 * k, score);
+
+    std::vector<uint64_t> measured(k, 0), by_distance(k, 0);
+    for (size_t n = 0; n < nodes.size(); ++n) {
+        measured[cluster[n]] += passed[n * 2 * k + cluster[n]];
+        by_distance[cluster[n]] += passed[n * 2 * k + k + cluster[n]];
+        choice.visible += visible[n];
+    }
+    choice.nodes = nodes.size();
+    bool switched = false;
+    for (size_t c = 0; c < k; ++c) {
+        choice.measured_passed += measured[c];
+        if (!distance[c].empty() && by_distance[c] < measured[c]) {
+            choice.distance[c] = 1;
+            switched = true;
+            run.triangle_orders[c] = std::move(distance[c]);
+            choice.chosen_passed += by_distance[c];
+        } else {
+            choice.chosen_passed += measured[c];
+        }
+    }
+    if (!switched || k < 2) return choice;
+
+    // The clusters were formed around the measured orders: every clustering node goes to the
+    // buffer, of the k now kept, that passes the fewest of its fragments (k-means' assignment
+    // step, rasterising the nodes once more; ties keep the node's cluster, then the lower one).
+    std::vector<OverdrawNode> learnt(keyframes * views);
+    for (size_t i = 0; i < keyframes; ++i)
+        for (size_t v = 0; v < views; ++v) {
+            learnt[i * views + v].keyframe = run.keyframes[i];
+            std::copy(&run.directions[3 * v], &run.directions[3 * v] + 3, learnt[i * views + v].direction);
+        }
+    orders.clear();
+    for (size_t c = 0; c < k; ++c) orders.push_back(run.triangle_orders[c].data());
+    const std::vector<uint32_t> kept_ranks = make_rank_table(orders, mesh.triangle_count());
+    std::vector<uint64_t> learnt_visible(learnt.size()), learnt_passed(learnt.size() * k);
+    score_nodes(learnt_visible.data(), learnt_passed.data(), mesh.keyframe_positions.data(), mesh.vertex_count,
+                framing, mesh.indices.data(), mesh.indices.size(), learnt.data(), learnt.size(), kept_ranks.data(), k,
+                score);
+    for (size_t n = 0; n < learnt.size(); ++n) {
+        const uint64_t* p = &learnt_passed[n * k];
+        uint32_t best = run.assignment[n];
+        for (uint32_t c = 0; c < k; ++c)
+            if (p[c] < p[best]) best = c;
+        choice.reassigned += best != run.assignment[n];
+        run.assignment[n] = best;
+    }
+    return choice;
+}
+
+}  // namespace animorder

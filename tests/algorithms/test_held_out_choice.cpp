@@ -1,0 +1,133 @@
+// The held-out check of measured orders (held_out_choice.cpp): on the bundled character's walk,
+// a cluster whose order is made bad on purpose (its distance order reversed: far patches first)
+// takes the distance order; a buffer that already is that order is kept (the check asks for
+// strictly fewer fragments); after a change every clustering node is drawn by the buffer that
+// passes the fewest of its fragments, checked node by node against a second scoring.
+#include "animorder/clustering.h"
+#include "animorder/held_out_choice.h"
+#include "animorder/mesh_patches.h"
+#include "animorder/overdraw.h"
+#include "animorder/procedural_character.h"
+#include "animorder/viewpoints.h"
+#include "support/meshes.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <vector>
+
+using namespace animorder;
+
+namespace {
+
+struct Walk {
+    AnimatedMesh mesh = make_procedural_character();
+    MeshPatches patches;
+    std::vector<uint32_t> keyframes;
+    Framing framing;
+    ClusteringResult run;
+    static constexpr unsigned kResolution = 64;
+
+    Walk() {
+        patches = build_mesh_patches(mesh, 0.85);
+        const Clip& walk = mesh.clips[0];
+        for (size_t f = 0; f < walk.keyframe_count; f += 6) keyframes.push_back(uint32_t(walk.first_keyframe + f));
+        framing = frame_subset(frame_animated_mesh(mesh), keyframes);
+        ClusteringSettings s;
+        s.clusters = 3;
+        s.views = 42;
+        s.resolution = kResolution;
+        s.max_iterations = 4;
+        s.threads = 2;
+        run = cluster_nodes(mesh, patches, framing, keyframes, s);
+    }
+    // passed[n · k + c]: the fragments buffer c passes at clustering node n.
+    std::vector<uint64_t> learnt_passed() const {
+        const size_t views = run.directions.size() / 3, k = run.triangle_orders.size();
+        std::vector<OverdrawNode> nodes(keyframes.size() * views);
+        for (size_t n = 0; n < nodes.size(); ++n) {
+            nodes[n].keyframe = keyframes[n / views];
+            std::copy(&run.directions[3 * (n % views)], &run.directions[3 * (n % views)] + 3, nodes[n].direction);
+        }
+        std::vector<const uint32_t*> orders;
+        for (const auto& o : run.triangle_orders) orders.push_back(o.data());
+        const std::vector<uint32_t> ranks = make_rank_table(orders, mesh.triangle_count());
+        const std::vector<uint8_t> modes = opaque_pass_modes(mesh);
+        ScoreSettings score;
+        score.resolution = kResolution;
+        score.threads = 1;
+        score.triangle_modes = modes.empty() ? nullptr : modes.data();
+        std::vector<uint64_t> visible(nodes.size()), passed(nodes.size() * k);
+        score_nodes(visible.data(), passed.data(), mesh.keyframe_positions.data(), mesh.vertex_count, framing,
+                    mesh.indices.data(), mesh.indices.size(), nodes.data(), nodes.size(), ranks.data(), k, score);
+        return passed;
+    }
+};
+
+}  // namespace
+
+TEST(HeldOutChoice, ViewsPerKeyframeAimAtSixHundredNodes) {
+    EXPECT_EQ(held_out_views_per_keyframe(0), 0u);
+    EXPECT_EQ(held_out_views_per_keyframe(1), 162u);   // 600, at most 162
+    EXPECT_EQ(held_out_views_per_keyframe(10), 60u);
+    EXPECT_EQ(held_out_views_per_keyframe(7), 86u);    // ceil(600 / 7)
+    EXPECT_EQ(held_out_views_per_keyframe(60), 12u);
+    EXPECT_EQ(held_out_views_per_keyframe(500), 12u);  // at least 12
+}
+
+TEST(HeldOutChoice, ABadOrderGivesWayToTheDistanceOrderAndTheNodesFollow) {
+    Walk w;
+    const size_t k = w.run.triangle_orders.size();
+    ASSERT_EQ(k, 3u);
+    // The distance orders themselves (the check's own candidates): a first check with the
+    // clusters' orders reversed takes every one of them.
+    ClusteringResult reversed = w.run;
+    for (auto& o : reversed.triangle_orders) std::reverse(o.begin(), o.end());
+    const std::vector<uint32_t> assignment_before = reversed.assignment;
+    const HeldOutChoice first = choose_on_held_out_views(w.mesh, w.patches, w.framing, Walk::kResolution, 2, reversed);
+    EXPECT_EQ(first.nodes, w.keyframes.size() * held_out_views_per_keyframe(w.keyframes.size()));
+    ASSERT_EQ(first.distance.size(), k);
+    for (size_t c = 0; c < k; ++c) EXPECT_EQ(first.distance[c], 1) << "cluster " << c;
+    EXPECT_LT(first.chosen_passed, first.measured_passed);
+    EXPECT_GE(first.chosen_passed, first.visible);  // at least one fragment a covered pixel
+    for (size_t c = 0; c < k; ++c) {
+        EXPECT_TRUE(test::is_permutation_of_iota(reversed.triangle_orders[c]));
+        EXPECT_NE(reversed.triangle_orders[c], w.run.triangle_orders[c]) << "not simply reversed back";
+    }
+    // The nodes went to the buffer that passes the fewest of their fragments (ties: their own).
+    Walk scored = w;
+    scored.run = reversed;
+    const std::vector<uint64_t> passed = scored.learnt_passed();
+    size_t moved = 0;
+    for (size_t n = 0; n < reversed.assignment.size(); ++n) {
+        const uint64_t* p = &passed[n * k];
+        for (size_t c = 0; c < k; ++c) EXPECT_LE(p[reversed.assignment[n]], p[c]) << "node " << n;
+        moved += reversed.assignment[n] != assignment_before[n];
+    }
+    EXPECT_EQ(moved, first.reassigned);
+
+    // The same clusters (the assignment before the first check) holding those distance orders:
+    // checked again, nothing is strictly better, nothing changes (orders, assignment).
+    ClusteringResult again = w.run;
+    again.triangle_orders = reversed.triangle_orders;
+    const HeldOutChoice second = choose_on_held_out_views(w.mesh, w.patches, w.framing, Walk::kResolution, 1, again);
+    for (size_t c = 0; c < k; ++c) EXPECT_EQ(second.distance[c], 0) << "cluster " << c;
+    EXPECT_EQ(second.measured_passed, second.chosen_passed);
+    EXPECT_EQ(second.reassigned, 0u);
+    EXPECT_EQ(again.triangle_orders, reversed.triangle_orders);
+    EXPECT_EQ(again.assignment, w.run.assignment);
+}
+
+TEST(HeldOutChoice, SameWhateverTheThreadCount) {
+    Walk w;
+    ClusteringResult a = w.run, b = w.run;
+    std::reverse(a.triangle_orders[1].begin(), a.triangle_orders[1].end());
+    b.triangle_orders[1] = a.triangle_orders[1];
+    const HeldOutChoice one = choose_on_held_out_views(w.mesh, w.patches, w.framing, Walk::kResolution, 1, a);
+    const HeldOutChoice two = choose_on_held_out_views(w.mesh, w.patches, w.framing, Walk::kResolution, 2, b);
+    EXPECT_EQ(one.distance, two.distance);
+    EXPECT_EQ(one.chosen_passed, two.chosen_passed);
+    EXPECT_EQ(a.triangle_orders, b.triangle_orders);
+    EXPECT_EQ(a.assignment, b.assignment);
+    EXPECT_EQ(one.distance[1], 1);
+}

@@ -103,7 +103,7 @@ TEST_F(Batch, ThreeParallelShardsGiveTheFilesAndSummaryOfOneRun) {
     EXPECT_EQ(test::slurp_existing(path("alone-joint.animorder.bin")), single_run.at("joint.animorder.bin"));
 
     // The summary's numbers: the input order's ACMR from inspect, the triangles, the clips, the
-    // buffers of single (k per clip) and joint (k), the index bytes those buffers add.
+    // buffers of measured, the default (k per clip), and joint (k), the index bytes those buffers add.
     const nlohmann::json inspect = nlohmann::json::parse(run("inspect --json -q").out);
     const nlohmann::json s = nlohmann::json::parse(summary_json);
     ASSERT_EQ(s["items"].size(), 5u);
@@ -125,7 +125,7 @@ TEST_F(Batch, ThreeParallelShardsGiveTheFilesAndSummaryOfOneRun) {
     EXPECT_EQ(s["items"][2]["clips"], 2);
     EXPECT_EQ(s["items"][2]["buffers"], 2);
     EXPECT_EQ(s["items"][4]["buffers"], 1);
-    EXPECT_NE(summary_md.find("| wave-seed2 | single | " + std::to_string(triangles) + " | 1 |"), std::string::npos)
+    EXPECT_NE(summary_md.find("| wave-seed2 | measured | " + std::to_string(triangles) + " | 1 |"), std::string::npos)
         << summary_md;
 
     // Again as three shards at once, then the merge: the same bytes.
@@ -179,7 +179,7 @@ TEST_F(Batch, CsvManifestIsTheJsonManifest) {
         "m.json",
         R"({"items": [{"clips": ["walk", "wave"], "options": "-k 2 --views 12 --resolution 32 --max-iterations 2", "output": "out/a"}]})");
     write("m.csv",
-          "clips,method,options,output\nwalk;wave,single,\"-k 2 --views 12 --resolution 32 --max-iterations "
+          "clips,method,options,output\nwalk;wave,measured,\"-k 2 --views 12 --resolution 32 --max-iterations "
           "2\",out/b\n");
     ASSERT_EQ(run("batch -q --eval-views 0 " + manifest()).exit_code, 0);
     const test::Outcome csv = run("batch -q --eval-views 0 " + path("m.csv").string());

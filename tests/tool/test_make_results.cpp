@@ -501,10 +501,13 @@ TEST_F(MakeResults, MeasuredSectionAgainstHandWorkedValues) {
     {
         json m = json::array();
         m.push_back(method("single", 0.85, 5, 162, 5, 0.933, 1.129, 10.0));
+        m.back()["peak_rss_bytes"] = 100 << 20;
         m.push_back(method("measured", 0.85, 5, 162, 5, 0.915, 1.05, 15.0));
         m.back()["stages_s"] = {{"patches", 0.01}, {"rasterization", 5.0}, {"assignment", 4.0}, {"update", 6.0}};
+        m.back()["peak_rss_bytes"] = 150 << 20;
         m.push_back(method("single", 3, 5, 162, 5, 2.8, 1.029, 10.0));
-        m.push_back(method("measured", 3, 5, 162, 5, 2.1, 1.02, 25.0));
+        m.back()["peak_rss_bytes"] = 200 << 20;
+        m.push_back(method("measured", 3, 5, 162, 5, 2.1, 1.02, 25.0));  // no peak: an older report
         write("measured/ganfaul-idle.json", report("g.gltf", 13810, {{"Idle", 60}}, m));
     }
     {
@@ -529,9 +532,13 @@ TEST_F(MakeResults, MeasuredSectionAgainstHandWorkedValues) {
     {
         json m = json::array();
         m.push_back(method("single", 0.85, 5, 162, 5, 0.9, 1.2, 4.0, {{"Walk", 0.0}}));
+        m.back()["peak_rss_bytes"] = 100 << 20;
         m.push_back(method("measured", 0.85, 5, 162, 5, 0.93, 1.21, 6.0, {{"Walk", 0.0}}));
+        m.back()["peak_rss_bytes"] = 160 << 20;
         m.push_back(method("single", 3, 5, 162, 5, 2.9, 1.1, 4.0, {{"Walk", 0.0}}));
+        m.back()["peak_rss_bytes"] = 100 << 20;
         m.push_back(method("measured", 3, 5, 162, 5, 2.5, 1.05, 9.0, {{"Walk", 0.0}}));
+        m.back()["peak_rss_bytes"] = 120 << 20;
         write("measured/fox.json", report("data/fox.glb", 576, {{"Walk", 24}}, m, 60, 256));
     }
     // Characters of "Every skinned character" without a measured report are named.
@@ -546,10 +553,11 @@ TEST_F(MakeResults, MeasuredSectionAgainstHandWorkedValues) {
     ASSERT_FALSE(md.empty());
     for (const char* line : {
              // Idle: 1.05 ≤ 1.06, 0.915 ≤ 0.95, 15 / 10 = 1.5 ≤ 2; at λ = 3: 1.02 > 1.012, 25 / 10 = 2.5 > 2.
+             // Peak memory 150 MiB over 100 MiB; none known for measured at λ = 3.
              "| measured | 0.85 | k=5 | OVR met, ACMR met, time met | patches 0.0, rasterization 5.0, assignment 4.0, "
-             "update 6.0 | 0.915 | 1.050 | 1.040 | 15.0 | 1.50× |",
-             "| measured | 3 | k=5 | OVR **not met**, time **not met** | — | 2.100 | 1.020 | 1.010 | 25.0 | 2.50× |",
-             "| single | 0.85 | k=5 | — | — | 0.933 | 1.129 | 1.119 | 10.0 | — |",
+             "update 6.0 | 0.915 | 1.050 | 1.040 | 15.0 | 1.50× | 150 | 1.50× |",
+             "| measured | 3 | k=5 | OVR **not met**, time **not met** | — | 2.100 | 1.020 | 1.010 | 25.0 | 2.50× | — | — |",
+             "| single | 0.85 | k=5 | — | — | 0.933 | 1.129 | 1.119 | 10.0 | — | 100 | — |",
              // k sweep: 82860 bytes per buffer.
              "| 1 | 1 | 82860 | 1.450 | 1.150 | 0.930 | 0.920 | 5.0 | 7.0 |",
              "| 2 | 2 | 165720 | 1.200 | 1.080 | 0.930 | 0.920 | 6.0 | 8.0 |",
@@ -559,13 +567,19 @@ TEST_F(MakeResults, MeasuredSectionAgainstHandWorkedValues) {
              "| measured | 0.85 | met | 10 | 0.920 | 1.070 | 1.060 | 60.0 |",
              "| measured-joint | 0.85 | **not met** | 5 | 0.920 | 1.100 | 1.090 | 120.0 |",
              "| Jump | 31 | 1.160 | 1.170 | 1.090 | 1.110 |",
-             // Characters: +0.010 OVR and +0.030 ACMR; -0.050 OVR and -0.400 ACMR.
-             "| fox | 0.85 | **worse**, **ACMR higher** | 576 | 24 | 1.200 | 1.210 | 0.010 | 0.900 | 0.930 | 0.030 | "
-             "4.0 | 6.0 |",
-             "| fox | 3 | ACMR lower | 576 | 24 | 1.100 | 1.050 | -0.050 | 2.900 | 2.500 | -0.400 | 4.0 | 9.0 |",
+             // Characters: +0.010 OVR and +0.030 ACMR; -0.050 OVR and -0.400 ACMR. The default goals:
+             // at 0.85 OVR above single's and memory 160 / 100 = 1.6 > 1.5 (time 6 / 4 = 1.5 ≤ 2); at 3
+             // time 9 / 4 = 2.25 > 2 (memory 1.2).
+             "| fox | 0.85 | **worse**, **ACMR higher** | **OVR**, **memory** | 576 | 24 | 1.200 | 1.210 | 0.010 | "
+             "0.900 | 0.930 | 0.030 | 4.0 | 6.0 | 1.50× | 1.60× |",
+             "| fox | 3 | ACMR lower | **time** | 576 | 24 | 1.100 | 1.050 | -0.050 | 2.900 | 2.500 | -0.400 | 4.0 | "
+             "9.0 | 2.25× | 1.20× |",
              "2 character × λ rows from 1 characters: measured's OVR ≤ single's in 1; ACMR more than 0.02 above "
              "single's in 1, more than 0.02 below in 1; both OVR and ACMR goals met (ACMR not higher by more than "
-             "the tolerance) in 1. No measured report for xbot."})
+             "the tolerance) in 1. No measured report for xbot. Issue 46's goals for the default (\"default "
+             "goals\": OVR ≤ single's, preprocessing time ≤ 2× and peak memory ≤ 1.5× single's in the same run; "
+             "memory is the process's peak resident size while the method ran, `peak_rss_bytes`) met in 0 of 2 "
+             "rows; memory measured in 2."})
         EXPECT_NE(md.find(line), std::string::npos) << line << "\n" << md;
     for (const char* svg : {"measured-k-ovr.svg", "measured-k-bytes.svg"}) {
         const std::string text = test::slurp(dir_ / "docs" / "results" / svg);

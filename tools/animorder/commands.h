@@ -46,7 +46,7 @@ struct InspectOptions {
 struct OptimizeOptions {
     CommonOptions common;
     std::string method = method_name(kDefaultMethod);
-    bool joint = false;  // --joint: the same as --method joint
+    bool joint = false;  // --joint: the method's joint variant (method_joint_variant)
     MethodOptions methods;
     std::string output;       // OUT → OUT.animorder.bin and OUT.animorder.json (+ OUT.glb/.gltf)
     std::string report_path;  // JSON report, optional

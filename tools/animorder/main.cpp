@@ -73,50 +73,50 @@ void add_method_options(CLI::App& command, animorder::tool::MethodOptions& optio
             ->check(CLI::Range(0.0, 1000.0));
         command
             .add_option("-k,--clusters", options.cluster_list,
-                        "single/joint: number of buffers k; a list runs each value")
+                        "k-means methods: number of buffers k; a list runs each value")
             ->delimiter(',')
             ->allow_extra_args(false)  // a list is one comma-separated value
             ->capture_default_str()
             ->check(CLI::Range(size_t(1), animorder::kMaxClusters));
         command
             .add_option("--views", options.view_list,
-                        "single/joint: clustering viewpoints (12, 42, 162, 642); a list runs each value")
+                        "k-means methods: clustering viewpoints (12, 42, 162, 642); a list runs each value")
             ->delimiter(',')
             ->allow_extra_args(false)  // a list is one comma-separated value
             ->capture_default_str()
             ->check(kWholeNumber);
     } else {
         command.add_option("-l,--lambda", m.lambda, lambda_help)->capture_default_str()->check(CLI::Range(0.0, 1000.0));
-        command.add_option("-k,--clusters", c.clusters, "single/joint: number of buffers k")
+        command.add_option("-k,--clusters", c.clusters, "k-means methods: number of buffers k")
             ->capture_default_str()
             ->check(CLI::Range(size_t(1), animorder::kMaxClusters));
-        command.add_option("--views", c.views, "single/joint: clustering viewpoints (12, 42, 162, 642)")
+        command.add_option("--views", c.views, "k-means methods: clustering viewpoints (12, 42, 162, 642)")
             ->capture_default_str()
             ->check(kWholeNumber);
     }
     command.add_option("--frame", m.keyframe, "static methods: keyframe whose positions they sort with")
         ->capture_default_str()
         ->check(kWholeNumber);
-    command.add_option("--resolution", c.resolution, "single/joint/static-nehab06: clustering viewport in pixels")
+    command.add_option("--resolution", c.resolution, "k-means methods, static-nehab06: clustering viewport in pixels")
         ->capture_default_str()
         ->check(CLI::Range(8u, 4096u));
-    command.add_option("--seed", c.seed, "single/joint: seed of the bootstrap viewpoints")
+    command.add_option("--seed", c.seed, "k-means methods: seed of the bootstrap viewpoints")
         ->capture_default_str()
         ->check(kWholeNumber);
-    command.add_option("--min-separation", c.min_separation_deg, "single/joint: degrees between bootstrap viewpoints")
+    command.add_option("--min-separation", c.min_separation_deg, "k-means methods: degrees between bootstrap viewpoints")
         ->capture_default_str();
-    command.add_option("--max-iterations", c.max_iterations, "single/joint: cap on k-means iterations")
+    command.add_option("--max-iterations", c.max_iterations, "k-means methods: cap on k-means iterations")
         ->capture_default_str()
         ->check(CLI::Range(size_t(1), size_t(1000)));
-    command.add_option("--distance", options.distance, "single/joint: jcgt (sum) or i3d (visible-only mean)")
+    command.add_option("--distance", options.distance, "k-means methods: jcgt (sum) or i3d (visible-only mean)")
         ->capture_default_str();
     command
         .add_option("--update", options.update,
-                    "single/joint: monotone (keep a cluster's new order only if its nodes' OVR falls) or paper")
+                    "k-means methods: monotone (keep a cluster's new order only if its nodes' OVR falls) or paper")
         ->capture_default_str();
     command.add_flag(
         "--blend-clusters", m.blend_clusters,
-        "single/joint: blended primitives get their own k clusters (buffers: the cluster pairs, up to k^2 per clip)");
+        "k-means methods: blended primitives get their own k clusters (buffers: the cluster pairs, up to k^2 per clip)");
     command.add_option("--nehab-clusters", m.nehab_clusters, "static-nehab06: planar clusters (0: automatic)")
         ->capture_default_str()
         ->check(CLI::Range(size_t(0), size_t(1) << 20));
@@ -129,7 +129,7 @@ void add_method_options(CLI::App& command, animorder::tool::MethodOptions& optio
                      "measured: Nehab 2006 planar clusters as units (as many as lambda's patches), not patches");
     command
         .add_option("--fragment-memory", c.max_cache_bytes,
-                    "single/joint/measured: bytes for the nodes' kept fragments; nodes beyond are rasterised again "
+                    "k-means methods: bytes for the nodes' kept fragments; nodes beyond are rasterised again "
                     "each iteration (same result, slower)")
         ->capture_default_str()
         ->check(kWholeNumber);
@@ -151,7 +151,8 @@ std::string method_list(bool shippable_only) {
 void add_optimize_options(CLI::App& command, animorder::tool::OptimizeOptions& optimize) {
     add_common(command, optimize.common);
     command.add_option("-m,--method", optimize.method, "One of: " + method_list(true))->capture_default_str();
-    command.add_flag("--joint", optimize.joint, "One set of buffers for all clips (same as --method joint)");
+    command.add_flag("--joint", optimize.joint,
+                     "One set of buffers for all clips: the method's joint variant (measured-joint, joint)");
     add_method_options(command, optimize.methods);
     command
         .add_option("-o,--output", optimize.output,

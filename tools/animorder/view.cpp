@@ -384,7 +384,6 @@ void make_bundled(const fs::path& dir, bool quiet) {
     OptimizeOptions o;
     o.common.quiet = quiet;
     o.common.input = s.output;
-    o.method = "single";
     o.output = (dir / "character.glb").string();
     if (run_optimize(o) != 0) throw std::runtime_error("could not optimise the bundled character");
 }

@@ -246,6 +246,13 @@ struct AnimatedMethodResult {
 // stay near single's, its OVR below (docs/RESULTS.md, issue 46's note). The vertex cache gains
 // nothing from λ there (no vertex is shared: ACMR 3 whatever the order).
 constexpr size_t kMeasuredSurfaceUnitTriangles = 8;
+// `measured` on a mesh with more λ patches than kMaxListedUnits (kept_fragments.h; Xbot at λ = 3):
+// `single`'s k-means over the patches, then each cluster's measured order of runs of them
+// (patch_pieces, as few patches a run as bring the units within kMaxListedUnits), from about this
+// many of the run's nodes (every stride-th of each cluster's), taken where it passes fewer
+// fragments on held-out views (held_out_choice.h). Elsewhere, measured k-means, then each
+// cluster's distance order taken where it passes fewer there.
+constexpr size_t kMeasuredRefineNodes = 2048;
 // `measured`'s ClusteringSettings::settled_gain (unless set): k-means stops once an iteration
 // lowers the mean node OVR by less than this fraction.
 constexpr double kMeasuredSettledGain = 1e-4;

@@ -7,32 +7,47 @@
 #include "animorder/held_out_choice.h"
 
 #include "animorder/invalid_input.h"
+#include "animorder/measured_order.h"
 #include "animorder/overdraw.h"
 
+#include "../support/worker_threads.h"
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
 #include <algorithm>
+#include <cstdint>
 #include <string>
 
 namespace animorder {
+
+namespace {
+
+// Throws InvalidInput unless the run's assignment covers its nodes and names its clusters.
+void check_run(const ClusteringResult& run) {
+    const size_t k = run.triangle_orders.size(), keyframes = run.keyframes.size();
+    const size_t views = run.directions.size() / 3;
+    if (run.assignment.size() != keyframes * views)
+        throw InvalidInput("held-out choice: the run assigns " + std::to_string(run.assignment.size()) +
+                           " nodes, not " + std::to_string(keyframes) + " × " + std::to_string(views));
+    for (const uint32_t c : run.assignment)
+        if (c >= k)
+            throw InvalidInput("held-out choice: a node of cluster " + std::to_string(c) + " of " + std::to_string(k));
+}
+
+}  // namespace
 
 size_t held_out_views_per_keyframe(size_t keyframes) {
     if (keyframes == 0) return 0;
     return std::clamp<size_t>((600 + keyframes - 1) / keyframes, 12, 162);
 }
 
-HeldOutChoice choose_on_held_out_views(const AnimatedMesh& mesh, const MeshPatches& patches, const Framing& framing,
-                                       unsigned resolution, unsigned threads, ClusteringResult& run) {
+std::vector<std::vector<uint32_t>> distance_cluster_orders(const AnimatedMesh& mesh, const MeshPatches& patches,
+                                                           const Framing& framing, const ClusteringResult& run) {
     const size_t k = run.triangle_orders.size(), keyframes = run.keyframes.size();
     const size_t views = run.directions.size() / 3;
-    HeldOutChoice choice;
-    choice.distance.assign(k, 0);
-    if (k < 1 || keyframes == 0 || views == 0) return choice;
-    if (run.assignment.size() != keyframes * views)
-        throw InvalidInput("held-out choice: the run assigns " + std::to_string(run.assignment.size()) +
-                           " nodes, not " + std::to_string(keyframes) + " × " + std::to_string(views));
-    for (const uint32_t c : run.assignment)
-        if (c >= k) throw InvalidInput("held-out choice: a node of cluster " + std::to_string(c) + " of " + std::to_string(k));
-
-    // Each cluster's distance order over the patches (the centroids of the run's keyframes, framed).
+    check_run(run);
+    // The centroids of the run's keyframes (framed), and each cluster's nodes and eyes.
     const std::vector<float> centroids = patch_centroids(mesh, patches, framing, run.keyframes);
     std::vector<std::vector<uint32_t>> rows(k);
     std::vector<std::vector<float>> eyes(k);
@@ -41,14 +56,86 @@ HeldOutChoice choose_on_held_out_views(const AnimatedMesh& mesh, const MeshPatch
         rows[c].push_back(uint32_t(n / views));
         for (int a = 0; a < 3; ++a) eyes[c].push_back(3.0f * framing.radius * run.directions[3 * (n % views) + a]);
     }
-    std::vector<std::vector<uint32_t>> distance(k);
+    std::vector<std::vector<uint32_t>> orders(k);
     for (size_t c = 0; c < k; ++c) {
-        if (rows[c].empty()) continue;  // no node draws it: nothing to choose
-        distance[c] = patch_order_to_triangle_order(
+        if (rows[c].empty()) continue;
+        orders[c] = patch_order_to_triangle_order(
             patches, integrated_distance_order(centroids.data(), keyframes, patches.patch_count(), rows[c].data(),
                                                eyes[c].data(), rows[c].size(), DistanceVariant::Jcgt, nullptr,
                                                patches.patch_primitive.data()));
     }
+    return orders;
+}
+
+std::vector<std::vector<uint32_t>> measured_cluster_orders(const AnimatedMesh& mesh, const MeshPatches& units,
+                                                           const Framing& framing, const ClusteringResult& run,
+                                                           unsigned resolution, unsigned threads, size_t stride) {
+    check_run(run);
+    if (stride == 0) throw InvalidInput("measured cluster orders: a stride of 0 nodes");
+    const size_t k = run.triangle_orders.size(), views = run.directions.size() / 3;
+    std::vector<uint32_t> unit_of_triangle(mesh.triangle_count(), 0);
+    for (size_t u = 0; u < units.patch_count(); ++u)
+        for (uint32_t j = units.patch_starts[u]; j < units.patch_starts[u + 1]; ++j)
+            unit_of_triangle[units.cache_order[j]] = uint32_t(u);
+    // Every stride-th node of each cluster, in node order.
+    std::vector<std::vector<OverdrawNode>> nodes(k);
+    std::vector<size_t> seen(k, 0);
+    for (size_t n = 0; n < run.assignment.size(); ++n) {
+        const uint32_t c = run.assignment[n];
+        if (seen[c]++ % stride != 0) continue;
+        OverdrawNode node;
+        node.keyframe = run.keyframes[n / views];
+        std::copy(&run.directions[3 * (n % views)], &run.directions[3 * (n % views)] + 3, node.direction);
+        nodes[c].push_back(node);
+    }
+    const std::vector<uint8_t> modes = opaque_pass_modes(mesh);
+    std::vector<std::vector<uint32_t>> orders(k);
+    // The clusters side by side, each counted by one worker straight into its own graph.
+    tbb::task_arena arena(worker_threads(threads));
+    arena.execute([&] {
+        tbb::parallel_for(size_t(0), k, [&](size_t c) {
+            if (nodes[c].empty()) return;
+            ScoreSettings score;
+            score.resolution = resolution;
+            score.threads = 1;
+            score.triangle_modes = modes.empty() ? nullptr : modes.data();
+            MeasuredPairCounts graph(units.patch_count(), unit_of_triangle.data(), unit_of_triangle.size(),
+                                     units.patch_primitive.data());
+            constexpr size_t kChunk = 16;  // nodes rasterised at a time (their full fragment lists)
+            for (size_t begin = 0; begin < nodes[c].size(); begin += kChunk) {
+                const size_t count = std::min(kChunk, nodes[c].size() - begin);
+                const std::vector<NodeFragments> fragments = rasterize_nodes(
+                    mesh.keyframe_positions.data(), mesh.vertex_count, framing, mesh.indices.data(),
+                    mesh.indices.size(), nodes[c].data() + begin, count, score, SIZE_MAX);
+                std::vector<const NodeFragments*> pointers;
+                for (const NodeFragments& f : fragments) pointers.push_back(&f);
+                graph.add(pointers.data(), pointers.size(), +1, 1);
+            }
+            const std::vector<Arc> arcs = graph.arcs();
+            const std::vector<uint32_t> order = measured_unit_order(units.patch_count(), arcs.data(), arcs.size(),
+                                                                    units.patch_primitive.data(), nullptr, nullptr);
+            orders[c] = patch_order_to_triangle_order(units, order);
+        });
+    });
+    return orders;
+}
+
+HeldOutChoice choose_on_held_out_views(const AnimatedMesh& mesh, const Framing& framing, unsigned resolution,
+                                       unsigned threads, ClusteringResult& run,
+                                       std::vector<std::vector<uint32_t>> alternatives) {
+    const size_t k = run.triangle_orders.size(), keyframes = run.keyframes.size();
+    const size_t views = run.directions.size() / 3;
+    HeldOutChoice choice;
+    choice.taken.assign(k, 0);
+    if (k < 1 || keyframes == 0 || views == 0) return choice;
+    check_run(run);
+    if (alternatives.size() != k)
+        throw InvalidInput("held-out choice: " + std::to_string(alternatives.size()) + " alternatives for " +
+                           std::to_string(k) + " clusters");
+    for (const auto& a : alternatives)
+        if (!a.empty() && a.size() != mesh.triangle_count())
+            throw InvalidInput("held-out choice: an alternative order of " + std::to_string(a.size()) +
+                               " triangles, the mesh has " + std::to_string(mesh.triangle_count()));
 
     // The held-out nodes and the cluster whose buffer each is drawn with.
     const size_t held_views = held_out_views_per_keyframe(keyframes);
@@ -70,11 +157,11 @@ HeldOutChoice choose_on_held_out_views(const AnimatedMesh& mesh, const MeshPatch
             cluster[i * held_views + v] = run.assignment[i * views + nearest];
         }
 
-    // Every node scored with the k measured buffers and the k distance ones (a cluster without
-    // nodes scores its measured buffer twice: never chosen).
+    // Every node scored with the k current buffers and the k alternatives (a cluster without an
+    // alternative scores its buffer twice: never changed).
     std::vector<const uint32_t*> orders;
     for (size_t c = 0; c < k; ++c) orders.push_back(run.triangle_orders[c].data());
-    for (size_t c = 0; c < k; ++c) orders.push_back(distance[c].empty() ? run.triangle_orders[c].data() : distance[c].data());
+    for (size_t c = 0; c < k; ++c) orders.push_back(alternatives[c].empty() ? run.triangle_orders[c].data() : alternatives[c].data());
     const std::vector<uint32_t> ranks = make_rank_table(orders, mesh.triangle_count());
     const std::vector<uint8_t> modes = opaque_pass_modes(mesh);
     ScoreSettings score;
@@ -85,23 +172,23 @@ HeldOutChoice choose_on_held_out_views(const AnimatedMesh& mesh, const MeshPatch
     score_nodes(visible.data(), passed.data(), mesh.keyframe_positions.data(), mesh.vertex_count, framing,
                 mesh.indices.data(), mesh.indices.size(), nodes.data(), nodes.size(), ranks.data(), 2 * k, score);
 
-    std::vector<uint64_t> measured(k, 0), by_distance(k, 0);
+    std::vector<uint64_t> current(k, 0), alternative(k, 0);
     for (size_t n = 0; n < nodes.size(); ++n) {
-        measured[cluster[n]] += passed[n * 2 * k + cluster[n]];
-        by_distance[cluster[n]] += passed[n * 2 * k + k + cluster[n]];
+        current[cluster[n]] += passed[n * 2 * k + cluster[n]];
+        alternative[cluster[n]] += passed[n * 2 * k + k + cluster[n]];
         choice.visible += visible[n];
     }
     choice.nodes = nodes.size();
     bool switched = false;
     for (size_t c = 0; c < k; ++c) {
-        choice.measured_passed += measured[c];
-        if (!distance[c].empty() && by_distance[c] < measured[c]) {
-            choice.distance[c] = 1;
+        choice.current_passed += current[c];
+        if (!alternatives[c].empty() && alternative[c] < current[c]) {
+            choice.taken[c] = 1;
             switched = true;
-            run.triangle_orders[c] = std::move(distance[c]);
-            choice.chosen_passed += by_distance[c];
+            run.triangle_orders[c] = std::move(alternatives[c]);
+            choice.chosen_passed += alternative[c];
         } else {
-            choice.chosen_passed += measured[c];
+            choice.chosen_passed += current[c];
         }
     }
     if (!switched || k < 2) return choice;

@@ -257,7 +257,7 @@ AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double
     result.patches = build_mesh_patches(mesh, lambda, cache_size);
     // measured: the λ patches, whose distance order each cluster may keep (held_out_choice.h).
     const bool measured = settings.order == OrderSource::Measured;
-    MeshPatches lambda_patches;
+    MeshPatches lambda_patches, measured_pieces;
     if (measured) lambda_patches = result.patches;
     if (planar_units) {
         result.patches = build_planar_units(mesh, result.patches, 0, cache_size);
@@ -280,17 +280,20 @@ AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double
             result.patches = std::move(pieces);
         } else if (result.patches.patch_count() > kMaxListedUnits) {
             // Beyond kMaxListedUnits a node's lists are kept per triangle, and the graph, the
-            // counting and the search grow with the square of the units a pixel sees: runs of
-            // the patches (at λ = 3, single triangles) packed along the cache order instead.
+            // counting and the search grow with the square of the units a pixel sees: k-means
+            // runs as `single`'s over the patches, then each cluster's measured order of runs
+            // of them (at λ = 3, single triangles) packed along the cache order, from some of
+            // its nodes, replaces the distance order where the held-out views say so.
             const size_t most = (result.patches.patch_count() + kMaxListedUnits - 1) / kMaxListedUnits;
-            MeshPatches pieces = patch_pieces(result.patches, most);
+            measured_pieces = patch_pieces(result.patches, most);
             if (settings.log)
                 settings.log("units: " + std::to_string(result.patches.patch_count()) + " patches, more than " +
-                             std::to_string(kMaxListedUnits) + ": " + std::to_string(pieces.patch_count()) +
-                             " pieces of at most " + std::to_string(most) + " triangles");
-            result.patches = std::move(pieces);
+                             std::to_string(kMaxListedUnits) + ": `single`'s k-means over them, then measured orders "
+                             "of " + std::to_string(measured_pieces.patch_count()) + " pieces of at most " +
+                             std::to_string(most) + " triangles checked against its orders on held-out views");
         }
     }
+    const bool refine = measured && measured_pieces.patch_count() > 0;
     result.seconds_patches = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     result.framing = frame_animated_mesh(mesh);
 
@@ -324,26 +327,38 @@ AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double
                     settings.progress(clip + stage, done, total);
                 };
         }
+        if (refine) {  // `single`'s k-means exactly (its stop rule too), measured orders after
+            run_settings.order = OrderSource::Distance;
+            run_settings.settled_gain = 0;
+        }
         result.runs.push_back(cluster_nodes(mesh, result.patches, framing, keyframes, run_settings));
         if (measured && !framing.shows_nothing()) {
             ClusteringResult& run = result.runs.back();
             const auto held_start = std::chrono::steady_clock::now();
-            const HeldOutChoice choice = choose_on_held_out_views(mesh, lambda_patches, framing, settings.resolution,
-                                                                  settings.threads, run);
+            // The alternative to each cluster's order: the distance order of the λ patches after
+            // measured k-means, or the measured order of the pieces after `single`'s.
+            const size_t stride = (run.assignment.size() + kMeasuredRefineNodes - 1) / kMeasuredRefineNodes;
+            const HeldOutChoice choice = choose_on_held_out_views(
+                mesh, framing, settings.resolution, settings.threads, run,
+                refine ? measured_cluster_orders(mesh, measured_pieces, framing, run, settings.resolution,
+                                                 settings.threads, std::max<size_t>(1, stride))
+                       : distance_cluster_orders(mesh, lambda_patches, framing, run));
             run.held_out_nodes = choice.nodes;
-            run.held_out_distance = choice.distance;
+            run.held_out_distance = choice.taken;
+            if (refine)
+                for (uint8_t& d : run.held_out_distance) d = !d;
             run.seconds_held_out =
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - held_start).count();
             if (run_settings.log) {
                 size_t kept = 0;
-                for (const uint8_t d : choice.distance) kept += d;
+                for (const uint8_t d : run.held_out_distance) kept += d;
                 const auto ovr = [&](uint64_t passed) {
                     return choice.visible ? std::to_string(double(passed) / double(choice.visible)) : std::string("-");
                 };
                 run_settings.log("held-out views: " + std::to_string(choice.nodes) + " nodes; the distance order kept in " +
-                                 std::to_string(kept) + " of " + std::to_string(choice.distance.size()) +
-                                 " clusters (OVR there " + ovr(choice.measured_passed) + " measured, " +
-                                 ovr(choice.chosen_passed) + " kept); " + std::to_string(choice.reassigned) +
+                                 std::to_string(kept) + " of " + std::to_string(choice.taken.size()) +
+                                 " clusters (OVR there " + ovr(choice.current_passed) + " before, " +
+                                 ovr(choice.chosen_passed) + " after); " + std::to_string(choice.reassigned) +
                                  " clustering nodes reassigned");
             }
         }

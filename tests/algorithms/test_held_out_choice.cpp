@@ -1,10 +1,11 @@
 // The held-out check of measured orders (held_out_choice.cpp): on the bundled character's walk,
 // a cluster whose order is made bad on purpose (its distance order reversed: far patches first)
-// takes the distance order; a buffer that already is that order is kept (the check asks for
+// takes the distance order offered as the alternative; a buffer that already is that order is kept (the check asks for
 // strictly fewer fragments); after a change every clustering node is drawn by the buffer that
 // passes the fewest of its fragments, checked node by node against a second scoring.
 #include "animorder/clustering.h"
 #include "animorder/held_out_choice.h"
+#include "animorder/invalid_input.h"
 #include "animorder/mesh_patches.h"
 #include "animorder/overdraw.h"
 #include "animorder/procedural_character.h"
@@ -84,11 +85,12 @@ TEST(HeldOutChoice, ABadOrderGivesWayToTheDistanceOrderAndTheNodesFollow) {
     ClusteringResult reversed = w.run;
     for (auto& o : reversed.triangle_orders) std::reverse(o.begin(), o.end());
     const std::vector<uint32_t> assignment_before = reversed.assignment;
-    const HeldOutChoice first = choose_on_held_out_views(w.mesh, w.patches, w.framing, Walk::kResolution, 2, reversed);
+    const HeldOutChoice first = choose_on_held_out_views(w.mesh, w.framing, Walk::kResolution, 2, reversed,
+                                                         distance_cluster_orders(w.mesh, w.patches, w.framing, reversed));
     EXPECT_EQ(first.nodes, w.keyframes.size() * held_out_views_per_keyframe(w.keyframes.size()));
-    ASSERT_EQ(first.distance.size(), k);
-    for (size_t c = 0; c < k; ++c) EXPECT_EQ(first.distance[c], 1) << "cluster " << c;
-    EXPECT_LT(first.chosen_passed, first.measured_passed);
+    ASSERT_EQ(first.taken.size(), k);
+    for (size_t c = 0; c < k; ++c) EXPECT_EQ(first.taken[c], 1) << "cluster " << c;
+    EXPECT_LT(first.chosen_passed, first.current_passed);
     EXPECT_GE(first.chosen_passed, first.visible);  // at least one fragment a covered pixel
     for (size_t c = 0; c < k; ++c) {
         EXPECT_TRUE(test::is_permutation_of_iota(reversed.triangle_orders[c]));
@@ -110,9 +112,10 @@ TEST(HeldOutChoice, ABadOrderGivesWayToTheDistanceOrderAndTheNodesFollow) {
     // checked again, nothing is strictly better, nothing changes (orders, assignment).
     ClusteringResult again = w.run;
     again.triangle_orders = reversed.triangle_orders;
-    const HeldOutChoice second = choose_on_held_out_views(w.mesh, w.patches, w.framing, Walk::kResolution, 1, again);
-    for (size_t c = 0; c < k; ++c) EXPECT_EQ(second.distance[c], 0) << "cluster " << c;
-    EXPECT_EQ(second.measured_passed, second.chosen_passed);
+    const HeldOutChoice second = choose_on_held_out_views(w.mesh, w.framing, Walk::kResolution, 1, again,
+                                                          distance_cluster_orders(w.mesh, w.patches, w.framing, again));
+    for (size_t c = 0; c < k; ++c) EXPECT_EQ(second.taken[c], 0) << "cluster " << c;
+    EXPECT_EQ(second.current_passed, second.chosen_passed);
     EXPECT_EQ(second.reassigned, 0u);
     EXPECT_EQ(again.triangle_orders, reversed.triangle_orders);
     EXPECT_EQ(again.assignment, w.run.assignment);
@@ -123,11 +126,24 @@ TEST(HeldOutChoice, SameWhateverTheThreadCount) {
     ClusteringResult a = w.run, b = w.run;
     std::reverse(a.triangle_orders[1].begin(), a.triangle_orders[1].end());
     b.triangle_orders[1] = a.triangle_orders[1];
-    const HeldOutChoice one = choose_on_held_out_views(w.mesh, w.patches, w.framing, Walk::kResolution, 1, a);
-    const HeldOutChoice two = choose_on_held_out_views(w.mesh, w.patches, w.framing, Walk::kResolution, 2, b);
-    EXPECT_EQ(one.distance, two.distance);
+    const HeldOutChoice one = choose_on_held_out_views(w.mesh, w.framing, Walk::kResolution, 1, a,
+                                                       distance_cluster_orders(w.mesh, w.patches, w.framing, a));
+    const HeldOutChoice two = choose_on_held_out_views(w.mesh, w.framing, Walk::kResolution, 2, b,
+                                                       distance_cluster_orders(w.mesh, w.patches, w.framing, b));
+    EXPECT_EQ(one.taken, two.taken);
     EXPECT_EQ(one.chosen_passed, two.chosen_passed);
     EXPECT_EQ(a.triangle_orders, b.triangle_orders);
     EXPECT_EQ(a.assignment, b.assignment);
-    EXPECT_EQ(one.distance[1], 1);
+    EXPECT_EQ(one.taken[1], 1);
+    // The measured orders of the clusters (here over the λ patches themselves, every second node):
+    // the same with one worker or two, each a permutation that keeps every patch whole.
+    const auto m1 = measured_cluster_orders(w.mesh, w.patches, w.framing, w.run, Walk::kResolution, 1, 2);
+    const auto m2 = measured_cluster_orders(w.mesh, w.patches, w.framing, w.run, Walk::kResolution, 2, 2);
+    EXPECT_EQ(m1, m2);
+    for (const auto& order : m1) {
+        ASSERT_TRUE(test::is_permutation_of_iota(order));
+        EXPECT_TRUE(test::keeps_units_whole(order, w.patches.patch_starts, w.patches.cache_order));
+    }
+    // A stride of none is refused.
+    EXPECT_THROW(measured_cluster_orders(w.mesh, w.patches, w.framing, w.run, Walk::kResolution, 1, 0), InvalidInput);
 }

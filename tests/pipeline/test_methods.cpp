@@ -114,9 +114,10 @@ TEST(Methods, EveryClusteredMethodMisSortsNoMoreBlendedPairsThanSingle) {
 // the surface patches in pieces of kMeasuredSurfaceUnitTriangles as its units, at λ = 0.85 and 3;
 // single keeps the λ patches (its outputs do not change), and on a smooth mesh measured keeps
 // them too.
-// More λ patches than a kept node lists (kMaxListedUnits): measured's units are runs of them,
-// as few patches a run as bring the units within the limit (a 20k-triangle knot at λ = 3: pairs).
-TEST(Methods, MeasuredPacksPatchesBeyondTheListedUnits) {
+// More λ patches than a kept node lists (kMaxListedUnits): measured runs `single`'s k-means over
+// them, then offers each cluster the measured order of runs of them (a 20k-triangle knot at
+// λ = 3: pairs): every buffer is `single`'s own, or one that keeps every pair whole.
+TEST(Methods, MeasuredBeyondTheListedUnitsIsSinglesKMeansWithMeasuredOrdersOffered) {
     const AnimatedMesh knot = make_torus_knot(20000);
     MethodSettings settings;
     settings.lambda = 3;
@@ -130,9 +131,20 @@ TEST(Methods, MeasuredPacksPatchesBeyondTheListedUnits) {
     const MeshPatches pairs = patch_pieces(patches, 2);
     EXPECT_LE(pairs.patch_count(), kMaxListedUnits);
     const MethodResult measured = run_method(knot, Method::Measured, settings);
-    EXPECT_EQ(measured.patch_count, pairs.patch_count());
-    for (const auto& order : measured.buffers.orders) EXPECT_TRUE(test::is_permutation_of_iota(order));
-    EXPECT_EQ(run_method(knot, Method::Single, settings).patch_count, patches.patch_count());
+    const MethodResult single = run_method(knot, Method::Single, settings);
+    EXPECT_EQ(measured.patch_count, patches.patch_count());
+    ASSERT_EQ(measured.buffers.orders.size(), single.buffers.orders.size());
+    ASSERT_EQ(measured.runs.size(), 1u);
+    ASSERT_EQ(measured.runs[0].held_out_distance.size(), measured.buffers.orders.size());
+    for (size_t b = 0; b < measured.buffers.orders.size(); ++b) {
+        const auto& order = measured.buffers.orders[b];
+        EXPECT_TRUE(test::is_permutation_of_iota(order));
+        if (measured.runs[0].held_out_distance[b])
+            EXPECT_EQ(order, single.buffers.orders[b]) << "buffer " << b << " kept as single's";
+        else
+            EXPECT_TRUE(test::keeps_units_whole(order, pairs.patch_starts, pairs.cache_order)) << "buffer " << b;
+    }
+    EXPECT_EQ(measured.runs[0].iterations.size(), single.runs[0].iterations.size());  // the same k-means
 }
 
 TEST(Methods, MeasuredTakesSurfacePiecesAsUnitsWhereThePatchesAreSingleTriangles) {

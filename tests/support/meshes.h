@@ -55,6 +55,18 @@ inline bool is_permutation_of_iota(const std::vector<uint32_t>& order) {
     return true;
 }
 
+// Every unit's triangles (unit u: cache_order[unit_starts[u] .. unit_starts[u + 1])) drawn one after
+// another in `order`, in the unit's own inner order.
+inline bool keeps_units_whole(const std::vector<uint32_t>& order, const std::vector<uint32_t>& unit_starts,
+                              const std::vector<uint32_t>& cache_order) {
+    std::vector<size_t> position(order.size());
+    for (size_t i = 0; i < order.size(); ++i) position[order[i]] = i;
+    for (size_t u = 0; u + 1 < unit_starts.size(); ++u)
+        for (uint32_t j = unit_starts[u] + 1; j < unit_starts[u + 1]; ++j)
+            if (position[cache_order[j]] != position[cache_order[j - 1]] + 1) return false;
+    return true;
+}
+
 inline std::vector<uint32_t> applied(const std::vector<uint32_t>& indices, const std::vector<uint32_t>& order) {
     std::vector<uint32_t> out(indices.size());
     apply_triangle_order(out.data(), indices.data(), order.data(), order.size());

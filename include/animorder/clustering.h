@@ -93,8 +93,10 @@ struct ClusteringResult {
     size_t kept_nodes = 0;             // nodes whose fragments fit the cache budget (the first ones)
     size_t kept_bytes = 0;             // their compact fragments (KeptNode)
     // `measured` only (held_out_choice.h): the held-out nodes its buffers were checked on, and per
-    // cluster 1 where the integrated-distance order was kept (triangle_orders then hold it, and
-    // patch_orders the measured one it replaced); empty for other methods.
+    // cluster 1 where its buffer (triangle_orders) is the integrated-distance order, 0 where it is
+    // a measured one; empty for other methods. patch_orders stay those of the k-means itself (the
+    // measured ones; `single`'s distance ones where measured ran `single`'s k-means: methods.h).
+    // The check may drop a buffer no node draws any more (fewer than k then).
     size_t held_out_nodes = 0;
     std::vector<uint8_t> held_out_distance;
     double seconds_held_out = 0;

@@ -48,6 +48,7 @@ struct HeldOutChoice {
     uint64_t chosen_passed = 0;      // … by the buffers kept
     uint64_t visible = 0;            // pixels covered on them (the overdraw ratio's denominator)
     size_t reassigned = 0;           // clustering nodes moved to another buffer after a change
+    size_t dropped = 0;              // buffers no node drew after that: removed, the rest renumbered
 };
 
 // For each cluster c of `run`, alternatives[c] (a face permutation; empty: none) replaces
@@ -55,7 +56,8 @@ struct HeldOutChoice {
 // c's buffer is drawn at (opaque pass, as the evaluation scores). When some order changed, every
 // clustering node then goes to the kept buffer that passes the fewest of its fragments
 // (run.assignment; ties keep its cluster, then the lower one), as k-means' assignment step
-// would. run.patch_orders is left as it was. framing: the run's (its R). Deterministic, whatever
+// would, and a buffer left with no node is removed (triangle_orders, patch_orders, taken; the
+// assignment renumbered). run.patch_orders is left as it was otherwise. framing: the run's (its R). Deterministic, whatever
 // the thread count (0: all cores).
 HeldOutChoice choose_on_held_out_views(const AnimatedMesh& mesh, const Framing& framing, unsigned resolution,
                                        unsigned threads, ClusteringResult& run,

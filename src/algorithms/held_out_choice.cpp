@@ -92,6 +92,8 @@ std::vector<std::vector<uint32_t>> measured_cluster_orders(const AnimatedMesh& m
     std::vector<std::vector<uint32_t>> orders(k);
     // The clusters side by side, each counted by one worker straight into its own graph.
     tbb::task_arena arena(worker_threads(threads));
+    const uint64_t workers = uint64_t(arena.max_concurrency());
+    constexpr uint64_t kTransientBytes = uint64_t(64) << 20;
     arena.execute([&] {
         tbb::parallel_for(size_t(0), k, [&](size_t c) {
             if (nodes[c].empty()) return;
@@ -101,14 +103,20 @@ std::vector<std::vector<uint32_t>> measured_cluster_orders(const AnimatedMesh& m
             score.triangle_modes = modes.empty() ? nullptr : modes.data();
             MeasuredPairCounts graph(units.patch_count(), unit_of_triangle.data(), unit_of_triangle.size(),
                                      units.patch_primitive.data());
-            constexpr size_t kChunk = 16;  // nodes rasterised at a time (their full fragment lists)
-            for (size_t begin = 0; begin < nodes[c].size(); begin += kChunk) {
-                const size_t count = std::min(kChunk, nodes[c].size() - begin);
+            // Full fragment lists a chunk at a time, about kTransientBytes per worker: one node
+            // first, then as many as the nodes so far say fit (a node at 4096² is hundreds of MB).
+            uint64_t bytes = 0;
+            for (size_t begin = 0, count = 1; begin < nodes[c].size(); begin += count) {
+                if (begin > 0) count = std::clamp<size_t>(size_t(kTransientBytes * begin / (bytes * workers + 1)), 1, 64);
+                count = std::min(count, nodes[c].size() - begin);
                 const std::vector<NodeFragments> fragments = rasterize_nodes(
                     mesh.keyframe_positions.data(), mesh.vertex_count, framing, mesh.indices.data(),
                     mesh.indices.size(), nodes[c].data() + begin, count, score, SIZE_MAX);
                 std::vector<const NodeFragments*> pointers;
-                for (const NodeFragments& f : fragments) pointers.push_back(&f);
+                for (const NodeFragments& f : fragments) {
+                    pointers.push_back(&f);
+                    bytes += f.bytes();
+                }
                 graph.add(pointers.data(), pointers.size(), +1, 1);
             }
             const std::vector<Arc> arcs = graph.arcs();
@@ -148,10 +156,11 @@ HeldOutChoice choose_on_held_out_views(const AnimatedMesh& mesh, const Framing& 
             node.keyframe = run.keyframes[i];
             std::copy(&directions[3 * v], &directions[3 * v] + 3, node.direction);
             size_t nearest = 0;
-            float best = -2.0f;
+            double best = -2.0;
             for (size_t u = 0; u < views; ++u) {
                 const float* d = &run.directions[3 * u];
-                const float dot = d[0] * node.direction[0] + d[1] * node.direction[1] + d[2] * node.direction[2];
+                const double dot = double(d[0]) * node.direction[0] + double(d[1]) * node.direction[1] +
+                                   double(d[2]) * node.direction[2];
                 if (dot > best) best = dot, nearest = u;
             }
             cluster[i * held_views + v] = run.assignment[i * views + nearest];
@@ -217,6 +226,26 @@ HeldOutChoice choose_on_held_out_views(const AnimatedMesh& mesh, const Framing& 
         choice.reassigned += best != run.assignment[n];
         run.assignment[n] = best;
     }
+    // A buffer no node draws any more is dropped and the others renumbered, as k-means' own
+    // finish does: a table never names it, so it would only be bytes in the file.
+    std::vector<uint32_t> renumbered(k, UINT32_MAX);
+    for (const uint32_t c : run.assignment) renumbered[c] = 0;
+    size_t kept = 0;
+    for (size_t c = 0; c < k; ++c) {
+        if (renumbered[c] == UINT32_MAX) continue;
+        renumbered[c] = uint32_t(kept);
+        if (kept != c) {  // (a vector moved onto itself is left empty)
+            run.triangle_orders[kept] = std::move(run.triangle_orders[c]);
+            if (run.patch_orders.size() == k) run.patch_orders[kept] = std::move(run.patch_orders[c]);
+            choice.taken[kept] = choice.taken[c];
+        }
+        ++kept;
+    }
+    choice.dropped = k - kept;
+    run.triangle_orders.resize(kept);
+    if (run.patch_orders.size() == k) run.patch_orders.resize(kept);
+    choice.taken.resize(kept);
+    for (uint32_t& c : run.assignment) c = renumbered[c];
     return choice;
 }
 

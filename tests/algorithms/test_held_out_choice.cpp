@@ -84,40 +84,43 @@ TEST(HeldOutChoice, ABadOrderGivesWayToTheDistanceOrderAndTheNodesFollow) {
     // clusters' orders reversed takes every one of them.
     ClusteringResult reversed = w.run;
     for (auto& o : reversed.triangle_orders) std::reverse(o.begin(), o.end());
-    const std::vector<uint32_t> assignment_before = reversed.assignment;
     const HeldOutChoice first = choose_on_held_out_views(w.mesh, w.framing, Walk::kResolution, 2, reversed,
                                                          distance_cluster_orders(w.mesh, w.patches, w.framing, reversed));
     EXPECT_EQ(first.nodes, w.keyframes.size() * held_out_views_per_keyframe(w.keyframes.size()));
     ASSERT_EQ(first.taken.size(), k);
-    for (size_t c = 0; c < k; ++c) EXPECT_EQ(first.taken[c], 1) << "cluster " << c;
     EXPECT_LT(first.chosen_passed, first.current_passed);
     EXPECT_GE(first.chosen_passed, first.visible);  // at least one fragment a covered pixel
-    for (size_t c = 0; c < k; ++c) {
+    // Buffers no node draws any more are dropped: the rest are the distance orders offered.
+    const size_t left = reversed.triangle_orders.size();
+    ASSERT_EQ(left + first.dropped, k);
+    ASSERT_GE(left, 1u);
+    for (size_t c = 0; c < left; ++c) {
+        ASSERT_EQ(reversed.triangle_orders[c].size(), w.mesh.triangle_count());
         EXPECT_TRUE(test::is_permutation_of_iota(reversed.triangle_orders[c]));
-        EXPECT_NE(reversed.triangle_orders[c], w.run.triangle_orders[c]) << "not simply reversed back";
+        EXPECT_EQ(first.taken[c], 1);
     }
     // The nodes went to the buffer that passes the fewest of their fragments (ties: their own).
     Walk scored = w;
     scored.run = reversed;
     const std::vector<uint64_t> passed = scored.learnt_passed();
-    size_t moved = 0;
     for (size_t n = 0; n < reversed.assignment.size(); ++n) {
-        const uint64_t* p = &passed[n * k];
-        for (size_t c = 0; c < k; ++c) EXPECT_LE(p[reversed.assignment[n]], p[c]) << "node " << n;
-        moved += reversed.assignment[n] != assignment_before[n];
+        const uint64_t* p = &passed[n * left];
+        ASSERT_LT(reversed.assignment[n], left);
+        for (size_t c = 0; c < left; ++c) EXPECT_LE(p[reversed.assignment[n]], p[c]) << "node " << n;
     }
-    EXPECT_EQ(moved, first.reassigned);
+    EXPECT_GT(first.reassigned, 0u);
 
-    // The same clusters (the assignment before the first check) holding those distance orders:
-    // checked again, nothing is strictly better, nothing changes (orders, assignment).
+    // The run's own clusters holding their own distance orders: checked, nothing is strictly
+    // better, nothing changes (orders, assignment).
     ClusteringResult again = w.run;
-    again.triangle_orders = reversed.triangle_orders;
+    again.triangle_orders = distance_cluster_orders(w.mesh, w.patches, w.framing, w.run);
     const HeldOutChoice second = choose_on_held_out_views(w.mesh, w.framing, Walk::kResolution, 1, again,
                                                           distance_cluster_orders(w.mesh, w.patches, w.framing, again));
     for (size_t c = 0; c < k; ++c) EXPECT_EQ(second.taken[c], 0) << "cluster " << c;
     EXPECT_EQ(second.current_passed, second.chosen_passed);
     EXPECT_EQ(second.reassigned, 0u);
-    EXPECT_EQ(again.triangle_orders, reversed.triangle_orders);
+    EXPECT_EQ(second.dropped, 0u);
+    EXPECT_EQ(again.triangle_orders, distance_cluster_orders(w.mesh, w.patches, w.framing, w.run));
     EXPECT_EQ(again.assignment, w.run.assignment);
 }
 
@@ -146,4 +149,37 @@ TEST(HeldOutChoice, SameWhateverTheThreadCount) {
     }
     // A stride of none is refused.
     EXPECT_THROW(measured_cluster_orders(w.mesh, w.patches, w.framing, w.run, Walk::kResolution, 1, 0), InvalidInput);
+}
+
+// A buffer that no clustering node draws after the reassignment is dropped, the others renumbered
+// (a lookup table never names it). Cluster 2's nodes handed to cluster 1 and its buffer made
+// cluster 1's (a node moves only to a strictly better buffer, and the lower of two equal ones);
+// cluster 0's order reversed (far patches first), giving way to its distance order: the nodes are
+// reassigned, and cluster 2, drawn by none, goes.
+TEST(HeldOutChoice, ABufferNoNodeDrawsAnyMoreIsDropped) {
+    Walk w;
+    ClusteringResult run = w.run;
+    for (uint32_t& c : run.assignment)
+        if (c == 2) c = 1;
+    run.triangle_orders[2] = run.triangle_orders[1];
+    std::reverse(run.triangle_orders[0].begin(), run.triangle_orders[0].end());
+    std::vector<std::vector<uint32_t>> alternatives = distance_cluster_orders(w.mesh, w.patches, w.framing, run);
+    ASSERT_TRUE(alternatives[2].empty());  // no node: nothing to offer
+    alternatives[1].clear();
+    const std::vector<uint32_t> distance = alternatives[0], second = run.triangle_orders[1];
+    const HeldOutChoice choice = choose_on_held_out_views(w.mesh, w.framing, Walk::kResolution, 2, run, alternatives);
+    ASSERT_EQ(choice.dropped, 1u);
+    ASSERT_EQ(run.triangle_orders.size(), 2u);
+    ASSERT_EQ(choice.taken, (std::vector<uint8_t>{1, 0}));
+    ASSERT_EQ(run.patch_orders.size(), 2u);
+    EXPECT_EQ(run.patch_orders[1], w.run.patch_orders[1]);
+    EXPECT_EQ(run.triangle_orders[0], distance);
+    EXPECT_EQ(run.triangle_orders[1], second);
+    std::vector<size_t> drawn(2, 0);
+    for (const uint32_t c : run.assignment) {
+        ASSERT_LT(c, 2u);
+        ++drawn[c];
+    }
+    EXPECT_GT(drawn[0], 0u);
+    EXPECT_GT(drawn[1], 0u);
 }

@@ -54,7 +54,7 @@ struct OptimizeOptions {
 
 struct EvaluateOptions {
     CommonOptions common;
-    std::string methods = "original,static-sander07,single";
+    std::string methods = "original,static-sander07,single,measured";
     MethodOptions method_options;
     EvaluationSettings evaluation;  // views, seed, resolution (threads from --threads)
     std::string report_path;

@@ -1,7 +1,7 @@
 // animorder view [FILE] — serves the viewer page (viewer/, with js/ and three.js from
 // viewer/node_modules) and FILE as /model.glb on 127.0.0.1 only, prints the address and opens it
 // in the default browser. Without FILE it first optimises the bundled character (subdivide
-// --levels 0, then optimize --method single) into a new scratch folder of its own (random name,
+// --levels 0, then optimize with the default method) into a new scratch folder of its own (random name,
 // mode 0700), and serves the un-optimised file too (/original.glb) so the page can compare the
 // original order with the optimised ones.
 // The server is deliberately tiny: GET and HEAD, one request per connection, nothing but loopback.

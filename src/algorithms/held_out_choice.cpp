@@ -8,9 +8,11 @@
 
 #include "animorder/invalid_input.h"
 #include "animorder/measured_order.h"
+#include "animorder/kept_fragments.h"
 #include "animorder/overdraw.h"
 
 #include "../support/worker_threads.h"
+#include "measured_update.h"
 
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -33,6 +35,24 @@ void check_run(const ClusteringResult& run) {
     for (const uint32_t c : run.assignment)
         if (c >= k)
             throw InvalidInput("held-out choice: a node of cluster " + std::to_string(c) + " of " + std::to_string(k));
+}
+
+// Clustering node n of the run: keyframes[n / views] seen from directions[n % views].
+OverdrawNode clustering_node(const ClusteringResult& run, size_t n) {
+    const size_t views = run.directions.size() / 3;
+    OverdrawNode node;
+    node.keyframe = run.keyframes[n / views];
+    std::copy(&run.directions[3 * (n % views)], &run.directions[3 * (n % views)] + 3, node.direction);
+    return node;
+}
+
+// The opaque pass at the run's resolution, as the evaluation scores it (modes must outlive it).
+ScoreSettings opaque_pass(const std::vector<uint8_t>& modes, unsigned resolution, unsigned threads) {
+    ScoreSettings score;
+    score.resolution = resolution;
+    score.threads = threads;
+    score.triangle_modes = modes.empty() ? nullptr : modes.data();
+    return score;
 }
 
 }  // namespace
@@ -72,42 +92,35 @@ std::vector<std::vector<uint32_t>> measured_cluster_orders(const AnimatedMesh& m
                                                            unsigned resolution, unsigned threads, size_t stride) {
     check_run(run);
     if (stride == 0) throw InvalidInput("measured cluster orders: a stride of 0 nodes");
-    const size_t k = run.triangle_orders.size(), views = run.directions.size() / 3;
-    std::vector<uint32_t> unit_of_triangle(mesh.triangle_count(), 0);
-    for (size_t u = 0; u < units.patch_count(); ++u)
-        for (uint32_t j = units.patch_starts[u]; j < units.patch_starts[u + 1]; ++j)
-            unit_of_triangle[units.cache_order[j]] = uint32_t(u);
+    const size_t k = run.triangle_orders.size();
+    const std::vector<uint32_t> unit_of_triangle =
+        make_unit_partition(units.patch_starts.data(), units.patch_count(), units.cache_order.data(),
+                            mesh.triangle_count())
+            .unit_of_triangle;
     // Every stride-th node of each cluster, in node order.
     std::vector<std::vector<OverdrawNode>> nodes(k);
     std::vector<size_t> seen(k, 0);
     for (size_t n = 0; n < run.assignment.size(); ++n) {
         const uint32_t c = run.assignment[n];
-        if (seen[c]++ % stride != 0) continue;
-        OverdrawNode node;
-        node.keyframe = run.keyframes[n / views];
-        std::copy(&run.directions[3 * (n % views)], &run.directions[3 * (n % views)] + 3, node.direction);
-        nodes[c].push_back(node);
+        if (seen[c]++ % stride == 0) nodes[c].push_back(clustering_node(run, n));
     }
     const std::vector<uint8_t> modes = opaque_pass_modes(mesh);
     std::vector<std::vector<uint32_t>> orders(k);
     // The clusters side by side, each counted by one worker straight into its own graph.
     tbb::task_arena arena(worker_threads(threads));
     const uint64_t workers = uint64_t(arena.max_concurrency());
-    constexpr uint64_t kTransientBytes = uint64_t(64) << 20;
     arena.execute([&] {
         tbb::parallel_for(size_t(0), k, [&](size_t c) {
             if (nodes[c].empty()) return;
-            ScoreSettings score;
-            score.resolution = resolution;
-            score.threads = 1;
-            score.triangle_modes = modes.empty() ? nullptr : modes.data();
+            const ScoreSettings score = opaque_pass(modes, resolution, 1);
             MeasuredPairCounts graph(units.patch_count(), unit_of_triangle.data(), unit_of_triangle.size(),
                                      units.patch_primitive.data());
-            // Full fragment lists a chunk at a time, about kTransientBytes per worker: one node
+            // Full fragment lists a chunk at a time, about kTransientFragmentBytes per worker: one node
             // first, then as many as the nodes so far say fit (a node at 4096² is hundreds of MB).
             uint64_t bytes = 0;
             for (size_t begin = 0, count = 1; begin < nodes[c].size(); begin += count) {
-                if (begin > 0) count = std::clamp<size_t>(size_t(kTransientBytes * begin / (bytes * workers + 1)), 1, 64);
+                if (begin > 0)
+                    count = std::clamp<size_t>(size_t(kTransientFragmentBytes * begin / (bytes * workers + 1)), 1, 64);
                 count = std::min(count, nodes[c].size() - begin);
                 const std::vector<NodeFragments> fragments = rasterize_nodes(
                     mesh.keyframe_positions.data(), mesh.vertex_count, framing, mesh.indices.data(),
@@ -173,10 +186,7 @@ HeldOutChoice choose_on_held_out_views(const AnimatedMesh& mesh, const Framing& 
     for (size_t c = 0; c < k; ++c) orders.push_back(alternatives[c].empty() ? run.triangle_orders[c].data() : alternatives[c].data());
     const std::vector<uint32_t> ranks = make_rank_table(orders, mesh.triangle_count());
     const std::vector<uint8_t> modes = opaque_pass_modes(mesh);
-    ScoreSettings score;
-    score.resolution = resolution;
-    score.threads = threads;
-    score.triangle_modes = modes.empty() ? nullptr : modes.data();
+    const ScoreSettings score = opaque_pass(modes, resolution, threads);
     std::vector<uint64_t> visible(nodes.size()), passed(nodes.size() * 2 * k);
     score_nodes(visible.data(), passed.data(), mesh.keyframe_positions.data(), mesh.vertex_count, framing,
                 mesh.indices.data(), mesh.indices.size(), nodes.data(), nodes.size(), ranks.data(), 2 * k, score);
@@ -206,11 +216,7 @@ HeldOutChoice choose_on_held_out_views(const AnimatedMesh& mesh, const Framing& 
     // buffer, of the k now kept, that passes the fewest of its fragments (k-means' assignment
     // step, rasterising the nodes once more; ties keep the node's cluster, then the lower one).
     std::vector<OverdrawNode> learnt(keyframes * views);
-    for (size_t i = 0; i < keyframes; ++i)
-        for (size_t v = 0; v < views; ++v) {
-            learnt[i * views + v].keyframe = run.keyframes[i];
-            std::copy(&run.directions[3 * v], &run.directions[3 * v] + 3, learnt[i * views + v].direction);
-        }
+    for (size_t n = 0; n < learnt.size(); ++n) learnt[n] = clustering_node(run, n);
     orders.clear();
     for (size_t c = 0; c < k; ++c) orders.push_back(run.triangle_orders[c].data());
     const std::vector<uint32_t> kept_ranks = make_rank_table(orders, mesh.triangle_count());

@@ -23,7 +23,6 @@ namespace {
 // rasterised again, a chunk of about kTransientFragmentBytes at a time (a few hundred nodes at
 // 256², a few dozen at 4096²: nodes beyond the budget never all come back at once). The counts
 // are sums, the same however the nodes are chunked.
-constexpr uint64_t kTransientFragmentBytes = uint64_t(64) << 20;
 
 bool all_kept(const NodeCache& cache, const std::vector<uint32_t>& which) {
     for (const uint32_t n : which)

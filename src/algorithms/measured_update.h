@@ -13,6 +13,10 @@
 
 namespace animorder {
 
+// Full fragment lists of nodes rasterised again are held about this many bytes at a time (a few
+// hundred nodes at 256², a few dozen at 4096²): by the update below, and by held_out_choice.cpp.
+constexpr uint64_t kTransientFragmentBytes = uint64_t(64) << 20;
+
 // OrderSource::Measured: each cluster's pair counts (measured_order.h), kept between iterations
 // and updated with the nodes that changed cluster only.
 struct MeasuredGraphs {

@@ -255,11 +255,12 @@ AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double
     AnimatedMethodResult result;
     const auto start = std::chrono::steady_clock::now();
     result.patches = build_mesh_patches(mesh, lambda, cache_size);
-    // measured: the λ patches, whose distance order each cluster may keep (held_out_choice.h).
+    // measured: the λ patches, whose distance order each cluster may keep (held_out_choice.h),
+    // set aside where other units replace them.
     const bool measured = settings.order == OrderSource::Measured;
     MeshPatches lambda_patches, measured_pieces;
-    if (measured) lambda_patches = result.patches;
     if (planar_units) {
+        lambda_patches = result.patches;
         result.patches = build_planar_units(mesh, result.patches, 0, cache_size);
     } else if (settings.order == OrderSource::Measured) {
         const std::vector<uint32_t> first = joined_vertices(mesh);
@@ -277,6 +278,7 @@ AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double
                              " pieces of at most " + std::to_string(most) +
                              " triangles of the surface's patches, not the " +
                              std::to_string(result.patches.patch_count()) + " patches of the vertex buffer");
+            lambda_patches = std::move(result.patches);
             result.patches = std::move(pieces);
         } else if (result.patches.patch_count() > kMaxListedUnits) {
             // Beyond kMaxListedUnits a node's lists are kept per triangle, and the graph, the
@@ -344,7 +346,8 @@ AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double
                 mesh, framing, settings.resolution, settings.threads, run,
                 refine ? measured_cluster_orders(mesh, measured_pieces, framing, run, settings.resolution,
                                                  settings.threads, std::max<size_t>(1, stride))
-                       : distance_cluster_orders(mesh, lambda_patches, framing, run));
+                       : distance_cluster_orders(mesh, lambda_patches.patch_count() ? lambda_patches : result.patches,
+                                                 framing, run));
             run.held_out_nodes = choice.nodes;
             run.held_out_distance = choice.taken;
             if (refine)

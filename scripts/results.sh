@@ -186,6 +186,10 @@ step materials/xbot-walk-single-sided.json $A evaluate "$DATA/glb-xbot/Xbot.glb"
 mkdir -p "$OUT/measured"
 step measured/ganfaul-idle.json $A evaluate "$GANFAUL" --clip Idle -q --methods single,measured \
   --lambda 0.85,3 --eval-views 300 --eval-resolution 512 -r "$OUT/measured/ganfaul-idle.json"
+# The same, counting every depth level in front (--front-levels 0) instead of the nearest two.
+step measured/ganfaul-idle-every-level.json $A evaluate "$GANFAUL" --clip Idle -q --methods measured \
+  --front-levels 0 --lambda 0.85,3 --eval-views 300 --eval-resolution 512 \
+  -r "$OUT/measured/ganfaul-idle-every-level.json"
 step measured/sweep-k.json $A evaluate "$GANFAUL" --clip Idle -q --methods single,measured,static-nehab06 \
   -k 1,2,3,5,8,12,16 --eval-views 100 --eval-resolution 256 -r "$OUT/measured/sweep-k.json"
 step measured/ganfaul-clips.json $A evaluate "$GANFAUL" -q --methods single,joint,measured,measured-joint \

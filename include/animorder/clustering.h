@@ -37,6 +37,13 @@ enum class OrderSource {
 // buffer id, within its clip, in one byte.
 constexpr size_t kMaxClusters = 255;
 
+// `measured` counts each unit's pixels against the units of this many nearest depth levels in
+// front of it (MeasuredPairCounts' front_levels), not every level: drawn after those, a unit is
+// hidden whatever the deeper levels hold. RESULTS.md's measured section has the pairs and the OVR
+// it saves and costs against every level (`--front-levels 0`).
+constexpr uint32_t kMeasuredFrontLevels = 2;
+constexpr uint32_t kMaxFrontLevels = 1024;
+
 struct ClusteringSettings {
     size_t clusters = 5;  // k, 1..kMaxClusters
     size_t views = 162;   // icosphere viewpoints (12, 42, 162, 642)
@@ -57,6 +64,7 @@ struct ClusteringSettings {
     DistanceVariant distance = DistanceVariant::Jcgt;
     UpdateRule update = UpdateRule::Monotone;
     OrderSource order = OrderSource::Distance;
+    uint32_t front_levels = kMeasuredFrontLevels;  // `measured`: as above; 0: every level in front
     unsigned threads = 0;
     // Nodes' fragments are kept between iterations (orders change, fragments do not), compactly
     // (kept_fragments.h), in node order while they fit in this many bytes; the nodes beyond are

@@ -36,10 +36,12 @@ std::vector<std::vector<uint32_t>> distance_cluster_orders(const AnimatedMesh& m
 // Each cluster's measured order (measured_order.h: the greedy feedback-arc-set order, then
 // sifting) of `units` from the overdraw graph over every `stride`-th of its nodes, rasterised
 // again (the clusters side by side, a chunk of nodes at a time), as a face permutation; empty for
-// a cluster no node is assigned to. For runs whose own units are too many to measure (methods.h).
+// a cluster no node is assigned to. front_levels: MeasuredPairCounts'. For runs whose own units
+// are too many to measure (methods.h).
 std::vector<std::vector<uint32_t>> measured_cluster_orders(const AnimatedMesh& mesh, const MeshPatches& units,
                                                            const Framing& framing, const ClusteringResult& run,
-                                                           unsigned resolution, unsigned threads, size_t stride);
+                                                           unsigned resolution, unsigned threads, size_t stride,
+                                                           uint32_t front_levels = kMeasuredFrontLevels);
 
 struct HeldOutChoice {
     size_t nodes = 0;                // held-out nodes scored

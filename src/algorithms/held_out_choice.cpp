@@ -89,7 +89,8 @@ std::vector<std::vector<uint32_t>> distance_cluster_orders(const AnimatedMesh& m
 
 std::vector<std::vector<uint32_t>> measured_cluster_orders(const AnimatedMesh& mesh, const MeshPatches& units,
                                                            const Framing& framing, const ClusteringResult& run,
-                                                           unsigned resolution, unsigned threads, size_t stride) {
+                                                           unsigned resolution, unsigned threads, size_t stride,
+                                                           uint32_t front_levels) {
     check_run(run);
     if (stride == 0) throw InvalidInput("measured cluster orders: a stride of 0 nodes");
     const size_t k = run.triangle_orders.size();
@@ -114,7 +115,7 @@ std::vector<std::vector<uint32_t>> measured_cluster_orders(const AnimatedMesh& m
             if (nodes[c].empty()) return;
             const ScoreSettings score = opaque_pass(modes, resolution, 1);
             MeasuredPairCounts graph(units.patch_count(), unit_of_triangle.data(), unit_of_triangle.size(),
-                                     units.patch_primitive.data());
+                                     units.patch_primitive.data(), front_levels);
             // Full fragment lists a chunk at a time, about kTransientFragmentBytes per worker: one node
             // first, then as many as the nodes so far say fit (a node at 4096² is hundreds of MB).
             uint64_t bytes = 0;

@@ -144,9 +144,11 @@ struct PairCounts {
 };
 
 // One list of units nearest first (unit | kTieBit at the previous entry's depth) into the counts,
-// `amount` times: each unit by its nearest entry, one count per pair at different depths.
+// `amount` times: each unit by its nearest entry, one count per pair at different depths, each
+// unit paired with the units of the `front_levels` nearest depth levels in front of it (of its
+// group; 0: every level).
 void accumulate_list(PairCounts& table, const uint32_t* units, uint32_t n, size_t unit_count, const uint32_t* group,
-                     int64_t amount, std::vector<std::pair<uint32_t, uint32_t>>& seen) {
+                     uint32_t front_levels, int64_t amount, std::vector<std::pair<uint32_t, uint32_t>>& seen) {
     seen.clear();  // (unit, depth level) of each unit's nearest entry, nearest first
     uint32_t level = 0;
     for (uint32_t i = 0; i < n; ++i) {
@@ -158,16 +160,25 @@ void accumulate_list(PairCounts& table, const uint32_t* units, uint32_t n, size_
         bool known = false;
         for (const auto& s : seen) known |= s.first == unit;
         if (known) continue;
-        for (const auto& s : seen)
-            if (s.second < level && (!group || group[s.first] == group[unit])) table.add(s.first, unit, amount);
+        uint32_t levels = 0, last = UINT32_MAX;  // the front levels met, nearest first
+        for (size_t q = seen.size(); q-- > 0;) {
+            const auto& s = seen[q];
+            if (s.second == level || (group && group[s.first] != group[unit])) continue;
+            if (s.second != last) {
+                if (levels == front_levels && front_levels != 0) break;
+                ++levels;
+                last = s.second;
+            }
+            table.add(s.first, unit, amount);
+        }
         seen.emplace_back(unit, level);
     }
 }
 
 // One node's pixels into the counts, each pixel's triangles mapped to their units.
 void accumulate_node(PairCounts& table, const NodeFragments& node, const uint32_t* unit_of_triangle,
-                     size_t triangle_count, size_t unit_count, const uint32_t* group, int64_t sign,
-                     std::vector<std::pair<uint32_t, uint32_t>>& seen, std::vector<uint32_t>& units) {
+                     size_t triangle_count, size_t unit_count, const uint32_t* group, uint32_t front_levels,
+                     int64_t sign, std::vector<std::pair<uint32_t, uint32_t>>& seen, std::vector<uint32_t>& units) {
     for (size_t p = 0; p + 1 < node.starts.size(); ++p) {
         units.clear();
         for (uint32_t i = node.starts[p]; i < node.starts[p + 1]; ++i) {
@@ -178,7 +189,7 @@ void accumulate_node(PairCounts& table, const NodeFragments& node, const uint32_
                                    ", but there are " + std::to_string(triangle_count));
             units.push_back(unit_of_triangle[triangle] | (f & kTieBit));
         }
-        accumulate_list(table, units.data(), uint32_t(units.size()), unit_count, group, sign, seen);
+        accumulate_list(table, units.data(), uint32_t(units.size()), unit_count, group, front_levels, sign, seen);
     }
 }
 
@@ -198,6 +209,7 @@ void sift_with(uint32_t* order, size_t unit_count, const Arc* arcs, size_t arc_c
 
 struct MeasuredPairCounts::State {
     std::vector<uint32_t> unit_of_triangle, group;
+    uint32_t front_levels = 0;
     PairCounts counts;
     explicit State(size_t units) : counts(units) {}
     struct Scratch {
@@ -210,10 +222,11 @@ struct MeasuredPairCounts::State {
 };
 
 MeasuredPairCounts::MeasuredPairCounts(size_t unit_count, const uint32_t* unit_of_triangle, size_t triangle_count,
-                                       const uint32_t* group) {
+                                       const uint32_t* group, uint32_t front_levels) {
     if (unit_count >= UINT32_MAX) throw InvalidInput("measured graph: too many units");
     state_ = std::make_unique<State>(unit_count);
     state_->unit_of_triangle.assign(unit_of_triangle, unit_of_triangle + triangle_count);
+    state_->front_levels = front_levels;
     if (group) state_->group.assign(group, group + unit_count);
 }
 MeasuredPairCounts::~MeasuredPairCounts() = default;
@@ -248,7 +261,7 @@ void MeasuredPairCounts::add(const NodeFragments* const* nodes, size_t node_coun
     const uint32_t* group = s.group.empty() ? nullptr : s.group.data();
     s.add_nodes(nodes, node_count, threads, [&](PairCounts& table, const NodeFragments& node, State::Scratch& w) {
         accumulate_node(table, node, s.unit_of_triangle.data(), s.unit_of_triangle.size(), s.counts.units, group,
-                        sign < 0 ? -1 : 1, w.seen, w.units);
+                        s.front_levels, sign < 0 ? -1 : 1, w.seen, w.units);
     });
 }
 
@@ -258,7 +271,7 @@ void MeasuredPairCounts::add(const KeptNode* const* nodes, size_t node_count, in
     s.add_nodes(nodes, node_count, threads, [&](PairCounts& table, const KeptNode& node, State::Scratch& w) {
         for_each_unit_list(node, s.unit_of_triangle.data(), s.unit_of_triangle.size(), w.units,
                            [&](const uint32_t* units, uint32_t n, uint32_t weight) {
-                               accumulate_list(table, units, n, s.counts.units, group,
+                               accumulate_list(table, units, n, s.counts.units, group, s.front_levels,
                                                (sign < 0 ? -1 : 1) * int64_t(weight), w.seen);
                            });
     });
@@ -274,29 +287,25 @@ std::vector<Arc> MeasuredPairCounts::arcs() const {
             arcs.push_back({hi, lo, uint64_t(-n)});
     };
     if (c.units <= kDenseMeasuredUnits) {
+        arcs.reserve(size_t(c.dense.size() - size_t(std::count(c.dense.begin(), c.dense.end(), 0))));
         for (uint32_t lo = 0; lo < c.units; ++lo)
             for (uint32_t hi = lo + 1; hi < c.units; ++hi) net(lo, hi, c.dense[PairCounts::slot(lo, hi)]);
     } else {
-        // In key order, whatever the table's layout: bucketed by the lower unit, then each
-        // bucket (a unit's few hundred pairs at most) sorted by the higher one.
-        struct Pair {
-            uint32_t hi;
-            int64_t net;
-        };
+        // In key order, whatever the table's layout: bucketed by the lower unit straight into the
+        // arcs (the net kept as the weight's bits), each bucket (a unit's few hundred pairs at
+        // most) sorted by the higher unit, then each arc turned to point from the unit in front.
         std::vector<size_t> first(c.units + 1, 0);
         c.sparse.for_each([&](uint32_t lo, uint32_t, int64_t n) { first[lo + 1] += n != 0; });
         std::partial_sum(first.begin(), first.end(), first.begin());
-        std::vector<Pair> all(first[c.units]);
-        std::vector<size_t> fill(first.begin(), first.end() - 1);
+        arcs.resize(first[c.units]);
         c.sparse.for_each([&](uint32_t lo, uint32_t hi, int64_t n) {
-            if (n != 0) all[fill[lo]++] = {hi, n};
+            if (n != 0) arcs[first[lo]++] = {lo, hi, uint64_t(n)};
         });
-        arcs.reserve(all.size());
-        for (uint32_t lo = 0; lo < c.units; ++lo) {
-            const auto begin = all.begin() + long(first[lo]), end = all.begin() + long(first[lo + 1]);
-            std::sort(begin, end, [](const Pair& a, const Pair& b) { return a.hi < b.hi; });
-            for (auto p = begin; p != end; ++p) net(lo, p->hi, p->net);
-        }
+        for (size_t lo = 0, begin = 0; lo < c.units; begin = first[lo++])
+            std::sort(arcs.begin() + long(begin), arcs.begin() + long(first[lo]),
+                      [](const Arc& a, const Arc& b) { return a.to < b.to; });
+        for (Arc& a : arcs)
+            if (int64_t(a.weight) < 0) a = {a.to, a.from, uint64_t(-int64_t(a.weight))};
     }
     return arcs;
 }
@@ -325,6 +334,7 @@ uint64_t sift_order(uint32_t* order, size_t unit_count, const Arc* arcs, size_t 
         ++start[a.to + 1];
     }
     std::partial_sum(start.begin(), start.end(), start.begin());
+    if (arc_count > UINT32_MAX) throw InvalidInput("sifting: " + std::to_string(arc_count) + " arcs, more than 2^32");
     if (narrow)
         sift_with<int32_t>(order, unit_count, arcs, arc_count, group, max_passes, start);
     else
@@ -347,20 +357,25 @@ void sift_with(uint32_t* order, size_t unit_count, const Arc* arcs, size_t arc_c
     // own neighbours moves: it is sorted again then, by insertion when few moved.
     std::vector<Neighbour> adjacency(start[unit_count]);
     {
-        // Each unit's arcs (s from the unit's side), then handed to the other ends in order of
-        // the unit's position: every list comes out sorted by position, in linear time.
-        std::vector<Neighbour> of_unit(start[unit_count]);
+        // Each unit's arcs (their indices), then handed to the other ends in order of the unit's
+        // position: every list comes out sorted by position, in linear time.
+        std::vector<uint32_t> arcs_of_unit(start[unit_count]);
         std::vector<size_t> fill(start.begin(), start.end() - 1);
         for (size_t i = 0; i < arc_count; ++i) {
             const Arc& a = arcs[i];
             if (a.from == a.to || (group && group[a.from] != group[a.to])) continue;
-            of_unit[fill[a.from]++] = {a.to, Weight(a.weight)};
-            of_unit[fill[a.to]++] = {a.from, Weight(-int64_t(a.weight))};
+            arcs_of_unit[fill[a.from]++] = uint32_t(i);
+            arcs_of_unit[fill[a.to]++] = uint32_t(i);
         }
         fill.assign(start.begin(), start.end() - 1);
         for (size_t x = 0; x < unit_count; ++x) {
             const uint32_t v = order[x];
-            for (size_t e = start[v]; e < start[v + 1]; ++e) adjacency[fill[of_unit[e].unit]++] = {v, -of_unit[e].s};
+            for (size_t e = start[v]; e < start[v + 1]; ++e) {
+                const Arc& a = arcs[arcs_of_unit[e]];  // the other end's entry s(other, v)
+                const bool other_first = a.to == v;
+                adjacency[fill[other_first ? a.from : a.to]++] = {
+                    v, other_first ? Weight(a.weight) : Weight(-int64_t(a.weight))};
+            }
         }
     }
     const auto before = [&](const Neighbour& a, const Neighbour& b) {
@@ -457,29 +472,33 @@ std::vector<uint32_t> measured_unit_order(size_t unit_count, const Arc* arcs, si
     std::iota(units.begin(), units.end(), 0u);
     if (group)
         std::stable_sort(units.begin(), units.end(), [&](uint32_t a, uint32_t b) { return group[a] < group[b]; });
-    std::vector<uint32_t> local(unit_count);
-    std::vector<uint32_t> greedy;
-    greedy.reserve(unit_count);
-    // Each group's arcs, in the given order: one pass over the arcs, not one per group.
     std::vector<uint32_t> block_of_unit(unit_count, 0);  // the rank of the unit's group among the groups
     size_t blocks = 0;
     for (size_t i = 0; i < unit_count; ++i) {
         const bool first = i == 0 || (group && group[units[i]] != group[units[i - 1]]);
         block_of_unit[units[i]] = first ? uint32_t(blocks++) : block_of_unit[units[i - 1]];
     }
-    std::vector<std::vector<size_t>> arcs_of_block(blocks);
-    for (size_t a = 0; a < arc_count; ++a)
-        if (!group || group[arcs[a].from] == group[arcs[a].to]) arcs_of_block[block_of_unit[arcs[a].from]].push_back(a);
-    for (size_t i = 0; i < unit_count;) {
-        size_t j = i;
-        while (j < unit_count && (!group || group[units[j]] == group[units[i]])) ++j;
-        for (size_t x = i; x < j; ++x) local[units[x]] = uint32_t(x - i);
-        std::vector<Arc> inside;
-        const std::vector<size_t>& block_arcs = arcs_of_block[block_of_unit[units[i]]];
-        inside.reserve(block_arcs.size());
-        for (const size_t a : block_arcs) inside.push_back({local[arcs[a].from], local[arcs[a].to], arcs[a].weight});
-        for (uint32_t x : order_feedback_arc_set(j - i, inside.data(), inside.size())) greedy.push_back(units[i + x]);
-        i = j;
+    std::vector<uint32_t> greedy;
+    if (blocks <= 1) {  // one group: its units in id order, every arc inside it (no copy of the arcs)
+        greedy = order_feedback_arc_set(unit_count, arcs, arc_count);
+    } else {
+        greedy.reserve(unit_count);
+        std::vector<uint32_t> local(unit_count);
+        // Each group's arcs, in the given order: one pass over the arcs, not one per group.
+        std::vector<std::vector<size_t>> arcs_of_block(blocks);
+        for (size_t a = 0; a < arc_count; ++a)
+            if (group[arcs[a].from] == group[arcs[a].to]) arcs_of_block[block_of_unit[arcs[a].from]].push_back(a);
+        for (size_t i = 0; i < unit_count;) {
+            size_t j = i;
+            while (j < unit_count && group[units[j]] == group[units[i]]) ++j;
+            for (size_t x = i; x < j; ++x) local[units[x]] = uint32_t(x - i);
+            std::vector<Arc> inside;
+            const std::vector<size_t>& block_arcs = arcs_of_block[block_of_unit[units[i]]];
+            inside.reserve(block_arcs.size());
+            for (const size_t a : block_arcs) inside.push_back({local[arcs[a].from], local[arcs[a].to], arcs[a].weight});
+            for (uint32_t x : order_feedback_arc_set(j - i, inside.data(), inside.size())) greedy.push_back(units[i + x]);
+            i = j;
+        }
     }
     MeasuredOrderStats s;
     s.greedy_weight = count_feedback_arcs(greedy.data(), unit_count, arcs, arc_count).weight;

@@ -71,7 +71,7 @@ std::vector<size_t> measured_update_orders(const MeasuredNodes& nodes, const Clu
                 state.unit_of_triangle[patches.cache_order[j]] = uint32_t(p);
         for (size_t c = 0; c < nodes.k; ++c)
             state.graphs.emplace_back(patches.patch_count(), state.unit_of_triangle.data(),
-                                      state.unit_of_triangle.size(), group);
+                                      state.unit_of_triangle.size(), group, settings.front_levels);
         state.counted.assign(nodes.count, UINT32_MAX);
         state.last.assign(nodes.k, {});
         state.start.assign(nodes.k, {});

@@ -150,6 +150,8 @@ void validate_method_settings(const MethodSettings& settings) {
         throw InvalidInput("k (clusters) must be between 1 and " + std::to_string(kMaxClusters));
     if (!(c.min_separation_deg >= 0 && c.min_separation_deg <= 180))
         throw InvalidInput("the minimum separation must be between 0 and 180 degrees");
+    if (c.front_levels > kMaxFrontLevels)
+        throw InvalidInput("front levels must be between 0 (every level) and " + std::to_string(kMaxFrontLevels));
     icosphere_subdivisions_for(c.views);  // throws for a count that is no icosphere
     icosphere_subdivisions_for(settings.nehab_views);
 }
@@ -345,7 +347,7 @@ AnimatedMethodResult run_han_sander(const AnimatedMesh& mesh, bool joint, double
             const HeldOutChoice choice = choose_on_held_out_views(
                 mesh, framing, settings.resolution, settings.threads, run,
                 refine ? measured_cluster_orders(mesh, measured_pieces, framing, run, settings.resolution,
-                                                 settings.threads, std::max<size_t>(1, stride))
+                                                 settings.threads, std::max<size_t>(1, stride), settings.front_levels)
                        : distance_cluster_orders(mesh, lambda_patches.patch_count() ? lambda_patches : result.patches,
                                                  framing, run));
             run.held_out_nodes = choice.nodes;

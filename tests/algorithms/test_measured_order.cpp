@@ -115,8 +115,30 @@ TEST(MeasuredGraph, SameWhateverTheThreadCountAndDropsArcsBetweenGroups) {
     }
 }
 
+TEST(MeasuredGraph, FrontLevelsPairEachUnitWithTheNearestDepthLevelsInFrontOnly) {
+    // One pixel, units 0..4 front to back, 1 and 2 at one depth (a tie): levels 0, 1, 1, 2, 3.
+    const std::vector<uint32_t> unit = {0, 1, 2, 3, 4};
+    const NodeFragments n = pixels({{0, 1, 2 | kTie, 3, 4}});
+    const NodeFragments* nodes[] = {&n};
+    const auto pairs = [&](uint32_t front_levels) {
+        MeasuredPairCounts counts(5, unit.data(), unit.size(), nullptr, front_levels);
+        counts.add(nodes, 1, +1, 1);
+        std::vector<std::pair<uint32_t, uint32_t>> out;
+        for (const Arc& a : counts.arcs()) out.emplace_back(a.from, a.to);
+        return out;
+    };
+    using P = std::vector<std::pair<uint32_t, uint32_t>>;
+    // Every level: every pair at different depths.
+    EXPECT_EQ(pairs(0), (P{{0, 1}, {0, 2}, {0, 3}, {0, 4}, {1, 3}, {1, 4}, {2, 3}, {2, 4}, {3, 4}}));
+    // One level: the tied 1 and 2 are one level, both in front of 3; 4 sees 3 only.
+    EXPECT_EQ(pairs(1), (P{{0, 1}, {0, 2}, {1, 3}, {2, 3}, {3, 4}}));
+    // Two levels: 3 reaches back to 0, 4 to 1 and 2 but not 0.
+    EXPECT_EQ(pairs(2), (P{{0, 1}, {0, 2}, {0, 3}, {1, 3}, {1, 4}, {2, 3}, {2, 4}, {3, 4}}));
+}
+
 // A second implementation of the graph's definition (a map of pair counts), against the library
-// on random pixels, with few units (the dense matrix) and many (the hash table).
+// on random pixels, with few units (the dense matrix) and many (the hash table), over every level
+// in front and over the nearest one and two (MeasuredPairCounts' front_levels).
 TEST(MeasuredGraph, MatchesASecondImplementationDenseAndSparse) {
     // 20: the dense triangle; 1700: 8-byte table slots; 70000: more than 16-bit unit ids, 16-byte slots.
     for (const size_t units : {size_t(20), size_t(1700), size_t(70000)}) {
@@ -125,7 +147,8 @@ TEST(MeasuredGraph, MatchesASecondImplementationDenseAndSparse) {
         std::vector<uint32_t> unit(triangles);
         for (size_t t = 0; t < triangles; ++t) unit[t] = uint32_t(rng() % units);
         std::vector<NodeFragments> nodes;
-        std::map<std::pair<uint32_t, uint32_t>, int64_t> front_of;  // (a, b): pixels with a strictly in front of b
+        // (a, b): pixels with a strictly in front of b, per front_levels 0, 1, 2
+        std::map<std::pair<uint32_t, uint32_t>, int64_t> front_of[3];
         for (int n = 0; n < 5; ++n) {
             std::vector<std::vector<uint32_t>> list;
             for (int p = 0; p < 400; ++p) {
@@ -141,23 +164,44 @@ TEST(MeasuredGraph, MatchesASecondImplementationDenseAndSparse) {
                     for (auto& x : first) known |= x.first == unit[t];
                     if (!known) first.emplace_back(unit[t], level);
                 }
-                for (auto& a : first)
-                    for (auto& b : first)
-                        if (a.second < b.second) ++front_of[{a.first, b.first}];
+                for (auto& b : first) {
+                    std::vector<int> levels;  // the distinct levels in front of b, nearest first
+                    for (auto& a : first)
+                        if (a.second < b.second) levels.push_back(a.second);
+                    std::sort(levels.rbegin(), levels.rend());
+                    levels.erase(std::unique(levels.begin(), levels.end()), levels.end());
+                    for (auto& a : first) {
+                        if (a.second >= b.second) continue;
+                        const long rank = std::find(levels.begin(), levels.end(), a.second) - levels.begin();
+                        for (int front_levels = 0; front_levels < 3; ++front_levels)
+                            if (front_levels == 0 || rank < front_levels) ++front_of[front_levels][{a.first, b.first}];
+                    }
+                }
                 list.push_back(px);
             }
             nodes.push_back(pixels(list));
         }
-        std::map<std::pair<uint32_t, uint32_t>, uint64_t> expected;
-        for (const auto& [pair, count] : front_of) {
-            const auto reverse = front_of.find({pair.second, pair.first});
-            const int64_t net = count - (reverse == front_of.end() ? 0 : reverse->second);
-            if (net > 0) expected[pair] = uint64_t(net);
+        std::vector<const NodeFragments*> pointers;
+        for (const NodeFragments& n : nodes) pointers.push_back(&n);
+        for (uint32_t front_levels = 0; front_levels < 3; ++front_levels) {
+            std::map<std::pair<uint32_t, uint32_t>, uint64_t> expected;
+            for (const auto& [pair, count] : front_of[front_levels]) {
+                const auto reverse = front_of[front_levels].find({pair.second, pair.first});
+                const int64_t net = count - (reverse == front_of[front_levels].end() ? 0 : reverse->second);
+                if (net > 0) expected[pair] = uint64_t(net);
+            }
+            MeasuredPairCounts counts(units, unit.data(), unit.size(), nullptr, front_levels);
+            counts.add(pointers.data(), pointers.size(), +1, 2);
+            std::map<std::pair<uint32_t, uint32_t>, uint64_t> got;
+            for (const Arc& a : counts.arcs()) got[{a.from, a.to}] = a.weight;
+            EXPECT_FALSE(expected.empty());
+            EXPECT_EQ(got, expected) << units << " units, " << front_levels << " front levels";
+            if (front_levels == 0) {
+                std::map<std::pair<uint32_t, uint32_t>, uint64_t> graph;
+                for (const Arc& a : graph_of(nodes, unit, units, nullptr, 2)) graph[{a.from, a.to}] = a.weight;
+                EXPECT_EQ(graph, expected) << units << " units, measured_overdraw_graph";
+            }
         }
-        std::map<std::pair<uint32_t, uint32_t>, uint64_t> got;
-        for (const Arc& a : graph_of(nodes, unit, units, nullptr, 2)) got[{a.from, a.to}] = a.weight;
-        EXPECT_FALSE(expected.empty());
-        EXPECT_EQ(got, expected) << units << " units";
     }
 }
 

@@ -252,6 +252,7 @@ int run_evaluate(const EvaluateOptions& options) {
                           {"nehab_views", b.nehab_views},
                           {"nehab_all_keyframes", b.nehab_all_keyframes},
                           {"blend_clusters", b.blend_clusters},
+                          {"front_levels", b.clustering.front_levels},
                           {"single_sided", options.single_sided},
                           {"cache_size", options.common.cache_size},
                           {"eval_views", eval.views},

@@ -128,6 +128,12 @@ void add_method_options(CLI::App& command, animorder::tool::MethodOptions& optio
     command.add_flag("--planar-units", m.measured_planar_units,
                      "measured: Nehab 2006 planar clusters as units (as many as lambda's patches), not patches");
     command
+        .add_option("--front-levels", c.front_levels,
+                    "measured: count each unit against the units of this many nearest depth levels in front "
+                    "(0: every level)")
+        ->capture_default_str()
+        ->check(CLI::Range(0u, animorder::kMaxFrontLevels));
+    command
         .add_option("--fragment-memory", c.max_cache_bytes,
                     "k-means methods: bytes for the nodes' kept fragments; nodes beyond are rasterised again "
                     "each iteration (same result, slower)")

@@ -65,7 +65,8 @@ nlohmann::ordered_json optimize_settings_json(const OptimizeOptions& options, co
                                        {"nehab_views", m.nehab_views},
                                        {"nehab_all_keyframes", m.nehab_all_keyframes},
                                        {"blend_clusters", m.blend_clusters},
-                                       {"planar_units", m.measured_planar_units}};
+                                       {"planar_units", m.measured_planar_units},
+                                       {"front_levels", m.clustering.front_levels}};
     if (with_threads) {  // how it ran, which changes no output: threads used, the memory budgets
         const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
         settings["threads"] = m.clustering.threads ? std::min(m.clustering.threads, cores) : cores;

@@ -51,6 +51,7 @@ packages=(
   libegl-dev libopengl-dev libgl-dev libegl-mesa0 libgl1-mesa-dri  # OpenGL reference (llvmpipe)
   strace procps                            # signal tests: strace slows a commit down; pgrep finds the child
   util-linux                               # unshare -p (a PID namespace); essential, so normally present
+  slurm-wlm munge                          # batch as a SLURM array job on a one-node cluster (tests/tool/one-node-slurm.sh)
 )
 
 # Node.js runs the Khronos glTF Validator in the tests; any node >= 12 will do (the machine's own

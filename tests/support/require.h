@@ -33,8 +33,9 @@ namespace animorder::test {
 //   namespaces  unshare -p -f --mount-proc (util-linux; root): a PID namespace
 //   root        running as root (files of another user, setresuid)
 //   proc        /proc mounted
-inline constexpr const char* kComponents[] = {"gl",      "validator", "data",       "results", "gltf-tools", "node",
-                                              "browser", "strace",    "namespaces", "root",    "proc"};
+//   slurm       a one-node SLURM started in a scratch folder (slurm-wlm, munge; tests/tool/one-node-slurm.sh)
+inline constexpr const char* kComponents[] = {"gl",     "validator",  "data", "results", "gltf-tools", "node",
+                                              "browser", "strace", "namespaces", "root",    "proc",       "slurm"};
 
 inline bool known_component(const std::string& name) {
     for (const char* c : kComponents)

@@ -16,6 +16,7 @@
 #include <unistd.h>
 #include <chrono>
 #include <csignal>
+#include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -789,6 +790,77 @@ TEST_F(Batch, TheReadmesKubernetesCommandCompletesAShardWithAFailedItem) {
     // An error before any work (here a manifest that is not JSON) still fails the pod.
     write("m.json", "not json");
     EXPECT_EQ(run_shell("JOB_COMPLETION_INDEX=0 sh -c '" + command + "'").exit_code, 1);
+}
+
+// docs/batch.md's SLURM lines, as written, on a real one-node SLURM (Debian's slurm-wlm and munge,
+// started in the test's folder by tests/tool/one-node-slurm.sh): the array job's tasks run the
+// manifest's items as shards on the cluster, the merge writes the summary, and every file and the
+// summary are the bytes of one local run of the same manifest.
+TEST_F(Batch, TheReadmesSlurmArrayJobGivesTheFilesAndSummaryOfOneLocalRun) {
+    const std::string doc = test::slurp(fs::path(ANIMORDER_SOURCE_DIR) / "docs" / "batch.md");
+    const size_t open = doc.find("```sh\nsbatch ");
+    ASSERT_NE(open, std::string::npos) << "docs/batch.md has no SLURM block";
+    const size_t begin = open + 6, end = doc.find("```", begin);
+    const std::string lines = doc.substr(begin, end - begin);
+    ASSERT_NE(lines.find("--array="), std::string::npos) << lines;
+    ASSERT_NE(lines.find("--wait"), std::string::npos) << lines;  // else the merge would not wait for the tasks
+
+    // The cluster's folder: a second scratch folder of this test, with a short path (slurmd's
+    // sockets live in it, and a Unix socket's path has at most 108 bytes).
+    char cluster_template[] = "/tmp/animorder-slurm-XXXXXX";
+    ASSERT_NE(::mkdtemp(cluster_template), nullptr);
+    const std::string cluster = cluster_template;
+    const std::string script = std::string(ANIMORDER_SOURCE_DIR) + "/tests/tool/one-node-slurm.sh";
+    const test::Outcome started = run_shell("bash " + script + " start " + cluster);
+    struct Stop {  // the daemons end with the test, whatever it did, and their folder goes
+        std::string command, folder;
+        ~Stop() {
+            if (std::system(command.c_str()) != 0) ADD_FAILURE() << command;
+            fs::remove_all(folder);
+        }
+    } stop{"bash " + script + " stop " + cluster + " > /dev/null 2>&1", cluster};
+    ANIMORDER_REQUIRE_OR_SKIP("slurm", started.exit_code == 0,
+                              "no one-node SLURM could be started: " + started.err);
+    const std::string conf = started.out.substr(0, started.out.find('\n'));
+    ASSERT_EQ(conf.rfind("SLURM_CONF=", 0), 0u) << started.out;
+
+    // Several characters: the bundled one (clips, joint, static methods) and the same exported
+    // as a glTF binary with a clip of its own.
+    ASSERT_EQ(run("subdivide -q --levels 0 --clip wave -o " + path("wave.glb").string()).exit_code, 0);
+    std::string items = kFiveItems;
+    items.replace(items.rfind("]}"), 2,
+                  ",\n  {\"name\": \"wave-glb\", \"input\": \"wave.glb\", \"options\": \"" + kFast +
+                      "\", \"output\": \"out/wave-glb\"},\n"
+                      "  {\"name\": \"wave-glb-sander\", \"input\": \"wave.glb\", \"method\": \"static-sander07\", "
+                      "\"output\": \"out/wave-glb-sander\"}\n]}");
+    write("manifest.json", items);
+    const test::Outcome local = run("batch -q --no-timings " + path("manifest.json").string());
+    ASSERT_EQ(local.exit_code, 0) << local.err;
+    const std::map<std::string, std::string> local_files = outputs();
+    const std::string summary_json = test::slurp_existing(path("manifest.summary.json")),
+                      summary_md = test::slurp_existing(path("manifest.summary.md"));
+    ASSERT_EQ(local_files.size(), 7u * 3u);  // each item: sidecar, its description, its report
+    for (const auto& e : fs::directory_iterator(path("out"))) fs::remove(e.path());
+    fs::remove(path("manifest.summary.json"));
+    fs::remove(path("manifest.summary.md"));
+
+    // The lines as written, with this build's animorder first on the PATH (sbatch passes the
+    // environment on to the tasks) and a bound on the whole: a cluster that never ran the tasks
+    // fails the test, not CI's time limit.
+    write("slurm-lines.sh", "set -e\n" + lines);
+    const std::string bin = fs::path(ANIMORDER_EXE).parent_path().string();
+    const test::Outcome farm =
+        run_shell("cd " + dir_.string() + " && env " + conf + " PATH=" + bin + ":\"$PATH\" timeout 600 bash slurm-lines.sh");
+    ASSERT_EQ(farm.exit_code, 0) << farm.out << farm.err;
+    // Every task ran on the cluster (its output file: slurm-JOB_TASK.out), shards beyond the
+    // items' count with nothing to do.
+    size_t task_logs = 0;
+    for (const auto& e : fs::directory_iterator(dir_))
+        task_logs += e.path().filename().string().rfind("slurm-", 0) == 0 && e.path().extension() == ".out";
+    EXPECT_EQ(task_logs, 50u);
+    EXPECT_EQ(outputs(), local_files);
+    EXPECT_EQ(test::slurp_existing(path("manifest.summary.json")), summary_json);
+    EXPECT_EQ(test::slurp_existing(path("manifest.summary.md")), summary_md);
 }
 
 // An output emptied or changed after its run is not up to date: the item is redone (only the

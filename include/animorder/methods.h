@@ -172,6 +172,10 @@ struct MethodResult {
     std::vector<double> run_seconds;
 };
 
+// The library's version, "MAJOR.MINOR.PATCH": the package's (`animorder --version`, the CMake
+// package's and pkg-config's).
+const char* library_version();
+
 // Runs the method on the whole mesh. Throws InvalidInput for an invalid mesh or settings.
 // Primitives loaded from one file primitive (a glTF mesh several nodes draw) share its one index
 // buffer, so every buffer gives them the first one's order (tie_instances; the k-means runs'

@@ -143,6 +143,8 @@ UpdateRule parse_update(const std::string& name) {
     throw InvalidInput("the update rule must be monotone or paper, not '" + name + "'");
 }
 
+const char* library_version() { return ANIMORDER_VERSION; }
+
 void validate_method_settings(const MethodSettings& settings) {
     if (!std::isfinite(settings.lambda)) throw InvalidInput("lambda must be a finite number");
     const ClusteringSettings& c = settings.clustering;

@@ -52,6 +52,7 @@ packages=(
   strace procps                            # signal tests: strace slows a commit down; pgrep finds the child
   util-linux                               # unshare -p (a PID namespace); essential, so normally present
   slurm-wlm munge                          # batch as a SLURM array job on a one-node cluster (tests/tool/one-node-slurm.sh)
+  python3-dev python3-pybind11 python3-numpy python3-pytest  # the Python module (python/) and its tests
 )
 
 # Node.js runs the Khronos glTF Validator in the tests; any node >= 12 will do (the machine's own

@@ -244,6 +244,12 @@ if [ -x "$BIN/bench/bench_scale" ] && selected bench-baseline.txt && [ ! -s "$OU
   BASELINE_ANIMORDER=$(bash scripts/build-baseline.sh | tail -n 1)
   step_stdout bench-baseline.txt "$BIN/bench/bench_scale" --baseline "$BASELINE_ANIMORDER" --rounds 5 xbot-single xbot-single-sided clip60-single
 fi
+# Issue 52: the Python module's overhead over the CLI, Ganfaul Idle with the default method, each
+# a whole process, rounds interleaved (goal: at most 5% over the CLI's time).
+if ls "$BIN"/python/animorder*.so > /dev/null 2>&1; then
+  step_stdout bench-python.txt env PYTHONPATH="$BIN/python" /usr/bin/python3 bench/bench_python.py "$BIN/animorder" \
+    "$GANFAUL" --clip Idle --rounds 5
+fi
 mkdir -p "$OUT/out"
 step optimize-ganfaul-idle.json $A optimize --method single "$GANFAUL" --clip Idle -q \
   -o "$OUT/out/ganfaul-idle" --report "$OUT/optimize-ganfaul-idle.json"

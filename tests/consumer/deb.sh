@@ -38,4 +38,11 @@ mkdir -p "$scratch/packaged" "$scratch/built"
 "$build/animorder" optimize -q -k 2 --views 12 --resolution 32 --max-iterations 2 -o "$scratch/built/out"
 cmp "$scratch/packaged/out.animorder.bin" "$scratch/built/out.animorder.bin"
 cmp "$scratch/packaged/out.animorder.json" "$scratch/built/out.animorder.json"
+# The Python module, where the build has one: it imports from the package's dist-packages.
+if ls "$build"/python/animorder*.so > /dev/null 2>&1; then
+  module=$(PYTHONPATH=$root/lib/python3/dist-packages /usr/bin/python3 -c \
+    'import animorder; print(animorder.__file__, animorder.__version__)')
+  [[ "$module" == "$root/lib/python3/dist-packages/animorder"*" $version" ]] ||
+    { echo "deb.sh: the packaged Python module is not imported from the package: $module" >&2; exit 1; }
+fi
 echo "deb.sh: $(basename "$deb") unpacks, declares its dependencies and its tool writes the build's bytes"

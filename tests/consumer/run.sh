@@ -50,4 +50,20 @@ g++ -std=c++17 -O1 "$here/main.cpp" $flags -o "$scratch/consumer-pc"
 cmp "$scratch/pc.animorder.bin" "$expected"
 [ "$(PKG_CONFIG_PATH=$(dirname "$pc") pkg-config --modversion animorder)" = "$("$prefix/bin/animorder" --version | cut -d' ' -f2)" ] ||
   { echo "run.sh: the .pc version is not the tool's" >&2; exit 1; }
-echo "run.sh: the installed package builds a consumer with CMake and with pkg-config; both write the tool's bytes"
+# The README's C++ block, its includes first and its statements as one main, built the same way and
+# run on a glb of the bundled character.
+mkdir -p "$scratch/snippet"
+awk '/^```cpp$/ {on = 1; next} on && /^```$/ {exit} on' "$readme" > "$scratch/snippet/block.cpp"
+[ -s "$scratch/snippet/block.cpp" ] || { echo "run.sh: README.md has no cpp block" >&2; exit 1; }
+{
+  grep '^#include' "$scratch/snippet/block.cpp"
+  echo 'int main() {'
+  grep -v '^#include' "$scratch/snippet/block.cpp"
+  echo '}'
+} > "$scratch/snippet/readme.cpp"
+# shellcheck disable=SC2086
+g++ -std=c++17 -O1 "$scratch/snippet/readme.cpp" $flags -o "$scratch/snippet/readme"
+(cd "$scratch/snippet" && "$prefix/bin/animorder" subdivide -q --levels 0 -o character.glb > /dev/null && ./readme)
+[ -s "$scratch/snippet/character.animorder.bin" ] || { echo "run.sh: the README's C++ block wrote no sidecar" >&2; exit 1; }
+
+echo "run.sh: the installed package builds a consumer with CMake and with pkg-config; both write the tool's bytes; the README's C++ block runs"

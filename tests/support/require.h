@@ -34,8 +34,10 @@ namespace animorder::test {
 //   root        running as root (files of another user, setresuid)
 //   proc        /proc mounted
 //   slurm       a one-node SLURM started in a scratch folder (slurm-wlm, munge; tests/tool/one-node-slurm.sh)
+//   python      the Python module built, with Debian's python3-numpy and python3-pytest (scripts/test-python.sh)
 inline constexpr const char* kComponents[] = {"gl",     "validator",  "data", "results", "gltf-tools", "node",
-                                              "browser", "strace", "namespaces", "root",    "proc",       "slurm"};
+                                              "browser", "strace", "namespaces", "root",    "proc",       "slurm",
+                                              "python"};
 
 inline bool known_component(const std::string& name) {
     for (const char* c : kComponents)

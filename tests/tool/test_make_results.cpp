@@ -1057,6 +1057,7 @@ TEST(CommittedDocs, CarryNoHandTypedMeasurements) {
         {"glTF-Transform 4.5", "a version"},
         {"gltf-pipeline 4.3", "a version"},
         {"gltfpack 0.18", "a version"},
+        {"find_package(animorder 0.1 CONFIG", "the package version asked for (tests/consumer/run.sh checks the line)"},
         {"--tolerance 0.001", "reapply's default"},
         {"3 and 7 minutes", "the install goals"},
         {"optimizeOverdraw(1.05)", "meshoptimizer's threshold as the method calls it"},

@@ -14,6 +14,8 @@
 #include "animorder/procedural_character.h"
 #include "animorder/sidecar.h"
 
+#include "report.h"  // tools/animorder: the CLI's report entries
+
 #include <pybind11/functional.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -36,11 +38,13 @@ namespace {
 struct Character {
     AnimatedMesh mesh;
     std::string source;
+    std::string name() const { return source.empty() ? std::string(kProceduralCharacterName) : source; }
 };
 
 struct Result {
     Method method = Method::Single;
     MethodResult run;
+    std::string report_json;  // the CLI's report of `optimize` without settings, outputs and timings
 };
 
 // settings["lambda"] and friends, named as the CLI's options (dashes as underscores); anything
@@ -102,6 +106,8 @@ py::array_t<uint32_t> to_numpy(const std::vector<uint32_t>& v) {
 }
 
 Character bundled_character() { return {make_procedural_character(), ""}; }
+
+py::object json_to_python(const std::string& text) { return py::module_::import("json").attr("loads")(text); }
 
 Character load(const std::string& path, const std::vector<std::string>& clips, size_t max_memory, unsigned threads) {
     LoadOptions options;
@@ -173,6 +179,10 @@ Result run(const Character& c, const std::string& method_name, const py::dict& s
     {
         py::gil_scoped_release nogil;
         r.run = run_validated_method(c.mesh, method, s);
+        nlohmann::ordered_json report = tool::report_header(c.mesh, c.name());
+        report["input_order"] = tool::cache_stats_json(analyze_mesh_vertex_cache(c.mesh, c.mesh.indices, s.cache_size));
+        report["methods"] = nlohmann::ordered_json::array({tool::method_entry(c.mesh, r.run, s, std::nullopt)});
+        r.report_json = tool::report_text(report);
     }
     return r;
 }
@@ -212,34 +222,6 @@ py::dict evaluate(const Character& c, const std::vector<const Result*>& results,
     report["seed"] = seed;
     report["methods"] = methods;
     return report;
-}
-
-py::dict report(const Result& r) {
-    const MethodResult& run = r.run;
-    py::list runs;
-    for (const ClusteringResult& k : run.runs) {
-        py::list iterations;
-        for (const ClusteringIteration& it : k.iterations) {
-            py::dict d;
-            d["mean_ovr"] = it.mean_ovr;
-            d["reassigned"] = it.reassigned;
-            d["reseeded"] = it.reseeded;
-            iterations.append(d);
-        }
-        py::dict d;
-        d["nodes"] = k.assignment.size();
-        d["iterations"] = iterations;
-        runs.append(d);
-    }
-    py::dict d;
-    d["method"] = method_name(r.method);
-    d["buffers"] = run.buffers.orders.size();
-    d["acmr"] = run.acmr_mean;
-    d["atvr"] = run.atvr_mean;
-    d["fallback"] = run.fallback;
-    d["seconds"] = run.seconds;
-    d["runs"] = runs;
-    return d;
 }
 
 // OUT.animorder.bin and OUT.animorder.json, both or neither, as `optimize -o OUT` writes them.
@@ -316,7 +298,8 @@ PYBIND11_MODULE(animorder, m) {
         .def_property_readonly("table_base", [](const Result& r) { return to_numpy(r.run.buffers.table_base); })
         .def_property_readonly("fallback", [](const Result& r) { return r.run.fallback; })
         .def_property_readonly("acmr", [](const Result& r) { return r.run.acmr_mean; })
-        .def_property_readonly("report", &report);
+        .def_property_readonly("report", [](const Result& r) { return json_to_python(r.report_json); },
+                               "The CLI's JSON report of `optimize` as a dict (no settings, outputs or timings)");
 
     m.def("bundled_character", &bundled_character, "The procedural character the CLI uses without an input");
     m.def("load", &load, py::arg("path"), py::arg("clips") = std::vector<std::string>{},

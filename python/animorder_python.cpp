@@ -26,6 +26,7 @@
 #include <filesystem>
 #include <mutex>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace py = pybind11;
@@ -37,49 +38,75 @@ namespace {
 // bundled character and for arrays).
 struct Character {
     AnimatedMesh mesh;
-    std::string source;
-    std::string name() const { return source.empty() ? std::string(kProceduralCharacterName) : source; }
+    std::string source;  // the file; "" for arrays and the bundled character
+    std::string name;    // the report's "input"
 };
+
+// What a result must match to be written or evaluated with a character: its triangles, vertices
+// and clips (a result of another character would index past this one's triangles).
+std::string shape_of(const AnimatedMesh& m) {
+    std::string clips;
+    for (const Clip& c : m.clips) clips += (clips.empty() ? "" : ", ") + c.name + " (" + std::to_string(c.keyframe_count) + ")";
+    return std::to_string(m.triangle_count()) + " triangles, " + std::to_string(m.vertex_count) + " vertices, clips " +
+           clips;
+}
 
 struct Result {
     Method method = Method::Single;
     MethodResult run;
+    std::string shape;        // shape_of the character it ran on
     std::string report_json;  // the CLI's report of `optimize` without settings, outputs and timings
 };
 
 // settings["lambda"] and friends, named as the CLI's options (dashes as underscores); anything
 // else is a ValueError that lists the names.
+// A setting's value as T, or InvalidInput naming the setting (a negative count, a string for a number).
+template <typename T>
+T setting(const std::string& key, const py::handle& value) {
+    try {
+        return value.cast<T>();
+    } catch (const py::cast_error&) {
+        throw InvalidInput("setting '" + key + "': " + std::string(py::str(py::repr(value))) + " is not " +
+                           (std::is_same<T, bool>::value                ? "a bool"
+                            : std::is_same<T, std::string>::value       ? "a string"
+                            : std::is_floating_point<T>::value          ? "a number"
+                                                                        : "a whole number of 0 or more"));
+    }
+}
+
 MethodSettings method_settings(const py::dict& given) {
     MethodSettings s;
     ClusteringSettings& c = s.clustering;
     for (const auto& item : given) {
         const std::string key = py::str(item.first);
         const py::handle v = item.second;
-        if (key == "lambda" || key == "lambda_") s.lambda = v.cast<double>();
-        else if (key == "clusters" || key == "k") c.clusters = v.cast<size_t>();
-        else if (key == "views") c.views = v.cast<size_t>();
-        else if (key == "resolution") c.resolution = v.cast<unsigned>();
-        else if (key == "seed") c.seed = v.cast<uint64_t>();
-        else if (key == "min_separation") c.min_separation_deg = v.cast<double>();
-        else if (key == "max_iterations") c.max_iterations = v.cast<size_t>();
-        else if (key == "distance") c.distance = parse_distance(v.cast<std::string>());
-        else if (key == "update") c.update = parse_update(v.cast<std::string>());
-        else if (key == "front_levels") c.front_levels = v.cast<uint32_t>();
-        else if (key == "fragment_memory") c.max_cache_bytes = v.cast<size_t>();
-        else if (key == "threads") c.threads = v.cast<unsigned>();
-        else if (key == "cache_size") s.cache_size = v.cast<unsigned>();
-        else if (key == "frame") s.keyframe = v.cast<size_t>();
-        else if (key == "nehab_clusters") s.nehab_clusters = v.cast<size_t>();
-        else if (key == "nehab_views") s.nehab_views = v.cast<size_t>();
-        else if (key == "nehab_all_keyframes") s.nehab_all_keyframes = v.cast<bool>();
-        else if (key == "blend_clusters") s.blend_clusters = v.cast<bool>();
-        else if (key == "planar_units") s.measured_planar_units = v.cast<bool>();
+        if (key == "lambda" || key == "lambda_") s.lambda = setting<double>(key, v);
+        else if (key == "clusters" || key == "k") c.clusters = setting<size_t>(key, v);
+        else if (key == "views") c.views = setting<size_t>(key, v);
+        else if (key == "resolution") c.resolution = setting<unsigned>(key, v);
+        else if (key == "seed") c.seed = setting<uint64_t>(key, v);
+        else if (key == "min_separation") c.min_separation_deg = setting<double>(key, v);
+        else if (key == "max_iterations") c.max_iterations = setting<size_t>(key, v);
+        else if (key == "distance") c.distance = parse_distance(setting<std::string>(key, v));
+        else if (key == "update") c.update = parse_update(setting<std::string>(key, v));
+        else if (key == "front_levels") c.front_levels = setting<uint32_t>(key, v);
+        else if (key == "fragment_memory") c.max_cache_bytes = setting<size_t>(key, v);
+        else if (key == "threads") c.threads = setting<unsigned>(key, v);
+        else if (key == "cache_size") s.cache_size = setting<unsigned>(key, v);
+        else if (key == "frame") s.keyframe = setting<size_t>(key, v);
+        else if (key == "nehab_clusters") s.nehab_clusters = setting<size_t>(key, v);
+        else if (key == "nehab_views") s.nehab_views = setting<size_t>(key, v);
+        else if (key == "nehab_all_keyframes") s.nehab_all_keyframes = setting<bool>(key, v);
+        else if (key == "blend_clusters") s.blend_clusters = setting<bool>(key, v);
+        else if (key == "planar_units") s.measured_planar_units = setting<bool>(key, v);
         else
             throw InvalidInput("unknown setting '" + key +
                                "' (lambda, clusters, views, resolution, seed, min_separation, max_iterations, "
                                "distance, update, front_levels, fragment_memory, threads, cache_size, frame, "
                                "nehab_clusters, nehab_views, nehab_all_keyframes, blend_clusters, planar_units)");
     }
+    // The CLI's ranges (tools/animorder/main.cpp).
+    if (!(s.lambda >= 0 && s.lambda <= 1000)) throw InvalidInput("lambda must be between 0 and 1000");
     if (s.cache_size < 3 || s.cache_size > 1024) throw InvalidInput("cache_size must be between 3 and 1024");
     if (c.resolution < 8 || c.resolution > 4096) throw InvalidInput("resolution must be between 8 and 4096");
     if (c.max_iterations < 1 || c.max_iterations > 1000) throw InvalidInput("max_iterations must be between 1 and 1000");
@@ -105,7 +132,7 @@ py::array_t<uint32_t> to_numpy(const std::vector<uint32_t>& v) {
     return a;
 }
 
-Character bundled_character() { return {make_procedural_character(), ""}; }
+Character bundled_character() { return {make_procedural_character(), "", kProceduralCharacterName}; }
 
 py::object json_to_python(const std::string& text) { return py::module_::import("json").attr("loads")(text); }
 
@@ -121,6 +148,7 @@ Character load(const std::string& path, const std::vector<std::string>& clips, s
         if (!clips.empty()) c.mesh = select_clips(c.mesh, clips);
     }
     c.source = path;
+    c.name = path;
     return c;
 }
 
@@ -136,6 +164,7 @@ Character from_arrays(const py::array_t<float, py::array::c_style | py::array::f
     if (indices.size() % 3 != 0) throw InvalidInput("indices: " + std::to_string(indices.size()) + " is no multiple of 3");
     if (!(sample_rate > 0 && std::isfinite(sample_rate))) throw InvalidInput("sample_rate must be a positive number");
     Character c;
+    c.name = "arrays";
     AnimatedMesh& m = c.mesh;
     m.name = "arrays";
     m.vertex_count = size_t(positions.shape(1));
@@ -176,10 +205,11 @@ Result run(const Character& c, const std::string& method_name, const py::dict& s
     attach_progress(s, progress, lock);
     Result r;
     r.method = method;
+    r.shape = shape_of(c.mesh);
     {
         py::gil_scoped_release nogil;
         r.run = run_validated_method(c.mesh, method, s);
-        nlohmann::ordered_json report = tool::report_header(c.mesh, c.name());
+        nlohmann::ordered_json report = tool::report_header(c.mesh, c.name);
         report["input_order"] = tool::cache_stats_json(analyze_mesh_vertex_cache(c.mesh, c.mesh.indices, s.cache_size));
         report["methods"] = nlohmann::ordered_json::array({tool::method_entry(c.mesh, r.run, s, std::nullopt)});
         r.report_json = tool::report_text(report);
@@ -187,10 +217,25 @@ Result run(const Character& c, const std::string& method_name, const py::dict& s
     return r;
 }
 
-py::dict evaluate(const Character& c, const std::vector<const Result*>& results, size_t views, unsigned resolution,
-                  uint64_t seed, unsigned threads) {
-    if (views == 0) throw InvalidInput("views must be at least 1");
-    if (resolution < 8 || resolution > 4096) throw InvalidInput("resolution must be between 8 and 4096");
+void check_shape(const Character& c, const Result& r) {
+    if (r.shape != shape_of(c.mesh))
+        throw InvalidInput("this result was run on a character of " + r.shape + ", not on this one (" + shape_of(c.mesh) +
+                           ")");
+}
+
+py::dict evaluate(const Character& c, const py::sequence& given, size_t views, unsigned resolution, uint64_t seed,
+                  unsigned threads) {
+    if (views < 1 || views > 100000) throw InvalidInput("views must be between 1 and 100000");  // the CLI's ranges
+    if (resolution < 1 || resolution > 8192) throw InvalidInput("resolution must be between 1 and 8192");
+    std::vector<const Result*> results;
+    for (size_t i = 0; i < given.size(); ++i) {
+        const py::object item = given[i];
+        if (!py::isinstance<Result>(item))
+            throw InvalidInput("results[" + std::to_string(i) + "] is " + std::string(py::str(py::repr(item))) +
+                               ", not a result of animorder.run");
+        results.push_back(&item.cast<const Result&>());
+        check_shape(c, *results.back());
+    }
     EvaluationSettings e;
     e.views = views;
     e.resolution = resolution;
@@ -226,6 +271,7 @@ py::dict evaluate(const Character& c, const std::vector<const Result*>& results,
 
 // OUT.animorder.bin and OUT.animorder.json, both or neither, as `optimize -o OUT` writes them.
 void write_sidecar(const Character& c, const Result& r, const std::string& out) {
+    check_shape(c, r);
     const std::string bin = out + ".animorder.bin", json = out + ".animorder.json";
     OutputSet files;
     files.add(bin, serialize_sidecar(c.mesh, r.run.buffers, r.run.framing));
@@ -236,12 +282,14 @@ void write_sidecar(const Character& c, const Result& r, const std::string& out) 
 
 // The glTF input with the orders in its extension, as `optimize IN -o OUT.glb|.gltf` writes it.
 void write_gltf(const Character& c, const Result& r, const std::string& out) {
+    check_shape(c, r);
     const std::string extension = file_extension(out);
     if (c.source.empty() || (file_extension(c.source) != ".gltf" && file_extension(c.source) != ".glb"))
         throw InvalidInput("write_gltf needs a character loaded from a glTF file (this one: " +
                            (c.source.empty() ? std::string("arrays or the bundled character") : c.source) + ")");
     if (extension != ".gltf" && extension != ".glb") throw InvalidInput("write_gltf: " + out + " is no .gltf or .glb");
-    if (std::filesystem::exists(out) && std::filesystem::equivalent(out, c.source))
+    std::error_code error;
+    if (std::filesystem::equivalent(out, c.source, error))
         throw InvalidInput("write_gltf: " + out + " is the input");
     OutputSet files;
     files.add(out, gltf_with_orders(c.source, out, c.mesh, r.run.buffers, r.run.fallback, r.run.framing,
@@ -256,6 +304,14 @@ PYBIND11_MODULE(animorder, m) {
     m.attr("__version__") = library_version();
     py::register_exception<InvalidInput>(m, "InvalidInput", PyExc_ValueError);
     py::register_exception<LoadError>(m, "LoadError", PyExc_OSError);
+    py::register_exception<OutputError>(m, "OutputError", PyExc_OSError);
+    py::register_exception_translator([](std::exception_ptr p) {
+        try {
+            if (p) std::rethrow_exception(p);
+        } catch (const std::filesystem::filesystem_error& e) {
+            PyErr_SetString(PyExc_OSError, e.what());
+        }
+    });
 
     py::class_<Character>(m, "Character")
         .def_property_readonly("triangles", [](const Character& c) { return c.mesh.triangle_count(); })

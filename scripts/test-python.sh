@@ -22,4 +22,4 @@ if [ -n "$why" ]; then
   exit 77
 fi
 cd "$(dirname "$0")/../python/tests" || exit 1
-PYTHONPATH="$module_dir" exec "$python" -m pytest -q -p no:cacheprovider .
+PYTHONDONTWRITEBYTECODE=1 PYTHONPATH="$module_dir" exec "$python" -m pytest -q -p no:cacheprovider .

@@ -43,7 +43,8 @@ class MeasuredPairCounts {
 public:
     // unit_of_triangle: triangle_count entries, each < unit_count; group as measured_overdraw_graph.
     // front_levels: each unit is paired with the units of that many nearest depth levels in front
-    // of it (of its group), 0 with every unit in front (measured_overdraw_graph's graph).
+    // of it, 0 with every unit in front (measured_overdraw_graph's graph). A level counts where a
+    // unit of its group has its nearest fragment (each unit is at its nearest fragment only).
     MeasuredPairCounts(size_t unit_count, const uint32_t* unit_of_triangle, size_t triangle_count,
                        const uint32_t* group, uint32_t front_levels = 0);
     ~MeasuredPairCounts();

@@ -110,6 +110,7 @@ def test_arrays_a_hand_worked_triangle():
     positions = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 0, 0], [2, 0, 0], [0, 2, 0]]], dtype=np.float32)
     character = animorder.from_arrays(positions, np.array([[0, 1, 2]]), clips=[("a", 1), ("b", 1)])
     assert (character.triangles, character.vertices, character.keyframes) == (1, 3, 2)
+    assert animorder.run(character, "original").report["input"] == "arrays"
     assert character.clips == [("a", 1), ("b", 1)]
     assert np.array_equal(character.positions, positions)
     result = animorder.run(character, "original")
@@ -129,16 +130,16 @@ def test_long_work_releases_the_gil_and_reports_progress():
             ticks.append(1)
             stop.wait(0.001)
 
-    stages = []
     counter = threading.Thread(target=count)
     counter.start()
     try:
-        animorder.run(character, "single", progress=lambda stage, done, total: stages.append((stage, done, total)),
-                      **FAST)
+        animorder.run(character, "single", clusters=2, views=42, resolution=64)  # no callback: no Python runs
     finally:
         stop.set()
         counter.join()
     assert len(ticks) > 10  # the other thread ran while the method did
+    stages = []
+    animorder.run(character, "single", progress=lambda stage, done, total: stages.append((stage, done, total)), **FAST)
     assert stages and all(0 <= done <= total for _, done, total in stages)
     assert any("rasterising nodes" in stage for stage, _, _ in stages), stages
 
@@ -161,6 +162,25 @@ def test_bad_input_is_an_exception_with_the_librarys_message(tmp_path):
         animorder.run(character, "single", clusters=0)
     with pytest.raises(ValueError, match="resolution"):
         animorder.run(character, "single", resolution=4)
+    with pytest.raises(ValueError, match="setting 'clusters': -1 is not a whole number"):
+        animorder.run(character, "single", clusters=-1)
+    with pytest.raises(ValueError, match="setting 'lambda_': 'x' is not a number"):
+        animorder.run(character, "single", lambda_="x")
+    with pytest.raises(ValueError, match="lambda must be between 0 and 1000"):
+        animorder.run(character, "single", lambda_=2000)
+    original = animorder.run(character, "original")
+    with pytest.raises(ValueError, match="results\\[1\\] is None"):
+        animorder.evaluate(character, [original, None], views=1, resolution=16)
+    with pytest.raises(ValueError, match="views must be between 1 and 100000"):
+        animorder.evaluate(character, [original], views=0)
+    # A result of another character is refused, not read past its triangles.
+    small = animorder.from_arrays(np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]]], dtype=np.float32), np.array([[0, 1, 2]]))
+    with pytest.raises(ValueError, match="this result was run on a character of 11760 triangles"):
+        animorder.write_sidecar(small, original, str(tmp_path / "small"))
+    with pytest.raises(ValueError, match="this result was run on a character of"):
+        animorder.evaluate(small, [original], views=1, resolution=16)
+    with pytest.raises(OSError):
+        animorder.write_sidecar(character, original, str(tmp_path / "no such folder" / "out"))
     with pytest.raises(OSError, match="missing.glb"):
         animorder.load(str(tmp_path / "missing.glb"))
     truncated = tmp_path / "truncated.glb"

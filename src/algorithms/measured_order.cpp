@@ -145,8 +145,9 @@ struct PairCounts {
 
 // One list of units nearest first (unit | kTieBit at the previous entry's depth) into the counts,
 // `amount` times: each unit by its nearest entry, one count per pair at different depths, each
-// unit paired with the units of the `front_levels` nearest depth levels in front of it (of its
-// group; 0: every level).
+// unit paired with the units of the `front_levels` nearest depth levels in front of it (0: every
+// level). The levels are those of the units in front, each at its nearest entry, of the unit's
+// group: a level that holds only a repeat of a nearer unit, or other groups' units, is not one.
 void accumulate_list(PairCounts& table, const uint32_t* units, uint32_t n, size_t unit_count, const uint32_t* group,
                      uint32_t front_levels, int64_t amount, std::vector<std::pair<uint32_t, uint32_t>>& seen) {
     seen.clear();  // (unit, depth level) of each unit's nearest entry, nearest first

@@ -134,6 +134,17 @@ TEST(MeasuredGraph, FrontLevelsPairEachUnitWithTheNearestDepthLevelsInFrontOnly)
     EXPECT_EQ(pairs(1), (P{{0, 1}, {0, 2}, {1, 3}, {2, 3}, {3, 4}}));
     // Two levels: 3 reaches back to 0, 4 to 1 and 2 but not 0.
     EXPECT_EQ(pairs(2), (P{{0, 1}, {0, 2}, {0, 3}, {1, 3}, {1, 4}, {2, 3}, {2, 4}, {3, 4}}));
+
+    // Levels are counted within a unit's group: units 0, 2, 3 in group 0 and 1 in group 1, front to
+    // back 0, 1, 2, 3. One level: 2's nearest level of its group is 0's (1's is another group's).
+    const std::vector<uint32_t> group = {0, 1, 0, 0, 0};
+    const NodeFragments g = pixels({{0, 1, 2, 3}});
+    const NodeFragments* grouped[] = {&g};
+    MeasuredPairCounts counts(5, unit.data(), unit.size(), group.data(), 1);
+    counts.add(grouped, 1, +1, 1);
+    P got;
+    for (const Arc& a : counts.arcs()) got.emplace_back(a.from, a.to);
+    EXPECT_EQ(got, (P{{0, 2}, {2, 3}}));
 }
 
 // A second implementation of the graph's definition (a map of pair counts), against the library

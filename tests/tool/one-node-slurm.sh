@@ -17,8 +17,7 @@ if [ -z "$command" ] || [ -z "$folder" ]; then
   echo "usage: one-node-slurm.sh start|stop FOLDER" >&2
   exit 2
 fi
-mkdir -p "$folder"
-folder=$(cd "$folder" && pwd)
+folder=$(realpath -m "$folder")
 conf=$folder/slurm.conf
 socket=$folder/munge/socket
 # slurmd's step sockets (FOLDER/spool/NODE_JOB.STEP) must fit a Unix socket path (108 bytes).
@@ -43,6 +42,10 @@ stop() {
     [ "$alive" = 1 ] || return 0
     sleep 0.1
   done
+  # Still there after 5 s: ended for good.
+  for pid_file in "$folder/slurmctld.pid" "$folder/slurmd.pid" "$folder/munge/munged.pid"; do
+    if [ -s "$pid_file" ]; then kill -KILL "$(cat "$pid_file")" > /dev/null 2>&1 || true; fi
+  done
 }
 
 if [ "$command" = stop ]; then
@@ -54,6 +57,13 @@ fi
 for program in munged slurmctld slurmd sbatch sinfo scontrol python3; do
   command -v "$program" > /dev/null || { echo "$program is not installed (Debian: slurm-wlm, munge)" >&2; exit 2; }
 done
+
+# From here on, a step that fails stops what was started, with the daemons' last log lines.
+failed() {
+  echo "one-node-slurm.sh: start failed: $(tail -q -n 3 "$folder"/log/* "$folder"/munge/*.log 2> /dev/null | tr '\n' ' ')" >&2
+  stop
+}
+trap 'failed; exit 1' ERR
 
 # munge: a key of its own, its socket in the folder (slurm.conf's AuthInfo names it).
 mkdir -p "$folder/munge" "$folder/state" "$folder/spool" "$folder/log"
@@ -110,6 +120,7 @@ if ! slurmctld > "$folder/log/slurmctld.out" 2>&1 || ! slurmd > "$folder/log/slu
   stop
   exit 1
 fi
+trap - ERR  # the checks below say what went wrong themselves
 for _ in $(seq 300); do
   state=$(sinfo --noheader --nodes="$node" --format=%t 2> /dev/null || true)
   if [ "$state" = idle ]; then

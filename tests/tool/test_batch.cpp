@@ -796,7 +796,7 @@ TEST_F(Batch, TheReadmesKubernetesCommandCompletesAShardWithAFailedItem) {
 // started in the test's folder by tests/tool/one-node-slurm.sh): the array job's tasks run the
 // manifest's items as shards on the cluster, the merge writes the summary, and every file and the
 // summary are the bytes of one local run of the same manifest.
-TEST_F(Batch, TheReadmesSlurmArrayJobGivesTheFilesAndSummaryOfOneLocalRun) {
+TEST_F(Batch, TheManualsSlurmArrayJobGivesTheFilesAndSummaryOfOneLocalRun) {
     const std::string doc = test::slurp(fs::path(ANIMORDER_SOURCE_DIR) / "docs" / "batch.md");
     const size_t open = doc.find("```sh\nsbatch ");
     ASSERT_NE(open, std::string::npos) << "docs/batch.md has no SLURM block";

@@ -105,13 +105,7 @@ MethodSettings method_settings(const py::dict& given) {
                                "distance, update, front_levels, fragment_memory, threads, cache_size, frame, "
                                "nehab_clusters, nehab_views, nehab_all_keyframes, blend_clusters, planar_units)");
     }
-    // The CLI's ranges (tools/animorder/main.cpp).
-    if (!(s.lambda >= 0 && s.lambda <= 1000)) throw InvalidInput("lambda must be between 0 and 1000");
-    if (s.cache_size < 3 || s.cache_size > 1024) throw InvalidInput("cache_size must be between 3 and 1024");
-    if (c.resolution < 8 || c.resolution > 4096) throw InvalidInput("resolution must be between 8 and 4096");
-    if (c.max_iterations < 1 || c.max_iterations > 1000) throw InvalidInput("max_iterations must be between 1 and 1000");
-    if (c.threads > 1024) throw InvalidInput("threads must be between 0 and 1024");
-    validate_method_settings(s);
+    validate_method_settings(s);  // the CLI's ranges
     return s;
 }
 

@@ -150,8 +150,9 @@ struct MethodSettings {
     bool measured_planar_units = false;
 };
 
-// Throws InvalidInput for settings no method can run with (non-finite λ, k outside
-// 1..kMaxClusters, a view count that is no icosphere, a separation outside 0..180°, ...).
+// Throws InvalidInput for settings no method can run with (λ outside 0..1000 or not finite, k
+// outside 1..kMaxClusters, a view count that is no icosphere, a separation outside 0..180°, the
+// resolution, cache size, iteration cap or threads outside the CLI's ranges, ...).
 void validate_method_settings(const MethodSettings& settings);
 
 struct MethodResult {

@@ -147,7 +147,15 @@ const char* library_version() { return ANIMORDER_VERSION; }
 
 void validate_method_settings(const MethodSettings& settings) {
     if (!std::isfinite(settings.lambda)) throw InvalidInput("lambda must be a finite number");
+    // The ranges the CLI's options check (tools/animorder/main.cpp), for every other caller too.
+    if (!(settings.lambda >= 0 && settings.lambda <= 1000)) throw InvalidInput("lambda must be between 0 and 1000");
+    if (settings.cache_size < 3 || settings.cache_size > 1024)
+        throw InvalidInput("cache_size must be between 3 and 1024");
     const ClusteringSettings& c = settings.clustering;
+    if (c.resolution < 8 || c.resolution > 4096) throw InvalidInput("resolution must be between 8 and 4096");
+    if (c.max_iterations < 1 || c.max_iterations > 1000)
+        throw InvalidInput("max_iterations must be between 1 and 1000");
+    if (c.threads > 1024) throw InvalidInput("threads must be between 0 and 1024");
     if (c.clusters == 0 || c.clusters > kMaxClusters)
         throw InvalidInput("k (clusters) must be between 1 and " + std::to_string(kMaxClusters));
     if (!(c.min_separation_deg >= 0 && c.min_separation_deg <= 180))

@@ -35,9 +35,12 @@ std::vector<Arc> measured_overdraw_graph(const NodeFragments* const* nodes, size
 // moves a few nodes between clusters each iteration, and a cluster's graph follows them without
 // measuring its other nodes again. Each pair keeps its net count (pixels with the lower unit in
 // front minus pixels with the higher in front): few units (<= kDenseMeasuredUnits) in a dense
-// triangle of unit_count · (unit_count − 1) / 2 counts, more in a hash table of the pairs met.
+// triangle of unit_count · (unit_count − 1) / 2 counts, more counted in a hash table of the pairs
+// met and then settled into an array of the pairs with a net count, sorted by pair.
 // Integer counts: the arcs are the same whatever the order of the updates and the thread count.
 constexpr size_t kDenseMeasuredUnits = 1024;
+
+struct MeasuredOrderStats;
 
 class MeasuredPairCounts {
 public:
@@ -55,13 +58,18 @@ public:
     void add(const NodeFragments* const* nodes, size_t node_count, int sign, unsigned threads = 0);
     // The same from kept nodes (kept_fragments.h) over the same units: the same counts.
     void add(const KeptNode* const* nodes, size_t node_count, int sign, unsigned threads = 0);
+    // Folds the counts added since the last call into the pairs kept between updates (sorted, one
+    // entry per pair met with a net count other than 0), giving back the counting table's memory.
+    // arcs() settles too; settling early keeps several graphs' peak memory low.
+    void settle();
     // The netted arcs, as measured_overdraw_graph returns them.
-    std::vector<Arc> arcs() const;
+    std::vector<Arc> arcs();
 
     struct State;
 
 private:
     std::unique_ptr<State> state_;
+    friend std::vector<uint32_t> measured_unit_order(MeasuredPairCounts&, const uint32_t*, MeasuredOrderStats*, bool);
 };
 
 // Local search on a linear order of units under the arcs: sifting (Chanas & Kobylański 1996;
@@ -70,13 +78,15 @@ private:
 // only inside its group's block (group nullptr: one block; the order must already keep each
 // group contiguous). Passes repeat until one changes nothing or max_passes. The backward weight
 // (count_feedback_arcs) never rises. Returns the final backward weight.
+constexpr size_t kSiftMaxPasses = 32;
 uint64_t sift_order(uint32_t* order, size_t unit_count, const Arc* arcs, size_t arc_count, const uint32_t* group,
-                    size_t max_passes = 32);
+                    size_t max_passes = kSiftMaxPasses);
 
 struct MeasuredOrderStats {
     uint64_t start_weight = 0;   // backward weight of the start the search took
     uint64_t greedy_weight = 0;  // of the greedy Eades–Lin–Smyth order
     uint64_t final_weight = 0;   // after sifting
+    size_t arc_count = 0;        // the graph's arcs
     bool from_previous = false;  // the previous order was the better start
 };
 
@@ -90,5 +100,11 @@ struct MeasuredOrderStats {
 std::vector<uint32_t> measured_unit_order(size_t unit_count, const Arc* arcs, size_t arc_count, const uint32_t* group,
                                           const uint32_t* previous, MeasuredOrderStats* stats = nullptr,
                                           bool try_greedy = true);
+
+// The same order from the counts themselves, over their units and groups: the same order and
+// stats as measured_unit_order of counts.arcs(), in less memory (the arcs live only while the
+// greedy order is made; sifting reads its adjacency straight from the settled counts).
+std::vector<uint32_t> measured_unit_order(MeasuredPairCounts& counts, const uint32_t* previous,
+                                          MeasuredOrderStats* stats = nullptr, bool try_greedy = true);
 
 }  // namespace animorder

@@ -8,15 +8,14 @@
 // blend orders.
 #include "animorder/feedback_arc_set.h"
 
+#include "greedy_feedback_order.h"
+
 #include "animorder/invalid_input.h"
 #include "animorder/triangle_order.h"
 
 #include <algorithm>
-#include <deque>
 #include <limits>
-#include <set>
 #include <string>
-#include <utility>
 #include <vector>
 
 namespace animorder {
@@ -50,92 +49,14 @@ std::vector<uint32_t> order_feedback_arc_set(size_t node_count, const Arc* arcs,
             in_arc[n[arcs[i].to]++] = uint32_t(i);
         }
     }
-    std::vector<size_t> out_degree(node_count), in_degree(node_count);
-    std::vector<int64_t> delta(node_count, 0);  // Σ out-weights − Σ in-weights of remaining arcs
-    for (size_t v = 0; v < node_count; ++v) {
-        out_degree[v] = out_start[v + 1] - out_start[v];
-        in_degree[v] = in_start[v + 1] - in_start[v];
-    }
-    for (size_t i = 0; i < arc_count; ++i) {
-        delta[arcs[i].from] += int64_t(arcs[i].weight);
-        delta[arcs[i].to] -= int64_t(arcs[i].weight);
-    }
-    // The greedy choice: largest |δ|, then lowest id.
-    auto key = [&](uint32_t v) { return std::make_pair(-(delta[v] < 0 ? -delta[v] : delta[v]), v); };
-    std::set<std::pair<int64_t, uint32_t>> candidates;
-    for (uint32_t v = 0; v < node_count; ++v) candidates.insert(key(v));
-
-    std::vector<bool> removed(node_count, false);
-    std::deque<uint32_t> sinks, sources;
-    for (uint32_t v = 0; v < node_count; ++v) {
-        if (out_degree[v] == 0)
-            sinks.push_back(v);
-        else if (in_degree[v] == 0)
-            sources.push_back(v);
-    }
-    std::vector<uint32_t> head, tail;  // order = head, then tail reversed
-    auto remove = [&](uint32_t v) {
-        removed[v] = true;
-        candidates.erase(key(v));
-        for (uint32_t i = out_start[v]; i < out_start[v + 1]; ++i) {
-            const Arc& a = arcs[out_arc[i]];
-            if (removed[a.to]) continue;
-            candidates.erase(key(a.to));
-            delta[a.to] += int64_t(a.weight);
-            candidates.insert(key(a.to));
-            if (--in_degree[a.to] == 0 && out_degree[a.to] != 0) sources.push_back(a.to);
-        }
-        for (uint32_t i = in_start[v]; i < in_start[v + 1]; ++i) {
-            const Arc& a = arcs[in_arc[i]];
-            if (removed[a.from]) continue;
-            candidates.erase(key(a.from));
-            delta[a.from] -= int64_t(a.weight);
-            candidates.insert(key(a.from));
-            if (--out_degree[a.from] == 0) sinks.push_back(a.from);
-        }
-    };
-    size_t left = node_count;
-    while (left > 0) {
-        bool progress = true;
-        while (progress) {
-            progress = false;
-            while (!sinks.empty()) {
-                const uint32_t v = sinks.front();
-                sinks.pop_front();
-                if (removed[v]) continue;
-                tail.push_back(v);
-                remove(v);
-                --left;
-                progress = true;
-            }
-            while (!sources.empty()) {
-                const uint32_t v = sources.front();
-                sources.pop_front();
-                if (removed[v]) continue;
-                if (out_degree[v] == 0) {  // became a sink meanwhile: the sinks' loop takes it
-                    sinks.push_back(v);
-                    progress = true;
-                    break;
-                }
-                head.push_back(v);
-                remove(v);
-                --left;
-                progress = true;
-                if (!sinks.empty()) break;  // sinks first, as the heuristic says
-            }
-        }
-        if (left == 0) break;
-        // Only cycles remain: the node with the largest |δ| goes to its winning side.
-        const uint32_t v = candidates.begin()->second;
-        if (delta[v] >= 0)
-            head.push_back(v);
-        else
-            tail.push_back(v);
-        remove(v);
-        --left;
-    }
-    head.insert(head.end(), tail.rbegin(), tail.rend());
-    return head;
+    return greedy_feedback_order(
+        node_count,
+        [&](uint32_t v, auto&& f) {
+            for (uint32_t i = out_start[v]; i < out_start[v + 1]; ++i) f(arcs[out_arc[i]].to, arcs[out_arc[i]].weight);
+        },
+        [&](uint32_t v, auto&& f) {
+            for (uint32_t i = in_start[v]; i < in_start[v + 1]; ++i) f(arcs[in_arc[i]].from, arcs[in_arc[i]].weight);
+        });
 }
 
 FeedbackArcs count_feedback_arcs(const uint32_t* node_order, size_t node_count, const Arc* arcs, size_t arc_count) {

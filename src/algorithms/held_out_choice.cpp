@@ -133,9 +133,7 @@ std::vector<std::vector<uint32_t>> measured_cluster_orders(const AnimatedMesh& m
                 }
                 graph.add(pointers.data(), pointers.size(), +1, 1);
             }
-            const std::vector<Arc> arcs = graph.arcs();
-            const std::vector<uint32_t> order = measured_unit_order(units.patch_count(), arcs.data(), arcs.size(),
-                                                                    units.patch_primitive.data(), nullptr, nullptr);
+            const std::vector<uint32_t> order = measured_unit_order(graph, nullptr);
             orders[c] = patch_order_to_triangle_order(units, order);
         });
     });

@@ -19,6 +19,7 @@
 #include "animorder/invalid_input.h"
 #include "animorder/feedback_arc_set.h"
 #include "../support/worker_threads.h"
+#include "greedy_feedback_order.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -75,22 +76,33 @@ struct OpenTable {
     }
 };
 
-// The pairs' net counts, in 8-byte slots (16-bit unit ids, 32-bit nets) while every unit id fits
-// in 16 bits and every net in 32 (half the memory of the wide slots, and twice the slots a cache
-// line holds), else — from the first count that does not fit, all moved over — in 16-byte ones.
+// The pairs' net counts: counted into an open-addressing table, then settled into an array sorted
+// by pair with the zero nets left out (the counts kept between k-means iterations: one entry per
+// pair, where the table holds one to two and a half slots per pair). Entries are 8 bytes (16-bit
+// unit ids, 32-bit nets) while every unit id fits in 16 bits and every net in 32 (half the memory
+// of the wide entries, and twice the entries a cache line holds), else — from the first count that
+// does not fit, all moved over — 16 bytes.
 struct PairTable {
+    template <typename Key, typename Net>
+    struct Entry {
+        Key key;
+        Net net;
+    };
     OpenTable<uint32_t, int32_t> narrow;
     OpenTable<uint64_t, int64_t> wide;
+    std::vector<Entry<uint32_t, int32_t>> settled_narrow;  // ascending keys, nets ≠ 0
+    std::vector<Entry<uint64_t, int64_t>> settled_wide;
     bool is_wide = false;
 
     explicit PairTable(size_t units) : is_wide(units > 0x10000) {
         if (is_wide) narrow.slots.clear(); else wide.slots.clear();
     }
+    static uint64_t wide_key(uint32_t narrow_key) { return uint64_t(narrow_key >> 16) << 32 | (narrow_key & 0xffff); }
     void add(uint32_t lo, uint32_t hi, int64_t net) {
         if (!is_wide) {
             auto& s = narrow.at(lo << 16 | hi);
             const int64_t sum = int64_t(s.net) + net;
-            if (sum >= std::numeric_limits<int32_t>::min() && sum <= std::numeric_limits<int32_t>::max()) {
+            if (fits_in<int32_t>(sum)) {
                 s.net = int32_t(sum);
                 return;
             }
@@ -98,23 +110,96 @@ struct PairTable {
         }
         wide.at(uint64_t(lo) << 32 | hi).net += net;
     }
+    template <typename Net>
+    static bool fits_in(int64_t net) {
+        return net >= std::numeric_limits<Net>::min() && net <= std::numeric_limits<Net>::max();
+    }
     void widen() {
         wide.slots.assign(std::max<size_t>(1024, narrow.slots.size()), {});
         for (const auto& s : narrow.slots)
-            if (s.key != narrow.kEmpty) wide.at(uint64_t(s.key >> 16) << 32 | (s.key & 0xffff)).net = s.net;
+            if (s.key != narrow.kEmpty) wide.at(wide_key(s.key)).net = s.net;
         narrow.slots = {};
         narrow.used = 0;
+        settled_wide.reserve(settled_narrow.size());
+        for (const auto& e : settled_narrow) settled_wide.push_back({wide_key(e.key), e.net});  // the same order
+        settled_narrow = {};
         is_wide = true;
     }
-    // f(lo, hi, net) for every pair met (net may be 0), in the table's own order.
+    // The table's counts into the settled array; the table emptied (its memory given back).
+    void settle() {
+        if (!is_wide) {
+            if (narrow.used == 0) return;
+            const std::vector<Entry<uint32_t, int32_t>> counted = take_sorted(narrow);
+            if (merge_into(settled_narrow, counted)) return;
+            // A sum beyond 32 bits: everything moved to wide entries (the same order), then merged.
+            std::vector<Entry<uint64_t, int64_t>> wide_counted;
+            wide_counted.reserve(counted.size());
+            for (const auto& e : counted) wide_counted.push_back({wide_key(e.key), e.net});
+            widen();
+            merge_into(settled_wide, wide_counted);
+            return;
+        }
+        if (wide.used != 0) merge_into(settled_wide, take_sorted(wide));
+    }
+    // The table's entries with a net count, sorted by key; the table emptied.
+    template <typename Key, typename Net>
+    static std::vector<Entry<Key, Net>> take_sorted(OpenTable<Key, Net>& table) {
+        std::vector<Entry<Key, Net>> counted;
+        counted.reserve(table.used);
+        for (const auto& s : table.slots)
+            if (s.key != table.kEmpty && s.net != 0) counted.push_back({s.key, s.net});
+        table = {};
+        std::sort(counted.begin(), counted.end(), [](const auto& a, const auto& b) { return a.key < b.key; });
+        return counted;
+    }
+    // Sorted counts into the settled array, zero sums left out; false (nothing changed) when a sum
+    // does not fit in Net.
+    template <typename Key, typename Net>
+    static bool merge_into(std::vector<Entry<Key, Net>>& settled, const std::vector<Entry<Key, Net>>& counted) {
+        // Two walks over the sorted runs: the merged size (and whether every sum fits), then the
+        // merge into an array of exactly that size.
+        const auto merge = [&](auto&& out) {
+            size_t i = 0, j = 0;
+            while (i < settled.size() || j < counted.size()) {
+                if (j == counted.size() || (i < settled.size() && settled[i].key < counted[j].key)) {
+                    out(settled[i++]);
+                } else if (i == settled.size() || counted[j].key < settled[i].key) {
+                    out(counted[j++]);
+                } else {
+                    const int64_t sum = int64_t(settled[i].net) + int64_t(counted[j].net);
+                    if (!fits_in<Net>(sum)) return false;
+                    if (sum != 0) out(Entry<Key, Net>{settled[i].key, Net(sum)});
+                    ++i, ++j;
+                }
+            }
+            return true;
+        };
+        size_t size = 0;
+        if (!merge([&](const Entry<Key, Net>&) { ++size; })) return false;
+        std::vector<Entry<Key, Net>> merged;
+        merged.reserve(size);
+        merge([&](const Entry<Key, Net>& e) { merged.push_back(e); });
+        settled = std::move(merged);
+        return true;
+    }
+    // f(lo, hi, net) for every pair met (net may be 0) not yet settled, in the table's own order.
     template <typename F>
-    void for_each(F&& f) const {
+    void for_each_unsettled(F&& f) const {
         if (is_wide) {
             for (const auto& s : wide.slots)
                 if (s.key != wide.kEmpty) f(uint32_t(s.key >> 32), uint32_t(s.key), int64_t(s.net));
         } else {
             for (const auto& s : narrow.slots)
                 if (s.key != narrow.kEmpty) f(s.key >> 16, s.key & 0xffff, int64_t(s.net));
+        }
+    }
+    // f(lo, hi, net) for every settled pair (net ≠ 0), in ascending (lo, hi).
+    template <typename F>
+    void for_each_settled(F&& f) const {
+        if (is_wide) {
+            for (const auto& e : settled_wide) f(uint32_t(e.key >> 32), uint32_t(e.key), int64_t(e.net));
+        } else {
+            for (const auto& e : settled_narrow) f(e.key >> 16, e.key & 0xffff, int64_t(e.net));
         }
     }
 };
@@ -139,7 +224,7 @@ struct PairCounts {
     }
     void merge(const PairCounts& other) {
         for (size_t i = 0; i < dense.size(); ++i) dense[i] += other.dense[i];
-        other.sparse.for_each([&](uint32_t lo, uint32_t hi, int64_t net) { sparse.add(lo, hi, net); });
+        other.sparse.for_each_unsettled([&](uint32_t lo, uint32_t hi, int64_t net) { sparse.add(lo, hi, net); });
     }
 };
 
@@ -194,6 +279,24 @@ void accumulate_node(PairCounts& table, const NodeFragments& node, const uint32_
     }
 }
 
+// f(from, to, weight) for every arc of the counts (weight > 0), in ascending (min, max) pairs:
+// the arcs measured_overdraw_graph returns. The sparse counts must be settled.
+template <typename F>
+void for_each_arc(const PairCounts& c, F&& f) {
+    auto net = [&](uint32_t lo, uint32_t hi, int64_t n) {
+        if (n > 0)
+            f(lo, hi, uint64_t(n));
+        else if (n < 0)
+            f(hi, lo, uint64_t(-n));
+    };
+    if (c.units <= kDenseMeasuredUnits) {
+        for (uint32_t lo = 0; lo < c.units; ++lo)
+            for (uint32_t hi = lo + 1; hi < c.units; ++hi) net(lo, hi, c.dense[PairCounts::slot(lo, hi)]);
+    } else {
+        c.sparse.for_each_settled(net);
+    }
+}
+
 // One entry of a unit's signed adjacency in sift_order: s > 0 when the unit should come first.
 // Weight: int32_t (8-byte entries) when every arc's weight fits, else int64_t.
 template <typename Weight>
@@ -202,9 +305,68 @@ struct Neighbour {
     Weight s;
 };
 
+// What sifting searches: each unit's neighbours, both ends of every arc, unit u's at
+// [start[u], start[u + 1]).
 template <typename Weight>
-void sift_with(uint32_t* order, size_t unit_count, const Arc* arcs, size_t arc_count, const uint32_t* group,
-               size_t max_passes, const std::vector<size_t>& start);
+struct SiftGraph {
+    std::vector<size_t> start;
+    std::vector<Neighbour<Weight>> adjacency;
+    bool by_position = false;  // each list already sorted by position in the order sifting starts from
+};
+
+template <typename Weight>
+void sift_with(uint32_t* order, size_t unit_count, const uint32_t* group, size_t max_passes, SiftGraph<Weight>& graph);
+
+// The weight of the arcs pointing backwards in the order (each arc counted at its `from` end).
+template <typename Weight>
+uint64_t backward_weight(const uint32_t* order, size_t unit_count, const SiftGraph<Weight>& graph) {
+    std::vector<uint32_t> position(unit_count);
+    for (size_t i = 0; i < unit_count; ++i) position[order[i]] = uint32_t(i);
+    uint64_t weight = 0;
+    for (size_t u = 0; u < unit_count; ++u)
+        for (size_t e = graph.start[u]; e < graph.start[u + 1]; ++e) {
+            const Neighbour<Weight>& n = graph.adjacency[e];
+            if (n.s > 0 && position[n.unit] < position[u]) weight += uint64_t(n.s);
+        }
+    return weight;
+}
+
+// The greedy feedback-arc-set order of each group's units (groups in ascending id, as
+// start_order's), over the graph's lists while they are in ascending neighbour id.
+template <typename Weight>
+std::vector<uint32_t> greedy_order(size_t unit_count, const uint32_t* group, const SiftGraph<Weight>& graph) {
+    std::vector<uint32_t> units(unit_count);
+    std::iota(units.begin(), units.end(), 0u);
+    if (group)
+        std::stable_sort(units.begin(), units.end(), [&](uint32_t a, uint32_t b) { return group[a] < group[b]; });
+    std::vector<uint32_t> local(unit_count), order;
+    order.reserve(unit_count);
+    for (size_t i = 0; i < unit_count;) {
+        size_t j = i;
+        while (j < unit_count && (!group || group[units[j]] == group[units[i]])) ++j;
+        for (size_t x = i; x < j; ++x) local[units[x]] = uint32_t(x - i);
+        // The neighbours of the group's v-th unit with the sign that makes them out- or in-arcs.
+        const auto arcs = [&](uint32_t v, int sign, auto&& f) {
+            const uint32_t u = units[i + v];
+            for (size_t e = graph.start[u]; e < graph.start[u + 1]; ++e) {
+                const Neighbour<Weight>& n = graph.adjacency[e];
+                if (sign * n.s > 0) f(local[n.unit], uint64_t(sign * int64_t(n.s)));
+            }
+        };
+        for (const uint32_t x : greedy_feedback_order(
+                 j - i, [&](uint32_t v, auto&& f) { arcs(v, +1, f); }, [&](uint32_t v, auto&& f) { arcs(v, -1, f); }))
+            order.push_back(units[i + x]);
+        i = j;
+    }
+    return order;
+}
+
+// A start order for sifting: per group, the greedy feedback-arc-set order, or `previous` when its
+// backward weight is lower (measured_unit_order's first step; stats' start and greedy weights).
+std::vector<uint32_t> start_order(size_t unit_count, const Arc* arcs, size_t arc_count, const uint32_t* group,
+                                  const uint32_t* previous, MeasuredOrderStats& s);
+
+void check_unit_order_input(size_t unit_count, const Arc* arcs, size_t arc_count, const uint32_t* previous);
 
 }  // namespace
 
@@ -278,36 +440,17 @@ void MeasuredPairCounts::add(const KeptNode* const* nodes, size_t node_count, in
     });
 }
 
-std::vector<Arc> MeasuredPairCounts::arcs() const {
-    const PairCounts& c = state_->counts;
+void MeasuredPairCounts::settle() { state_->counts.sparse.settle(); }
+
+std::vector<Arc> MeasuredPairCounts::arcs() {
+    PairCounts& c = state_->counts;
+    c.sparse.settle();
     std::vector<Arc> arcs;
-    auto net = [&](uint32_t lo, uint32_t hi, int64_t n) {
-        if (n > 0)
-            arcs.push_back({lo, hi, uint64_t(n)});
-        else if (n < 0)
-            arcs.push_back({hi, lo, uint64_t(-n)});
-    };
-    if (c.units <= kDenseMeasuredUnits) {
+    if (c.units <= kDenseMeasuredUnits)
         arcs.reserve(size_t(c.dense.size() - size_t(std::count(c.dense.begin(), c.dense.end(), 0))));
-        for (uint32_t lo = 0; lo < c.units; ++lo)
-            for (uint32_t hi = lo + 1; hi < c.units; ++hi) net(lo, hi, c.dense[PairCounts::slot(lo, hi)]);
-    } else {
-        // In key order, whatever the table's layout: bucketed by the lower unit straight into the
-        // arcs (the net kept as the weight's bits), each bucket (a unit's few hundred pairs at
-        // most) sorted by the higher unit, then each arc turned to point from the unit in front.
-        std::vector<size_t> first(c.units + 1, 0);
-        c.sparse.for_each([&](uint32_t lo, uint32_t, int64_t n) { first[lo + 1] += n != 0; });
-        std::partial_sum(first.begin(), first.end(), first.begin());
-        arcs.resize(first[c.units]);
-        c.sparse.for_each([&](uint32_t lo, uint32_t hi, int64_t n) {
-            if (n != 0) arcs[first[lo]++] = {lo, hi, uint64_t(n)};
-        });
-        for (size_t lo = 0, begin = 0; lo < c.units; begin = first[lo++])
-            std::sort(arcs.begin() + long(begin), arcs.begin() + long(first[lo]),
-                      [](const Arc& a, const Arc& b) { return a.to < b.to; });
-        for (Arc& a : arcs)
-            if (int64_t(a.weight) < 0) a = {a.to, a.from, uint64_t(-int64_t(a.weight))};
-    }
+    else
+        arcs.reserve(c.sparse.is_wide ? c.sparse.settled_wide.size() : c.sparse.settled_narrow.size());
+    for_each_arc(c, [&](uint32_t from, uint32_t to, uint64_t weight) { arcs.push_back({from, to, weight}); });
     return arcs;
 }
 
@@ -336,49 +479,55 @@ uint64_t sift_order(uint32_t* order, size_t unit_count, const Arc* arcs, size_t 
     }
     std::partial_sum(start.begin(), start.end(), start.begin());
     if (arc_count > UINT32_MAX) throw InvalidInput("sifting: " + std::to_string(arc_count) + " arcs, more than 2^32");
+    // Each unit's arcs (their indices), then handed to the other ends in order of the unit's
+    // position: every list comes out sorted by position, in linear time.
+    const auto sift = [&](auto graph) {
+        using Weight = decltype(graph.adjacency[0].s);
+        graph.adjacency.resize(start[unit_count]);
+        {
+            std::vector<uint32_t> arcs_of_unit(start[unit_count]);
+            std::vector<size_t> fill(start.begin(), start.end() - 1);
+            for (size_t i = 0; i < arc_count; ++i) {
+                const Arc& a = arcs[i];
+                if (a.from == a.to || (group && group[a.from] != group[a.to])) continue;
+                arcs_of_unit[fill[a.from]++] = uint32_t(i);
+                arcs_of_unit[fill[a.to]++] = uint32_t(i);
+            }
+            fill.assign(start.begin(), start.end() - 1);
+            for (size_t x = 0; x < unit_count; ++x) {
+                const uint32_t v = order[x];
+                for (size_t e = start[v]; e < start[v + 1]; ++e) {
+                    const Arc& a = arcs[arcs_of_unit[e]];  // the other end's entry s(other, v)
+                    const bool other_first = a.to == v;
+                    graph.adjacency[fill[other_first ? a.from : a.to]++] = {
+                        v, other_first ? Weight(a.weight) : Weight(-int64_t(a.weight))};
+                }
+            }
+        }
+        graph.start = std::move(start);
+        graph.by_position = true;
+        sift_with(order, unit_count, group, max_passes, graph);
+    };
     if (narrow)
-        sift_with<int32_t>(order, unit_count, arcs, arc_count, group, max_passes, start);
+        sift(SiftGraph<int32_t>());
     else
-        sift_with<int64_t>(order, unit_count, arcs, arc_count, group, max_passes, start);
+        sift(SiftGraph<int64_t>());
     return count_feedback_arcs(order, unit_count, arcs, arc_count).weight;
 }
 
 namespace {
 
-// sift_order's search, with `start` each unit's offset into the adjacency (both ends of every arc
-// kept).
+// sift_order's search over the graph's adjacency.
 template <typename Weight>
-void sift_with(uint32_t* order, size_t unit_count, const Arc* arcs, size_t arc_count, const uint32_t* group,
-               size_t max_passes, const std::vector<size_t>& start) {
+void sift_with(uint32_t* order, size_t unit_count, const uint32_t* group, size_t max_passes, SiftGraph<Weight>& graph) {
     using Neighbour = animorder::Neighbour<Weight>;
+    const std::vector<size_t>& start = graph.start;
+    std::vector<Neighbour>& adjacency = graph.adjacency;
     std::vector<uint32_t> position(unit_count);
     for (size_t i = 0; i < unit_count; ++i) position[order[i]] = uint32_t(i);
     // Each unit's neighbours, sorted by their current position when the unit is visited. Moving
     // one unit keeps the relative order of all others, so a list goes stale only when one of its
     // own neighbours moves: it is sorted again then, by insertion when few moved.
-    std::vector<Neighbour> adjacency(start[unit_count]);
-    {
-        // Each unit's arcs (their indices), then handed to the other ends in order of the unit's
-        // position: every list comes out sorted by position, in linear time.
-        std::vector<uint32_t> arcs_of_unit(start[unit_count]);
-        std::vector<size_t> fill(start.begin(), start.end() - 1);
-        for (size_t i = 0; i < arc_count; ++i) {
-            const Arc& a = arcs[i];
-            if (a.from == a.to || (group && group[a.from] != group[a.to])) continue;
-            arcs_of_unit[fill[a.from]++] = uint32_t(i);
-            arcs_of_unit[fill[a.to]++] = uint32_t(i);
-        }
-        fill.assign(start.begin(), start.end() - 1);
-        for (size_t x = 0; x < unit_count; ++x) {
-            const uint32_t v = order[x];
-            for (size_t e = start[v]; e < start[v + 1]; ++e) {
-                const Arc& a = arcs[arcs_of_unit[e]];  // the other end's entry s(other, v)
-                const bool other_first = a.to == v;
-                adjacency[fill[other_first ? a.from : a.to]++] = {
-                    v, other_first ? Weight(a.weight) : Weight(-int64_t(a.weight))};
-            }
-        }
-    }
     const auto before = [&](const Neighbour& a, const Neighbour& b) {
         return position[a.unit] < position[b.unit] || (a.unit == b.unit && a.s < b.s);
     };
@@ -393,7 +542,11 @@ void sift_with(uint32_t* order, size_t unit_count, const Arc* arcs, size_t arc_c
         }
         stale[u] = 0;
     };
-    for (uint32_t u = 0; u < unit_count; ++u) sort_neighbours(u);  // only a pair given twice is out of place
+    // Lists built by position hold only a pair given twice out of place; others are sorted whole.
+    for (uint32_t u = 0; u < unit_count; ++u) {
+        stale[u] = graph.by_position ? 0 : UINT32_MAX / 16;
+        sort_neighbours(u);
+    }
     // Each group's block [first, last] in the order.
     std::vector<uint32_t> block_first(unit_count), block_last(unit_count);
     for (size_t i = 0; i < unit_count;) {
@@ -442,10 +595,7 @@ void sift_with(uint32_t* order, size_t unit_count, const Arc* arcs, size_t arc_c
     }
 }
 
-}  // namespace
-
-std::vector<uint32_t> measured_unit_order(size_t unit_count, const Arc* arcs, size_t arc_count, const uint32_t* group,
-                                          const uint32_t* previous, MeasuredOrderStats* stats, bool try_greedy) {
+void check_unit_order_input(size_t unit_count, const Arc* arcs, size_t arc_count, const uint32_t* previous) {
     if (previous) {
         std::vector<uint8_t> seen(unit_count, 0);
         for (size_t i = 0; i < unit_count; ++i) {
@@ -459,15 +609,10 @@ std::vector<uint32_t> measured_unit_order(size_t unit_count, const Arc* arcs, si
         if (arcs[a].from >= unit_count || arcs[a].to >= unit_count)
             throw InvalidInput("measured order: arc " + std::to_string(a) + " names a unit outside 0.." +
                                std::to_string(unit_count));
-    if (previous && !try_greedy) {
-        MeasuredOrderStats s;
-        std::vector<uint32_t> order(previous, previous + unit_count);
-        s.start_weight = count_feedback_arcs(previous, unit_count, arcs, arc_count).weight;
-        s.from_previous = true;
-        s.final_weight = sift_order(order.data(), unit_count, arcs, arc_count, group);
-        if (stats) *stats = s;
-        return order;
-    }
+}
+
+std::vector<uint32_t> start_order(size_t unit_count, const Arc* arcs, size_t arc_count, const uint32_t* group,
+                                  const uint32_t* previous, MeasuredOrderStats& s) {
     // Units of each group (ascending group id, units ascending), and the arcs inside each group.
     std::vector<uint32_t> units(unit_count);
     std::iota(units.begin(), units.end(), 0u);
@@ -501,19 +646,99 @@ std::vector<uint32_t> measured_unit_order(size_t unit_count, const Arc* arcs, si
             i = j;
         }
     }
-    MeasuredOrderStats s;
     s.greedy_weight = count_feedback_arcs(greedy.data(), unit_count, arcs, arc_count).weight;
-    std::vector<uint32_t> order = greedy;
     s.start_weight = s.greedy_weight;
     if (previous) {
         const uint64_t w = count_feedback_arcs(previous, unit_count, arcs, arc_count).weight;
         if (w < s.greedy_weight) {
-            order.assign(previous, previous + unit_count);
             s.start_weight = w;
             s.from_previous = true;
+            return std::vector<uint32_t>(previous, previous + unit_count);
         }
     }
+    return greedy;
+}
+
+}  // namespace
+
+std::vector<uint32_t> measured_unit_order(size_t unit_count, const Arc* arcs, size_t arc_count, const uint32_t* group,
+                                          const uint32_t* previous, MeasuredOrderStats* stats, bool try_greedy) {
+    check_unit_order_input(unit_count, arcs, arc_count, previous);
+    MeasuredOrderStats s;
+    std::vector<uint32_t> order;
+    if (previous && !try_greedy) {
+        order.assign(previous, previous + unit_count);
+        s.start_weight = count_feedback_arcs(previous, unit_count, arcs, arc_count).weight;
+        s.from_previous = true;
+    } else {
+        order = start_order(unit_count, arcs, arc_count, group, previous, s);
+    }
     s.final_weight = sift_order(order.data(), unit_count, arcs, arc_count, group);
+    s.arc_count = arc_count;
+    if (stats) *stats = s;
+    return order;
+}
+
+std::vector<uint32_t> measured_unit_order(MeasuredPairCounts& counts, const uint32_t* previous,
+                                          MeasuredOrderStats* stats, bool try_greedy) {
+    PairCounts& c = counts.state_->counts;
+    const uint32_t* group = counts.state_->group.empty() ? nullptr : counts.state_->group.data();
+    c.sparse.settle();
+    const size_t unit_count = c.units;
+    check_unit_order_input(unit_count, nullptr, 0, previous);
+    // The signed adjacency straight from the counts (no array of arcs beside it): each list comes
+    // out in ascending neighbour id, the order order_feedback_arc_set meets the arcs in.
+    MeasuredOrderStats s;
+    std::vector<size_t> start(unit_count + 1, 0);
+    bool narrow = true;
+    size_t arc_count = 0;
+    const auto inside = [&](uint32_t from, uint32_t to) { return !group || group[from] == group[to]; };
+    for_each_arc(c, [&](uint32_t from, uint32_t to, uint64_t weight) {
+        ++s.arc_count;
+        if (!inside(from, to)) return;
+        narrow = narrow && weight <= uint64_t(std::numeric_limits<int32_t>::max());
+        ++start[from + 1];
+        ++start[to + 1];
+        ++arc_count;
+    });
+    std::partial_sum(start.begin(), start.end(), start.begin());
+    if (arc_count > UINT32_MAX) throw InvalidInput("sifting: " + std::to_string(arc_count) + " arcs, more than 2^32");
+    std::vector<uint32_t> order;
+    const auto search = [&](auto graph) {
+        using Weight = decltype(graph.adjacency[0].s);
+        graph.adjacency.resize(start[unit_count]);
+        {
+            std::vector<size_t> fill(start.begin(), start.end() - 1);
+            for_each_arc(c, [&](uint32_t from, uint32_t to, uint64_t weight) {
+                if (!inside(from, to)) return;
+                graph.adjacency[fill[from]++] = {to, Weight(weight)};
+                graph.adjacency[fill[to]++] = {from, Weight(-int64_t(weight))};
+            });
+        }
+        graph.start = std::move(start);
+        if (previous && !try_greedy) {
+            order.assign(previous, previous + unit_count);
+            s.start_weight = backward_weight(order.data(), unit_count, graph);
+            s.from_previous = true;
+        } else {
+            order = greedy_order(unit_count, group, graph);
+            s.greedy_weight = s.start_weight = backward_weight(order.data(), unit_count, graph);
+            if (previous) {
+                const uint64_t w = backward_weight(previous, unit_count, graph);
+                if (w < s.greedy_weight) {
+                    order.assign(previous, previous + unit_count);
+                    s.start_weight = w;
+                    s.from_previous = true;
+                }
+            }
+        }
+        sift_with(order.data(), unit_count, group, kSiftMaxPasses, graph);
+        s.final_weight = backward_weight(order.data(), unit_count, graph);
+    };
+    if (narrow)
+        search(SiftGraph<int32_t>());
+    else
+        search(SiftGraph<int64_t>());
     if (stats) *stats = s;
     return order;
 }

@@ -104,6 +104,7 @@ std::vector<size_t> measured_update_orders(const MeasuredNodes& nodes, const Clu
     const auto count = [&](size_t c, unsigned threads) {
         add_to_graph(nodes.cache, leaving[c], -1, threads, state.graphs[c]);
         add_to_graph(nodes.cache, arriving[c], +1, threads, state.graphs[c]);
+        state.graphs[c].settle();  // the counting table's memory given back before the next cluster's
     };
     if (by_cluster)
         arena.execute([&] {
@@ -128,12 +129,10 @@ std::vector<size_t> measured_update_orders(const MeasuredNodes& nodes, const Clu
                 return;
             }
             state.start[c] = patch_orders[c];
-            const std::vector<Arc> arcs = state.graphs[c].arcs();
             MeasuredOrderStats stats;
-            patch_orders[c] = measured_unit_order(patches.patch_count(), arcs.data(), arcs.size(), group,
-                                                  patch_orders[c].data(), &stats, !measured_before);
+            patch_orders[c] = measured_unit_order(state.graphs[c], patch_orders[c].data(), &stats, !measured_before);
             state.last[c] = patch_orders[c];
-            lines[c] = " " + std::to_string(c) + ": " + std::to_string(arcs.size()) + " arcs, greedy " +
+            lines[c] = " " + std::to_string(c) + ": " + std::to_string(stats.arc_count) + " arcs, greedy " +
                        std::to_string(stats.greedy_weight) + (stats.from_previous ? ", current " : ", start ") +
                        std::to_string(stats.start_weight) + ", sifted " + std::to_string(stats.final_weight) + ";";
         });

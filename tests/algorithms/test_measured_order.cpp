@@ -243,10 +243,12 @@ TEST(MeasuredGraph, RemovingNodesGivesTheGraphOfTheRest) {
     }
 }
 
-// A pair's net count beyond 32 bits (the compact table's limit) moves the table to 64-bit counts
-// with nothing lost, and removing nodes after that still gives the rest's graph: 40,000 nodes of
-// 65,535 pixels where unit 5 covers unit 7 (2,621,400,000 pixels, above 2^31 − 1), then all but
-// one removed.
+// A pair's net count beyond 32 bits (the compact entries' limit) moves the counts to 64-bit
+// entries with nothing lost, and removing nodes after that still gives the rest's graph: 40,000
+// nodes of 65,535 pixels where unit 5 covers unit 7 (2,621,400,000 pixels, above 2^31 − 1), then
+// all but one removed. Counted at once (the sum overflows while counting) and in two halves
+// settled one after the other (the sum overflows when the second half is settled). The order from
+// the counts is the order of their arcs (64-bit weights in sifting).
 TEST(MeasuredGraph, NetCountsBeyond32BitsAreKeptExactly) {
     const size_t units = 1100;
     std::vector<uint32_t> unit(units), starts(units + 1);
@@ -260,27 +262,115 @@ TEST(MeasuredGraph, NetCountsBeyond32BitsAreKeptExactly) {
                               partition, scratch);
     };
     const KeptNode big = kept(std::vector<std::vector<uint32_t>>(65535, {5, 7}));
-    const KeptNode small = kept({{9, 3}, {9, 3}, {2, 4}});
+    const KeptNode small = kept({{9, 3}, {9, 3}, {2, 4}, {7, 5}});
     const std::vector<const KeptNode*> many(40000, &big);
     const KeptNode* const other = &small;
-    MeasuredPairCounts counts(units, unit.data(), units, nullptr);
-    counts.add(&other, 1, +1, 1);
-    counts.add(many.data(), many.size(), +1, 2);
     const auto weight = [](const std::vector<Arc>& arcs, uint32_t from, uint32_t to) {
         for (const Arc& a : arcs)
             if (a.from == from && a.to == to) return a.weight;
         return uint64_t(0);
     };
-    std::vector<Arc> arcs = counts.arcs();
-    ASSERT_EQ(arcs.size(), 3u);
-    EXPECT_EQ(weight(arcs, 5, 7), uint64_t(40000) * 65535);
-    EXPECT_EQ(weight(arcs, 9, 3), 2u);
-    EXPECT_EQ(weight(arcs, 2, 4), 1u);
-    counts.add(many.data(), many.size() - 1, -1, 1);
-    arcs = counts.arcs();
-    ASSERT_EQ(arcs.size(), 3u);
-    EXPECT_EQ(weight(arcs, 5, 7), 65535u);
-    EXPECT_EQ(weight(arcs, 9, 3), 2u);
+    for (const bool halves : {false, true}) {
+        MeasuredPairCounts counts(units, unit.data(), units, nullptr);
+        counts.add(&other, 1, +1, 1);
+        if (halves) {
+            counts.add(many.data(), many.size() / 2, +1, 2);
+            counts.settle();
+            counts.add(many.data(), many.size() - many.size() / 2, +1, 1);
+            counts.settle();
+        } else {
+            counts.add(many.data(), many.size(), +1, 2);
+        }
+        std::vector<Arc> arcs = counts.arcs();
+        ASSERT_EQ(arcs.size(), 3u) << halves;
+        EXPECT_EQ(weight(arcs, 5, 7), uint64_t(40000) * 65535 - 1) << halves;
+        EXPECT_EQ(weight(arcs, 9, 3), 2u) << halves;
+        EXPECT_EQ(weight(arcs, 2, 4), 1u) << halves;
+        MeasuredOrderStats from_counts, from_arcs;
+        EXPECT_EQ(measured_unit_order(counts, nullptr, &from_counts),
+                  measured_unit_order(units, arcs.data(), arcs.size(), nullptr, nullptr, &from_arcs));
+        EXPECT_EQ(from_counts.final_weight, from_arcs.final_weight);
+        if (halves) {
+            counts.add(many.data(), many.size() / 2, -1, 1);
+            counts.settle();
+            counts.add(many.data(), many.size() - many.size() / 2 - 1, -1, 1);
+        } else {
+            counts.add(many.data(), many.size() - 1, -1, 1);
+        }
+        arcs = counts.arcs();
+        ASSERT_EQ(arcs.size(), 3u) << halves;
+        EXPECT_EQ(weight(arcs, 5, 7), 65534u) << halves;
+        EXPECT_EQ(weight(arcs, 9, 3), 2u) << halves;
+        // A pair whose counts cancel leaves no arc: 7 over 5 once more, settled.
+        const KeptNode again = kept(std::vector<std::vector<uint32_t>>(65534, {7, 5}));
+        const KeptNode* const cancel = &again;
+        counts.add(&cancel, 1, +1, 1);
+        counts.settle();
+        arcs = counts.arcs();
+        ASSERT_EQ(arcs.size(), 2u) << halves;
+        EXPECT_EQ(weight(arcs, 5, 7), 0u) << halves;
+    }
+}
+
+// The order from the counts themselves (sifting's adjacency read from the settled pairs, the greedy
+// order over it) against the order of their arcs: the same order and the same statistics, with and
+// without groups, with no previous order, a previous order tried against the greedy one, and a
+// previous order taken as the start; dense counts, 8-byte entries and 16-byte entries.
+TEST(MeasuredOrder, FromTheCountsIsTheOrderOfTheirArcs) {
+    for (const size_t units : {size_t(20), size_t(1700), size_t(70000)}) {
+        std::mt19937 rng{uint32_t(units) + 7};
+        const size_t triangles = 2 * units;
+        std::vector<uint32_t> unit(triangles);
+        for (size_t t = 0; t < triangles; ++t) unit[t] = uint32_t(rng() % units);
+        std::vector<NodeFragments> nodes;
+        for (int n = 0; n < 4; ++n) {
+            std::vector<std::vector<uint32_t>> list;
+            for (int p = 0; p < 600; ++p) {
+                std::vector<uint32_t> px;
+                for (int f = 0, count = 2 + int(rng() % 5); f < count; ++f)
+                    px.push_back(uint32_t(rng() % (units < 100 ? triangles : 500)) | (f > 0 && rng() % 5 == 0 ? kTie : 0));
+                list.push_back(px);
+            }
+            nodes.push_back(pixels(list));
+        }
+        std::vector<const NodeFragments*> pointers;
+        for (const NodeFragments& n : nodes) pointers.push_back(&n);
+        for (const uint32_t groups : {1u, 3u}) {
+            std::vector<uint32_t> group(units);
+            for (auto& g : group) g = uint32_t(rng() % groups);
+            MeasuredPairCounts counts(units, unit.data(), unit.size(), groups > 1 ? group.data() : nullptr, 2);
+            counts.add(pointers.data(), 3, +1, 2);
+            counts.settle();
+            counts.add(pointers.data() + 3, 1, +1, 1);  // left for measured_unit_order to settle
+            const std::vector<Arc> arcs = counts.arcs();
+            ASSERT_FALSE(arcs.empty());
+            // A previous order: units by group, shuffled inside each group.
+            std::vector<uint32_t> previous(units);
+            std::iota(previous.begin(), previous.end(), 0u);
+            std::shuffle(previous.begin(), previous.end(), rng);
+            std::stable_sort(previous.begin(), previous.end(), [&](uint32_t a, uint32_t b) {
+                return groups > 1 && group[a] < group[b];
+            });
+            for (int start = 0; start < 3; ++start) {
+                const uint32_t* prev = start == 0 ? nullptr : previous.data();
+                const bool try_greedy = start != 2;
+                MeasuredOrderStats a, b;
+                const std::vector<uint32_t> got = measured_unit_order(counts, prev, &a, try_greedy);
+                const std::vector<uint32_t> expected = measured_unit_order(
+                    units, arcs.data(), arcs.size(), groups > 1 ? group.data() : nullptr, prev, &b, try_greedy);
+                const std::string where =
+                    std::to_string(units) + " units, " + std::to_string(groups) + " groups, start " + std::to_string(start);
+                ASSERT_EQ(got, expected) << where;
+                EXPECT_EQ(a.greedy_weight, b.greedy_weight) << where;
+                EXPECT_EQ(a.start_weight, b.start_weight) << where;
+                EXPECT_EQ(a.final_weight, b.final_weight) << where;
+                EXPECT_EQ(a.from_previous, b.from_previous) << where;
+                EXPECT_EQ(a.arc_count, arcs.size()) << where;
+                EXPECT_EQ(b.arc_count, arcs.size()) << where;
+                EXPECT_EQ(a.final_weight, cost(got, arcs)) << where;
+            }
+        }
+    }
 }
 
 TEST(MeasuredGraph, RejectsTrianglesAndUnitsOutOfRange) {

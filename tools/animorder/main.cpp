@@ -1,6 +1,7 @@
 // animorder — command-line entry point: parses options, dispatches to a subcommand, and turns
 // every failure into one line on stderr and a non-zero exit code (never a crash).
 #include "commands.h"
+#include "peak_memory.h"
 
 #include "animorder/atomic_write.h"
 
@@ -204,6 +205,7 @@ int main(int argc, char** argv) {
     // SIGTERM ends a run at any moment, also as a container's first process (PID 1), which the
     // signal's default action would leave running until it is killed.
     animorder::install_signal_cleanup();
+    fix_allocator_threshold();
 
     InspectOptions inspect;
     CLI::App* inspect_cmd =

@@ -9,6 +9,12 @@
 
 namespace animorder::tool {
 
+void fix_allocator_threshold() {
+#ifdef M_MMAP_THRESHOLD
+    mallopt(M_MMAP_THRESHOLD, 1 << 20);
+#endif
+}
+
 PeakResident::PeakResident() {
     malloc_trim(0);
     std::ofstream clear("/proc/self/clear_refs");

@@ -35,6 +35,7 @@ tool_packages=(
   libstb-dev                               # PNG heatmaps
   nettle-dev                               # batch: SHA-256 stamps of items' inputs and options
   libmeshoptimizer-dev                     # the meshopt baseline method
+  libnanoflann-dev                         # reapply --nearest: the nearest optimised triangle (k-d tree)
   libtinygltf-dev                          # glTF 2.0 in and out
   libassimp-dev                            # FBX, Collada, .X, .b3d, MD5, ...
 )

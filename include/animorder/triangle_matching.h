@@ -1,6 +1,7 @@
 // animorder — triangles of one index buffer found in another (triangle_matching.cpp): by vertex
-// indices (is an order a permutation of a primitive's triangles?) and by corner data (which
-// triangle of a processed mesh is which triangle of the optimised one?).
+// indices (is an order a permutation of a primitive's triangles?), by corner data (which
+// triangle of a processed mesh is which triangle of the optimised one?) and by nearness (which
+// triangle of the optimised mesh does a simplified mesh's triangle stand for?).
 #pragma once
 
 #include <cstddef>
@@ -26,5 +27,17 @@ struct TriangleMatch {
 };
 TriangleMatch match_triangles(const std::vector<float>& from, const std::vector<float>& to, size_t dims,
                               float tolerance);
+
+// For each triangle of `to`, the triangle of `from` whose centroid is nearest (Euclidean distance
+// over the centroid's `dims` values: a corner's values averaged over the three corners), and that
+// distance; triangles laid out as in match_triangles. Several triangles of `to` may name the same
+// one (a simplified mesh's triangles stand for several of the original's). Among equally near
+// triangles of `from`, the one the search meets first: the same for the same input. Empty when
+// `from` has no triangle.
+struct NearestTriangles {
+    std::vector<uint32_t> from_of_to;
+    std::vector<double> distance;
+};
+NearestTriangles nearest_triangles(const std::vector<float>& from, const std::vector<float>& to, size_t dims);
 
 }  // namespace animorder

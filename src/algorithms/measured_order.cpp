@@ -92,9 +92,10 @@ struct PairTable {
     OpenTable<uint64_t, int64_t> wide;
     std::vector<Entry<uint32_t, int32_t>> settled_narrow;  // ascending keys, nets ≠ 0
     std::vector<Entry<uint64_t, int64_t>> settled_wide;
+    size_t units = 0;
     bool is_wide = false;
 
-    explicit PairTable(size_t units) : is_wide(units > 0x10000) {
+    explicit PairTable(size_t unit_count) : units(unit_count), is_wide(unit_count > 0x10000) {
         if (is_wide) narrow.slots.clear(); else wide.slots.clear();
     }
     static uint64_t wide_key(uint32_t narrow_key) { return uint64_t(narrow_key >> 16) << 32 | (narrow_key & 0xffff); }
@@ -141,15 +142,23 @@ struct PairTable {
         }
         if (wide.used != 0) merge_into(settled_wide, take_sorted(wide));
     }
-    // The table's entries with a net count, sorted by key; the table emptied.
+    // The table's entries with a net count, sorted by key; the table emptied. Bucketed by the
+    // lower unit (the key's high part) first, then each bucket (a unit's pairs: a few hundred at
+    // most) sorted: linear in the entries but for the small sorts.
     template <typename Key, typename Net>
-    static std::vector<Entry<Key, Net>> take_sorted(OpenTable<Key, Net>& table) {
-        std::vector<Entry<Key, Net>> counted;
-        counted.reserve(table.used);
+    std::vector<Entry<Key, Net>> take_sorted(OpenTable<Key, Net>& table) const {
+        constexpr int kShift = sizeof(Key) * 4;  // 16 for narrow keys, 32 for wide ones
+        std::vector<size_t> first(units + 1, 0);
         for (const auto& s : table.slots)
-            if (s.key != table.kEmpty && s.net != 0) counted.push_back({s.key, s.net});
+            if (s.key != table.kEmpty && s.net != 0) ++first[size_t(s.key >> kShift) + 1];
+        std::partial_sum(first.begin(), first.end(), first.begin());
+        std::vector<Entry<Key, Net>> counted(first[units]);
+        for (const auto& s : table.slots)
+            if (s.key != table.kEmpty && s.net != 0) counted[first[size_t(s.key >> kShift)]++] = {s.key, s.net};
         table = {};
-        std::sort(counted.begin(), counted.end(), [](const auto& a, const auto& b) { return a.key < b.key; });
+        for (size_t lo = 0, begin = 0; lo < units; begin = first[lo++])
+            std::sort(counted.begin() + long(begin), counted.begin() + long(first[lo]),
+                      [](const auto& a, const auto& b) { return a.key < b.key; });
         return counted;
     }
     // Sorted counts into the settled array, zero sums left out; false (nothing changed) when a sum

@@ -1,5 +1,7 @@
 // Triangle identity by vertex indices (a hash of the rotation-normalised triple) and by corner
-// data (a uniform grid over the corners' first three values, the triangle's centroid).
+// data (a uniform grid over the corners' first three values, the triangle's centroid); the
+// nearest triangle by centroid through nanoflann's k-d tree (Blanco & Rai, 2014; Friedman,
+// Bentley & Finkel, "An algorithm for finding best matches in logarithmic expected time", 1977).
 #include "animorder/triangle_matching.h"
 
 #include <algorithm>
@@ -7,6 +9,8 @@
 #include <cmath>
 #include <map>
 #include <unordered_map>
+
+#include <nanoflann.hpp>
 
 namespace animorder {
 namespace {
@@ -94,6 +98,51 @@ TriangleMatch match_triangles(const std::vector<float>& from, const std::vector<
         }
     }
     return m;
+}
+
+namespace {
+
+// The centroids of the triangles, `dims` doubles each, as nanoflann's dataset.
+struct Centroids {
+    std::vector<double> values;
+    size_t dims = 0;
+    Centroids(const std::vector<float>& corners, size_t d) : dims(d) {
+        const size_t count = d == 0 ? 0 : corners.size() / (3 * d);
+        values.resize(count * d);
+        for (size_t t = 0; t < count; ++t)
+            for (size_t i = 0; i < d; ++i)
+                values[t * d + i] =
+                    (double(corners[(3 * t) * d + i]) + corners[(3 * t + 1) * d + i] + corners[(3 * t + 2) * d + i]) /
+                    3;
+    }
+    size_t kdtree_get_point_count() const { return dims == 0 ? 0 : values.size() / dims; }
+    double kdtree_get_pt(size_t t, size_t i) const { return values[t * dims + i]; }
+    template <typename Box>
+    bool kdtree_get_bbox(Box&) const {
+        return false;
+    }
+};
+
+}  // namespace
+
+NearestTriangles nearest_triangles(const std::vector<float>& from, const std::vector<float>& to, size_t dims) {
+    NearestTriangles n;
+    const Centroids a(from, dims), b(to, dims);
+    const size_t from_count = a.kdtree_get_point_count(), to_count = b.kdtree_get_point_count();
+    if (from_count == 0) return n;
+    using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, Centroids>, Centroids, -1,
+                                                     uint32_t>;
+    Tree tree(int(dims), a, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+    n.from_of_to.resize(to_count);
+    n.distance.resize(to_count);
+    for (size_t t = 0; t < to_count; ++t) {
+        uint32_t index = 0;
+        double squared = 0;
+        tree.knnSearch(&b.values[t * dims], 1, &index, &squared);
+        n.from_of_to[t] = index;
+        n.distance[t] = std::sqrt(squared);
+    }
+    return n;
 }
 
 }  // namespace animorder

@@ -761,6 +761,9 @@ TEST_F(Cli, BadInputAndOptionsGiveOneLineErrors) {
         {"optimize --max-memory -1", "--max-memory: must be a whole number (digits only), not '-1'"},
         {"reapply a.glb b.glb -o c.glb --max-memory 0", "--max-memory: Value 0 not in range 1048576"},
         {"reapply a.glb b.glb -o c.glb --tolerance nan", "--tolerance: must be a number, not 'nan'"},
+        {"reapply a.glb b.glb -o c.glb --nearest nan", "--nearest: must be a number, not 'nan'"},
+        {"reapply a.glb b.glb -o c.glb --nearest -0.1", "--nearest: Value -0.1 not in range 0"},
+        {"reapply a.glb b.glb -o c.glb --nearest 2", "--nearest: Value 2 not in range 0"},
     };
     for (const Case& c : cases) {
         const test::Outcome o = run(c.args + " --quiet");  // errors print even when quiet

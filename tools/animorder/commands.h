@@ -97,6 +97,7 @@ struct CheckOptions {
 struct ReapplyOptions {
     std::string optimized, processed, output;
     double tolerance = 1e-3;  // corner distance allowed, as a fraction of OPTIMIZED's bounding-box diagonal
+    double nearest = 0;       // > 0: unmatched triangles placed by the nearest optimised one within this fraction
     size_t max_memory = LoadOptions{}.max_keyframe_bytes;
     bool quiet = false;
 };

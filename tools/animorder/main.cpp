@@ -358,17 +358,25 @@ int main(int argc, char** argv) {
     reapply_cmd->add_option("-o,--output", reapply.output, "OUT.glb or OUT.gltf: PROCESSED with the orders")
         ->required()
         ->check(kPath);
+    const CLI::Validator number(
+        [](std::string& text) {  // CLI::Range lets NaN through (every comparison with it is false)
+            const double v = std::strtod(text.c_str(), nullptr);
+            return std::isnan(v) ? std::string("must be a number, not '") + text + "'" : std::string();
+        },
+        "NUMBER");
     reapply_cmd
         ->add_option("--tolerance", reapply.tolerance,
                      "Corner distance allowed, as a fraction of the bounding-box diagonal")
         ->capture_default_str()
-        ->check(CLI::Validator(
-            [](std::string& text) {  // CLI::Range lets NaN through (every comparison with it is false)
-                const double v = std::strtod(text.c_str(), nullptr);
-                return std::isnan(v) ? std::string("must be a number, not '") + text + "'" : std::string();
-            },
-            "NUMBER"))
+        ->check(number)
         ->check(CLI::Range(0.0, 0.1));
+    reapply_cmd
+        ->add_option("--nearest", reapply.nearest,
+                     "A simplified PROCESSED: a triangle found nowhere is drawn where the optimised triangle with the "
+                     "nearest posed centroid is, when within this fraction of the bounding-box diagonal (0: off)")
+        ->capture_default_str()
+        ->check(number)
+        ->check(CLI::Range(0.0, 1.0));
     reapply_cmd->add_option("--max-memory", reapply.max_memory, "Loading budget in bytes for the sampled animation")
         ->capture_default_str()
         ->check(kWholeNumber)

@@ -6,6 +6,10 @@
 // targets and KHR_mesh_quantization dequantisation applied, so indices and vertex layouts may
 // differ). Refused, with nothing written, unless every triangle of every optimised primitive
 // matches one triangle of PROCESSED and every processed primitive is wholly matched or untouched.
+// With --nearest D (a simplified PROCESSED), a processed triangle found nowhere takes the place
+// of the optimised triangle whose posed centroid is nearest (within D of the diagonal): each
+// order then draws the processed triangles in the order of the optimised triangles they stand
+// for, ties in PROCESSED's own sequence, and the tables' centres become the processed mesh's.
 #include "commands.h"
 #include "input.h"
 
@@ -15,8 +19,10 @@
 #include "animorder/gltf_loader.h"
 #include "animorder/load.h"
 #include "animorder/triangle_matching.h"
+#include "animorder/viewpoints.h"
 
 #include <algorithm>
+#include <numeric>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -66,7 +72,7 @@ int run_reapply(const ReapplyOptions& options) {
         }
     }
     check_outputs({options.output}, inputs);
-    const OrdersExtensionCheck orders = read_orders_extension(options.optimized);
+    OrdersExtensionCheck orders = read_orders_extension(options.optimized);
     LoadOptions load;
     load.max_keyframe_bytes = options.max_memory;
     const AnimatedMesh a = load_gltf(options.optimized, load);
@@ -163,7 +169,31 @@ int run_reapply(const ReapplyOptions& options) {
         const uint32_t* corner = &a.indices[3 * t];
         dropped += b_of_a[t] < 0 && (corner[0] == corner[1] || corner[1] == corner[2] || corner[0] == corner[2]);
     }
-    if (m.matched + dropped != a_triangles.size()) {
+    // Per triangle of PROCESSED: the optimised triangle (global index) it is, or stands for.
+    std::vector<int64_t> source(b.triangle_count(), -1);
+    for (size_t t = 0; t < m.from_of_to.size(); ++t)
+        if (m.from_of_to[t] >= 0) source[t] = int64_t(a_triangles[size_t(m.from_of_to[t])]);
+    size_t near = 0;
+    double farthest = 0;  // of the processed triangles beyond --nearest, as a fraction of the diagonal
+    if (options.nearest > 0) {
+        std::vector<size_t> missing;
+        for (size_t t = 0; t < source.size(); ++t)
+            if (source[t] < 0) missing.push_back(t);
+        // Centroid distances over the compared keyframes, as one keyframe's: divided by √keyframes.
+        const NearestTriangles n = nearest_triangles(corners(a, a_triangles, ka), corners(b, missing, kb), 3 * ka.size());
+        const double limit = options.nearest * diagonal * std::sqrt(double(ka.size()));
+        for (size_t i = 0; i < missing.size() && !n.from_of_to.empty(); ++i) {
+            if (n.distance[i] > limit) {
+                farthest = std::max(farthest, n.distance[i] / (diagonal * std::sqrt(double(ka.size()))));
+                continue;
+            }
+            source[missing[i]] = int64_t(a_triangles[n.from_of_to[i]]);
+            ++near;
+        }
+        if (!options.quiet)
+            std::fprintf(stderr, "animorder: %zu of %zu other processed triangles lie within --nearest %s of an optimised one\n",
+                         near, missing.size(), shown(options.nearest).c_str());
+    } else if (m.matched + dropped != a_triangles.size()) {
         // A mesh left as it was whose animation a pipeline resampled or quantised (gltfpack's
         // defaults) poses its corners a little apart: say which tolerance would match them all.
         std::string wider;
@@ -177,10 +207,18 @@ int run_reapply(const ReapplyOptions& options) {
         }
         throw std::runtime_error(options.processed + ": only " + std::to_string(m.matched) + " of " +
                                  std::to_string(a_triangles.size() - dropped) + " optimised triangles found within " +
-                                 "--tolerance " + shown(options.tolerance) + " (simplified or changed mesh?)" + wider +
-                                 "; nothing written");
+                                 "--tolerance " + shown(options.tolerance) +
+                                 " (changed mesh? a simplified one takes --nearest 0.1)" + wider + "; nothing written");
     }
 
+    // Per order, each optimised triangle's place: its source's rank among the sources, then its
+    // position in that source's order (the sequence the orders draw OPTIMIZED's triangles in).
+    std::vector<std::vector<uint64_t>> rank(orders.buffer_count, std::vector<uint64_t>(a.triangle_count(), 0));
+    for (uint32_t o = 0; o < orders.buffer_count; ++o) {
+        uint64_t at = 0;
+        for (const Source& src : sources)
+            for (const uint32_t q : src.order_triangles[o]) rank[o][src.first_triangle + q] = at++;
+    }
     std::vector<PrimitiveOrders> out;
     std::map<std::pair<int, int>, size_t> seen;
     // Processed primitives none of whose triangles is OPTIMIZED's (new geometry, or a copy of a
@@ -188,8 +226,9 @@ int run_reapply(const ReapplyOptions& options) {
     std::string unordered;
     size_t unordered_primitives = 0, unordered_triangles = 0;
     for (const Primitive& p : b.primitives) {
+        const size_t first = p.first_index / 3, last = first + p.index_count / 3;
         size_t hits = 0;
-        for (size_t t = p.first_index / 3; t < (p.first_index + p.index_count) / 3; ++t) hits += m.from_of_to[t] >= 0;
+        for (size_t t = first; t < last; ++t) hits += source[t] >= 0;
         if (hits == 0) {
             unordered += (unordered.empty() ? "" : ", ") + p.name;
             ++unordered_primitives;
@@ -197,20 +236,25 @@ int run_reapply(const ReapplyOptions& options) {
             continue;
         }
         if (hits != p.index_count / 3)
-            throw std::runtime_error(options.processed + ": primitive " + p.name + " holds " +
-                                     std::to_string(p.index_count / 3 - hits) +
-                                     " triangles that are not OPTIMIZED's (changed mesh?); nothing written");
+            throw std::runtime_error(
+                options.processed + ": primitive " + p.name + " holds " + std::to_string(p.index_count / 3 - hits) +
+                " triangles that are not OPTIMIZED's" +
+                (options.nearest > 0 ? " nor within --nearest " + shown(options.nearest) +
+                                           " of one (the farthest lies " + shown(farthest) + " away)"
+                                     : std::string()) +
+                " (changed mesh?); nothing written");
         PrimitiveOrders po;
         po.mesh = p.source_mesh, po.primitive = p.source_primitive;
-        const size_t first = p.first_index / 3, last = first + p.index_count / 3;
-        for (uint32_t o = 0; o < orders.buffer_count; ++o)
-            for (const Source& s : sources)
-                for (uint32_t q : s.order_triangles[o]) {
-                    const int64_t t = b_of_a[s.first_triangle + q];
-                    if (t < int64_t(first) || t >= int64_t(last)) continue;
-                    for (size_t c = 0; c < 3; ++c)
-                        po.orders.push_back(uint32_t(b_file[3 * size_t(t) + c] - p.vertex_base));
-                }
+        std::vector<uint32_t> drawn(p.index_count / 3);
+        for (uint32_t o = 0; o < orders.buffer_count; ++o) {
+            // The processed triangles in the order of the optimised ones they are or stand for.
+            std::iota(drawn.begin(), drawn.end(), uint32_t(first));
+            std::stable_sort(drawn.begin(), drawn.end(), [&](uint32_t x, uint32_t y) {
+                return rank[o][size_t(source[x])] < rank[o][size_t(source[y])];
+            });
+            for (const uint32_t t : drawn)
+                for (size_t c = 0; c < 3; ++c) po.orders.push_back(uint32_t(b_file[3 * size_t(t) + c] - p.vertex_base));
+        }
         // A mesh several nodes draw (instances) has one index buffer: written once, when every
         // instance's orders agree (OPTIMIZED's instances share theirs, so they do unless the
         // pipeline changed one of them).
@@ -222,6 +266,29 @@ int run_reapply(const ReapplyOptions& options) {
                                      " is drawn by several nodes whose optimised triangles come in different orders; "
                                      "nothing written");
     }
+    if (near > 0) {
+        // A simplified mesh frames a little apart from the optimised one (its extremities cut
+        // short): each clip's centres become the processed mesh's frame centres, where an
+        // engine's lookup (and `check`) takes them from. The n-th clip of a name takes the n-th
+        // of PROCESSED's clips of that name.
+        const Framing framing = frame_animated_mesh(b);
+        std::map<std::string, size_t> rank_of_name;
+        for (ExtensionClip& c : orders.clips) {
+            size_t rank = rank_of_name[c.name]++;
+            for (const Clip& clip : b.clips) {
+                if (clip.name != c.name || rank-- != 0) continue;
+                if (clip.keyframe_count != c.keyframes) break;
+                c.centers = std::vector<float>(framing.centres.begin() + long(3 * clip.first_keyframe),
+                                               framing.centres.begin() + long(3 * (clip.first_keyframe + c.keyframes)));
+                break;
+            }
+        }
+    }
+    if (out.empty())
+        throw std::runtime_error(options.processed + ": no primitive whose triangles are OPTIMIZED's" +
+                                 (options.nearest > 0 ? " or lie within --nearest " + shown(options.nearest) + " of them"
+                                                      : std::string()) +
+                                 "; nothing written");
     std::string kept;
     const std::string bytes =
         gltf_with_extension_orders(options.processed, options.output, orders, out, extension == ".glb", &kept);
@@ -232,8 +299,10 @@ int run_reapply(const ReapplyOptions& options) {
                      "animorder: note: %zu primitive(s) of %s (%s: %zu triangles) match no optimised triangle: "
                      "written without orders\n",
                      unordered_primitives, options.processed.c_str(), unordered.c_str(), unordered_triangles);
-    std::printf("reapplied %u orders: %zu of %zu triangles matched, %zu primitive(s)", orders.buffer_count, m.matched,
-                a_triangles.size(), out.size());
+    std::printf("reapplied %u orders: %zu of %zu triangles matched", orders.buffer_count, m.matched, a_triangles.size());
+    if (options.nearest > 0)
+        std::printf(", %zu processed triangles placed by the nearest optimised one", near);
+    std::printf(", %zu primitive(s)", out.size());
     if (unordered_primitives > 0)
         std::printf(", %zu without orders (%zu triangles no optimised one matches)", unordered_primitives,
                     unordered_triangles);

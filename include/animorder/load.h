@@ -71,6 +71,13 @@ AnimatedMesh load_character(const std::string& path, const std::vector<std::stri
 // be listed or is empty, or glTF JSON over 1 GiB.
 std::vector<std::string> files_load_reads(const std::string& path, const std::vector<std::string>& clip_files = {});
 
+// A .gltf's or .glb's external buffers and images, each by its URI as the file writes it and the
+// file files_load_reads resolves it to, in the file's order (buffers, then images).
+struct ExternalFile {
+    std::string uri, file;
+};
+std::vector<ExternalFile> gltf_external_uris(const std::string& path);
+
 // Appends to files_read those of `more` it does not hold yet, in order (LoadOptions::files_read).
 void add_files_read(std::vector<std::string>& files_read, const std::vector<std::string>& more);
 

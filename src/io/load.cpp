@@ -96,8 +96,10 @@ std::string find_file(const std::string& gltf, const std::string& name) {
     return std::filesystem::is_regular_file(here, error) ? here : beside;
 }
 
-std::vector<std::string> gltf_external_files(const std::string& path) {
-    std::vector<std::string> files;
+}  // namespace
+
+std::vector<ExternalFile> gltf_external_uris(const std::string& path) {
+    std::vector<ExternalFile> files;
     const std::string text = io::gltf_json_text(path);
     if (text.empty()) return files;
     const nlohmann::json doc = nlohmann::json::parse(text, nullptr, false);
@@ -113,9 +115,17 @@ std::vector<std::string> gltf_external_files(const std::string& path) {
             // Empty: no file (a GLB's BIN chunk, an image left out); a data URI tinygltf decodes
             // (its own test: only some media types are) is inside the file.
             if (u.empty() || tinygltf::IsDataURI(u)) continue;
-            files.push_back(find_file(path, decode_uri(u)));
+            files.push_back({u, find_file(path, decode_uri(u))});
         }
     }
+    return files;
+}
+
+namespace {
+
+std::vector<std::string> gltf_external_files(const std::string& path) {
+    std::vector<std::string> files;
+    for (const ExternalFile& f : gltf_external_uris(path)) files.push_back(f.file);
     return files;
 }
 

@@ -7,8 +7,11 @@
 
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <string>
 
@@ -108,7 +111,7 @@ TEST_F(JsTest, ViewerInHeadlessChromium) {
     optimise_character();
     if (HasFatalFailure()) return;
     const fs::path shot = path("screenshot.png");
-    run_browser_test(*this, dir_, "", shot, 10);
+    run_browser_test(*this, dir_, "", shot, 11);
     const char* keep = std::getenv("ANIMORDER_VIEWER_SCREENSHOT");
     if (keep && *keep && fs::exists(shot)) {
         fs::copy_file(shot, keep, fs::copy_options::overwrite_existing);
@@ -116,18 +119,55 @@ TEST_F(JsTest, ViewerInHeadlessChromium) {
     }
 }
 
-// A skinned character (CesiumMan: SkinnedMesh, node transforms, a texture) of ../shared/data.
+// `glb` as a .gltf with its binary chunk in an external .bin and each embedded image in a file of
+// its own under a subfolder, URIs percent-encoded (the way characters are often shared):
+// NAME.gltf, NAME.bin and textures/image N.EXT in `folder`.
+void write_external_gltf(const fs::path& glb, const fs::path& folder, const std::string& name) {
+    const std::string bytes = test::slurp(glb);
+    ASSERT_GT(bytes.size(), 28u);
+    const auto u32 = [&](size_t at) {
+        uint32_t v = 0;
+        for (int i = 3; i >= 0; --i) v = v << 8 | uint8_t(bytes[at + size_t(i)]);
+        return size_t(v);
+    };
+    const size_t json_length = u32(12);
+    nlohmann::json j = nlohmann::json::parse(bytes.substr(20, json_length));
+    const std::string bin = bytes.substr(20 + json_length + 8, u32(20 + json_length));
+    fs::create_directories(folder / "textures");
+    j["buffers"][0]["uri"] = name + ".bin";
+    std::ofstream(folder / (name + ".bin"), std::ios::binary) << bin;
+    for (size_t i = 0; i < j["images"].size(); ++i) {
+        nlohmann::json& image = j["images"][i];
+        const nlohmann::json& view = j["bufferViews"][image["bufferView"].get<size_t>()];
+        const std::string file = "image " + std::to_string(i) + (image["mimeType"] == "image/png" ? ".png" : ".jpg");
+        std::ofstream(folder / "textures" / file, std::ios::binary)
+            << bin.substr(view.value("byteOffset", size_t(0)), view["byteLength"].get<size_t>());
+        image.erase("bufferView");
+        image["uri"] = "textures/image%20" + std::to_string(i) + file.substr(file.find('.'));
+    }
+    std::ofstream(folder / (name + ".gltf")) << j.dump();
+}
+
+// A skinned character (CesiumMan: SkinnedMesh, node transforms, a texture) of ../shared/data, as
+// a .gltf with an external .bin and texture (written by write_external_gltf, under names with a
+// space), optimised into another folder: its .glb names the texture at "../ext/textures/…". The
+// page loads both files with their buffers and textures through `animorder view`.
 TEST_F(JsTest, SkinnedViewerInHeadlessChromium) {
     std::string why;
     ANIMORDER_REQUIRE_OR_SKIP("browser", have_browser(why), why);
     const fs::path cesium = test::shared_data_path("gltf-cesiumman/CesiumMan.glb");
     ANIMORDER_REQUIRE_DATA(cesium);
-    const test::Outcome o = run(std::string(ANIMORDER_EXE) + " optimize -q " + sh(cesium) +
-                                " --method single -k 3 --views 42 --resolution 64 -o " + sh(path("cesium.glb")));
+    write_external_gltf(cesium, path("ext"), "Cesium Man");
+    if (HasFatalFailure()) return;
+    fs::create_directories(path("out"));
+    const test::Outcome o = run(std::string(ANIMORDER_EXE) + " optimize -q " + sh(path("ext/Cesium Man.gltf")) +
+                                " --method single -k 3 --views 42 --resolution 64 -o " + sh(path("out/cesium.glb")));
     ASSERT_EQ(o.exit_code, 0) << o.err;
+    EXPECT_NE(test::slurp(path("out/cesium.glb")).find("../ext/textures/image%200.jpg"), std::string::npos);
     run_browser_test(*this, dir_,
-                     " --model cesium.glb --sidecar cesium.animorder.bin --input " + sh(cesium) + " --expect-skinned 1",
-                     path("cesium.png"), 11);
+                     " --model out/cesium.glb --sidecar out/cesium.animorder.bin --input " +
+                         sh(path("ext/Cesium Man.gltf")) + " --expect-skinned 1 --expect-textured 1",
+                     path("cesium.png"), 13);
 }
 
 // `animorder view`: the viewer's files and the model only, GET/HEAD only, nothing above its folders.

@@ -1059,6 +1059,8 @@ TEST(CommittedDocs, CarryNoHandTypedMeasurements) {
         {"gltfpack 0.18", "a version"},
         {"find_package(animorder 0.1 CONFIG", "the package version asked for (tests/consumer/run.sh checks the line)"},
         {"--tolerance 0.001", "reapply's default"},
+        {"--nearest 0.1", "reapply's suggested setting for a simplified mesh (an option value)"},
+        {"gltfpack -si 0.3 -sa", "the simplification the pipeline test runs (an option value)"},
         {"3 and 7 minutes", "the install goals"},
         {"optimizeOverdraw(1.05)", "meshoptimizer's threshold as the method calls it"},
         {"200–650 s per clip, 1,700–3,400 s for a joint set", "the paper's Table 1 (I3D version)"},

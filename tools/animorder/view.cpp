@@ -1,6 +1,8 @@
 // animorder view [FILE] — serves the viewer page (viewer/, with js/ and three.js from
-// viewer/node_modules) and FILE as /model.glb on 127.0.0.1 only, prints the address and opens it
-// in the default browser. Without FILE it first optimises the bundled character (subdivide
+// viewer/node_modules) and FILE as /model/NAME (also /model.glb) on 127.0.0.1 only, with the
+// external buffers and images a .gltf or .glb names (at the URLs its URIs resolve to from there;
+// the same for --original's file under /original/), prints the address and opens it in the
+// default browser. Without FILE it first optimises the bundled character (subdivide
 // --levels 0, then optimize with the default method) into a new scratch folder of its own (random name,
 // mode 0700), and serves the un-optimised file too (/original.glb) so the page can compare the
 // original order with the optimised ones.
@@ -17,7 +19,7 @@
 //   the server within about a second whatever the clients do: the workers' sockets are shut down,
 //   the workers joined, and the scratch folder removed.
 // - Files only below the viewer's folders (no "..", no "%", no backslash; real paths checked, see
-//   resolve()), and requests whose Host is not this server's loopback address and port are refused
+//   resolve()) and the files the two glTF files name (nothing else of their folders), and requests whose Host is not this server's loopback address and port are refused
 //   (421: a page rebound to 127.0.0.1 by DNS rebinding cannot read the model).
 // - Without -q, refused requests are logged with their URL's control bytes and non-ASCII bytes
 //   written as \xNN.
@@ -25,6 +27,7 @@
 #include "http_request.h"
 
 #include "animorder/atomic_write.h"
+#include "animorder/load.h"
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
@@ -37,6 +40,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <condition_variable>
@@ -47,6 +51,7 @@
 #include <deque>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <mutex>
 #include <random>
 #include <stdexcept>
@@ -99,11 +104,88 @@ std::string content_type(const fs::path& path) {
 
 struct Site {
     fs::path root;      // the folder holding viewer/ and js/
-    fs::path model;     // served as /model.glb
-    fs::path original;  // served as /original.glb (may be empty)
+    fs::path model;     // served as /model/NAME (and /model.glb)
+    fs::path original;  // served as /original/NAME (and /original.glb; may be empty)
+    std::string model_url, original_url;  // /model/NAME, /original/NAME, percent-encoded
+    // The two files and their external buffers and images, by the URL path a browser asks for
+    // them at (each URI resolved against its file's URL, percent-encoded as canonical_path does).
+    std::map<std::string, fs::path> files;
     unsigned port = 0;  // the port listened on (the Host check)
     bool quiet = false;
 };
+
+// `text` percent-encoded: every byte but the unreserved ones (RFC 3986) and '/' as %XX.
+std::string percent_encode(const std::string& text, bool keep_slash) {
+    static const char* hex = "0123456789ABCDEF";
+    std::string out;
+    for (const unsigned char c : text) {
+        if (std::isalnum(c) || c == '-' || c == '.' || c == '_' || c == '~' || (keep_slash && c == '/')) {
+            out += char(c);
+        } else {
+            out += '%';
+            out += hex[c >> 4];
+            out += hex[c & 15];
+        }
+    }
+    return out;
+}
+
+// A URL path in one spelling: percent-decoded (false for a '%' not followed by two hex digits),
+// its "." and ".." segments removed (RFC 3986 §5.2.4, ".." at the root staying there), then
+// percent-encoded again. Two spellings of one path a browser may send come out equal.
+bool canonical_path(const std::string& path, std::string& out) {
+    std::string decoded;
+    for (size_t i = 0; i < path.size(); ++i) {
+        if (path[i] != '%') {
+            decoded += path[i];
+            continue;
+        }
+        if (i + 2 >= path.size() || !std::isxdigit(static_cast<unsigned char>(path[i + 1])) ||
+            !std::isxdigit(static_cast<unsigned char>(path[i + 2])))
+            return false;
+        decoded += char(std::stoi(path.substr(i + 1, 2), nullptr, 16));
+        i += 2;
+    }
+    std::vector<std::string> segments;
+    size_t begin = decoded.empty() || decoded[0] != '/' ? 0 : 1;
+    while (begin <= decoded.size()) {
+        size_t end = decoded.find('/', begin);
+        if (end == std::string::npos) end = decoded.size();
+        const std::string segment = decoded.substr(begin, end - begin);
+        const bool last = end == decoded.size();
+        if (segment == "..") {
+            if (!segments.empty()) segments.pop_back();
+            if (last) segments.push_back("");
+        } else if (segment == ".") {
+            if (last) segments.push_back("");
+        } else {
+            segments.push_back(segment);
+        }
+        begin = end + 1;
+    }
+    out.clear();
+    for (const std::string& segment : segments) out += "/" + percent_encode(segment, false);
+    return true;
+}
+
+// `file` served under `prefix` (/model/ or /original/): its URL, and each of its external
+// buffers and images at the URL its URI resolves to from there (the browser's URL, which may
+// leave the prefix: "../textures/a.png"). Returns the file's URL.
+std::string serve_with_its_files(Site& site, const std::string& prefix, const fs::path& file) {
+    const std::string url = prefix + percent_encode(file.filename().string(), false);
+    site.files[url] = file;
+    const std::string ext = file.extension().string();
+    if (ext != ".gltf" && ext != ".glb" && ext != ".GLTF" && ext != ".GLB") return url;
+    for (const ExternalFile& f : gltf_external_uris(file.string())) {
+        // The URI relative to the file's URL: a relative reference's path (an absolute URI, a
+        // scheme, is the browser's own business and not served here).
+        if (f.uri.find(':') != std::string::npos && f.uri.find(':') < f.uri.find('/')) continue;
+        const std::string reference = f.uri.substr(0, f.uri.find_first_of("?#"));
+        std::string key;
+        if (canonical_path(reference[0] == '/' ? reference : prefix + reference, key)) site.files.emplace(key, f.file);
+    }
+    return url;
+}
 
 // One client's socket, the time by which what is under way (reading the request, then sending
 // the response) must be done, and the server's stop flag.
@@ -170,6 +252,11 @@ bool inside(const fs::path& path, const fs::path& base) {
 fs::path resolve(const Site& site, const std::string& url) {
     if (url == "/model.glb") return site.model;
     if (url == "/original.glb") return site.original;
+    if (url.rfind("/viewer/", 0) != 0 && url.rfind("/js/", 0) != 0) {
+        std::string key;
+        const auto it = canonical_path(url, key) ? site.files.find(key) : site.files.end();
+        return it == site.files.end() ? fs::path() : it->second;
+    }
     if (url.find("..") != std::string::npos || url.find('%') != std::string::npos ||
         url.find('\\') != std::string::npos)
         return {};
@@ -266,8 +353,8 @@ void serve_one(int fd, const Site& site, const std::atomic<bool>& stopping) {
     }
     if (url == "/") {
         respond(c, 302, "Found", "text/plain", "", head,
-                "Location: /viewer/?file=/model.glb" +
-                    std::string(site.original.empty() ? "" : "&original=/original.glb") + "\r\n");
+                "Location: /viewer/?file=" + percent_encode(site.model_url, true) +
+                    (site.original.empty() ? "" : "&original=" + percent_encode(site.original_url, true)) + "\r\n");
         return;
     }
     const fs::path path = resolve(site, url);
@@ -484,6 +571,8 @@ int run_view(const ViewOptions& options) {
         site.original = options.original;
         if (!fs::is_regular_file(site.original)) throw std::runtime_error("cannot read " + site.original.string());
     }
+    site.model_url = serve_with_its_files(site, "/model/", site.model);
+    if (!site.original.empty()) site.original_url = serve_with_its_files(site, "/original/", site.original);
 
     socklen_t length = sizeof address;
     getsockname(server, reinterpret_cast<sockaddr*>(&address), &length);

@@ -14,7 +14,9 @@
 //      fragments the browser counts (additive blending into a float target) for the original and
 //      the optimised order agree with the overdraw engine of `animorder evaluate` within TOLERANCE
 //      (relative, per node), and the optimised order has the lower OVR over the nodes;
-//   4. a glb without the extension (char.glb) loads and the page says so.
+//   4. a file without the extension (the original) loads and the page says so.
+// The page is the one `animorder view`'s / redirects to (checked first); --expect-skinned 1 and
+// --expect-textured 1 also check for a SkinnedMesh and for every texture of the optimised file.
 // Prints one line per check; exit 0 when all pass.
 import { spawn, execFileSync } from 'node:child_process';
 import { readFileSync, writeFileSync } from 'node:fs';
@@ -76,7 +78,11 @@ try {
     const consoleLines = [];
     page.on('console', (m) => consoleLines.push(m.text()));
     page.on('pageerror', (e) => consoleLines.push(`page error: ${e.message}`));
-    await page.goto(`${base}viewer/?file=/model.glb&original=/original.glb&overdraw=1`);
+    // The page as `animorder view` sends a browser to it (its redirect from /, which names both
+    // files by their own names, so that a .gltf's buffers and images resolve beside them).
+    const location = (await fetch(base, { redirect: 'manual' })).headers.get('location');
+    check(location && location.startsWith('/viewer/?file=/model/'), `/ redirects to ${location}`);
+    await page.goto(`${base}${(location || '/viewer/?file=/model.glb&original=/original.glb').slice(1)}&overdraw=1`);
     await page.waitForFunction(() => window.animorderViewer && (window.animorderViewer.state.ready || window.animorderViewer.state.error),
                                { timeout: 60000 });
     const loaded = await page.evaluate(() => ({ error: animorderViewer.state.error, has: animorderViewer.state.hasExtension,
@@ -87,6 +93,17 @@ try {
     check(!loaded.error && loaded.has && loaded.original >= 0,
           `the optimised glb loads with its orders (${loaded.message}; ${loaded.meshes} optimised meshes, ${loaded.skinned} skinned; float blending: ${loaded.floatBlend})`);
     if (args['expect-skinned']) check(loaded.skinned > 0, 'the optimised meshes include a SkinnedMesh');
+    if (args['expect-textured']) {
+        // Every texture of the optimised file loaded (an external image it names, served beside it).
+        const textures = await page.evaluate(() => {
+            const maps = [];
+            animorderViewer.scene.traverse((o) => {
+                if (o.material && o.material.map) maps.push(o.material.map.image ? o.material.map.image.width || 0 : 0);
+            });
+            return maps;
+        });
+        check(textures.length > 0 && textures.every((w) => w > 0), `the optimised file's textures load (widths ${textures.join(', ')})`);
+    }
 
     // 1. renders: let a few frames play, screenshot, and count non-background pixels of the canvas.
     await page.evaluate(() => new Promise((r) => setTimeout(r, 2500)));
@@ -237,8 +254,9 @@ try {
           `three copies of the character in one scene: in ${copies.frames} frames every mesh drew its own copy's order ` +
           `(${copies.wrong} wrong draws); the copies needed different orders in ${copies.differing} frames`);
 
-    // 4. a glb without the extension.
-    await page.goto(`${base}viewer/?file=/original.glb&environment=0`);
+    // 4. a file without the extension: the original, at the URL the redirect gave it.
+    const originalUrl = new URLSearchParams((location || '?original=/original.glb').split('?')[1]).get('original');
+    await page.goto(`${base}viewer/?file=${encodeURIComponent(originalUrl)}&environment=0`);
     await page.waitForFunction(() => window.animorderViewer && (animorderViewer.state.ready || animorderViewer.state.error), { timeout: 60000 });
     const plain = await page.evaluate(() => ({ ready: animorderViewer.state.ready, has: animorderViewer.state.hasExtension,
                                                text: document.getElementById('message').textContent }));

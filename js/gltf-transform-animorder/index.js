@@ -7,8 +7,11 @@
 // renumbered vertices or re-sequenced triangles (weld, reorder) the orders are re-derived: each
 // triangle is found again by its corners' attributes as they were when the file was read, and
 // `indices` becomes the fallback order again. Where the triangles themselves changed (simplify, a
-// moved vertex, quantised positions) the orders are dropped with a warning (and the whole
-// extension when no primitive keeps valid orders): never written stale. A file whose extension
+// moved vertex) each current triangle is placed where the original triangle with the nearest
+// centroid was (positions as read; within a tenth of their bounding-box diagonal): every order
+// draws the current triangles in its order of the originals they stand for, with a warning.
+// Where even that fails (quantised positions, a mesh moved away) the orders are dropped with a
+// warning (and the whole extension when no primitive keeps valid orders): never written stale. A file whose extension
 // does not check out (the rules of animorder's runtime and `animorder check`) is read without
 // it, with a warning: a pipeline never carries, nor rewrites `indices` from, orders that an
 // engine would refuse.
@@ -141,6 +144,130 @@ export function rederive(primitive, orders, bufferCount) {
   return out;
 }
 
+// Each triangle's centroid (x, y, z) from `indices` [begin, end) and the primitive's POSITION, or
+// null without positions.
+function centroids(primitive, indices, begin, end) {
+  const position = primitive.getAttribute('POSITION');
+  if (!position) return null;
+  const out = new Float64Array(end - begin);
+  const v = [0, 0, 0];
+  for (let i = begin, t = 0; i < end; i += 3, t += 3)
+    for (let c = 0; c < 3; ++c) {
+      position.getElement(indices[i + c], v);
+      for (let a = 0; a < 3; ++a) out[t + a] += v[a] / 3;
+    }
+  return out;
+}
+
+/**
+ * What placing needs, made when the file is read: the centroids of order 0's triangles, each
+ * one's position in every order (`keys`: cornerKeys of each order, triangles paired in sequence),
+ * and the diagonal of the bounding box of the vertices they use. Null when an order is no
+ * permutation of order 0.
+ */
+function placementOf(primitive, all, n, keys) {
+  const centres = centroids(primitive, all, 0, n);
+  if (!centres) return null;
+  const ranks = [];
+  for (const orderKeys of keys) {
+    const where = new Map();
+    orderKeys.forEach((k, q) => { if (!where.has(k.key)) where.set(k.key, []); where.get(k.key).push(q); });
+    for (const list of where.values()) list.reverse();
+    const rank = new Uint32Array(n / 3);
+    for (let q = 0; q < n / 3; ++q) {
+      const list = where.get(keys[0][q].key);
+      if (!list || list.length === 0) return null;
+      rank[q] = list.pop();
+    }
+    ranks.push(rank);
+  }
+  // The bounding box of the vertices the triangles use.
+  const position = primitive.getAttribute('POSITION'), v = [0, 0, 0];
+  const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+  for (let i = 0; i < n; ++i) {
+    position.getElement(all[i], v);
+    for (let a = 0; a < 3; ++a) { lo[a] = Math.min(lo[a], v[a]); hi[a] = Math.max(hi[a], v[a]); }
+  }
+  const diagonal = Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+  return { centres, ranks, diagonal };
+}
+
+/**
+ * For each centroid of `to`, the index of the nearest centroid of `from` (lowest index among
+ * equally near ones), or null when one lies farther than `limit` from all of them. A uniform grid
+ * over `from`, searched in shells of cells around each query until no nearer one can lie beyond.
+ */
+export function nearestCentroids(from, to, limit) {
+  const count = from.length / 3;
+  if (count === 0) return null;
+  const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+  for (let i = 0; i < from.length; i += 3)
+    for (let a = 0; a < 3; ++a) { lo[a] = Math.min(lo[a], from[i + a]); hi[a] = Math.max(hi[a], from[i + a]); }
+  const extent = Math.max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+  const h = Math.max(extent / Math.max(1, Math.cbrt(count)), limit / 64, 1e-12);
+  const cell = (x, a) => Math.floor((x - lo[a]) / h);
+  const grid = new Map();
+  for (let q = 0; q < count; ++q) {
+    const k = `${cell(from[3 * q], 0)},${cell(from[3 * q + 1], 1)},${cell(from[3 * q + 2], 2)}`;
+    if (!grid.has(k)) grid.set(k, []);
+    grid.get(k).push(q);
+  }
+  const rings = Math.ceil(limit / h) + 1;
+  const out = new Uint32Array(to.length / 3);
+  for (let t = 0; t < to.length / 3; ++t) {
+    const x = to[3 * t], y = to[3 * t + 1], z = to[3 * t + 2];
+    const c = [cell(x, 0), cell(y, 1), cell(z, 2)];
+    let best = Infinity, bestQ = -1;
+    for (let r = 0; r <= rings; ++r) {
+      // Every cell at Chebyshev distance r: a point there lies at least (r − 1)·h away.
+      if (bestQ >= 0 && best <= (r - 1) * h) break;
+      for (let dx = -r; dx <= r; ++dx)
+        for (let dy = -r; dy <= r; ++dy)
+          for (let dz = -r; dz <= r; ++dz) {
+            if (Math.max(Math.abs(dx), Math.abs(dy), Math.abs(dz)) !== r) continue;
+            const list = grid.get(`${c[0] + dx},${c[1] + dy},${c[2] + dz}`);
+            if (!list) continue;
+            for (const q of list) {
+              const d = Math.hypot(from[3 * q] - x, from[3 * q + 1] - y, from[3 * q + 2] - z);
+              if (d < best || (d === best && q < bestQ)) { best = d; bestQ = q; }
+            }
+          }
+    }
+    if (bestQ < 0 || best > limit) return null;
+    out[t] = bestQ;
+  }
+  return out;
+}
+
+/**
+ * The orders placed for a primitive whose triangles a transform changed (simplify, a moved
+ * vertex): each current triangle stands for the original triangle with the nearest centroid
+ * (within `limit` of the original bounding-box diagonal), and order b draws the current triangles
+ * in order b's order of the originals they stand for, several standing for one in their current
+ * sequence. Returns the new K × n index array, or null when a triangle lies farther (or the
+ * primitive has no positions, or its orders were not placeable when read).
+ */
+export function place(primitive, orders, bufferCount, limit = 0.1) {
+  const p = orders.placement;
+  if (!p || primitive.getMode() !== 4 || orders.getOrderCount() !== bufferCount || p.ranks.length !== bufferCount) return null;
+  const indices = primitive.getIndices();
+  if (!indices) return null;
+  const current = indices.getArray(), n = indices.getCount();
+  if (n === 0 || n % 3 !== 0) return null;
+  const here = centroids(primitive, current, 0, n);
+  if (!here) return null;
+  const near = nearestCentroids(p.centres, here, limit * p.diagonal);
+  if (!near) return null;
+  const out = new Uint32Array(bufferCount * n);
+  const sequence = Array.from({ length: n / 3 }, (_, t) => t);
+  for (let b = 0; b < bufferCount; ++b) {
+    const rank = p.ranks[b];
+    sequence.sort((x, y) => rank[near[x]] - rank[near[y]] || x - y);
+    sequence.forEach((t, q) => { for (let c = 0; c < 3; ++c) out[b * n + 3 * q + c] = current[3 * t + c]; });
+  }
+  return out;
+}
+
 /**
  * Why a primitive's orders are not usable with its current triangles (a string), or null when
  * they are: every order a permutation of the triangles of `indices` with their winding, and
@@ -248,7 +375,7 @@ export class AnimorderTriangleOrders extends Extension {
     // transform that renumbers vertices or re-sequences triangles (not written to the file): made
     // once per (orders, indices, attributes) and shared, at most 8 × the buffers' bytes + 2^20
     // corners in all (past that a primitive keeps its orders but cannot have them re-derived).
-    const keysOf = new Map();
+    const keysOf = new Map(), placementOf_ = new Map();
     let budget = 2 ** 20;
     for (const b of json.buffers || []) if (b && Number.isInteger(b.byteLength)) budget += 8 * b.byteLength;
     (json.meshes || []).forEach((meshDef, m) => {
@@ -276,7 +403,20 @@ export class AnimorderTriangleOrders extends Extension {
           }
           keysOf.set(key, keys);
         }
-        if (keysOf.get(key)) orders.cornerKeys = keysOf.get(key);
+        if (keysOf.get(key)) {
+          orders.cornerKeys = keysOf.get(key);
+          if (!placementOf_.has(key)) {
+            let placement = null;
+            try {
+              placement = placementOf(primitive, orders.getOrders().getArray(), primitive.getIndices().getCount(),
+                                      orders.cornerKeys);
+            } catch {
+              placement = null;
+            }
+            placementOf_.set(key, placement);
+          }
+          if (placementOf_.get(key)) orders.placement = placementOf_.get(key);
+        }
       });
     });
   }
@@ -300,7 +440,9 @@ export class AnimorderTriangleOrders extends Extension {
         if (!orders) continue;
         const why = root ? stale(primitive, orders) : 'no root object';
         if (why === null) { ++kept; continue; }
-        const derived = root ? rederive(primitive, orders, root.getBufferCount()) : null;
+        let derived = root ? rederive(primitive, orders, root.getBufferCount()) : null;
+        const placed = !derived && root ? place(primitive, orders, root.getBufferCount()) : null;
+        derived = derived || placed;
         if (derived) {
           // New accessors (the old ones may be shared): the orders, and `indices` = the fallback.
           const n = primitive.getIndices().getCount(), f = root.getFallback();
@@ -313,7 +455,9 @@ export class AnimorderTriangleOrders extends Extension {
           const oldIndices = primitive.getIndices();
           primitive.setIndices(make(derived.slice(f * n, (f + 1) * n)));
           if (oldIndices.listParents().every((p) => p.propertyType === PropertyType.ROOT)) oldIndices.dispose();
-          logger.warn(`${NAME}: re-derived the orders of mesh "${mesh.getName()}" (${why}).`);
+          logger.warn(placed
+            ? `${NAME}: placed the triangles of mesh "${mesh.getName()}" by the nearest original triangle (${why}).`
+            : `${NAME}: re-derived the orders of mesh "${mesh.getName()}" (${why}).`);
           ++kept;
           continue;
         }

@@ -6,7 +6,7 @@ import { readFileSync } from 'node:fs';
 import { fileURLToPath } from 'node:url';
 import { Logger, NodeIO } from '@gltf-transform/core';
 import { dedup, prune, resample, sparse } from '@gltf-transform/functions';
-import { AnimorderTriangleOrders, NAME, staleReason } from '../index.js';
+import { AnimorderTriangleOrders, NAME, nearestCentroids, staleReason } from '../index.js';
 
 const example = fileURLToPath(new URL('../../../docs/extension/example.gltf', import.meta.url));
 
@@ -83,10 +83,14 @@ test('prune, dedup and resample keep the orders', async () => {
   assert.deepEqual(logger.warnings, []);
 });
 
-test('orders made stale by rewritten triangles are dropped with a warning', async () => {
+test('orders made stale by rewritten triangles far from every original one are dropped with a warning', async () => {
   const { io, document, logger } = await load();
-  // A winding flipped (as a rewrite would): triangle (0 2 1) is no triangle of the orders.
-  document.getRoot().listMeshes()[0].listPrimitives()[0].getIndices().setArray(new Uint16Array([0, 2, 1, 0, 2, 3]));
+  const primitive = document.getRoot().listMeshes()[0].listPrimitives()[0];
+  // A winding flipped (as a rewrite would): triangle (0 2 1) is no triangle of the orders; and the
+  // quad moved 100 units away, far beyond a tenth of its diagonal: no original triangle is near.
+  primitive.getIndices().setArray(new Uint16Array([0, 2, 1, 0, 2, 3]));
+  const moved = Array.from(primitive.getAttribute('POSITION').getArray(), (v, i) => (i % 3 === 0 ? v + 100 : v));
+  primitive.getAttribute('POSITION').setArray(new Float32Array(moved));
   const { json } = await roundTrip(io, document);
   assert.equal(json.meshes[0].primitives[0].extensions?.[NAME], undefined);
   assert.equal(json.extensions?.[NAME], undefined);
@@ -108,12 +112,57 @@ test('re-sequenced triangles and renumbered vertices (reorder, weld) re-derive t
   assert.match(logger.warnings.join('\n'), /re-derived/);
 });
 
-test('a simplified primitive (fewer triangles) loses its orders', async () => {
+test('a simplified primitive keeps orders placed by the nearest original triangle', async () => {
   const { io, document, logger } = await load();
+  // The quad cut to one triangle, (0 1 2): order 0 draws it first, order 1 second; alone it is
+  // every order, and `indices`.
   document.getRoot().listMeshes()[0].listPrimitives()[0].getIndices().setArray(new Uint16Array([0, 1, 2]));
-  const { json } = await roundTrip(io, document);
-  assert.equal(json.extensions?.[NAME], undefined);
-  assert.match(logger.warnings.join('\n'), /orders accessor has 12 elements, not 6/);
+  const { glb, json } = await roundTrip(io, document);
+  assert.equal(json.extensions?.[NAME]?.bufferCount, 2);
+  const back = (await io.readBinary(glb)).getRoot().listMeshes()[0].listPrimitives()[0];
+  assert.deepEqual(Array.from(back.getExtension(NAME).getOrders().getArray()), [0, 1, 2, 0, 1, 2]);
+  assert.deepEqual(Array.from(back.getIndices().getArray()), [0, 1, 2]);
+  assert.match(logger.warnings.join('\n'), /placed the triangles of mesh .* by the nearest original triangle \(orders accessor has 12 elements, not 6\)/);
+});
+
+test('placing draws the current triangles in each order of the originals they stand for', async () => {
+  const { io, document, logger } = await load();
+  const primitive = document.getRoot().listMeshes()[0].listPrimitives()[0];
+  // Each of the quad's two triangles shrunk by a tenth towards its centroid, on new vertices (as a
+  // rewrite that moved every vertex would leave them: no corner is found again), and given in the
+  // other sequence. Order 0 draws (0 1 2) first and order 1 (0 2 3) first: placed, order 0 must
+  // draw the first shrunk triangle first and order 1 the second.
+  const p = Array.from(primitive.getAttribute('POSITION').getArray());
+  const stored = Array.from(primitive.getExtension(NAME).getOrders().getArray());
+  const shrunk = (a, b, c) => {
+    const centre = [0, 1, 2].map((k) => (p[3 * a + k] + p[3 * b + k] + p[3 * c + k]) / 3);
+    return [a, b, c].flatMap((v) => [0, 1, 2].map((k) => p[3 * v + k] + 0.1 * (centre[k] - p[3 * v + k])));
+  };
+  const first = shrunk(stored[0], stored[1], stored[2]), second = shrunk(stored[3], stored[4], stored[5]);
+  primitive.getAttribute('POSITION').setArray(new Float32Array([...p, ...first, ...second]));
+  primitive.getIndices().setArray(new Uint16Array([7, 8, 9, 4, 5, 6]));  // the second, then the first
+  const { glb } = await roundTrip(io, document);
+  const back = (await io.readBinary(glb)).getRoot().listMeshes()[0].listPrimitives()[0];
+  assert.deepEqual(Array.from(back.getExtension(NAME).getOrders().getArray()), [4, 5, 6, 7, 8, 9, 7, 8, 9, 4, 5, 6]);
+  assert.deepEqual(Array.from(back.getIndices().getArray()), [4, 5, 6, 7, 8, 9]);
+  assert.match(logger.warnings.join('\n'), /placed the triangles/);
+});
+
+test('nearestCentroids against a brute-force search; farther than the limit gives null', () => {
+  let seed = 7;
+  const random = () => ((seed = (seed * 1103515245 + 12345) % 2147483648) / 2147483648) * 2 - 1;
+  const from = Float64Array.from({ length: 3 * 500 }, random), to = Float64Array.from({ length: 3 * 200 }, random);
+  const got = nearestCentroids(from, to, 10);
+  for (let t = 0; t < 200; ++t) {
+    let best = Infinity, bestQ = -1;
+    for (let q = 0; q < 500; ++q) {
+      const d = Math.hypot(from[3 * q] - to[3 * t], from[3 * q + 1] - to[3 * t + 1], from[3 * q + 2] - to[3 * t + 2]);
+      if (d < best) { best = d; bestQ = q; }
+    }
+    assert.equal(got[t], bestQ, `centroid ${t}`);
+  }
+  assert.equal(nearestCentroids(from, Float64Array.from([50, 50, 50]), 1), null);
+  assert.deepEqual(Array.from(nearestCentroids(Float64Array.from([1, 0, 0, -1, 0, 0]), Float64Array.from([0, 0, 0]), 5)), [0]);
 });
 
 test('without the extension registered, glTF-Transform drops it (why registering matters)', async () => {

@@ -102,8 +102,8 @@ std::vector<uint32_t> measured_unit_order(size_t unit_count, const Arc* arcs, si
                                           bool try_greedy = true);
 
 // The same order from the counts themselves, over their units and groups: the same order and
-// stats as measured_unit_order of counts.arcs(), in less memory (the arcs live only while the
-// greedy order is made; sifting reads its adjacency straight from the settled counts).
+// stats as measured_unit_order of counts.arcs(), in less memory (no array of arcs: the greedy
+// order and sifting read one signed adjacency built straight from the settled counts).
 std::vector<uint32_t> measured_unit_order(MeasuredPairCounts& counts, const uint32_t* previous,
                                           MeasuredOrderStats* stats = nullptr, bool try_greedy = true);
 

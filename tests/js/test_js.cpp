@@ -170,7 +170,8 @@ TEST_F(JsTest, SkinnedViewerInHeadlessChromium) {
                      path("cesium.png"), 13);
 }
 
-// `animorder view`: the viewer's files and the model only, GET/HEAD only, nothing above its folders.
+// `animorder view`: the viewer's files, the model and the files it names from below its folder only,
+// GET/HEAD only, nothing above its folders.
 TEST_F(JsTest, ViewServesOnlyTheViewer) {
     std::string why;
     ANIMORDER_REQUIRE_OR_SKIP("node", have_node(why), why);
@@ -180,9 +181,9 @@ TEST_F(JsTest, ViewServesOnlyTheViewer) {
     const test::Outcome a = run(std::string(ANIMORDER_EXE) + " subdivide -q --levels 0 -o " + sh(path("char.glb")));
     ASSERT_EQ(a.exit_code, 0) << a.err;
     const test::Outcome o = run("node " + sh(source_dir + "/viewer/test/server.mjs") + " " + sh(ANIMORDER_EXE) + " " +
-                                sh(path("char.glb")));
+                                sh(path("char.glb")) + " " + sh(dir_));
     EXPECT_EQ(o.exit_code, 0) << o.out << o.err;
-    EXPECT_EQ(test::line_count(o.out), 20u) << o.out;
+    EXPECT_EQ(test::line_count(o.out), 33u) << o.out;
     EXPECT_EQ(o.out.find("FAIL"), std::string::npos) << o.out;
 }
 

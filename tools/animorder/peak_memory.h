@@ -6,12 +6,6 @@
 
 namespace animorder::tool {
 
-// Peak resident bytes of this process from now on: free heap memory handed back to the system
-// first (malloc_trim), then Linux's high-water mark (VmHWM) reset to the current resident size
-// (/proc/self/clear_refs, "5"). peak() reads the mark: the most this process held since the
-// reset, including what it already held (the loaded mesh, earlier methods' results). Where the
-// kernel offers no reset or no mark (not Linux, a restricted /proc), peak() is nullopt: a method's
-// peak is then not known, rather than the whole process's passed off as it.
 // Fixes glibc's mmap threshold at 1 MiB for the whole process. glibc otherwise raises it to the
 // largest block freed (up to 32 MiB), after which large short-lived buffers (a cluster's graph of
 // several MB, built and freed per cluster and per iteration) come from the heap and leave it
@@ -19,6 +13,12 @@ namespace animorder::tool {
 // the same either way). Elsewhere than glibc, nothing.
 void fix_allocator_threshold();
 
+// Peak resident bytes of this process from now on: free heap memory handed back to the system
+// first (malloc_trim), then Linux's high-water mark (VmHWM) reset to the current resident size
+// (/proc/self/clear_refs, "5"). peak() reads the mark: the most this process held since the
+// reset, including what it already held (the loaded mesh, earlier methods' results). Where the
+// kernel offers no reset or no mark (not Linux, a restricted /proc), peak() is nullopt: a method's
+// peak is then not known, rather than the whole process's passed off as it.
 class PeakResident {
 public:
     PeakResident();

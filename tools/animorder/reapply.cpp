@@ -174,7 +174,9 @@ int run_reapply(const ReapplyOptions& options) {
     for (size_t t = 0; t < m.from_of_to.size(); ++t)
         if (m.from_of_to[t] >= 0) source[t] = int64_t(a_triangles[size_t(m.from_of_to[t])]);
     size_t near = 0;
-    double farthest = 0;  // of the processed triangles beyond --nearest, as a fraction of the diagonal
+    // Per processed triangle beyond --nearest: how far the nearest optimised one lies, as a fraction
+    // of the diagonal (0 for the others).
+    std::vector<double> beyond(b.triangle_count(), 0);
     if (options.nearest > 0) {
         std::vector<size_t> missing;
         for (size_t t = 0; t < source.size(); ++t)
@@ -184,7 +186,7 @@ int run_reapply(const ReapplyOptions& options) {
         const double limit = options.nearest * diagonal * std::sqrt(double(ka.size()));
         for (size_t i = 0; i < missing.size() && !n.from_of_to.empty(); ++i) {
             if (n.distance[i] > limit) {
-                farthest = std::max(farthest, n.distance[i] / (diagonal * std::sqrt(double(ka.size()))));
+                beyond[missing[i]] = n.distance[i] / (diagonal * std::sqrt(double(ka.size())));
                 continue;
             }
             source[missing[i]] = int64_t(a_triangles[n.from_of_to[i]]);
@@ -213,9 +215,9 @@ int run_reapply(const ReapplyOptions& options) {
 
     // Per order, each optimised triangle's place: its source's rank among the sources, then its
     // position in that source's order (the sequence the orders draw OPTIMIZED's triangles in).
-    std::vector<std::vector<uint64_t>> rank(orders.buffer_count, std::vector<uint64_t>(a.triangle_count(), 0));
+    std::vector<std::vector<uint32_t>> rank(orders.buffer_count, std::vector<uint32_t>(a.triangle_count(), 0));
     for (uint32_t o = 0; o < orders.buffer_count; ++o) {
-        uint64_t at = 0;
+        uint32_t at = 0;
         for (const Source& src : sources)
             for (const uint32_t q : src.order_triangles[o]) rank[o][src.first_triangle + q] = at++;
     }
@@ -235,6 +237,8 @@ int run_reapply(const ReapplyOptions& options) {
             unordered_triangles += p.index_count / 3;
             continue;
         }
+        double farthest = 0;
+        for (size_t t = first; t < last; ++t) farthest = std::max(farthest, beyond[t]);
         if (hits != p.index_count / 3)
             throw std::runtime_error(
                 options.processed + ": primitive " + p.name + " holds " + std::to_string(p.index_count / 3 - hits) +
@@ -277,7 +281,15 @@ int run_reapply(const ReapplyOptions& options) {
             size_t rank = rank_of_name[c.name]++;
             for (const Clip& clip : b.clips) {
                 if (clip.name != c.name || rank-- != 0) continue;
-                if (clip.keyframe_count != c.keyframes) break;
+                if (clip.keyframe_count != c.keyframes) {
+                    if (!options.quiet)
+                        std::fprintf(stderr,
+                                     "animorder: note: clip '%s' has %zu keyframes in %s, %u in the orders: its "
+                                     "centres stay OPTIMIZED's\n",
+                                     printable(c.name).c_str(), size_t(clip.keyframe_count), options.processed.c_str(),
+                                     c.keyframes);
+                    break;
+                }
                 c.centers = std::vector<float>(framing.centres.begin() + long(3 * clip.first_keyframe),
                                                framing.centres.begin() + long(3 * (clip.first_keyframe + c.keyframes)));
                 break;

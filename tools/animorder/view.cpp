@@ -168,23 +168,62 @@ bool canonical_path(const std::string& path, std::string& out) {
     return true;
 }
 
+// Whether the canonical path `path` is `base` or lies below it.
+bool inside(const fs::path& path, const fs::path& base);
+
 // `file` served under `prefix` (/model/ or /original/): its URL, and each of its external
 // buffers and images at the URL its URI resolves to from there (the browser's URL, which may
-// leave the prefix: "../textures/a.png"). Returns the file's URL.
-std::string serve_with_its_files(Site& site, const std::string& prefix, const fs::path& file) {
+// leave the prefix: "../textures/a.png"). Only files whose real path lies below one of `roots`
+// (the folders of the model and the original) are served, and only under a URL no other file
+// holds; a URI that is absolute, has a scheme or a backslash is left to the page (it fails
+// there). Without `quiet`, says on stderr what it serves and what it leaves out. Returns the
+// file's URL.
+std::string serve_with_its_files(Site& site, const std::string& prefix, const fs::path& file,
+                                 const std::vector<fs::path>& roots, bool quiet) {
     const std::string url = prefix + percent_encode(file.filename().string(), false);
     site.files[url] = file;
-    const std::string ext = file.extension().string();
-    if (ext != ".gltf" && ext != ".glb" && ext != ".GLTF" && ext != ".GLB") return url;
+    const std::string ext = file_extension(file.string());
+    if (ext != ".gltf" && ext != ".glb") return url;
+    const auto say = [&](const std::string& text) {
+        if (!quiet) std::fprintf(stderr, "view: %s\n", text.c_str());
+    };
     for (const ExternalFile& f : gltf_external_uris(file.string())) {
-        // The URI relative to the file's URL: a relative reference's path (an absolute URI, a
-        // scheme, is the browser's own business and not served here).
-        if (f.uri.find(':') != std::string::npos && f.uri.find(':') < f.uri.find('/')) continue;
+        const size_t colon = f.uri.find(':');
+        if (f.uri.empty() || f.uri[0] == '/' || f.uri.find('\\') != std::string::npos ||
+            (colon != std::string::npos && colon < f.uri.find('/')))
+            continue;
+        std::error_code error;
+        const fs::path real = fs::canonical(f.file, error);
+        if (error || !fs::is_regular_file(real, error)) continue;  // the page says what it misses
+        if (std::none_of(roots.begin(), roots.end(), [&](const fs::path& root) { return inside(real, root); })) {
+            say("not serving " + real.string() + " (named by " + file.string() +
+                "): it lies outside the folders of the files given");
+            continue;
+        }
         const std::string reference = f.uri.substr(0, f.uri.find_first_of("?#"));
         std::string key;
-        if (canonical_path(reference[0] == '/' ? reference : prefix + reference, key)) site.files.emplace(key, f.file);
+        if (!canonical_path(prefix + reference, key)) continue;
+        const auto [at, added] = site.files.emplace(key, real);
+        if (!added && fs::canonical(at->second, error) != real) {
+            say("not serving " + real.string() + " at " + key + ": that URL is " + at->second.string() + "'s");
+            continue;
+        }
+        if (added) say("serving " + real.string() + " at " + key);
     }
     return url;
+}
+
+// What a named file is sent as: glTF, an image, else bytes (never a page or a script: a file a
+// glTF names runs nothing on the viewer's origin).
+std::string named_content_type(const fs::path& path) {
+    const std::string e = file_extension(path.string());
+    if (e == ".glb") return "model/gltf-binary";
+    if (e == ".gltf") return "model/gltf+json";
+    if (e == ".png") return "image/png";
+    if (e == ".jpg" || e == ".jpeg") return "image/jpeg";
+    if (e == ".webp") return "image/webp";
+    if (e == ".ktx2") return "image/ktx2";
+    return "application/octet-stream";
 }
 
 // One client's socket, the time by which what is under way (reading the request, then sending
@@ -303,8 +342,9 @@ HttpParse read_request(const Connection& c, HttpRequest& request) {
 }
 
 // The file at `path` as a 200 response (its head only for HEAD), read and sent in pieces.
-void send_file(const Connection& c, const fs::path& path, std::ifstream& in, size_t size, bool head) {
-    const std::string start = response_head(200, "OK", content_type(path), size);
+void send_file(const Connection& c, const std::string& type, const std::string& extra, std::ifstream& in, size_t size,
+               bool head) {
+    const std::string start = response_head(200, "OK", type, size, extra);
     if (!send_all(c, start.data(), start.size()) || head) return;
     std::vector<char> piece(1 << 16);
     size_t left = size;
@@ -367,7 +407,10 @@ void serve_one(int fd, const Site& site, const std::atomic<bool>& stopping) {
         respond(c, 404, "Not Found", "text/plain", "not found\n", head);
         return;
     }
-    send_file(c, path, in, size, head);
+    // A file the model or the original names: sent as what it is, with nothing a browser would run.
+    const bool named = url.rfind("/viewer/", 0) != 0 && url.rfind("/js/", 0) != 0;
+    send_file(c, named ? named_content_type(path) : content_type(path),
+              named ? "X-Content-Type-Options: nosniff\r\nContent-Security-Policy: sandbox\r\n" : "", in, size, head);
 }
 
 // The workers: kWorkers threads that each serve one accepted connection at a time. The accept
@@ -571,8 +614,15 @@ int run_view(const ViewOptions& options) {
         site.original = options.original;
         if (!fs::is_regular_file(site.original)) throw std::runtime_error("cannot read " + site.original.string());
     }
-    site.model_url = serve_with_its_files(site, "/model/", site.model);
-    if (!site.original.empty()) site.original_url = serve_with_its_files(site, "/original/", site.original);
+    // The external files the two name, from below their folders only.
+    std::vector<fs::path> roots;
+    for (const fs::path* file : {&site.model, &site.original}) {
+        std::error_code ec;
+        if (!file->empty()) roots.push_back(fs::canonical(fs::absolute(*file).parent_path(), ec));
+    }
+    site.model_url = serve_with_its_files(site, "/model/", site.model, roots, options.common.quiet);
+    if (!site.original.empty())
+        site.original_url = serve_with_its_files(site, "/original/", site.original, roots, options.common.quiet);
 
     socklen_t length = sizeof address;
     getsockname(server, reinterpret_cast<sockaddr*>(&address), &length);

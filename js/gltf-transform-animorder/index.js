@@ -11,10 +11,10 @@
 // centroid was (positions as read; within a tenth of their bounding-box diagonal): every order
 // draws the current triangles in its order of the originals they stand for, with a warning.
 // Where even that fails (quantised positions, a mesh moved away) the orders are dropped with a
-// warning (and the whole extension when no primitive keeps valid orders): never written stale. A file whose extension
-// does not check out (the rules of animorder's runtime and `animorder check`) is read without
-// it, with a warning: a pipeline never carries, nor rewrites `indices` from, orders that an
-// engine would refuse.
+// warning (and the whole extension when no primitive keeps valid orders): never written stale. A
+// file whose extension does not check out (the rules of animorder's runtime and `animorder
+// check`) is read without it, with a warning: a pipeline never carries, nor rewrites `indices`
+// from, orders that an engine would refuse.
 import { Extension, ExtensionProperty, PropertyType, RefList } from '@gltf-transform/core';
 import { AccessorReader, extensionProblems } from '../runtime/animorder.js';
 
@@ -375,7 +375,7 @@ export class AnimorderTriangleOrders extends Extension {
     // transform that renumbers vertices or re-sequences triangles (not written to the file): made
     // once per (orders, indices, attributes) and shared, at most 8 × the buffers' bytes + 2^20
     // corners in all (past that a primitive keeps its orders but cannot have them re-derived).
-    const keysOf = new Map(), placementOf_ = new Map();
+    const keysOf = new Map(), placements = new Map();
     let budget = 2 ** 20;
     for (const b of json.buffers || []) if (b && Number.isInteger(b.byteLength)) budget += 8 * b.byteLength;
     (json.meshes || []).forEach((meshDef, m) => {
@@ -405,7 +405,7 @@ export class AnimorderTriangleOrders extends Extension {
         }
         if (keysOf.get(key)) {
           orders.cornerKeys = keysOf.get(key);
-          if (!placementOf_.has(key)) {
+          if (!placements.has(key)) {
             let placement = null;
             try {
               placement = placementOf(primitive, orders.getOrders().getArray(), primitive.getIndices().getCount(),
@@ -413,9 +413,9 @@ export class AnimorderTriangleOrders extends Extension {
             } catch {
               placement = null;
             }
-            placementOf_.set(key, placement);
+            placements.set(key, placement);
           }
-          if (placementOf_.get(key)) orders.placement = placementOf_.get(key);
+          if (placements.get(key)) orders.placement = placements.get(key);
         }
       });
     });

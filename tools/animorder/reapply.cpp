@@ -22,11 +22,11 @@
 #include "animorder/viewpoints.h"
 
 #include <algorithm>
-#include <numeric>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <numeric>
 #include <stdexcept>
 
 namespace animorder::tool {
@@ -276,11 +276,11 @@ int run_reapply(const ReapplyOptions& options) {
         // engine's lookup (and `check`) takes them from. The n-th clip of a name takes the n-th
         // of PROCESSED's clips of that name.
         const Framing framing = frame_animated_mesh(b);
-        std::map<std::string, size_t> rank_of_name;
+        std::map<std::string, size_t> seen_of_name;
         for (ExtensionClip& c : orders.clips) {
-            size_t rank = rank_of_name[c.name]++;
+            size_t nth = seen_of_name[c.name]++;
             for (const Clip& clip : b.clips) {
-                if (clip.name != c.name || rank-- != 0) continue;
+                if (clip.name != c.name || nth-- != 0) continue;
                 if (clip.keyframe_count != c.keyframes) {
                     if (!options.quiet)
                         std::fprintf(stderr,

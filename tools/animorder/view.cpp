@@ -19,7 +19,9 @@
 //   the server within about a second whatever the clients do: the workers' sockets are shut down,
 //   the workers joined, and the scratch folder removed.
 // - Files only below the viewer's folders (no "..", no "%", no backslash; real paths checked, see
-//   resolve()) and the files the two glTF files name (nothing else of their folders), and requests whose Host is not this server's loopback address and port are refused
+//   resolve()) and the files the two glTF files name from below their folders (sent as bytes or
+//   images, never as a page: serve_with_its_files), and requests whose Host is not this server's
+//   loopback address and port are refused
 //   (421: a page rebound to 127.0.0.1 by DNS rebinding cannot read the model).
 // - Without -q, refused requests are logged with their URL's control bytes and non-ASCII bytes
 //   written as \xNN.
@@ -618,7 +620,8 @@ int run_view(const ViewOptions& options) {
     std::vector<fs::path> roots;
     for (const fs::path* file : {&site.model, &site.original}) {
         std::error_code ec;
-        if (!file->empty()) roots.push_back(fs::canonical(fs::absolute(*file).parent_path(), ec));
+        const fs::path root = file->empty() ? fs::path() : fs::canonical(fs::absolute(*file).parent_path(), ec);
+        if (!root.empty() && !ec) roots.push_back(root);  // never an empty root: everything lies below it
     }
     site.model_url = serve_with_its_files(site, "/model/", site.model, roots, options.common.quiet);
     if (!site.original.empty())

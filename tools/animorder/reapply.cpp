@@ -153,8 +153,9 @@ int run_reapply(const ReapplyOptions& options) {
                     best = trial.matched, ka = {a.clips[i].first_keyframe}, kb = {b.clips[j].first_keyframe};
             }
     }
-    const TriangleMatch m = match_triangles(corners(a, a_triangles, ka), corners(b, b_triangles, kb), 3 * ka.size(),
-                                            float(options.tolerance) * diagonal);
+    // Both files' corners at the compared keyframes, made once for every search below.
+    const std::vector<float> a_corners = corners(a, a_triangles, ka), b_corners = corners(b, b_triangles, kb);
+    const TriangleMatch m = match_triangles(a_corners, b_corners, 3 * ka.size(), float(options.tolerance) * diagonal);
     // Per triangle of OPTIMIZED (global index): its triangle of PROCESSED.
     std::vector<int64_t> b_of_a(a.triangle_count(), -1);
     for (size_t t = 0; t < m.from_of_to.size(); ++t)
@@ -182,7 +183,7 @@ int run_reapply(const ReapplyOptions& options) {
         for (size_t t = 0; t < source.size(); ++t)
             if (source[t] < 0) missing.push_back(t);
         // Centroid distances over the compared keyframes, as one keyframe's: divided by √keyframes.
-        const NearestTriangles n = nearest_triangles(corners(a, a_triangles, ka), corners(b, missing, kb), 3 * ka.size());
+        const NearestTriangles n = nearest_triangles(a_corners, corners(b, missing, kb), 3 * ka.size());
         const double limit = options.nearest * diagonal * std::sqrt(double(ka.size()));
         for (size_t i = 0; i < missing.size() && !n.from_of_to.empty(); ++i) {
             if (n.distance[i] > limit) {
@@ -200,8 +201,8 @@ int run_reapply(const ReapplyOptions& options) {
         // defaults) poses its corners a little apart: say which tolerance would match them all.
         std::string wider;
         for (const double factor : {10.0, 100.0}) {
-            const TriangleMatch trial = match_triangles(corners(a, a_triangles, ka), corners(b, b_triangles, kb),
-                                                        3 * ka.size(), float(options.tolerance * factor) * diagonal);
+            const TriangleMatch trial =
+                match_triangles(a_corners, b_corners, 3 * ka.size(), float(options.tolerance * factor) * diagonal);
             if (trial.matched + dropped != a_triangles.size()) continue;
             wider = "; all are found at --tolerance " + shown(options.tolerance * factor) +
                     " (the posed corners moved: was the animation resampled or quantised?)";
